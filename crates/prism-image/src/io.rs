@@ -1,0 +1,284 @@
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::{ImageError, Rgb8Image, Rgba8Image};
+
+/// The largest image, in pixels, that the readers accept (256 megapixels).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+fn decode_err(what: &str, message: impl ToString) -> ImageError {
+    ImageError::Decode {
+        what: what.to_string(),
+        message: message.to_string(),
+    }
+}
+
+fn check_size(what: &str, width: u64, height: u64) -> Result<(), ImageError> {
+    if width == 0 || height == 0 || width * height > MAX_IMAGE_PIXELS {
+        return Err(ImageError::BadSize {
+            what: what.to_string(),
+            width,
+            height,
+            max: MAX_IMAGE_PIXELS,
+        });
+    }
+    Ok(())
+}
+
+/// Decodes a PNG of any colour type and bit depth to straight-alpha RGBA8.
+///
+/// Palettes and grey are expanded, 16-bit channels keep their high byte, a missing alpha
+/// channel becomes 255. `what` names the source in errors.
+///
+/// # Errors
+/// [`ImageError::Decode`] for a malformed or truncated file, [`ImageError::BadSize`] for an
+/// empty or oversized image.
+pub fn decode_png(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
+    let mut decoder = png::Decoder::new(bytes);
+    decoder.set_transformations(png::Transformations::normalize_to_color8());
+    let mut reader = decoder.read_info().map_err(|e| decode_err(what, e))?;
+    let (w, h) = {
+        let info = reader.info();
+        (info.width, info.height)
+    };
+    check_size(what, u64::from(w), u64::from(h))?;
+    let mut buf = vec![0u8; reader.output_buffer_size()];
+    let frame = reader.next_frame(&mut buf).map_err(|e| decode_err(what, e))?;
+    let data = &buf[..frame.buffer_size()];
+    let n = w as usize * h as usize;
+    let stride = frame.line_size;
+    let mut out = Vec::with_capacity(n);
+    for y in 0..h as usize {
+        let row = &data[y * stride..(y + 1) * stride];
+        for x in 0..w as usize {
+            let px = match frame.color_type {
+                png::ColorType::Grayscale => [row[x], row[x], row[x], 255],
+                png::ColorType::GrayscaleAlpha => {
+                    let (g, a) = (row[2 * x], row[2 * x + 1]);
+                    [g, g, g, a]
+                }
+                png::ColorType::Rgb => [row[3 * x], row[3 * x + 1], row[3 * x + 2], 255],
+                png::ColorType::Rgba => [row[4 * x], row[4 * x + 1], row[4 * x + 2], row[4 * x + 3]],
+                png::ColorType::Indexed => {
+                    return Err(decode_err(what, "palette was not expanded"));
+                }
+            };
+            out.push(px);
+        }
+    }
+    Ok(Rgba8Image::from_vec(w, h, out))
+}
+
+/// Decodes a baseline or progressive JPEG to RGBA8 (alpha 255).
+///
+/// # Errors
+/// [`ImageError::Decode`] for malformed data or an unsupported pixel format.
+pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
+    let mut decoder = jpeg_decoder::Decoder::new(bytes);
+    decoder.read_info().map_err(|e| decode_err(what, e))?;
+    let info = decoder
+        .info()
+        .ok_or_else(|| decode_err(what, "missing JPEG header"))?;
+    check_size(what, u64::from(info.width), u64::from(info.height))?;
+    let data = decoder.decode().map_err(|e| decode_err(what, e))?;
+    let n = usize::from(info.width) * usize::from(info.height);
+    let pixels: Vec<[u8; 4]> = match info.pixel_format {
+        jpeg_decoder::PixelFormat::L8 => data.iter().map(|&g| [g, g, g, 255]).collect(),
+        jpeg_decoder::PixelFormat::RGB24 => data
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        jpeg_decoder::PixelFormat::CMYK32 => data
+            .chunks_exact(4)
+            .map(|c| {
+                let k = u32::from(c[3]);
+                let f = |v: u8| (u32::from(v) * k / 255) as u8;
+                [f(c[0]), f(c[1]), f(c[2]), 255]
+            })
+            .collect(),
+        jpeg_decoder::PixelFormat::L16 => data
+            .chunks_exact(2)
+            .map(|c| [c[0], c[0], c[0], 255])
+            .collect(),
+    };
+    if pixels.len() != n {
+        return Err(decode_err(what, "pixel data is shorter than the header says"));
+    }
+    Ok(Rgba8Image::from_vec(
+        u32::from(info.width),
+        u32::from(info.height),
+        pixels,
+    ))
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageError> {
+    std::fs::read(path).map_err(|source| ImageError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Reads a PNG file as RGBA8.
+///
+/// # Errors
+/// [`ImageError::Io`] if the file cannot be read, or a decode error naming the file.
+pub fn read_png(path: &Path) -> Result<Rgba8Image, ImageError> {
+    decode_png(&read_bytes(path)?, &path.display().to_string())
+}
+
+/// Reads a PNG or JPEG file (recognised by its signature) as RGBA8.
+///
+/// # Errors
+/// [`ImageError::Io`] if the file cannot be read; [`ImageError::Decode`] if it is neither a
+/// PNG nor a JPEG, or is malformed.
+pub fn read_image(path: &Path) -> Result<Rgba8Image, ImageError> {
+    let bytes = read_bytes(path)?;
+    let what = path.display().to_string();
+    if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        decode_png(&bytes, &what)
+    } else if bytes.starts_with(&[0xff, 0xd8]) {
+        decode_jpeg(&bytes, &what)
+    } else {
+        Err(decode_err(&what, "expected a PNG or JPEG signature"))
+    }
+}
+
+/// Encodes 8-bit pixels (3 or 4 channels per pixel, `CHANNELS`) as a PNG.
+fn encode_png_channels(
+    width: u32,
+    height: u32,
+    data: &[u8],
+    color: png::ColorType,
+    out: &mut impl Write,
+) -> Result<(), ImageError> {
+    let err = |e: png::EncodingError| ImageError::Encode {
+        format: "PNG",
+        message: e.to_string(),
+    };
+    let mut enc = png::Encoder::new(out, width, height);
+    enc.set_color(color);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Fast);
+    enc.set_filter(png::FilterType::Paeth);
+    let mut w = enc.write_header().map_err(err)?;
+    w.write_image_data(data).map_err(err)?;
+    w.finish().map_err(err)
+}
+
+/// Encodes an RGB8 image as PNG bytes.
+///
+/// # Errors
+/// [`ImageError::Encode`] if the encoder fails.
+pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
+    let mut out = Vec::new();
+    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgb, &mut out)?;
+    Ok(out)
+}
+
+/// Writes an RGB8 image as a PNG file, atomically (see [`write_atomic`]).
+///
+/// # Errors
+/// [`ImageError::Io`] or [`ImageError::Encode`]; on error the destination is untouched.
+pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
+    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    write_atomic(path, |w| {
+        encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgb, w)
+    })
+}
+
+/// Writes a file by streaming into a temporary file beside `path`, then renaming it over
+/// `path`, so that a failure never leaves a truncated file or clobbers an existing one.
+///
+/// # Errors
+/// [`ImageError::Io`] for file-system errors, or whatever `write` returns.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
+) -> Result<(), ImageError> {
+    let io_err = |p: &Path| {
+        let p: PathBuf = p.to_path_buf();
+        move |source| ImageError::Io { path: p, source }
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".to_string());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let file = File::create(&tmp).map_err(io_err(&tmp))?;
+        let mut w = BufWriter::new(file);
+        write(&mut w)?;
+        let file = w
+            .into_inner()
+            .map_err(|e| ImageError::Io {
+                path: tmp.clone(),
+                source: e.into_error(),
+            })?;
+        file.sync_all().map_err(io_err(&tmp))?;
+        std::fs::rename(&tmp, path).map_err(io_err(path))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Image;
+
+    #[test]
+    fn png_round_trip_is_lossless() {
+        let im = Image::from_fn(7, 5, |x, y| [(x * 30) as u8, (y * 50) as u8, 200]);
+        let bytes = encode_png(&im).unwrap();
+        let back = decode_png(&bytes, "mem").unwrap().to_rgb8();
+        assert_eq!(back, im);
+    }
+
+    #[test]
+    fn truncated_png_is_an_error_not_a_panic() {
+        let im = Image::from_fn(16, 16, |x, y| [x as u8, y as u8, 0]);
+        let bytes = encode_png(&im).unwrap();
+        for cut in [0, 8, 20, 40, bytes.len() - 5] {
+            assert!(decode_png(&bytes[..cut], "mem").is_err(), "cut at {cut}");
+        }
+    }
+
+    #[test]
+    fn write_atomic_leaves_old_file_on_failure() {
+        let dir = std::env::temp_dir().join(format!("prism-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("keep.png");
+        std::fs::write(&path, b"old").unwrap();
+        let r = write_atomic(&path, |w| {
+            w.write_all(b"partial").unwrap();
+            Err(ImageError::Encode {
+                format: "PNG",
+                message: "boom".into(),
+            })
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "temp file left behind");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn reads_staged_palette_and_grey_alpha_pngs() {
+        let img = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/rasterizer/img");
+        if !img.exists() {
+            return;
+        }
+        let seal = read_png(&img.join("seal.png")).unwrap();
+        assert_eq!((seal.width(), seal.height()), (260, 260));
+        let grid = read_png(&img.join("grid.png")).unwrap();
+        assert_eq!((grid.width(), grid.height()), (397, 385));
+    }
+}

@@ -1,0 +1,22 @@
+//! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
+//! the one texture sampler (mipmaps, nearest/bilinear/trilinear) and image-difference metrics.
+#![warn(missing_docs)]
+
+mod diff;
+mod error;
+mod exr;
+mod image;
+mod io;
+mod srgb;
+mod texture;
+
+pub use diff::{compare_rgb8, DiffStats};
+pub use error::ImageError;
+pub use exr::{encode_exr, write_exr};
+pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
+pub use io::{
+    decode_jpeg, decode_png, encode_png, read_image, read_png, write_atomic, write_png,
+    MAX_IMAGE_PIXELS,
+};
+pub use srgb::{linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear};
+pub use texture::{LevelSampling, PixelSampling, Texture};

@@ -1,0 +1,337 @@
+//! The one texture sampler of prism: a full box-filtered mipmap chain, nearest and bilinear
+//! texel lookups with clamp-to-edge, and level selection from screen-space uv derivatives.
+
+use prism_math::{Rgb, Vec2};
+
+use crate::{Image, RgbImage};
+
+/// How texels are looked up within one mip level.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PixelSampling {
+    /// The texel whose square contains the sample point.
+    #[default]
+    Nearest,
+    /// Bilinear interpolation between the four nearest texel centres.
+    Bilinear,
+}
+
+/// How the mip level is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LevelSampling {
+    /// Always level 0 (no mipmapping).
+    #[default]
+    Zero,
+    /// The level nearest to the continuous level `D`.
+    Nearest,
+    /// Linear interpolation between levels `floor(D)` and `floor(D) + 1` (trilinear with
+    /// bilinear pixel sampling).
+    Linear,
+}
+
+/// A texture with its full mipmap chain.
+///
+/// Level 0 is the image as given; level `k + 1` has size `max(1, floor(w_k / 2))` by
+/// `max(1, floor(h_k / 2))` and every texel is the area-weighted (box) average of the
+/// level-`k` texels its footprint covers, so odd and non-power-of-two sizes are filtered
+/// exactly. The chain ends with a 1x1 level. Values are stored as given: no colour-space
+/// conversion happens here. uv `(0, 0)` is the top-left corner of the first row, `(1, 1)`
+/// the bottom-right corner of the last row.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    levels: Vec<RgbImage>,
+}
+
+/// Per-destination-index list of `(source index, weight)` for a box filter from `src` to
+/// `dst` samples.
+fn box_weights(src: u32, dst: u32) -> Vec<Vec<(u32, f32)>> {
+    let scale = f64::from(src) / f64::from(dst);
+    (0..dst)
+        .map(|i| {
+            let lo = f64::from(i) * scale;
+            let hi = f64::from(i + 1) * scale;
+            let mut taps = Vec::new();
+            let mut s = lo.floor() as u32;
+            while f64::from(s) < hi && s < src {
+                let a = lo.max(f64::from(s));
+                let b = hi.min(f64::from(s + 1));
+                if b > a {
+                    taps.push((s, ((b - a) / scale) as f32));
+                }
+                s += 1;
+            }
+            taps
+        })
+        .collect()
+}
+
+fn downsample(src: &RgbImage) -> RgbImage {
+    let (w, h) = (src.width(), src.height());
+    let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+    let wx = box_weights(w, nw);
+    let wy = box_weights(h, nh);
+    // Filter rows first, then columns.
+    let tmp = Image::from_fn(nw, h, |x, y| {
+        let row = src.row(y);
+        wx[x as usize]
+            .iter()
+            .fold(Rgb::BLACK, |acc, &(s, wt)| acc + row[s as usize] * wt)
+    });
+    Image::from_fn(nw, nh, |x, y| {
+        wy[y as usize]
+            .iter()
+            .fold(Rgb::BLACK, |acc, &(s, wt)| acc + tmp.get(x, s) * wt)
+    })
+}
+
+impl Texture {
+    /// Builds the full mipmap chain from a level-0 image.
+    #[must_use]
+    pub fn new(base: RgbImage) -> Texture {
+        let mut levels = vec![base];
+        loop {
+            let last = levels.last().expect("chain starts non-empty");
+            if last.width() == 1 && last.height() == 1 {
+                break;
+            }
+            let next = downsample(last);
+            levels.push(next);
+        }
+        Texture { levels }
+    }
+
+    /// The mip levels, finest first.
+    #[must_use]
+    pub fn levels(&self) -> &[RgbImage] {
+        &self.levels
+    }
+
+    /// Width and height of level 0.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.levels[0].width(), self.levels[0].height())
+    }
+
+    /// The continuous mip level `D = log2(L)` for screen-space uv derivatives, where `L` is
+    /// the longer of the two derivative vectors measured in level-0 texels. Clamped to
+    /// `[0, levels - 1]`; 0 for degenerate or non-finite input.
+    #[must_use]
+    pub fn level_for(&self, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
+        let (w, h) = self.size();
+        let scale = Vec2::new(w as f32, h as f32);
+        let l = (duv_dx * scale).length().max((duv_dy * scale).length());
+        let d = l.log2();
+        if !d.is_finite() || d <= 0.0 {
+            return 0.0;
+        }
+        d.min((self.levels.len() - 1) as f32)
+    }
+
+    /// Samples one mip level at `uv`, clamping to the edge.
+    ///
+    /// # Panics
+    /// If `level` is not below `levels().len()`.
+    #[must_use]
+    pub fn sample_level(&self, uv: Vec2, level: usize, mode: PixelSampling) -> Rgb {
+        let im = &self.levels[level];
+        let (w, h) = (im.width() as i64, im.height() as i64);
+        let fx = f64::from(uv.x) * w as f64;
+        let fy = f64::from(uv.y) * h as f64;
+        let clamp_x = |x: i64| x.clamp(0, w - 1) as u32;
+        let clamp_y = |y: i64| y.clamp(0, h - 1) as u32;
+        match mode {
+            PixelSampling::Nearest => {
+                let (x, y) = (fx.floor(), fy.floor());
+                if !x.is_finite() || !y.is_finite() {
+                    return im.get(0, 0);
+                }
+                im.get(clamp_x(x as i64), clamp_y(y as i64))
+            }
+            PixelSampling::Bilinear => {
+                let (gx, gy) = (fx - 0.5, fy - 0.5);
+                if !gx.is_finite() || !gy.is_finite() {
+                    return im.get(0, 0);
+                }
+                let (x0, y0) = (gx.floor(), gy.floor());
+                let (tx, ty) = ((gx - x0) as f32, (gy - y0) as f32);
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let (xa, xb, ya, yb) = (clamp_x(x0), clamp_x(x0 + 1), clamp_y(y0), clamp_y(y0 + 1));
+                let top = im.get(xa, ya).lerp(im.get(xb, ya), tx);
+                let bottom = im.get(xa, yb).lerp(im.get(xb, yb), tx);
+                top.lerp(bottom, ty)
+            }
+        }
+    }
+
+    /// Samples at `uv` with the given level and pixel modes, choosing the level from the
+    /// screen-space derivatives `duv_dx`, `duv_dy` (uv change per pixel step in x and y).
+    #[must_use]
+    pub fn sample(
+        &self,
+        uv: Vec2,
+        duv_dx: Vec2,
+        duv_dy: Vec2,
+        pixel: PixelSampling,
+        level: LevelSampling,
+    ) -> Rgb {
+        match level {
+            LevelSampling::Zero => self.sample_level(uv, 0, pixel),
+            LevelSampling::Nearest => {
+                let d = self.level_for(duv_dx, duv_dy);
+                self.sample_level(uv, d.round() as usize, pixel)
+            }
+            LevelSampling::Linear => self.sample_at_level(uv, self.level_for(duv_dx, duv_dy), pixel),
+        }
+    }
+
+    /// Samples at a continuous level `d`, blending levels `floor(d)` and `floor(d) + 1`
+    /// linearly; `d` is clamped to the chain.
+    #[must_use]
+    pub fn sample_at_level(&self, uv: Vec2, d: f32, pixel: PixelSampling) -> Rgb {
+        let max = (self.levels.len() - 1) as f32;
+        let d = if d.is_finite() { d.clamp(0.0, max) } else { 0.0 };
+        let lo = d.floor();
+        let t = d - lo;
+        let lo = lo as usize;
+        let a = self.sample_level(uv, lo, pixel);
+        if t == 0.0 || lo + 1 >= self.levels.len() {
+            return a;
+        }
+        a.lerp(self.sample_level(uv, lo + 1, pixel), t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn checker(n: u32) -> RgbImage {
+        Image::from_fn(n, n, |x, y| {
+            if (x + y) % 2 == 0 {
+                Rgb::WHITE
+            } else {
+                Rgb::BLACK
+            }
+        })
+    }
+
+    fn close(a: Rgb, b: Rgb, eps: f32) -> bool {
+        (a.r - b.r).abs() <= eps && (a.g - b.g).abs() <= eps && (a.b - b.b).abs() <= eps
+    }
+
+    #[test]
+    fn chain_reaches_one_by_one_for_non_power_of_two() {
+        let t = Texture::new(Image::new(2058, 1036, Rgb::WHITE));
+        let sizes: Vec<_> = t.levels().iter().map(|l| (l.width(), l.height())).collect();
+        assert_eq!(sizes[1], (1029, 518));
+        assert_eq!(sizes[2], (514, 259));
+        assert_eq!(*sizes.last().unwrap(), (1, 1));
+        assert_eq!(sizes.len(), 12);
+    }
+
+    /// Closed form: a constant texture samples to the constant at every level and mode.
+    #[test]
+    fn constant_texture_is_constant_everywhere() {
+        let c = Rgb::new(0.25, 0.5, 0.75);
+        let t = Texture::new(Image::new(37, 23, c));
+        for (k, l) in t.levels().iter().enumerate() {
+            for p in l.pixels() {
+                assert!(close(*p, c, 1e-6), "level {k}");
+            }
+            for uv in [Vec2::new(0.0, 0.0), Vec2::new(0.31, 0.77), Vec2::new(1.0, 1.0)] {
+                for m in [PixelSampling::Nearest, PixelSampling::Bilinear] {
+                    assert!(close(t.sample_level(uv, k, m), c, 1e-6));
+                }
+            }
+        }
+        let s = t.sample_at_level(Vec2::splat(0.4), 1.3, PixelSampling::Bilinear);
+        assert!(close(s, c, 1e-6));
+    }
+
+    /// Closed form: bilinear interpolation reproduces an affine ramp exactly between texel
+    /// centres.
+    #[test]
+    fn bilinear_reproduces_linear_ramp() {
+        let (w, h) = (16u32, 8u32);
+        let ramp = |x: f32, y: f32| Rgb::new(0.01 * x, 0.02 * y, 0.005 * x + 0.01 * y);
+        let t = Texture::new(Image::from_fn(w, h, |x, y| ramp(x as f32, y as f32)));
+        for i in 0..50 {
+            let tx = 0.5 + (w as f32 - 1.0) * (i as f32 / 49.0);
+            let ty = 0.5 + (h as f32 - 1.0) * ((i * 7 % 50) as f32 / 49.0);
+            let uv = Vec2::new(tx / w as f32, ty / h as f32);
+            let got = t.sample_level(uv, 0, PixelSampling::Bilinear);
+            assert!(close(got, ramp(tx - 0.5, ty - 0.5), 1e-5), "at {tx},{ty}");
+        }
+    }
+
+    /// Closed form: level k of a checkerboard of 2^k-texel squares is their box average.
+    #[test]
+    fn checkerboard_levels_are_box_averages() {
+        let n = 64;
+        let t = Texture::new(checker(n));
+        for p in t.levels()[1].pixels() {
+            assert!(close(*p, Rgb::splat(0.5), 1e-6));
+        }
+        // A checkerboard of 4x4 squares: level 2 alternates pure colours, level 3 is grey.
+        let big = Image::from_fn(n, n, |x, y| {
+            if (x / 4 + y / 4) % 2 == 0 {
+                Rgb::WHITE
+            } else {
+                Rgb::BLACK
+            }
+        });
+        let t = Texture::new(big);
+        let l2 = &t.levels()[2];
+        assert_eq!(l2.get(0, 0), Rgb::WHITE);
+        assert_eq!(l2.get(1, 0), Rgb::BLACK);
+        for p in t.levels()[3].pixels() {
+            assert!(close(*p, Rgb::splat(0.5), 1e-6));
+        }
+    }
+
+    /// Property: the box filter preserves the mean of an odd-sized image exactly.
+    #[test]
+    fn odd_sizes_preserve_mean() {
+        let im = Image::from_fn(7, 5, |x, y| Rgb::splat(((x * 13 + y * 7) % 11) as f32 / 10.0));
+        let mean = |im: &RgbImage| {
+            im.pixels().iter().map(|p| p.r as f64).sum::<f64>() / im.pixels().len() as f64
+        };
+        let t = Texture::new(im.clone());
+        for l in t.levels() {
+            assert!((mean(l) - mean(&im)).abs() < 1e-5);
+        }
+    }
+
+    /// Closed form: trilinear at level 1.5 is the average of levels 1 and 2.
+    #[test]
+    fn trilinear_midpoint_is_average_of_levels() {
+        let im = Image::from_fn(32, 32, |x, y| Rgb::new(x as f32 / 31.0, y as f32 / 31.0, 0.3));
+        let t = Texture::new(im);
+        let uv = Vec2::new(0.37, 0.61);
+        let a = t.sample_level(uv, 1, PixelSampling::Bilinear);
+        let b = t.sample_level(uv, 2, PixelSampling::Bilinear);
+        let m = t.sample_at_level(uv, 1.5, PixelSampling::Bilinear);
+        assert!(close(m, (a + b) * 0.5, 1e-6));
+        // Derivatives of 2^1.5 texels per pixel select level 1.5.
+        let d = 2f32.powf(1.5) / 32.0;
+        let s = t.sample(uv, Vec2::new(d, 0.0), Vec2::new(0.0, d), PixelSampling::Bilinear, LevelSampling::Linear);
+        assert!(close(s, (a + b) * 0.5, 1e-5));
+    }
+
+    #[test]
+    fn level_selection_closed_form() {
+        let t = Texture::new(Image::new(64, 64, Rgb::WHITE));
+        assert_eq!(t.level_for(Vec2::new(1.0 / 64.0, 0.0), Vec2::ZERO), 0.0);
+        assert!((t.level_for(Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)) - 2.0).abs() < 1e-6);
+        assert_eq!(t.level_for(Vec2::new(1e9, 0.0), Vec2::ZERO), 6.0);
+        assert_eq!(t.level_for(Vec2::new(f32::NAN, 0.0), Vec2::ZERO), 0.0);
+    }
+
+    #[test]
+    fn nearest_clamps_to_edge() {
+        let t = Texture::new(Image::from_fn(4, 1, |x, _| Rgb::splat(x as f32)));
+        assert_eq!(t.sample_level(Vec2::new(-3.0, 0.5), 0, PixelSampling::Nearest).r, 0.0);
+        assert_eq!(t.sample_level(Vec2::new(0.3, 0.5), 0, PixelSampling::Nearest).r, 1.0);
+        assert_eq!(t.sample_level(Vec2::new(9.0, 0.5), 0, PixelSampling::Nearest).r, 3.0);
+        assert_eq!(t.sample_level(Vec2::new(1.0, 0.5), 0, PixelSampling::Bilinear).r, 3.0);
+    }
+}
