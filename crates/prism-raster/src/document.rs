@@ -1,0 +1,314 @@
+//! The plain document a reader produces and the rasterizer consumes: shapes with their
+//! transforms and paints, no pixels and no parsing state.
+
+use std::sync::Arc;
+
+use prism_image::Texture;
+use prism_math::{DVec2, Rgb, Vec2};
+
+use crate::path::{Path, StrokeStyle};
+
+/// A 3x3 homogeneous 2D transform in `f64`, row-major, mapping column vectors
+/// `(x, y, 1)`; points are divided by the third component after mapping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mat3(pub [[f64; 3]; 3]);
+
+impl Default for Mat3 {
+    fn default() -> Self {
+        Mat3::IDENTITY
+    }
+}
+
+impl Mat3 {
+    /// The identity transform.
+    pub const IDENTITY: Mat3 = Mat3([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+
+    /// The SVG `matrix(a, b, c, d, e, f)`: `[[a, c, e], [b, d, f], [0, 0, 1]]`.
+    #[must_use]
+    pub fn affine(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Mat3 {
+        Mat3([[a, c, e], [b, d, f], [0.0, 0.0, 1.0]])
+    }
+
+    /// A translation.
+    #[must_use]
+    pub fn translate(x: f64, y: f64) -> Mat3 {
+        Mat3::affine(1.0, 0.0, 0.0, 1.0, x, y)
+    }
+
+    /// A scale about the origin.
+    #[must_use]
+    pub fn scale(x: f64, y: f64) -> Mat3 {
+        Mat3::affine(x, 0.0, 0.0, y, 0.0, 0.0)
+    }
+
+    /// A rotation by `deg` degrees, clockwise on a y-down screen (the SVG convention).
+    #[must_use]
+    pub fn rotate(deg: f64) -> Mat3 {
+        let (s, c) = (deg * std::f64::consts::PI / 180.0).sin_cos();
+        Mat3::affine(c, s, -s, c, 0.0, 0.0)
+    }
+
+    /// Skew along x by `deg` degrees.
+    #[must_use]
+    pub fn skew_x(deg: f64) -> Mat3 {
+        Mat3::affine(1.0, 0.0, (deg * std::f64::consts::PI / 180.0).tan(), 1.0, 0.0, 0.0)
+    }
+
+    /// Skew along y by `deg` degrees.
+    #[must_use]
+    pub fn skew_y(deg: f64) -> Mat3 {
+        Mat3::affine(1.0, (deg * std::f64::consts::PI / 180.0).tan(), 0.0, 1.0, 0.0, 0.0)
+    }
+
+    /// The product `self * rhs` (apply `rhs` first).
+    #[must_use]
+    pub fn mul(&self, rhs: &Mat3) -> Mat3 {
+        let (a, b) = (&self.0, &rhs.0);
+        let mut m = [[0.0; 3]; 3];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+            }
+        }
+        Mat3(m)
+    }
+
+    /// Maps a point, dividing by the homogeneous coordinate.
+    #[must_use]
+    pub fn apply(&self, p: DVec2) -> DVec2 {
+        let m = &self.0;
+        let x = p.x * m[0][0] + p.y * m[0][1] + m[0][2];
+        let y = p.x * m[1][0] + p.y * m[1][1] + m[1][2];
+        let z = p.x * m[2][0] + p.y * m[2][1] + m[2][2];
+        DVec2::new(x / z, y / z)
+    }
+
+    /// The affine part after normalising the homogeneous row, as `(linear 2x2, translation)`.
+    /// Valid for transforms whose last row is `[0, 0, w]`.
+    #[must_use]
+    pub fn to_affine(&self) -> prism_math::DAffine2 {
+        let m = &self.0;
+        let w = m[2][2];
+        prism_math::DAffine2::from_cols_array(&[
+            m[0][0] / w,
+            m[1][0] / w,
+            m[0][1] / w,
+            m[1][1] / w,
+            m[0][2] / w,
+            m[1][2] / w,
+        ])
+    }
+
+    /// The largest factor by which the transform stretches a length.
+    #[must_use]
+    pub fn max_scale(&self) -> f64 {
+        let a = self.to_affine();
+        let (c0, c1) = (a.matrix2.x_axis, a.matrix2.y_axis);
+        // Largest singular value of the 2x2 part.
+        let (p, q, r) = (c0.length_squared(), c1.length_squared(), c0.dot(c1));
+        let t = 0.5 * (p + q);
+        let d = (0.25 * (p - q) * (p - q) + r * r).sqrt();
+        (t + d).sqrt()
+    }
+
+    /// True if every entry is finite and the homogeneous scale is non-zero.
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        self.0.iter().flatten().all(|v| v.is_finite()) && self.0[2][2] != 0.0
+    }
+}
+
+/// Which points a filled path covers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FillRule {
+    /// Inside where the winding number is non-zero.
+    #[default]
+    NonZero,
+    /// Inside where the winding number is odd.
+    EvenOdd,
+}
+
+/// One colour stop of a gradient.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stop {
+    /// Position along the gradient in [0, 1].
+    pub offset: f32,
+    /// Colour at the stop (stored sRGB values, as in the file).
+    pub color: Rgb,
+    /// Opacity at the stop in [0, 1].
+    pub opacity: f32,
+}
+
+/// How a gradient continues outside [0, 1].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Spread {
+    /// Extend the end colours.
+    #[default]
+    Pad,
+    /// Repeat the pattern.
+    Repeat,
+    /// Repeat, mirroring every other copy.
+    Reflect,
+}
+
+/// The geometry of a gradient, in its own gradient space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GradientKind {
+    /// Colour varies along the line from `start` to `end`.
+    Linear {
+        /// Where offset 0 lies.
+        start: DVec2,
+        /// Where offset 1 lies.
+        end: DVec2,
+    },
+    /// Colour varies with distance from `focus` to the circle (`center`, `radius`).
+    Radial {
+        /// Centre of the end circle.
+        center: DVec2,
+        /// Radius of the end circle.
+        radius: f64,
+        /// The focal point (offset 0).
+        focus: DVec2,
+    },
+}
+
+/// A linear or radial gradient paint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gradient {
+    /// Geometry.
+    pub kind: GradientKind,
+    /// Stops sorted by offset; at least one.
+    pub stops: Vec<Stop>,
+    /// Behaviour outside [0, 1].
+    pub spread: Spread,
+    /// Maps gradient space to the user space of the painted element.
+    pub transform: Mat3,
+}
+
+/// What a fill or stroke is painted with.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Paint {
+    /// One colour (stored sRGB values in [0, 1]).
+    Solid(Rgb),
+    /// A gradient.
+    Gradient(Arc<Gradient>),
+}
+
+/// One drawable thing, in painter's order.
+#[derive(Clone, Debug)]
+pub enum Item {
+    /// Triangles filled with one colour, each sample covered when it lies inside or on an
+    /// edge (the course renderer's inclusive rule, used by `--compat cs184`).
+    Triangles {
+        /// Vertices in local coordinates.
+        tris: Vec<[DVec2; 3]>,
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Fill colour.
+        color: Rgb,
+    },
+    /// A filled path.
+    Fill {
+        /// Geometry in local coordinates.
+        path: Path,
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Inside test.
+        rule: FillRule,
+        /// Paint.
+        paint: Paint,
+        /// Opacity in [0, 1].
+        opacity: f32,
+    },
+    /// A stroked path.
+    Stroke {
+        /// Geometry in local coordinates.
+        path: Path,
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Width, joins, caps and dashes in local units.
+        style: StrokeStyle,
+        /// Paint.
+        paint: Paint,
+        /// Opacity in [0, 1].
+        opacity: f32,
+    },
+    /// One-pixel lines through `points` drawn with the course's DDA: not antialiased, every
+    /// sub-sample of a touched pixel takes the colour.
+    Hairline {
+        /// Vertices in local coordinates.
+        points: Vec<DVec2>,
+        /// Connect the last point back to the first.
+        closed: bool,
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Line colour.
+        color: Rgb,
+    },
+    /// A single pixel at `floor` of the transformed point, every sub-sample set.
+    Point {
+        /// Position in local coordinates.
+        at: DVec2,
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Colour.
+        color: Rgb,
+    },
+    /// A triangle with per-vertex colours interpolated barycentrically.
+    ColorTri {
+        /// Vertices in local coordinates.
+        points: [DVec2; 3],
+        /// Vertex colours.
+        colors: [Rgb; 3],
+        /// Local-to-document transform.
+        transform: Mat3,
+    },
+    /// A texture-mapped triangle.
+    TexTri {
+        /// Vertices in local coordinates.
+        points: [DVec2; 3],
+        /// Texture coordinates per vertex; (0, 0) is the top-left of the first row.
+        uvs: [Vec2; 3],
+        /// Index into [`Document::textures`].
+        texture: usize,
+        /// Local-to-document transform.
+        transform: Mat3,
+    },
+    /// A raster image stretched over the rectangle `rect` = (x, y, width, height).
+    Image {
+        /// Index into [`Document::textures`].
+        texture: usize,
+        /// Placement in local coordinates.
+        rect: [f64; 4],
+        /// Local-to-document transform.
+        transform: Mat3,
+        /// Opacity in [0, 1].
+        opacity: f32,
+    },
+    /// Starts an offscreen layer; everything up to the matching [`Item::EndLayer`] is
+    /// composited onto what lies below with `opacity`.
+    BeginLayer,
+    /// Ends the innermost layer.
+    EndLayer {
+        /// Group opacity in [0, 1].
+        opacity: f32,
+    },
+}
+
+/// A parsed SVG, ready to rasterize.
+#[derive(Clone, Debug, Default)]
+pub struct Document {
+    /// Viewport width in user units (the course's canvas width).
+    pub width: f64,
+    /// Viewport height in user units.
+    pub height: f64,
+    /// Maps user space to viewport space (the `viewBox` and `preserveAspectRatio` mapping;
+    /// identity without a viewBox).
+    pub view_box_transform: Mat3,
+    /// Drawables in painter's order.
+    pub items: Vec<Item>,
+    /// Textures referenced by index from items.
+    pub textures: Vec<Arc<Texture>>,
+    /// One line per kind of thing that was skipped or approximated.
+    pub warnings: Vec<String>,
+}

@@ -1,0 +1,29 @@
+//! Floor-2 2D rasterization for prism: an SVG reader (the CS184 subset and standard SVG
+//! shapes, paths, strokes, gradients and images) producing a plain [`Document`], and a
+//! supersampling rasterizer that renders it to an image.
+//!
+//! ```
+//! use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+//! let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">
+//!   <rect width="10" height="10" fill="red"/></svg>"#;
+//! let doc = parse_svg(svg, Dialect::Svg, &Source::default()).unwrap();
+//! let opts = RenderOptions { width: 10, height: 10, ..Default::default() };
+//! let (image, _) = render(&doc, &opts).unwrap();
+//! assert_eq!(image.get(5, 5), [255, 0, 0, 255]);
+//! ```
+#![warn(missing_docs)]
+
+mod document;
+mod parse;
+pub mod path;
+mod raster;
+
+pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+pub use parse::{
+    ear_clip, parse_path_data, parse_svg, read_svg, Dialect, Source, SvgError, MAX_DEPTH,
+    MAX_FILE_BYTES, MAX_ITEMS,
+};
+pub use raster::{
+    render, sample_rate, view_transform, RenderError, RenderOptions, RenderStats, View,
+    MAX_DIMENSION, MAX_SAMPLES,
+};

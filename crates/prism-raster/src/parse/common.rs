@@ -1,0 +1,285 @@
+//! Pieces shared by both SVG dialects: errors with locations, limits, numbers, transforms.
+
+use std::fmt;
+
+use crate::document::Mat3;
+
+/// Deepest element nesting a document may have.
+pub const MAX_DEPTH: usize = 256;
+/// Largest SVG file accepted, in bytes.
+pub const MAX_FILE_BYTES: usize = 256 << 20;
+/// Most drawables (after expanding points and triangles) a document may produce.
+pub const MAX_ITEMS: usize = 20_000_000;
+
+/// A reader error with its location: `file:line: element: message`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SvgError {
+    /// The file (or `<memory>`).
+    pub file: String,
+    /// 1-based line of the offending element or token; 0 when unknown.
+    pub line: u32,
+    /// The element name, or `xml` for syntax errors.
+    pub element: String,
+    /// What was expected and what was found.
+    pub message: String,
+}
+
+impl fmt::Display for SvgError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}: {}: {}", self.file, self.line, self.element, self.message)
+    }
+}
+
+impl std::error::Error for SvgError {}
+
+/// Where the element being read sits, for error messages.
+#[derive(Clone, Copy)]
+pub(crate) struct Loc<'a> {
+    pub file: &'a str,
+    pub line: u32,
+    pub element: &'a str,
+}
+
+impl Loc<'_> {
+    pub fn err(&self, message: impl Into<String>) -> SvgError {
+        SvgError {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            message: message.into(),
+        }
+    }
+}
+
+/// How numbers are rounded on reading: the course renderer reads `f32`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Precision {
+    F32,
+    F64,
+}
+
+/// Length of the longest prefix of `s` that is an SVG number (sign, digits, fraction,
+/// exponent), or 0.
+pub(crate) fn number_prefix_len(s: &str) -> usize {
+    let b = s.as_bytes();
+    let mut i = 0;
+    if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
+        i += 1;
+    }
+    let digits_start = i;
+    while i < b.len() && b[i].is_ascii_digit() {
+        i += 1;
+    }
+    let mut any = i > digits_start;
+    if i < b.len() && b[i] == b'.' {
+        let j = i + 1;
+        let mut k = j;
+        while k < b.len() && b[k].is_ascii_digit() {
+            k += 1;
+        }
+        if k > j || any {
+            any = any || k > j;
+            i = k;
+        }
+    }
+    if !any {
+        return 0;
+    }
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        let mut k = i + 1;
+        if k < b.len() && (b[k] == b'+' || b[k] == b'-') {
+            k += 1;
+        }
+        let ds = k;
+        while k < b.len() && b[k].is_ascii_digit() {
+            k += 1;
+        }
+        if k > ds {
+            i = k;
+        }
+    }
+    i
+}
+
+pub(crate) fn to_num(s: &str, p: Precision) -> Option<f64> {
+    let v = match p {
+        Precision::F32 => s.parse::<f32>().ok().map(f64::from),
+        Precision::F64 => s.parse::<f64>().ok(),
+    }?;
+    v.is_finite().then_some(v)
+}
+
+/// Reads a whole list of numbers separated by whitespace and/or single commas.
+pub(crate) fn number_list(s: &str, p: Precision, loc: &Loc, attr: &str) -> Result<Vec<f64>, SvgError> {
+    let mut out = Vec::new();
+    let mut rest = s.trim_start();
+    while !rest.is_empty() {
+        let n = number_prefix_len(rest);
+        if n == 0 {
+            return Err(loc.err(format!(
+                "{attr}: expected a number, found {:?}",
+                rest.chars().take(12).collect::<String>()
+            )));
+        }
+        let v = to_num(&rest[..n], p)
+            .ok_or_else(|| loc.err(format!("{attr}: number {:?} is not finite", &rest[..n])))?;
+        out.push(v);
+        rest = rest[n..].trim_start();
+        if let Some(r) = rest.strip_prefix(',') {
+            rest = r.trim_start();
+        }
+    }
+    Ok(out)
+}
+
+/// Reads one number, allowing a trailing unit of letters or `%` (returned alongside).
+pub(crate) fn number_with_unit<'s>(
+    s: &'s str,
+    p: Precision,
+    loc: &Loc,
+    attr: &str,
+) -> Result<(f64, &'s str), SvgError> {
+    let t = s.trim();
+    let n = number_prefix_len(t);
+    let bad = || loc.err(format!("{attr}: expected a number, found {t:?}"));
+    if n == 0 {
+        return Err(bad());
+    }
+    let v = to_num(&t[..n], p).ok_or_else(bad)?;
+    let unit = t[n..].trim();
+    if !unit.chars().all(|c| c.is_ascii_alphabetic() || c == '%') {
+        return Err(bad());
+    }
+    Ok((v, unit))
+}
+
+/// Parses an SVG `transform` list into one matrix, functions applied in document order
+/// (`M = M1 * M2 * ...`). With `scale_y_defaults_to_one`, `scale(s)` means `scale(s, 1)`
+/// as in the course renderer; otherwise `scale(s, s)` as in the SVG spec.
+pub(crate) fn parse_transform(
+    s: &str,
+    p: Precision,
+    loc: &Loc,
+    scale_y_defaults_to_one: bool,
+) -> Result<Mat3, SvgError> {
+    let mut m = Mat3::IDENTITY;
+    let mut rest = s.trim();
+    while !rest.is_empty() {
+        let open = rest
+            .find('(')
+            .ok_or_else(|| loc.err(format!("transform: expected '(' in {rest:?}")))?;
+        let name = rest[..open].trim();
+        let close = rest[open..]
+            .find(')')
+            .ok_or_else(|| loc.err(format!("transform: expected ')' after {name}(")))?
+            + open;
+        let args = number_list(&rest[open + 1..close], p, loc, "transform")?;
+        let arity = |ok: &[usize]| {
+            if ok.contains(&args.len()) {
+                Ok(())
+            } else {
+                Err(loc.err(format!(
+                    "transform: {name}() takes {ok:?} arguments, found {}",
+                    args.len()
+                )))
+            }
+        };
+        let f = match name {
+            "matrix" => {
+                arity(&[6])?;
+                Mat3::affine(args[0], args[1], args[2], args[3], args[4], args[5])
+            }
+            "translate" => {
+                arity(&[1, 2])?;
+                Mat3::translate(args[0], args.get(1).copied().unwrap_or(0.0))
+            }
+            "scale" => {
+                arity(&[1, 2])?;
+                let y = args
+                    .get(1)
+                    .copied()
+                    .unwrap_or(if scale_y_defaults_to_one { 1.0 } else { args[0] });
+                Mat3::scale(args[0], y)
+            }
+            "rotate" => {
+                arity(&[1, 3])?;
+                let r = Mat3::rotate(args[0]);
+                if args.len() == 3 {
+                    Mat3::translate(args[1], args[2])
+                        .mul(&r)
+                        .mul(&Mat3::translate(-args[1], -args[2]))
+                } else {
+                    r
+                }
+            }
+            "skewX" => {
+                arity(&[1])?;
+                Mat3::skew_x(args[0])
+            }
+            "skewY" => {
+                arity(&[1])?;
+                Mat3::skew_y(args[0])
+            }
+            other => {
+                return Err(loc.err(format!(
+                    "transform: expected matrix, translate, scale, rotate, skewX or skewY, found {other:?}"
+                )))
+            }
+        };
+        m = m.mul(&f);
+        rest = rest[close + 1..].trim_start();
+        if let Some(r) = rest.strip_prefix(',') {
+            rest = r.trim_start();
+        }
+    }
+    Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_math::DVec2;
+
+    fn loc() -> Loc<'static> {
+        Loc {
+            file: "t.svg",
+            line: 3,
+            element: "rect",
+        }
+    }
+
+    #[test]
+    fn number_prefixes() {
+        assert_eq!(number_prefix_len("487.211px"), 7);
+        assert_eq!(number_prefix_len(".5.5"), 2);
+        assert_eq!(number_prefix_len("-1e-3x"), 5);
+        assert_eq!(number_prefix_len("1em"), 1);
+        assert_eq!(number_prefix_len("abc"), 0);
+        assert_eq!(number_prefix_len("-."), 0);
+    }
+
+    #[test]
+    fn lists_accept_commas_and_compact_signs() {
+        let l = number_list("10,20 30-40 .5.5", Precision::F64, &loc(), "points").unwrap();
+        assert_eq!(l, vec![10.0, 20.0, 30.0, -40.0, 0.5, 0.5]);
+        let e = number_list("1 2 x", Precision::F64, &loc(), "points").unwrap_err();
+        assert_eq!(e.to_string(), "t.svg:3: rect: points: expected a number, found \"x\"");
+        assert!(number_list("1e999", Precision::F64, &loc(), "points").is_err());
+    }
+
+    /// Closed form: composite transforms apply right to left to points.
+    #[test]
+    fn transform_lists_compose_in_document_order() {
+        let m = parse_transform("translate(10 20) scale(2)", Precision::F64, &loc(), false).unwrap();
+        assert_eq!(m.apply(DVec2::new(1.0, 1.0)), DVec2::new(12.0, 22.0));
+        let m = parse_transform("scale(2)", Precision::F64, &loc(), true).unwrap();
+        assert_eq!(m.apply(DVec2::new(1.0, 1.0)), DVec2::new(2.0, 1.0));
+        let m = parse_transform("rotate(90 10 10)", Precision::F64, &loc(), false).unwrap();
+        let p = m.apply(DVec2::new(20.0, 10.0));
+        assert!((p - DVec2::new(10.0, 20.0)).length() < 1e-12);
+        let m = parse_transform("matrix(1,0,0,1,5,6)", Precision::F64, &loc(), false).unwrap();
+        assert_eq!(m.apply(DVec2::ZERO), DVec2::new(5.0, 6.0));
+        assert!(parse_transform("spin(3)", Precision::F64, &loc(), false).is_err());
+        assert!(parse_transform("translate(1", Precision::F64, &loc(), false).is_err());
+    }
+}

@@ -1,0 +1,325 @@
+//! The CS184 HW1 dialect (`--compat cs184`), read as the course renderer reads it: only
+//! `width`/`height` of the root, no style inheritance, hex colours with anything else black,
+//! numbers rounded to `f32`, `scale(s)` meaning `scale(s, 1)`, filled shapes triangulated by
+//! ear clipping, outlines as one-pixel DDA lines, and unknown elements skipped.
+
+use std::collections::HashMap;
+
+use prism_math::{DVec2, Rgb, Vec2};
+use roxmltree::Node;
+
+use super::common::{number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS};
+use super::{element_loc, load_texture, Ctx};
+use crate::document::{Document, Item, Mat3};
+
+const P: Precision = Precision::F32;
+
+/// The course's `Color::fromHex`: an optional `#`, then the longest hex prefix as one
+/// integer; no digits (e.g. `none`) is black.
+pub(crate) fn hex_color(s: &str) -> Rgb {
+    let t = s.trim();
+    let t = t.strip_prefix('#').unwrap_or(t);
+    let digits: String = t.chars().take_while(char::is_ascii_hexdigit).collect();
+    let v = u32::from_str_radix(&digits, 16).unwrap_or(0);
+    let ch = |shift: u32| (f64::from((v >> shift) & 0xff) / 255.0) as f32;
+    Rgb::new(ch(16), ch(8), ch(0))
+}
+
+/// Ear-clipping triangulation as the course renderer performs it (in `f32`): the vertex
+/// order is made counter-clockwise by the shoelace sign, the first candidate ear is
+/// (last, first, second), and scanning resumes after a clipped ear. Returns triangles as
+/// vertex triples; a polygon that cannot be fully clipped yields the triangles found so far.
+#[must_use]
+pub fn ear_clip(pts: &[DVec2]) -> Vec<[DVec2; 3]> {
+    let n = pts.len();
+    let mut out = Vec::new();
+    if n < 3 {
+        return out;
+    }
+    let f = |p: DVec2| Vec2::new(p.x as f32, p.y as f32);
+    let mut area = 0f32;
+    let mut p = n - 1;
+    for q in 0..n {
+        area = (f64::from(area) + (pts[p].x * pts[q].y - pts[q].x * pts[p].y)) as f32;
+        p = q;
+    }
+    let area = area * 0.5;
+    let mut v: Vec<usize> = if area > 0.0 { (0..n).collect() } else { (0..n).rev().collect() };
+    let cross = |u: Vec2, w: Vec2| u.x * w.y - u.y * w.x;
+    let inside = |a: Vec2, b: Vec2, c: Vec2, p: Vec2| {
+        cross(c - b, p - b) >= 0.0 && cross(b - a, p - a) >= 0.0 && cross(a - c, p - c) >= 0.0
+    };
+    let mut nv = n;
+    let mut count = 2 * nv;
+    let mut vi = nv - 1;
+    while nv > 2 {
+        if count == 0 {
+            break;
+        }
+        count -= 1;
+        let mut u = vi;
+        if u >= nv {
+            u = 0;
+        }
+        vi = u + 1;
+        if vi >= nv {
+            vi = 0;
+        }
+        let mut w = vi + 1;
+        if w >= nv {
+            w = 0;
+        }
+        let (a, b, c) = (f(pts[v[u]]), f(pts[v[vi]]), f(pts[v[w]]));
+        let convex = 1e-10f32 <= (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+        let ear = convex
+            && (0..nv)
+                .filter(|&k| k != u && k != vi && k != w)
+                .all(|k| !inside(a, b, c, f(pts[v[k]])));
+        if ear {
+            out.push([pts[v[u]], pts[v[vi]], pts[v[w]]]);
+            v.remove(vi);
+            nv -= 1;
+            count = 2 * nv;
+        }
+    }
+    out
+}
+
+fn num_attr(node: &Node, name: &str, loc: &Loc) -> Result<f64, SvgError> {
+    match node.attribute(name) {
+        None => Ok(0.0),
+        Some(s) => Ok(number_with_unit(s, P, loc, name)?.0),
+    }
+}
+
+fn points_attr(node: &Node, name: &str, loc: &Loc) -> Result<Vec<DVec2>, SvgError> {
+    let l = number_list(node.attribute(name).unwrap_or(""), P, loc, name)?;
+    if l.len() % 2 != 0 {
+        return Err(loc.err(format!("{name}: expected x,y pairs, found {} numbers", l.len())));
+    }
+    Ok(l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect())
+}
+
+fn exact_points<const N: usize>(node: &Node, name: &str, loc: &Loc) -> Result<[DVec2; N], SvgError> {
+    let p = points_attr(node, name, loc)?;
+    p.try_into()
+        .map_err(|p: Vec<DVec2>| loc.err(format!("{name}: expected {N} points, found {}", p.len())))
+}
+
+pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
+    let loc = element_loc(ctx, &root);
+    let size = |name: &str| -> Result<f64, SvgError> {
+        let s = root
+            .attribute(name)
+            .ok_or_else(|| loc.err(format!("expected a {name} attribute on the root svg")))?;
+        let v = number_with_unit(s, P, &loc, name)?.0;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(loc.err(format!("{name}: expected a positive size, found {s:?}")))
+        }
+    };
+    let mut doc = Document {
+        width: size("width")?,
+        height: size("height")?,
+        ..Document::default()
+    };
+    let mut textures = HashMap::new();
+    walk(root, Mat3::IDENTITY, 0, ctx, &mut doc, &mut textures)?;
+    Ok(doc)
+}
+
+fn walk<'a>(
+    parent: Node<'a, 'a>,
+    ctm: Mat3,
+    depth: usize,
+    ctx: &mut Ctx<'a>,
+    doc: &mut Document,
+    textures: &mut HashMap<String, usize>,
+) -> Result<(), SvgError> {
+    for node in parent.children().filter(Node::is_element) {
+        let loc = element_loc(ctx, &node);
+        if depth >= MAX_DEPTH {
+            return Err(loc.err(format!("elements nest deeper than the limit of {MAX_DEPTH}")));
+        }
+        if doc.items.len() > MAX_ITEMS {
+            return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
+        }
+        let name = node.tag_name().name();
+        let t = match node.attribute("transform") {
+            Some(s) => ctm.mul(&parse_transform(s, P, &loc, true)?),
+            None => ctm,
+        };
+        let fill = node.attribute("fill").map_or(Rgb::BLACK, hex_color);
+        let stroke = node.attribute("stroke").map(hex_color);
+        match name {
+            "g" => walk(node, t, depth + 1, ctx, doc, textures)?,
+            "rect" => {
+                let (x, y) = (num_attr(&node, "x", &loc)? as f32, num_attr(&node, "y", &loc)? as f32);
+                let (w, h) = (num_attr(&node, "width", &loc)? as f32, num_attr(&node, "height", &loc)? as f32);
+                if w == 0.0 && h == 0.0 {
+                    doc.items.push(Item::Point {
+                        at: DVec2::new(f64::from(x), f64::from(y)),
+                        transform: t,
+                        color: fill,
+                    });
+                    continue;
+                }
+                let p = |a: f32, b: f32| DVec2::new(f64::from(a), f64::from(b));
+                let (p0, p1, p2, p3) = (p(x, y), p(x + w, y), p(x, y + h), p(x + w, y + h));
+                doc.items.push(Item::Triangles {
+                    tris: vec![[p0, p1, p2], [p2, p1, p3]],
+                    transform: t,
+                    color: fill,
+                });
+                if let Some(c) = stroke {
+                    doc.items.push(Item::Hairline {
+                        points: vec![p0, p1, p3, p2],
+                        closed: true,
+                        transform: t,
+                        color: c,
+                    });
+                }
+            }
+            "line" => {
+                let a = DVec2::new(num_attr(&node, "x1", &loc)?, num_attr(&node, "y1", &loc)?);
+                let b = DVec2::new(num_attr(&node, "x2", &loc)?, num_attr(&node, "y2", &loc)?);
+                if let Some(c) = stroke {
+                    doc.items.push(Item::Hairline {
+                        points: vec![a, b],
+                        closed: false,
+                        transform: t,
+                        color: c,
+                    });
+                }
+            }
+            "polyline" => {
+                let pts = points_attr(&node, "points", &loc)?;
+                doc.items.push(Item::Hairline {
+                    points: pts,
+                    closed: false,
+                    transform: t,
+                    color: stroke.unwrap_or(Rgb::BLACK),
+                });
+            }
+            "polygon" => {
+                let pts = points_attr(&node, "points", &loc)?;
+                doc.items.push(Item::Triangles {
+                    tris: ear_clip(&pts),
+                    transform: t,
+                    color: fill,
+                });
+                if let Some(c) = stroke {
+                    doc.items.push(Item::Hairline {
+                        points: pts,
+                        closed: true,
+                        transform: t,
+                        color: c,
+                    });
+                }
+            }
+            "colortri" => {
+                let points = exact_points::<3>(&node, "points", &loc)?;
+                let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
+                if c.len() != 12 {
+                    return Err(loc.err(format!("colors: expected 12 numbers (r g b a per vertex), found {}", c.len())));
+                }
+                let col = |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
+                doc.items.push(Item::ColorTri {
+                    points,
+                    colors: [col(0), col(1), col(2)],
+                    transform: t,
+                });
+            }
+            "texture" => {
+                let id = node
+                    .attribute("texid")
+                    .ok_or_else(|| loc.err("expected a texid attribute"))?;
+                let file = node
+                    .attribute("filename")
+                    .ok_or_else(|| loc.err("expected a filename attribute"))?;
+                let idx = load_texture(ctx, doc, file, &loc)?;
+                textures.insert(id.to_string(), idx);
+            }
+            "textri" => {
+                let points = exact_points::<3>(&node, "points", &loc)?;
+                let uv = exact_points::<3>(&node, "uvs", &loc)?;
+                let id = node.attribute("texid").unwrap_or("");
+                let texture = *textures
+                    .get(id)
+                    .ok_or_else(|| loc.err(format!("texid {id:?}: expected the id of an earlier <texture>")))?;
+                let f = |p: DVec2| Vec2::new(p.x as f32, p.y as f32);
+                doc.items.push(Item::TexTri {
+                    points,
+                    uvs: [f(uv[0]), f(uv[1]), f(uv[2])],
+                    texture,
+                    transform: t,
+                });
+            }
+            "image" => {
+                if let Some(item) = super::image_item(&node, t, ctx, doc, &loc, P)? {
+                    doc.items.push(item);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hex_colors_as_the_course_reads_them() {
+        assert_eq!(hex_color("#ff0000"), Rgb::new(1.0, 0.0, 0.0));
+        assert_eq!(hex_color("000000"), Rgb::BLACK);
+        assert_eq!(hex_color("none"), Rgb::BLACK);
+        // "#f00" is the integer 0xf00, not red.
+        assert_eq!(hex_color("#f00"), Rgb::new(0.0, 15.0 / 255.0, 0.0));
+        for k in 0..=255u32 {
+            let c = hex_color(&format!("#{k:02x}0000"));
+            assert_eq!((c.r * 255.0) as u32, k, "truncation must round-trip");
+        }
+    }
+
+    /// Worked example from the course's triangulator: a counter-clockwise square.
+    #[test]
+    fn ear_clip_square_matches_course_order() {
+        let sq = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(10.0, 0.0),
+            DVec2::new(10.0, 10.0),
+            DVec2::new(0.0, 10.0),
+        ];
+        let t = ear_clip(&sq);
+        assert_eq!(t, vec![[sq[3], sq[0], sq[1]], [sq[1], sq[2], sq[3]]]);
+    }
+
+    /// Property: a simple polygon with n vertices gives n - 2 triangles whose areas sum to
+    /// the polygon's area, concave or not, either orientation.
+    #[test]
+    fn ear_clip_preserves_area() {
+        let star: Vec<DVec2> = (0..10)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 10.0;
+                let r = if i % 2 == 0 { 10.0 } else { 4.0 };
+                DVec2::new(r * a.cos(), r * a.sin())
+            })
+            .collect();
+        let area = |p: &[DVec2]| {
+            (0..p.len())
+                .map(|i| p[i].perp_dot(p[(i + 1) % p.len()]))
+                .sum::<f64>()
+                .abs()
+                / 2.0
+        };
+        for poly in [star.clone(), star.iter().rev().copied().collect()] {
+            let tris = ear_clip(&poly);
+            assert_eq!(tris.len(), 8);
+            let sum: f64 = tris.iter().map(|t| area(t)).sum();
+            assert!((sum - area(&poly)).abs() < 1e-6 * area(&poly));
+        }
+    }
+}

@@ -1,0 +1,209 @@
+//! SVG readers: the standard dialect ([`Dialect::Svg`]) and the course's
+//! ([`Dialect::Cs184`]), both producing a [`Document`].
+
+mod color;
+pub(crate) mod common;
+pub(crate) mod cs184;
+mod pathdata;
+mod svg;
+
+use std::path::{Path as FsPath, PathBuf};
+use std::sync::Arc;
+
+use base64::Engine;
+use prism_image::Texture;
+use roxmltree::Node;
+
+pub use common::{SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_ITEMS};
+use common::{number_with_unit, Loc, Precision};
+pub use cs184::ear_clip;
+pub use pathdata::parse_path_data;
+
+use crate::document::{Document, Item, Mat3};
+
+/// Which reading of SVG to apply.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Dialect {
+    /// The SVG 1.1/2 specification's reading (what resvg and browsers do).
+    #[default]
+    Svg,
+    /// The CS184 course renderer's reading, quirks included (see `FORMATS.md` section 1).
+    Cs184,
+}
+
+/// Where a document came from, for resolving relative files and naming errors.
+#[derive(Clone, Debug, Default)]
+pub struct Source {
+    /// The name used in error messages (usually the file path).
+    pub name: String,
+    /// The directory relative file references are resolved against.
+    pub base_dir: PathBuf,
+}
+
+pub(crate) struct Ctx<'a> {
+    pub source: &'a Source,
+    pub xml: &'a roxmltree::Document<'a>,
+    pub warned: std::collections::BTreeSet<String>,
+}
+
+impl Ctx<'_> {
+    pub fn warn_once(&mut self, doc: &mut Document, key: &str, message: String) {
+        if self.warned.insert(key.to_string()) {
+            doc.warnings.push(message);
+        }
+    }
+}
+
+pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> Loc<'a> {
+    let source: &'a Source = ctx.source;
+    Loc {
+        file: &source.name,
+        line: ctx.xml.text_pos_at(node.range().start).row,
+        element: node.tag_name().name(),
+    }
+}
+
+/// Decodes an image file or `data:` URI into a texture and registers it.
+pub(crate) fn load_texture(ctx: &Ctx, doc: &mut Document, href: &str, loc: &Loc) -> Result<usize, SvgError> {
+    let rgba = if let Some(data) = href.trim().strip_prefix("data:") {
+        let comma = data
+            .find(',')
+            .ok_or_else(|| loc.err("href: expected a data URI with a ',' before its payload"))?;
+        let meta = &data[..comma];
+        if !meta.ends_with(";base64") {
+            return Err(loc.err("href: expected a base64 data URI"));
+        }
+        let payload: String = data[comma + 1..].chars().filter(|c| !c.is_whitespace()).collect();
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(payload.as_bytes())
+            .map_err(|e| loc.err(format!("href: invalid base64 image data: {e}")))?;
+        let what = format!("{}:{}: embedded image", loc.file, loc.line);
+        if bytes.starts_with(&[0xff, 0xd8]) {
+            prism_image::decode_jpeg(&bytes, &what)
+        } else {
+            prism_image::decode_png(&bytes, &what)
+        }
+        .map_err(|e| loc.err(e.to_string()))?
+    } else {
+        let path: PathBuf = ctx.source.base_dir.join(FsPath::new(href));
+        prism_image::read_image(&path).map_err(|e| loc.err(format!("texture {href:?}: {e}")))?
+    };
+    let rgb = rgba.to_rgb8().to_rgb_f32();
+    doc.textures.push(Arc::new(Texture::new(rgb)));
+    Ok(doc.textures.len() - 1)
+}
+
+/// An `<image>` element as an [`Item::Image`]; `None` when it has no size.
+pub(crate) fn image_item(
+    node: &Node,
+    transform: Mat3,
+    ctx: &Ctx,
+    doc: &mut Document,
+    loc: &Loc,
+    p: Precision,
+) -> Result<Option<Item>, SvgError> {
+    let href = node
+        .attribute(("http://www.w3.org/1999/xlink", "href"))
+        .or_else(|| node.attribute("href"))
+        .ok_or_else(|| loc.err("expected an xlink:href attribute"))?;
+    let num = |name: &str| -> Result<Option<f64>, SvgError> {
+        node.attribute(name)
+            .map(|s| number_with_unit(s, p, loc, name).map(|v| v.0))
+            .transpose()
+    };
+    let texture = load_texture(ctx, doc, href, loc)?;
+    let (tw, th) = doc.textures[texture].size();
+    let (x, y) = (num("x")?.unwrap_or(0.0), num("y")?.unwrap_or(0.0));
+    let (mut w, mut h) = (num("width")?, num("height")?);
+    // A missing dimension follows the image's aspect ratio.
+    match (w, h) {
+        (None, None) => (w, h) = (Some(f64::from(tw)), Some(f64::from(th))),
+        (Some(w0), None) => h = Some(w0 * f64::from(th) / f64::from(tw)),
+        (None, Some(h0)) => w = Some(h0 * f64::from(tw) / f64::from(th)),
+        _ => {}
+    }
+    let (w, h) = (w.unwrap_or(0.0), h.unwrap_or(0.0));
+    if w <= 0.0 || h <= 0.0 {
+        return Ok(None);
+    }
+    // preserveAspectRatio: default xMidYMid meet; "none" stretches.
+    let par = node.attribute("preserveAspectRatio").unwrap_or("xMidYMid meet");
+    let rect = if par.trim() == "none" {
+        [x, y, w, h]
+    } else {
+        let s = (w / f64::from(tw)).min(h / f64::from(th));
+        let (iw, ih) = (f64::from(tw) * s, f64::from(th) * s);
+        [x + (w - iw) / 2.0, y + (h - ih) / 2.0, iw, ih]
+    };
+    Ok(Some(Item::Image {
+        texture,
+        rect,
+        transform,
+        opacity: 1.0,
+    }))
+}
+
+/// Parses SVG text in the given dialect.
+///
+/// # Errors
+/// [`SvgError`] naming the file, line and element: malformed XML, a root that is not
+/// `<svg>`, bad numbers, colours or path data, non-finite coordinates, a missing or corrupt
+/// texture, or a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_FILE_BYTES`],
+/// [`MAX_ITEMS`]).
+pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Document, SvgError> {
+    let top = |line: u32, message: String| SvgError {
+        file: source.name.clone(),
+        line,
+        element: "xml".into(),
+        message,
+    };
+    if text.len() > MAX_FILE_BYTES {
+        return Err(top(0, format!("file is larger than the limit of {MAX_FILE_BYTES} bytes")));
+    }
+    let opts = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        nodes_limit: 50_000_000,
+    };
+    let xml = roxmltree::Document::parse_with_options(text, opts)
+        .map_err(|e| top(e.pos().row, format!("malformed XML: {e}")))?;
+    let root = xml.root_element();
+    let mut ctx = Ctx {
+        source,
+        xml: &xml,
+        warned: Default::default(),
+    };
+    if root.tag_name().name() != "svg" {
+        let loc = element_loc(&ctx, &root);
+        return Err(loc.err("expected the root element to be <svg>"));
+    }
+    match dialect {
+        Dialect::Cs184 => cs184::parse(root, &mut ctx),
+        Dialect::Svg => svg::parse(root, &mut ctx),
+    }
+}
+
+/// Reads and parses an SVG file; relative references resolve against its directory.
+///
+/// # Errors
+/// As [`parse_svg`], plus an unreadable or non-UTF-8 file.
+pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
+    let name = path.display().to_string();
+    let err = |message: String| SvgError {
+        file: name.clone(),
+        line: 0,
+        element: "file".into(),
+        message,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
+    if meta.len() > MAX_FILE_BYTES as u64 {
+        return Err(err(format!("file is larger than the limit of {MAX_FILE_BYTES} bytes")));
+    }
+    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+    let text = String::from_utf8(bytes).map_err(|e| err(format!("expected UTF-8 text: {e}")))?;
+    let base_dir = path
+        .parent()
+        .map(FsPath::to_path_buf)
+        .unwrap_or_default();
+    let source = Source { name, base_dir };
+    parse_svg(&text, dialect, &source)
+}

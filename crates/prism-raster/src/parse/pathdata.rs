@@ -1,0 +1,210 @@
+//! The SVG path-data mini-language (`d` attribute), all commands, arcs included.
+
+use prism_math::DVec2;
+
+use super::common::{number_prefix_len, to_num, Precision};
+use crate::path::Path;
+
+struct Cursor<'a> {
+    s: &'a str,
+    pos: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn skip_ws(&mut self) {
+        let b = self.s.as_bytes();
+        while self.pos < b.len() && (b[self.pos] as char).is_ascii_whitespace() {
+            self.pos += 1;
+        }
+    }
+    fn skip_sep(&mut self) {
+        self.skip_ws();
+        if self.s.as_bytes().get(self.pos) == Some(&b',') {
+            self.pos += 1;
+            self.skip_ws();
+        }
+    }
+    fn at_number(&mut self) -> bool {
+        self.skip_ws();
+        matches!(self.s.as_bytes().get(self.pos), Some(c) if c.is_ascii_digit() || matches!(c, b'-' | b'+' | b'.'))
+    }
+    fn number(&mut self) -> Result<f64, String> {
+        self.skip_ws();
+        let rest = &self.s[self.pos..];
+        let n = number_prefix_len(rest);
+        if n == 0 {
+            return Err(format!("expected a number at offset {}", self.pos));
+        }
+        let v = to_num(&rest[..n], Precision::F64)
+            .ok_or_else(|| format!("number {:?} at offset {} is not finite", &rest[..n], self.pos))?;
+        self.pos += n;
+        self.skip_sep();
+        Ok(v)
+    }
+    fn flag(&mut self) -> Result<bool, String> {
+        self.skip_ws();
+        let v = match self.s.as_bytes().get(self.pos) {
+            Some(b'0') => false,
+            Some(b'1') => true,
+            _ => return Err(format!("expected an arc flag 0 or 1 at offset {}", self.pos)),
+        };
+        self.pos += 1;
+        self.skip_sep();
+        Ok(v)
+    }
+    fn point(&mut self) -> Result<DVec2, String> {
+        Ok(DVec2::new(self.number()?, self.number()?))
+    }
+}
+
+/// Parses SVG path data into a [`Path`] (quadratics as exact cubics, arcs as cubics).
+///
+/// # Errors
+/// A message with the byte offset of the first malformed token; the SVG spec's "render up to
+/// the error" is not applied, so bad data is reported rather than silently truncated.
+pub fn parse_path_data(d: &str) -> Result<Path, String> {
+    let mut c = Cursor { s: d, pos: 0 };
+    let mut path = Path::default();
+    let mut cur = DVec2::ZERO;
+    let mut start = DVec2::ZERO;
+    // Reflection points for S/s and T/t.
+    let mut last_cubic_ctrl: Option<DVec2> = None;
+    let mut last_quad_ctrl: Option<DVec2> = None;
+    let mut cmd: Option<u8> = None;
+    loop {
+        c.skip_ws();
+        let Some(&b) = c.s.as_bytes().get(c.pos) else { break };
+        if b.is_ascii_alphabetic() {
+            c.pos += 1;
+            cmd = Some(b);
+        } else if cmd.is_none() {
+            return Err(format!("expected a command letter at offset {}", c.pos));
+        } else if !c.at_number() {
+            return Err(format!("unexpected {:?} at offset {}", b as char, c.pos));
+        }
+        let k = cmd.expect("set above");
+        let rel = k.is_ascii_lowercase();
+        let base = if rel { cur } else { DVec2::ZERO };
+        let mut cubic_ctrl = None;
+        let mut quad_ctrl = None;
+        match k.to_ascii_uppercase() {
+            b'M' => {
+                cur = base + c.point()?;
+                start = cur;
+                path.move_to(cur);
+                // Further pairs are implicit line-tos.
+                cmd = Some(if rel { b'l' } else { b'L' });
+            }
+            b'L' => {
+                cur = base + c.point()?;
+                path.line_to(cur);
+            }
+            b'H' => {
+                let x = c.number()?;
+                cur = DVec2::new(if rel { cur.x + x } else { x }, cur.y);
+                path.line_to(cur);
+            }
+            b'V' => {
+                let y = c.number()?;
+                cur = DVec2::new(cur.x, if rel { cur.y + y } else { y });
+                path.line_to(cur);
+            }
+            b'C' => {
+                let (c1, c2, p) = (base + c.point()?, base + c.point()?, base + c.point()?);
+                path.cubic_to(c1, c2, p);
+                cubic_ctrl = Some(c2);
+                cur = p;
+            }
+            b'S' => {
+                let c1 = last_cubic_ctrl.map_or(cur, |q| 2.0 * cur - q);
+                let (c2, p) = (base + c.point()?, base + c.point()?);
+                path.cubic_to(c1, c2, p);
+                cubic_ctrl = Some(c2);
+                cur = p;
+            }
+            b'Q' => {
+                let (q, p) = (base + c.point()?, base + c.point()?);
+                path.quad_to(cur, q, p);
+                quad_ctrl = Some(q);
+                cur = p;
+            }
+            b'T' => {
+                let q = last_quad_ctrl.map_or(cur, |q| 2.0 * cur - q);
+                let p = base + c.point()?;
+                path.quad_to(cur, q, p);
+                quad_ctrl = Some(q);
+                cur = p;
+            }
+            b'A' => {
+                let (rx, ry, rot) = (c.number()?, c.number()?, c.number()?);
+                let (large, sweep) = (c.flag()?, c.flag()?);
+                let p = base + c.point()?;
+                path.arc_to(cur, rx, ry, rot, large, sweep, p);
+                cur = p;
+            }
+            b'Z' => {
+                path.close();
+                cur = start;
+                // A command letter must follow.
+                c.skip_ws();
+                if c.at_number() {
+                    return Err(format!("expected a command after Z at offset {}", c.pos));
+                }
+            }
+            other => {
+                return Err(format!(
+                    "unknown path command {:?} at offset {}",
+                    other as char,
+                    c.pos - 1
+                ))
+            }
+        }
+        last_cubic_ctrl = cubic_ctrl;
+        last_quad_ctrl = quad_ctrl;
+    }
+    if let Some(crate::path::Segment::MoveTo(_)) | None = path.segments.first() {
+        Ok(path)
+    } else {
+        Err("path data must begin with a moveto".to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::Segment;
+
+    #[test]
+    fn implicit_commands_and_relative_forms() {
+        let p = parse_path_data("m10 10 20 0 0 20z h5 v-5 H0").unwrap();
+        let s = &p.segments;
+        assert_eq!(s[0], Segment::MoveTo(DVec2::new(10.0, 10.0)));
+        assert_eq!(s[1], Segment::LineTo(DVec2::new(30.0, 10.0)));
+        assert_eq!(s[2], Segment::LineTo(DVec2::new(30.0, 30.0)));
+        assert_eq!(s[3], Segment::Close);
+        assert_eq!(s[4], Segment::LineTo(DVec2::new(15.0, 10.0)));
+        assert_eq!(s[5], Segment::LineTo(DVec2::new(15.0, 5.0)));
+        assert_eq!(s[6], Segment::LineTo(DVec2::new(0.0, 5.0)));
+    }
+
+    #[test]
+    fn smooth_curves_reflect_control_points() {
+        let p = parse_path_data("M0,0 C0,10 10,10 10,0 S20,-10 20,0").unwrap();
+        match p.segments[2] {
+            Segment::CubicTo(c1, _, _) => assert_eq!(c1, DVec2::new(10.0, -10.0)),
+            ref s => panic!("{s:?}"),
+        }
+        // Compact arc flags: "a1 1 0 1,0 400,0" and "a5,5 0 0110,0".
+        assert!(parse_path_data("M0 0 a200,200 0 1,0 400,0 a5,5 0 0110,0").is_ok());
+    }
+
+    #[test]
+    fn errors_name_offsets() {
+        assert!(parse_path_data("L1 1").is_err());
+        assert_eq!(parse_path_data("M0 0 L1 x").unwrap_err(), "expected a number at offset 8");
+        assert!(parse_path_data("M0 0 A1 1 0 2 0 3 3").is_err());
+        assert!(parse_path_data("M0 0 L1e999 0").is_err());
+        assert!(parse_path_data("M0 0 K1").is_err());
+        assert!(parse_path_data("").unwrap().segments.is_empty());
+    }
+}

@@ -1,0 +1,751 @@
+//! The standard SVG dialect: presentation attributes and `style` declarations with
+//! inheritance, units, `viewBox` with `preserveAspectRatio`, basic shapes, paths, images,
+//! `use`, linear and radial gradients, and group opacity as offscreen layers.
+//!
+//! Not drawn (a warning is recorded once per kind): text, filters, clipping paths, masks,
+//! markers and patterns. Elements of foreign namespaces (editor metadata) are skipped
+//! silently.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use prism_math::{DVec2, Rgb, Vec2};
+use roxmltree::Node;
+
+use super::color::parse_color;
+use super::common::{number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS};
+use super::pathdata::parse_path_data;
+use super::{element_loc, image_item, load_texture, Ctx};
+use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+use crate::path::{LineCap, LineJoin, Path, StrokeStyle};
+
+const P: Precision = Precision::F64;
+const SVG_NS: &str = "http://www.w3.org/2000/svg";
+const XLINK_NS: &str = "http://www.w3.org/1999/xlink";
+
+#[derive(Clone, Debug)]
+enum PaintSpec {
+    None,
+    Color(Rgb, f32),
+    CurrentColor,
+    Url(String, Option<Box<PaintSpec>>),
+}
+
+#[derive(Clone, Debug)]
+struct Style {
+    fill: PaintSpec,
+    fill_opacity: f32,
+    fill_rule: FillRule,
+    stroke_paint: PaintSpec,
+    stroke_opacity: f32,
+    stroke: StrokeStyle,
+    color: Rgb,
+    visible: bool,
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Style {
+            fill: PaintSpec::Color(Rgb::BLACK, 1.0),
+            fill_opacity: 1.0,
+            fill_rule: FillRule::NonZero,
+            stroke_paint: PaintSpec::None,
+            stroke_opacity: 1.0,
+            stroke: StrokeStyle::default(),
+            color: Rgb::BLACK,
+            visible: true,
+        }
+    }
+}
+
+/// Viewport size used to resolve percentages.
+#[derive(Clone, Copy)]
+struct Viewport {
+    w: f64,
+    h: f64,
+}
+
+impl Viewport {
+    fn diag(&self) -> f64 {
+        ((self.w * self.w + self.h * self.h) / 2.0).sqrt()
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Axis {
+    X,
+    Y,
+    Diag,
+}
+
+fn length(s: &str, loc: &Loc, attr: &str, vp: Viewport, axis: Axis) -> Result<f64, SvgError> {
+    let (v, unit) = number_with_unit(s, P, loc, attr)?;
+    let k = match unit {
+        "" | "px" => 1.0,
+        "pt" => 4.0 / 3.0,
+        "pc" => 16.0,
+        "mm" => 96.0 / 25.4,
+        "cm" => 96.0 / 2.54,
+        "in" => 96.0,
+        "em" => 16.0,
+        "ex" => 8.0,
+        "%" => {
+            let base = match axis {
+                Axis::X => vp.w,
+                Axis::Y => vp.h,
+                Axis::Diag => vp.diag(),
+            };
+            base / 100.0
+        }
+        other => return Err(loc.err(format!("{attr}: unknown unit {other:?} in {s:?}"))),
+    };
+    Ok(v * k)
+}
+
+fn parse_paint(s: &str, loc: &Loc, attr: &str) -> Result<PaintSpec, SvgError> {
+    let t = s.trim();
+    if t == "none" {
+        return Ok(PaintSpec::None);
+    }
+    if t == "currentColor" {
+        return Ok(PaintSpec::CurrentColor);
+    }
+    if let Some(rest) = t.strip_prefix("url(") {
+        let close = rest
+            .find(')')
+            .ok_or_else(|| loc.err(format!("{attr}: expected ')' in {t:?}")))?;
+        let id = rest[..close].trim().trim_matches(|c| c == '\'' || c == '"');
+        let id = id.strip_prefix('#').unwrap_or(id).to_string();
+        let fallback = rest[close + 1..].trim();
+        let fb = if fallback.is_empty() {
+            None
+        } else {
+            Some(Box::new(parse_paint(fallback, loc, attr)?))
+        };
+        return Ok(PaintSpec::Url(id, fb));
+    }
+    parse_color(t)
+        .map(|(c, a)| PaintSpec::Color(c, a))
+        .ok_or_else(|| loc.err(format!("{attr}: expected a colour, 'none' or url(#id), found {t:?}")))
+}
+
+fn opacity_value(s: &str, loc: &Loc, attr: &str) -> Result<f32, SvgError> {
+    let (v, unit) = number_with_unit(s, P, loc, attr)?;
+    let v = match unit {
+        "" => v,
+        "%" => v / 100.0,
+        _ => return Err(loc.err(format!("{attr}: expected a number in [0, 1], found {s:?}"))),
+    };
+    Ok(v.clamp(0.0, 1.0) as f32)
+}
+
+/// The element's own declarations: presentation attributes, overridden by `style`.
+fn declarations<'a>(node: &Node<'a, 'a>) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = node
+        .attributes()
+        .filter(|a| a.namespace().is_none())
+        .map(|a| (a.name().to_string(), a.value().to_string()))
+        .collect();
+    if let Some(style) = node.attribute("style") {
+        for decl in style.split(';') {
+            if let Some((k, v)) = decl.split_once(':') {
+                let v = v.trim().trim_end_matches("!important").trim();
+                out.push((k.trim().to_string(), v.to_string()));
+            }
+        }
+    }
+    out
+}
+
+struct Parser<'c, 'a> {
+    ctx: &'c mut Ctx<'a>,
+    doc: Document,
+    ids: HashMap<&'a str, Node<'a, 'a>>,
+    textures: HashMap<String, usize>,
+}
+
+/// Properties this reader resolves; anything else in `style` is ignored.
+fn apply_declarations(
+    style: &mut Style,
+    decls: &[(String, String)],
+    loc: &Loc,
+    vp: Viewport,
+) -> Result<(f32, bool), SvgError> {
+    let mut opacity = 1.0;
+    let mut display = true;
+    for (k, v) in decls {
+        let v = v.as_str();
+        if v.trim() == "inherit" {
+            continue;
+        }
+        match k.as_str() {
+            "fill" => style.fill = parse_paint(v, loc, k)?,
+            "stroke" => style.stroke_paint = parse_paint(v, loc, k)?,
+            "color" => {
+                if let Some((c, _)) = parse_color(v) {
+                    style.color = c;
+                }
+            }
+            "fill-opacity" => style.fill_opacity = opacity_value(v, loc, k)?,
+            "stroke-opacity" => style.stroke_opacity = opacity_value(v, loc, k)?,
+            "opacity" => opacity = opacity_value(v, loc, k)?,
+            "fill-rule" => {
+                style.fill_rule = match v.trim() {
+                    "evenodd" => FillRule::EvenOdd,
+                    "nonzero" => FillRule::NonZero,
+                    other => return Err(loc.err(format!("fill-rule: expected nonzero or evenodd, found {other:?}"))),
+                }
+            }
+            "stroke-width" => {
+                let w = length(v, loc, k, vp, Axis::Diag)?;
+                if w < 0.0 {
+                    return Err(loc.err(format!("stroke-width: expected a non-negative length, found {v:?}")));
+                }
+                style.stroke.width = w;
+            }
+            "stroke-linejoin" => {
+                style.stroke.join = match v.trim() {
+                    "miter" | "miter-clip" | "arcs" => LineJoin::Miter,
+                    "round" => LineJoin::Round,
+                    "bevel" => LineJoin::Bevel,
+                    other => return Err(loc.err(format!("stroke-linejoin: expected miter, round or bevel, found {other:?}"))),
+                }
+            }
+            "stroke-linecap" => {
+                style.stroke.cap = match v.trim() {
+                    "butt" => LineCap::Butt,
+                    "round" => LineCap::Round,
+                    "square" => LineCap::Square,
+                    other => return Err(loc.err(format!("stroke-linecap: expected butt, round or square, found {other:?}"))),
+                }
+            }
+            "stroke-miterlimit" => {
+                let m = number_with_unit(v, P, loc, k)?.0;
+                if m < 1.0 {
+                    return Err(loc.err(format!("stroke-miterlimit: expected a number >= 1, found {v:?}")));
+                }
+                style.stroke.miter_limit = m;
+            }
+            "stroke-dasharray" => {
+                if v.trim() == "none" {
+                    style.stroke.dashes.clear();
+                } else {
+                    let mut d = Vec::new();
+                    for part in v.split(|c: char| c == ',' || c.is_whitespace()).filter(|p| !p.is_empty()) {
+                        d.push(length(part, loc, k, vp, Axis::Diag)?);
+                    }
+                    if d.iter().any(|x| *x < 0.0) {
+                        return Err(loc.err("stroke-dasharray: expected non-negative lengths"));
+                    }
+                    if d.len() % 2 == 1 {
+                        let copy = d.clone();
+                        d.extend(copy);
+                    }
+                    style.stroke.dashes = d;
+                }
+            }
+            "stroke-dashoffset" => style.stroke.dash_offset = length(v, loc, k, vp, Axis::Diag)?,
+            "visibility" => style.visible = v.trim() == "visible",
+            "display" => display = v.trim() != "none",
+            _ => {}
+        }
+    }
+    Ok((opacity, display))
+}
+
+fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<Mat3>, SvgError> {
+    let Some(vb) = node.attribute("viewBox") else {
+        return Ok(None);
+    };
+    let v = number_list(vb, P, loc, "viewBox")?;
+    if v.len() != 4 || v[2] <= 0.0 || v[3] <= 0.0 {
+        return Err(loc.err(format!("viewBox: expected min-x min-y width height with positive size, found {vb:?}")));
+    }
+    let par = node.attribute("preserveAspectRatio").unwrap_or("xMidYMid meet");
+    let mut words = par.split_whitespace();
+    let align = words.next().unwrap_or("xMidYMid");
+    let slice = words.next() == Some("slice");
+    let (sx, sy) = (w / v[2], h / v[3]);
+    if align == "none" {
+        return Ok(Some(Mat3::scale(sx, sy).mul(&Mat3::translate(-v[0], -v[1]))));
+    }
+    if align.len() != 8 {
+        return Err(loc.err(format!("preserveAspectRatio: expected an alignment such as xMidYMid, found {align:?}")));
+    }
+    let s = if slice { sx.max(sy) } else { sx.min(sy) };
+    let frac = |a: &str| match a {
+        "Min" => Ok(0.0),
+        "Mid" => Ok(0.5),
+        "Max" => Ok(1.0),
+        _ => Err(loc.err(format!("preserveAspectRatio: bad alignment {align:?}"))),
+    };
+    let (fx, fy) = (frac(&align[1..4])?, frac(&align[5..8])?);
+    let tx = (w - v[2] * s) * fx;
+    let ty = (h - v[3] * s) * fy;
+    Ok(Some(
+        Mat3::translate(tx, ty)
+            .mul(&Mat3::scale(s, s))
+            .mul(&Mat3::translate(-v[0], -v[1])),
+    ))
+}
+
+pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
+    let loc = element_loc(ctx, &root);
+    let vb = root.attribute("viewBox").map(|s| number_list(s, P, &loc, "viewBox")).transpose()?;
+    let vb_size = vb.as_ref().filter(|v| v.len() == 4).map(|v| (v[2], v[3]));
+    let dim = |name: &str, axis: Axis, fallback: f64| -> Result<f64, SvgError> {
+        match root.attribute(name) {
+            Some(s) if s.trim().ends_with('%') => {
+                let pc = number_with_unit(s, P, &loc, name)?.0 / 100.0;
+                Ok(fallback * pc)
+            }
+            Some(s) => {
+                let v = length(s, &loc, name, Viewport { w: 100.0, h: 100.0 }, axis)?;
+                if v > 0.0 {
+                    Ok(v)
+                } else {
+                    Err(loc.err(format!("{name}: expected a positive length, found {s:?}")))
+                }
+            }
+            None => Ok(fallback),
+        }
+    };
+    let width = dim("width", Axis::X, vb_size.map_or(100.0, |s| s.0))?;
+    let height = dim("height", Axis::Y, vb_size.map_or(100.0, |s| s.1))?;
+    let view_box_transform = view_box_transform(&root, &loc, width, height)?.unwrap_or(Mat3::IDENTITY);
+    let xml = ctx.xml;
+    let mut ids = HashMap::new();
+    for n in xml.descendants().filter(Node::is_element) {
+        if let Some(id) = n.attribute("id") {
+            ids.entry(id).or_insert(n);
+        }
+    }
+    let mut p = Parser {
+        ctx,
+        doc: Document {
+            width,
+            height,
+            view_box_transform,
+            ..Document::default()
+        },
+        ids,
+        textures: HashMap::new(),
+    };
+    let vp = vb_size.map_or(Viewport { w: width, h: height }, |(w, h)| Viewport { w, h });
+    let mut style = Style::default();
+    let decls = declarations(&root);
+    let (opacity, _) = apply_declarations(&mut style, &decls, &loc, vp)?;
+    let layer = opacity < 1.0;
+    if layer {
+        p.doc.items.push(Item::BeginLayer);
+    }
+    p.children(root, Mat3::IDENTITY, &style, vp, 1)?;
+    if layer {
+        p.doc.items.push(Item::EndLayer { opacity });
+    }
+    Ok(p.doc)
+}
+
+impl<'a> Parser<'_, 'a> {
+    fn children(&mut self, parent: Node<'a, 'a>, ctm: Mat3, style: &Style, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+        for node in parent.children().filter(Node::is_element) {
+            self.element(node, ctm, style, vp, depth)?;
+        }
+        Ok(())
+    }
+
+    fn warn(&mut self, key: &str, message: String) {
+        self.ctx.warn_once(&mut self.doc, key, message);
+    }
+
+    fn element(&mut self, node: Node<'a, 'a>, ctm: Mat3, parent_style: &Style, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+        let ctx = &*self.ctx;
+        let loc = element_loc(ctx, &node);
+        let loc = Loc {
+            file: loc.file,
+            line: loc.line,
+            element: loc.element,
+        };
+        // Copy the location out of the borrow of ctx.
+        let (file, line, elem) = (loc.file.to_string(), loc.line, loc.element.to_string());
+        let loc = Loc {
+            file: &file,
+            line,
+            element: &elem,
+        };
+        if depth >= MAX_DEPTH {
+            return Err(loc.err(format!("elements nest deeper than the limit of {MAX_DEPTH}")));
+        }
+        if self.doc.items.len() > MAX_ITEMS {
+            return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
+        }
+        match node.tag_name().namespace() {
+            None | Some(SVG_NS) => {}
+            Some(_) => return Ok(()),
+        }
+        let name = node.tag_name().name();
+        match name {
+            "defs" | "symbol" | "linearGradient" | "radialGradient" | "stop" | "title" | "desc" | "metadata"
+            | "style" | "script" | "clipPath" | "mask" | "pattern" | "marker" | "filter" => return Ok(()),
+            _ => {}
+        }
+        let mut style = parent_style.clone();
+        let (opacity, display) = apply_declarations(&mut style, &declarations(&node), &loc, vp)?;
+        if !display {
+            return Ok(());
+        }
+        for unsupported in ["clip-path", "mask", "filter"] {
+            if node.attribute(unsupported).is_some_and(|v| v.trim() != "none") {
+                self.warn(unsupported, format!("{file}:{line}: {elem}: {unsupported} is not supported; drawn without it"));
+            }
+        }
+        let mut t = match node.attribute("transform") {
+            Some(s) => ctm.mul(&parse_transform(s, P, &loc, false)?),
+            None => ctm,
+        };
+        let num = |attr: &str, axis: Axis| -> Result<f64, SvgError> {
+            node.attribute(attr).map_or(Ok(0.0), |s| length(s, &loc, attr, vp, axis))
+        };
+        let path = match name {
+            "g" | "a" | "switch" => {
+                return self.group(node, t, &style, opacity, vp, depth);
+            }
+            "svg" => {
+                let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
+                t = t.mul(&Mat3::translate(x, y));
+                let w = node.attribute("width").map_or(Ok(vp.w), |s| length(s, &loc, "width", vp, Axis::X))?;
+                let h = node.attribute("height").map_or(Ok(vp.h), |s| length(s, &loc, "height", vp, Axis::Y))?;
+                let mut inner = vp;
+                if let Some(m) = view_box_transform(&node, &loc, w, h)? {
+                    t = t.mul(&m);
+                    let v = number_list(node.attribute("viewBox").unwrap_or(""), P, &loc, "viewBox")?;
+                    inner = Viewport { w: v[2], h: v[3] };
+                }
+                return self.group(node, t, &style, opacity, inner, depth);
+            }
+            "use" => {
+                let href = node
+                    .attribute((XLINK_NS, "href"))
+                    .or_else(|| node.attribute("href"))
+                    .ok_or_else(|| loc.err("expected an href attribute"))?;
+                let id = href.trim().strip_prefix('#').unwrap_or(href.trim());
+                let Some(&target) = self.ids.get(id) else {
+                    self.warn(&format!("use#{id}"), format!("{file}:{line}: use: no element with id {id:?}; skipped"));
+                    return Ok(());
+                };
+                if target.ancestors().any(|a| a == node) {
+                    return Err(loc.err(format!("href #{id} refers to its own ancestor")));
+                }
+                let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
+                let t = t.mul(&Mat3::translate(x, y));
+                let layer = opacity < 1.0;
+                if layer {
+                    self.doc.items.push(Item::BeginLayer);
+                }
+                if target.tag_name().name() == "symbol" {
+                    self.children(target, t, &style, vp, depth + 1)?;
+                } else {
+                    self.element(target, t, &style, vp, depth + 1)?;
+                }
+                if layer {
+                    self.doc.items.push(Item::EndLayer { opacity });
+                }
+                return Ok(());
+            }
+            "rect" => {
+                let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
+                let (w, h) = (num("width", Axis::X)?, num("height", Axis::Y)?);
+                if w <= 0.0 || h <= 0.0 {
+                    return Ok(());
+                }
+                let rx_attr = node.attribute("rx").map(|s| length(s, &loc, "rx", vp, Axis::X)).transpose()?;
+                let ry_attr = node.attribute("ry").map(|s| length(s, &loc, "ry", vp, Axis::Y)).transpose()?;
+                let (rx, ry) = match (rx_attr, ry_attr) {
+                    (None, None) => (0.0, 0.0),
+                    (Some(r), None) | (None, Some(r)) => (r, r),
+                    (Some(a), Some(b)) => (a, b),
+                };
+                let (rx, ry) = (rx.clamp(0.0, w / 2.0), ry.clamp(0.0, h / 2.0));
+                let mut p = Path::default();
+                if rx > 0.0 && ry > 0.0 {
+                    let d = |a: f64, b: f64| DVec2::new(a, b);
+                    p.move_to(d(x + rx, y));
+                    p.line_to(d(x + w - rx, y));
+                    p.arc_to(d(x + w - rx, y), rx, ry, 0.0, false, true, d(x + w, y + ry));
+                    p.line_to(d(x + w, y + h - ry));
+                    p.arc_to(d(x + w, y + h - ry), rx, ry, 0.0, false, true, d(x + w - rx, y + h));
+                    p.line_to(d(x + rx, y + h));
+                    p.arc_to(d(x + rx, y + h), rx, ry, 0.0, false, true, d(x, y + h - ry));
+                    p.line_to(d(x, y + ry));
+                    p.arc_to(d(x, y + ry), rx, ry, 0.0, false, true, d(x + rx, y));
+                    p.close();
+                } else {
+                    p = Path::polygon(&[DVec2::new(x, y), DVec2::new(x + w, y), DVec2::new(x + w, y + h), DVec2::new(x, y + h)], true);
+                }
+                p
+            }
+            "circle" | "ellipse" => {
+                let c = DVec2::new(num("cx", Axis::X)?, num("cy", Axis::Y)?);
+                let (rx, ry) = if name == "circle" {
+                    let r = num("r", Axis::Diag)?;
+                    (r, r)
+                } else {
+                    (num("rx", Axis::X)?, num("ry", Axis::Y)?)
+                };
+                if rx <= 0.0 || ry <= 0.0 {
+                    return Ok(());
+                }
+                Path::ellipse(c, rx, ry)
+            }
+            "line" => {
+                let a = DVec2::new(num("x1", Axis::X)?, num("y1", Axis::Y)?);
+                let b = DVec2::new(num("x2", Axis::X)?, num("y2", Axis::Y)?);
+                Path::polygon(&[a, b], false)
+            }
+            "polyline" | "polygon" => {
+                let l = number_list(node.attribute("points").unwrap_or(""), P, &loc, "points")?;
+                if l.len() % 2 != 0 {
+                    return Err(loc.err(format!("points: expected x,y pairs, found {} numbers", l.len())));
+                }
+                let pts: Vec<DVec2> = l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect();
+                Path::polygon(&pts, name == "polygon")
+            }
+            "path" => parse_path_data(node.attribute("d").unwrap_or("")).map_err(|e| loc.err(format!("d: {e}")))?,
+            "image" => {
+                if !style.visible {
+                    return Ok(());
+                }
+                if let Some(Item::Image { texture, rect, transform, .. }) = image_item(&node, t, self.ctx, &mut self.doc, &loc, P)? {
+                    self.doc.items.push(Item::Image { texture, rect, transform, opacity });
+                }
+                return Ok(());
+            }
+            "texture" => {
+                let id = node.attribute("texid").ok_or_else(|| loc.err("expected a texid attribute"))?;
+                let f = node.attribute("filename").ok_or_else(|| loc.err("expected a filename attribute"))?;
+                let idx = load_texture(self.ctx, &mut self.doc, f, &loc)?;
+                self.textures.insert(id.to_string(), idx);
+                return Ok(());
+            }
+            "colortri" | "textri" => {
+                let pts = number_list(node.attribute("points").unwrap_or(""), P, &loc, "points")?;
+                if pts.len() != 6 {
+                    return Err(loc.err(format!("points: expected 6 numbers, found {}", pts.len())));
+                }
+                let points = [DVec2::new(pts[0], pts[1]), DVec2::new(pts[2], pts[3]), DVec2::new(pts[4], pts[5])];
+                if name == "colortri" {
+                    let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
+                    if c.len() != 12 {
+                        return Err(loc.err(format!("colors: expected 12 numbers, found {}", c.len())));
+                    }
+                    let col = |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
+                    self.doc.items.push(Item::ColorTri { points, colors: [col(0), col(1), col(2)], transform: t });
+                } else {
+                    let uv = number_list(node.attribute("uvs").unwrap_or(""), P, &loc, "uvs")?;
+                    if uv.len() != 6 {
+                        return Err(loc.err(format!("uvs: expected 6 numbers, found {}", uv.len())));
+                    }
+                    let id = node.attribute("texid").unwrap_or("");
+                    let texture = *self
+                        .textures
+                        .get(id)
+                        .ok_or_else(|| loc.err(format!("texid {id:?}: expected the id of an earlier <texture>")))?;
+                    let f = |i: usize| Vec2::new(uv[2 * i] as f32, uv[2 * i + 1] as f32);
+                    self.doc.items.push(Item::TexTri { points, uvs: [f(0), f(1), f(2)], texture, transform: t });
+                }
+                return Ok(());
+            }
+            "text" | "tspan" | "textPath" => {
+                self.warn("text", format!("{file}:{line}: {name}: text is not supported; skipped"));
+                return Ok(());
+            }
+            other => {
+                self.warn(&format!("elem:{other}"), format!("{file}:{line}: {other}: unknown element; skipped"));
+                return Ok(());
+            }
+        };
+        if !path.is_finite() {
+            return Err(loc.err("coordinates must be finite"));
+        }
+        if !style.visible || path.segments.is_empty() {
+            return Ok(());
+        }
+        self.shape(path, t, &style, opacity, name, &loc)
+    }
+
+    fn group(&mut self, node: Node<'a, 'a>, t: Mat3, style: &Style, opacity: f32, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+        let layer = opacity < 1.0;
+        if layer {
+            self.doc.items.push(Item::BeginLayer);
+        }
+        self.children(node, t, style, vp, depth + 1)?;
+        if layer {
+            self.doc.items.push(Item::EndLayer { opacity });
+        }
+        Ok(())
+    }
+
+    fn shape(&mut self, path: Path, t: Mat3, style: &Style, opacity: f32, name: &str, loc: &Loc) -> Result<(), SvgError> {
+        let fillable = name != "line";
+        let fill = if fillable { self.resolve_paint(&style.fill, style, &path, loc)? } else { None };
+        let stroke = if style.stroke.width > 0.0 { self.resolve_paint(&style.stroke_paint, style, &path, loc)? } else { None };
+        let both = fill.is_some() && stroke.is_some();
+        let layer = both && opacity < 1.0;
+        let inner = if layer { 1.0 } else { opacity };
+        if layer {
+            self.doc.items.push(Item::BeginLayer);
+        }
+        if let Some((paint, a)) = fill {
+            self.doc.items.push(Item::Fill {
+                path: path.clone(),
+                transform: t,
+                rule: style.fill_rule,
+                paint,
+                opacity: a * style.fill_opacity * inner,
+            });
+        }
+        if let Some((paint, a)) = stroke {
+            self.doc.items.push(Item::Stroke {
+                path,
+                transform: t,
+                style: style.stroke.clone(),
+                paint,
+                opacity: a * style.stroke_opacity * inner,
+            });
+        }
+        if layer {
+            self.doc.items.push(Item::EndLayer { opacity });
+        }
+        Ok(())
+    }
+
+    fn resolve_paint(&mut self, spec: &PaintSpec, style: &Style, path: &Path, loc: &Loc) -> Result<Option<(Paint, f32)>, SvgError> {
+        Ok(match spec {
+            PaintSpec::None => None,
+            PaintSpec::Color(c, a) => Some((Paint::Solid(*c), *a)),
+            PaintSpec::CurrentColor => Some((Paint::Solid(style.color), 1.0)),
+            PaintSpec::Url(id, fallback) => match self.gradient(id, path, loc)? {
+                Some(g) => {
+                    if g.stops.len() == 1 {
+                        Some((Paint::Solid(g.stops[0].color), g.stops[0].opacity))
+                    } else {
+                        Some((Paint::Gradient(g), 1.0))
+                    }
+                }
+                None => match fallback {
+                    Some(fb) => self.resolve_paint(fb, style, path, loc)?,
+                    None => {
+                        if !self.ids.contains_key(id.as_str()) {
+                            let msg = format!("{}:{}: {}: paint url(#{id}) not found; not painted", loc.file, loc.line, loc.element);
+                            self.warn(&format!("paint#{id}"), msg);
+                        }
+                        None
+                    }
+                },
+            },
+        })
+    }
+
+    /// Resolves a gradient by id for an element whose local path is `path`, following
+    /// `href` chains for stops and attributes.
+    fn gradient(&mut self, id: &str, path: &Path, loc: &Loc) -> Result<Option<Arc<Gradient>>, SvgError> {
+        let Some(&node) = self.ids.get(id) else { return Ok(None) };
+        let kind = node.tag_name().name();
+        if kind != "linearGradient" && kind != "radialGradient" {
+            if kind == "pattern" {
+                self.warn("pattern", format!("{}:{}: pattern paint is not supported; not painted", loc.file, loc.line));
+            }
+            return Ok(None);
+        }
+        // The chain of referenced gradients, nearest first.
+        let mut chain = vec![node];
+        while chain.len() < 16 {
+            let last = chain[chain.len() - 1];
+            let href = last.attribute((XLINK_NS, "href")).or_else(|| last.attribute("href"));
+            match href.and_then(|h| self.ids.get(h.trim().trim_start_matches('#'))) {
+                Some(&n) if !chain.contains(&n) => chain.push(n),
+                _ => break,
+            }
+        }
+        let attr = |name: &str| chain.iter().find_map(|n| n.attribute(name));
+        let gloc = element_loc(self.ctx, &node);
+        let (gfile, gline, gelem) = (gloc.file.to_string(), gloc.line, gloc.element.to_string());
+        let gloc = Loc { file: &gfile, line: gline, element: &gelem };
+        let user_space = attr("gradientUnits") == Some("userSpaceOnUse");
+        let vp = Viewport { w: self.doc.width, h: self.doc.height };
+        let coord = |name: &str, default: &str, axis: Axis| -> Result<f64, SvgError> {
+            let s = attr(name).unwrap_or(default);
+            if !user_space {
+                let (v, unit) = number_with_unit(s, P, &gloc, name)?;
+                return Ok(if unit == "%" { v / 100.0 } else { v });
+            }
+            length(s, &gloc, name, vp, axis)
+        };
+        let stops_node = chain.iter().find(|n| n.children().any(|c| c.tag_name().name() == "stop"));
+        let mut stops: Vec<Stop> = Vec::new();
+        if let Some(sn) = stops_node {
+            for s in sn.children().filter(|c| c.tag_name().name() == "stop") {
+                let sl = element_loc(self.ctx, &s);
+                let (sfile, sline) = (sl.file.to_string(), sl.line);
+                let sloc = Loc { file: &sfile, line: sline, element: "stop" };
+                let decls = declarations(&s);
+                let get = |k: &str| decls.iter().rev().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
+                let offset = get("offset").map_or(Ok(0.0), |v| opacity_value(v, &sloc, "offset"))?;
+                let (color, ca) = match get("stop-color") {
+                    None => (Rgb::BLACK, 1.0),
+                    Some(v) => parse_color(v).ok_or_else(|| sloc.err(format!("stop-color: expected a colour, found {v:?}")))?,
+                };
+                let op = get("stop-opacity").map_or(Ok(1.0), |v| opacity_value(v, &sloc, "stop-opacity"))?;
+                let prev = stops.last().map_or(0.0, |s| s.offset);
+                stops.push(Stop { offset: offset.max(prev), color, opacity: op * ca });
+            }
+        }
+        if stops.is_empty() {
+            return Ok(None);
+        }
+        let spread = match attr("spreadMethod") {
+            Some("reflect") => Spread::Reflect,
+            Some("repeat") => Spread::Repeat,
+            _ => Spread::Pad,
+        };
+        let gt = match attr("gradientTransform") {
+            Some(s) => parse_transform(s, P, &gloc, false)?,
+            None => Mat3::IDENTITY,
+        };
+        let units = if user_space {
+            Mat3::IDENTITY
+        } else {
+            // objectBoundingBox: map the unit square onto the element's bounding box.
+            let pts: Vec<DVec2> = path.flatten(0.01).into_iter().flat_map(|l| l.points).collect();
+            let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for p in pts {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let size = hi - lo;
+            if !(size.x > 0.0 && size.y > 0.0) {
+                return Ok(None);
+            }
+            Mat3::translate(lo.x, lo.y).mul(&Mat3::scale(size.x, size.y))
+        };
+        let kind = if kind == "linearGradient" {
+            GradientKind::Linear {
+                start: DVec2::new(coord("x1", "0%", Axis::X)?, coord("y1", "0%", Axis::Y)?),
+                end: DVec2::new(coord("x2", "100%", Axis::X)?, coord("y2", "0%", Axis::Y)?),
+            }
+        } else {
+            let center = DVec2::new(coord("cx", "50%", Axis::X)?, coord("cy", "50%", Axis::Y)?);
+            let radius = coord("r", "50%", Axis::Diag)?;
+            let focus = DVec2::new(
+                attr("fx").map_or(Ok(center.x), |_| coord("fx", "50%", Axis::X))?,
+                attr("fy").map_or(Ok(center.y), |_| coord("fy", "50%", Axis::Y))?,
+            );
+            if radius <= 0.0 {
+                let last = stops[stops.len() - 1];
+                stops = vec![last];
+            }
+            GradientKind::Radial { center, radius, focus }
+        };
+        Ok(Some(Arc::new(Gradient { kind, stops, spread, transform: units.mul(&gt) })))
+    }
+}

@@ -1,0 +1,896 @@
+//! The rasterizer: a document is prepared into device-space primitives, then rendered in
+//! horizontal bands (in parallel, one sample buffer per band) and each band is resolved
+//! by a box filter over its samples.
+//!
+//! Sample `(i, j)` of pixel `(x, y)` at rate `r` (samples = r * r) sits at
+//! `(x + (i + 0.5) / r, y + (j + 0.5) / r)`. Samples hold premultiplied RGBA in the
+//! document's colour space (stored sRGB values, as SVG composites). Coverage rules:
+//! paths and triangles use a top-left rule (a sample on a shared edge belongs to exactly
+//! one side); the course's triangles ([`Item::Triangles`], and every triangle in
+//! compat mode) count samples on an edge as inside. DDA lines and points are not
+//! antialiased: they set every sample of the pixels they touch.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use prism_image::{LevelSampling, PixelSampling, Rgba8Image, Texture};
+use prism_math::{DVec2, Rgb, Vec2};
+use rayon::prelude::*;
+
+use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread};
+use crate::path::{stroke, Path};
+
+/// Largest output width or height in pixels.
+pub const MAX_DIMENSION: u32 = 16_384;
+/// Largest sample count per pixel (a 16 x 16 grid).
+pub const MAX_SAMPLES: u32 = 256;
+
+/// Curve flattening tolerance in output pixels.
+const TOLERANCE: f64 = 0.05;
+
+/// How the document is placed in the output image.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum View {
+    /// The document's viewport (after its `viewBox`) fills the output.
+    #[default]
+    Fit,
+    /// The square region centred at `(cx, cy)` reaching `span` user units to each side,
+    /// centred in the output with uniform scale `min(width, height) / (2 span)`.
+    Region {
+        /// Centre x in user units.
+        cx: f64,
+        /// Centre y in user units.
+        cy: f64,
+        /// Half the side of the visible square, in user units.
+        span: f64,
+    },
+}
+
+/// Settings for one render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// Samples per pixel; a perfect square.
+    pub samples: u32,
+    /// Texel lookup for textured triangles.
+    pub pixel_sampling: PixelSampling,
+    /// Mip level selection for textured triangles.
+    pub level_sampling: LevelSampling,
+    /// Placement of the document.
+    pub view: View,
+    /// The course renderer's behaviour: opaque white background, all triangles with the
+    /// inclusive edge rule, a one-pixel black canvas outline, truncating 8-bit conversion,
+    /// and [`View::Fit`] meaning the course's view (centre of the canvas, 20% margin).
+    pub compat: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 1024,
+            height: 1024,
+            samples: 1,
+            pixel_sampling: PixelSampling::Nearest,
+            level_sampling: LevelSampling::Zero,
+            view: View::Fit,
+            compat: false,
+        }
+    }
+}
+
+/// Invalid render settings.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RenderError {
+    /// Width or height outside `1..=MAX_DIMENSION`.
+    #[error("output size {0}x{1} is outside 1..={MAX_DIMENSION} pixels per side")]
+    BadSize(u32, u32),
+    /// Sample count not a perfect square in `1..=MAX_SAMPLES`.
+    #[error("samples per pixel must be a perfect square from 1 to {MAX_SAMPLES} (1, 4, 9, 16, ...), found {0}")]
+    BadSamples(u32),
+    /// The view region is not finite and positive.
+    #[error("view span must be finite and positive, found centre ({0}, {1}) span {2}")]
+    BadView(f64, f64, f64),
+}
+
+/// Wall-clock time spent in each stage of [`render`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Transforming, flattening and stroking items into device primitives.
+    pub prepare: Duration,
+    /// Rasterizing samples (band phase, apportioned by thread time).
+    pub raster: Duration,
+    /// Box-filtering samples into pixels (band phase, apportioned by thread time).
+    pub resolve: Duration,
+}
+
+/// The sample rate `r` for `samples = r * r`, if it is a valid count.
+#[must_use]
+pub fn sample_rate(samples: u32) -> Option<u32> {
+    let r = (f64::from(samples)).sqrt().round() as u32;
+    (samples >= 1 && samples <= MAX_SAMPLES && r * r == samples).then_some(r)
+}
+
+/// The transform from document user space to output pixels for these options.
+#[must_use]
+pub fn view_transform(doc: &Document, opts: &RenderOptions) -> Mat3 {
+    let region = match opts.view {
+        View::Region { cx, cy, span } => Some((cx, cy, span)),
+        View::Fit if opts.compat => {
+            // The course's view: the canvas centre, 1.2 x the larger side across.
+            let (w, h) = (doc.width as f32, doc.height as f32);
+            let span = (1.2 * f64::from(w.max(h)) / 2.0) as f32;
+            Some((f64::from(w / 2.0), f64::from(h / 2.0), f64::from(span)))
+        }
+        View::Fit => None,
+    };
+    match region {
+        Some((cx, cy, span)) => {
+            // Computed exactly as the course renderer does: NDC from a homogeneous
+            // matrix with w = 2 span, then NDC to a centred square of the output.
+            let (cx, cy, span) = (cx as f32, cy as f32, span as f32);
+            let svg_to_ndc = Mat3([
+                [1.0, 0.0, f64::from(span - cx)],
+                [0.0, 1.0, f64::from(span - cy)],
+                [0.0, 0.0, f64::from(2.0 * span)],
+            ]);
+            let (w, h) = (opts.width as f32, opts.height as f32);
+            let s = w.min(h);
+            let ndc_to_screen = Mat3([
+                [f64::from(s), 0.0, f64::from((w - s) / 2.0)],
+                [0.0, f64::from(s), f64::from((h - s) / 2.0)],
+                [0.0, 0.0, 1.0],
+            ]);
+            let m = ndc_to_screen.mul(&svg_to_ndc);
+            if opts.compat {
+                m
+            } else {
+                m.mul(&doc.view_box_transform)
+            }
+        }
+        None => Mat3::scale(
+            f64::from(opts.width) / doc.width,
+            f64::from(opts.height) / doc.height,
+        )
+        .mul(&doc.view_box_transform),
+    }
+}
+
+/// A non-horizontal polygon edge in device space with `y0 < y1`.
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    x0: f64,
+    y0: f64,
+    y1: f64,
+    dxdy: f64,
+    dir: i32,
+}
+
+fn edges_of(polys: impl IntoIterator<Item = Vec<DVec2>>, closed: bool, out: &mut Vec<Edge>) {
+    for poly in polys {
+        let n = poly.len();
+        if n < 2 {
+            continue;
+        }
+        let count = if closed { n } else { n - 1 };
+        for i in 0..count {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            if a.y == b.y || !a.is_finite() || !b.is_finite() {
+                continue;
+            }
+            let (p, q, dir) = if a.y < b.y { (a, b, 1) } else { (b, a, -1) };
+            out.push(Edge {
+                x0: p.x,
+                y0: p.y,
+                y1: q.y,
+                dxdy: (q.x - p.x) / (q.y - p.y),
+                dir,
+            });
+        }
+    }
+}
+
+/// A paint resolved to device space.
+#[derive(Clone, Debug)]
+enum DevPaint {
+    Solid([f32; 4]),
+    Gradient {
+        g: Arc<Gradient>,
+        /// Device pixel to gradient space.
+        inv: prism_math::DAffine2,
+        opacity: f32,
+    },
+}
+
+impl DevPaint {
+    fn at(&self, x: f64, y: f64) -> [f32; 4] {
+        match self {
+            DevPaint::Solid(c) => *c,
+            DevPaint::Gradient { g, inv, opacity } => {
+                let p = inv.transform_point2(DVec2::new(x, y));
+                let t = match g.kind {
+                    GradientKind::Linear { start, end } => {
+                        let d = end - start;
+                        let l2 = d.length_squared();
+                        if l2 == 0.0 {
+                            1.0
+                        } else {
+                            (p - start).dot(d) / l2
+                        }
+                    }
+                    GradientKind::Radial { center, radius, focus } => radial_t(p, center, radius, focus),
+                };
+                let t = match g.spread {
+                    Spread::Pad => t.clamp(0.0, 1.0),
+                    Spread::Repeat => t.rem_euclid(1.0),
+                    Spread::Reflect => {
+                        let m = t.rem_euclid(2.0);
+                        if m > 1.0 {
+                            2.0 - m
+                        } else {
+                            m
+                        }
+                    }
+                } as f32;
+                let stops = &g.stops;
+                let (c, a) = if t <= stops[0].offset {
+                    (stops[0].color, stops[0].opacity)
+                } else if t >= stops[stops.len() - 1].offset {
+                    let s = stops[stops.len() - 1];
+                    (s.color, s.opacity)
+                } else {
+                    let k = stops.windows(2).position(|w| t >= w[0].offset && t <= w[1].offset).unwrap_or(0);
+                    let (s0, s1) = (stops[k], stops[k + 1]);
+                    let span = s1.offset - s0.offset;
+                    let f = if span > 0.0 { (t - s0.offset) / span } else { 1.0 };
+                    (s0.color.lerp(s1.color, f), s0.opacity + (s1.opacity - s0.opacity) * f)
+                };
+                let a = a * opacity;
+                [c.r * a, c.g * a, c.b * a, a]
+            }
+        }
+    }
+}
+
+/// The gradient parameter of point `p` for a radial gradient with a focal point: the `t`
+/// for which `p` lies on the circle interpolated from (focus, 0) to (center, radius).
+fn radial_t(p: DVec2, center: DVec2, radius: f64, focus: DVec2) -> f64 {
+    let cd = center - focus;
+    let pd = p - focus;
+    // Solve |pd - t cd| = t r for t >= 0.
+    let a = cd.length_squared() - radius * radius;
+    let b = pd.dot(cd);
+    let c = pd.length_squared();
+    if a.abs() < 1e-12 {
+        if b.abs() < 1e-12 {
+            return 0.0;
+        }
+        return c / (2.0 * b);
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return 0.0;
+    }
+    let s = disc.sqrt();
+    let t1 = (b + s) / a;
+    let t2 = (b - s) / a;
+    // The reciprocal form: t is 1 / the larger root of the standard quadratic.
+    let t = t1.min(t2);
+    if t > 0.0 {
+        1.0 / (1.0 / t).max(f64::MIN_POSITIVE)
+    } else {
+        t1.max(t2).max(0.0)
+    }
+}
+
+#[derive(Clone, Debug)]
+enum TriShade {
+    Solid([f32; 4]),
+    Color([Rgb; 3]),
+    Tex {
+        tex: Arc<Texture>,
+        uvs: [Vec2; 3],
+        duv_dx: Vec2,
+        duv_dy: Vec2,
+        psm: PixelSampling,
+        lsm: LevelSampling,
+        alpha: f32,
+    },
+}
+
+#[derive(Clone, Debug)]
+enum Prim {
+    Tri {
+        v: [DVec2; 3],
+        inclusive: bool,
+        shade: TriShade,
+    },
+    Poly {
+        edges: Vec<Edge>,
+        rule: FillRule,
+        paint: DevPaint,
+    },
+    Pixels {
+        px: Vec<(i32, i32)>,
+        color: [f32; 4],
+    },
+    BeginLayer,
+    EndLayer(f32),
+}
+
+/// A primitive with the pixel rows it can touch, `[y0, y1)`.
+#[derive(Clone, Debug)]
+struct Placed {
+    y0: i32,
+    y1: i32,
+    prim: Prim,
+}
+
+fn solid(c: Rgb, a: f32) -> [f32; 4] {
+    [c.r * a, c.g * a, c.b * a, a]
+}
+
+/// The course's DDA line (`rasterize_line`), in `f32` with accumulated steps, appending the
+/// pixels `(floor x, floor y)` it visits.
+fn dda(mut x0: f32, mut y0: f32, mut x1: f32, mut y1: f32, out: &mut Vec<(i32, i32)>) {
+    if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite()) {
+        return;
+    }
+    if x0 > x1 {
+        std::mem::swap(&mut x0, &mut x1);
+        std::mem::swap(&mut y0, &mut y1);
+    }
+    let m = (y1 - y0) / (x1 - x0);
+    let (mut dx, mut dy) = (1.0f32, m);
+    if m.abs() > 1.0 {
+        if x1 == x0 {
+            dx = 0.0;
+            dy = (y1 - y0) / (y1 - y0).abs();
+        } else {
+            dx = 1.0 / m.abs();
+            dy = m / m.abs();
+        }
+    }
+    let (mut x, mut y) = (x0, y0);
+    // Bounded by the line's extent; the cap guards against pathological input.
+    let mut guard = 0u64;
+    let limit = (2.0 * f64::from((x1 - x0).abs() + (y1 - y0).abs()) + 4.0).min(1e8) as u64;
+    while x.floor() <= x1.floor() && (y - y0).abs() <= (y1 - y0).abs() && guard < limit {
+        out.push((x.floor() as i32, y.floor() as i32));
+        x += dx;
+        y += dy;
+        guard += 1;
+    }
+}
+
+fn to_f32(p: DVec2) -> (f32, f32) {
+    (p.x as f32, p.y as f32)
+}
+
+/// Turns document items into device primitives.
+fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
+    let h = opts.height as i32;
+    let w = opts.width as f64;
+    let hf = opts.height as f64;
+    let rows = |lo: f64, hi: f64| -> Option<(i32, i32)> {
+        if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 || lo > hf {
+            return None;
+        }
+        let y0 = (lo.floor() as i64).clamp(0, i64::from(h)) as i32;
+        let y1 = ((hi.floor() as i64) + 1).clamp(0, i64::from(h)) as i32;
+        (y1 > y0).then_some((y0, y1))
+    };
+    let xs_visible = |lo: f64, hi: f64| hi >= -1.0 && lo <= w + 1.0;
+    let place_tri = |v: [DVec2; 3], inclusive: bool, shade: TriShade| -> Option<Placed> {
+        let lo = v[0].min(v[1]).min(v[2]);
+        let hi = v[0].max(v[1]).max(v[2]);
+        if !xs_visible(lo.x, hi.x) {
+            return None;
+        }
+        let (y0, y1) = rows(lo.y, hi.y)?;
+        Some(Placed { y0, y1, prim: Prim::Tri { v, inclusive, shade } })
+    };
+    let place_poly = |edges: Vec<Edge>, rule: FillRule, paint: DevPaint| -> Option<Placed> {
+        if edges.is_empty() {
+            return None;
+        }
+        let lo = edges.iter().map(|e| e.y0).fold(f64::INFINITY, f64::min);
+        let hi = edges.iter().map(|e| e.y1).fold(f64::NEG_INFINITY, f64::max);
+        let (y0, y1) = rows(lo, hi)?;
+        Some(Placed { y0, y1, prim: Prim::Poly { edges, rule, paint } })
+    };
+    let dev_paint = |paint: &Paint, m: &Mat3, opacity: f32| -> Option<DevPaint> {
+        match paint {
+            Paint::Solid(c) => Some(DevPaint::Solid(solid(*c, opacity))),
+            Paint::Gradient(g) => {
+                let full = m.mul(&g.transform).to_affine();
+                let det = full.matrix2.determinant();
+                if det == 0.0 || !det.is_finite() {
+                    return None;
+                }
+                Some(DevPaint::Gradient { g: g.clone(), inv: full.inverse(), opacity })
+            }
+        }
+    };
+    let tex_shade = |tex: &Arc<Texture>, dv: [DVec2; 3], uvs: [Vec2; 3], psm, lsm, alpha| {
+        // uv is an affine function of screen position: its derivatives are constant.
+        let e1 = dv[1] - dv[0];
+        let e2 = dv[2] - dv[0];
+        let det = e1.x * e2.y - e1.y * e2.x;
+        let (du1, du2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+        let (duv_dx, duv_dy) = if det == 0.0 {
+            (Vec2::ZERO, Vec2::ZERO)
+        } else {
+            let inv = 1.0 / det;
+            let dx = (du1 * e2.y as f32 - du2 * e1.y as f32) * inv as f32;
+            let dy = (du2 * e1.x as f32 - du1 * e2.x as f32) * inv as f32;
+            (dx, dy)
+        };
+        TriShade::Tex { tex: tex.clone(), uvs, duv_dx, duv_dy, psm, lsm, alpha }
+    };
+    // Device vertices as the course computes them: mapped in f64, passed on as f32.
+    let dev = |m: &Mat3, p: DVec2| {
+        let q = m.apply(p);
+        if opts.compat {
+            DVec2::new(f64::from(q.x as f32), f64::from(q.y as f32))
+        } else {
+            q
+        }
+    };
+    let per_item = |item: &Item| -> Vec<Placed> {
+        let mut out = Vec::new();
+        match item {
+            Item::Triangles { tris, transform, color } => {
+                let m = view.mul(transform);
+                for t in tris {
+                    let v = [dev(&m, t[0]), dev(&m, t[1]), dev(&m, t[2])];
+                    out.extend(place_tri(v, true, TriShade::Solid(solid(*color, 1.0))));
+                }
+            }
+            Item::Fill { path, transform, rule, paint, opacity } => {
+                let m = view.mul(transform);
+                let Some(paint) = dev_paint(paint, &m, *opacity) else { return out };
+                let dpath: Path = path.transformed(&m.to_affine());
+                let lines = dpath.flatten(TOLERANCE);
+                let mut edges = Vec::new();
+                edges_of(lines.into_iter().map(|l| l.points), true, &mut edges);
+                out.extend(place_poly(edges, *rule, paint));
+            }
+            Item::Stroke { path, transform, style, paint, opacity } => {
+                let m = view.mul(transform);
+                let Some(paint) = dev_paint(paint, &m, *opacity) else { return out };
+                let affine = m.to_affine();
+                let scale = m.max_scale();
+                if !(scale > 0.0 && scale.is_finite()) {
+                    return out;
+                }
+                let tol = TOLERANCE / scale;
+                let polys = stroke(&path.flatten(tol), style, tol);
+                let mut edges = Vec::new();
+                edges_of(
+                    polys.into_iter().map(|p| p.into_iter().map(|q| affine.transform_point2(q)).collect()),
+                    true,
+                    &mut edges,
+                );
+                out.extend(place_poly(edges, FillRule::NonZero, paint));
+            }
+            Item::Hairline { points, closed, transform, color } => {
+                let m = view.mul(transform);
+                let n = points.len();
+                let segs = if *closed { n } else { n.saturating_sub(1) };
+                let mut px = Vec::new();
+                for i in 0..segs {
+                    let (a, b) = (points[i], points[(i + 1) % n]);
+                    let ((x0, y0), (x1, y1)) = (to_f32(m.apply(a)), to_f32(m.apply(b)));
+                    dda(x0, y0, x1, y1, &mut px);
+                }
+                px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
+                if let (Some(lo), Some(hi)) = (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max()) {
+                    out.push(Placed { y0: lo, y1: hi + 1, prim: Prim::Pixels { px, color: solid(*color, 1.0) } });
+                }
+            }
+            Item::Point { at, transform, color } => {
+                let m = view.mul(transform);
+                let (x, y) = to_f32(m.apply(*at));
+                let (sx, sy) = (x.floor(), y.floor());
+                if sx >= 0.0 && sy >= 0.0 && sx < opts.width as f32 && sy < opts.height as f32 {
+                    let (sx, sy) = (sx as i32, sy as i32);
+                    out.push(Placed { y0: sy, y1: sy + 1, prim: Prim::Pixels { px: vec![(sx, sy)], color: solid(*color, 1.0) } });
+                }
+            }
+            Item::ColorTri { points, colors, transform } => {
+                let m = view.mul(transform);
+                let v = [dev(&m, points[0]), dev(&m, points[1]), dev(&m, points[2])];
+                out.extend(place_tri(v, opts.compat, TriShade::Color(*colors)));
+            }
+            Item::TexTri { points, uvs, texture, transform } => {
+                let m = view.mul(transform);
+                let v = [dev(&m, points[0]), dev(&m, points[1]), dev(&m, points[2])];
+                let shade = tex_shade(&doc.textures[*texture], v, *uvs, opts.pixel_sampling, opts.level_sampling, 1.0);
+                out.extend(place_tri(v, opts.compat, shade));
+            }
+            Item::Image { texture, rect, transform, opacity } => {
+                let m = view.mul(transform);
+                let [x, y, w, h] = *rect;
+                let c = [DVec2::new(x, y), DVec2::new(x + w, y), DVec2::new(x, y + h), DVec2::new(x + w, y + h)];
+                let d = c.map(|p| dev(&m, p));
+                let uv = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)];
+                let tex = &doc.textures[*texture];
+                for (a, b, cc) in [(0, 1, 2), (2, 1, 3)] {
+                    let v = [d[a], d[b], d[cc]];
+                    let shade = tex_shade(tex, v, [uv[a], uv[b], uv[cc]], PixelSampling::Bilinear, LevelSampling::Linear, *opacity);
+                    out.extend(place_tri(v, opts.compat, shade));
+                }
+            }
+            Item::BeginLayer => out.push(Placed { y0: 0, y1: h, prim: Prim::BeginLayer }),
+            Item::EndLayer { opacity } => out.push(Placed { y0: 0, y1: h, prim: Prim::EndLayer(*opacity) }),
+        }
+        out
+    };
+    let mut prims: Vec<Placed> = doc.items.par_iter().map(per_item).flatten_iter().collect();
+    if opts.compat {
+        // The course's canvas outline, corners pushed out by one pixel.
+        let corner = |x: f64, y: f64, dx: f64, dy: f64| {
+            let p = view.apply(DVec2::new(x, y));
+            to_f32(DVec2::new(p.x + dx, p.y + dy))
+        };
+        let a = corner(0.0, 0.0, -1.0, 1.0);
+        let b = corner(doc.width, 0.0, 1.0, 1.0);
+        let c = corner(0.0, doc.height, -1.0, -1.0);
+        let d = corner(doc.width, doc.height, 1.0, -1.0);
+        let mut px = Vec::new();
+        for (p, q) in [(a, b), (a, c), (d, b), (d, c)] {
+            dda(p.0, p.1, q.0, q.1, &mut px);
+        }
+        px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
+        if !px.is_empty() {
+            prims.push(Placed { y0: 0, y1: h, prim: Prim::Pixels { px, color: [0.0, 0.0, 0.0, 1.0] } });
+        }
+    }
+    prims
+}
+
+#[inline]
+fn blend(dst: &mut [f32; 4], src: [f32; 4]) {
+    if src[3] >= 1.0 {
+        *dst = src;
+    } else if src[3] > 0.0 {
+        let k = 1.0 - src[3];
+        for c in 0..4 {
+            dst[c] = src[c] + dst[c] * k;
+        }
+    }
+}
+
+/// One band's sample storage: `rows` sample rows of `cols` samples.
+struct Band {
+    /// Layer stack; the bottom is the band's canvas.
+    layers: Vec<Vec<[f32; 4]>>,
+    spare: Vec<Vec<[f32; 4]>>,
+    cols: usize,
+    /// First pixel row of the band.
+    y0: i32,
+    /// Pixel rows in the band.
+    rows_px: i32,
+    r: usize,
+    width: i32,
+}
+
+impl Band {
+    fn top(&mut self) -> &mut Vec<[f32; 4]> {
+        self.layers.last_mut().expect("band has a canvas")
+    }
+
+    fn sample_y(&self, j: usize) -> f64 {
+        f64::from(self.y0) + (j as f64 + 0.5) / self.r as f64
+    }
+
+    fn draw(&mut self, p: &Prim, compat: bool) {
+        match p {
+            Prim::BeginLayer => {
+                let mut buf = self.spare.pop().unwrap_or_default();
+                buf.clear();
+                buf.resize(self.layers[0].len(), [0.0; 4]);
+                self.layers.push(buf);
+            }
+            Prim::EndLayer(op) => {
+                if self.layers.len() < 2 {
+                    return;
+                }
+                let src = self.layers.pop().expect("checked");
+                let dst = self.top();
+                for (d, s) in dst.iter_mut().zip(&src) {
+                    blend(d, [s[0] * op, s[1] * op, s[2] * op, s[3] * op]);
+                }
+                self.spare.push(src);
+            }
+            Prim::Pixels { px, color } => {
+                let (y0, y1, r, cols) = (self.y0, self.y0 + self.rows_px, self.r, self.cols);
+                let buf = self.top();
+                for &(x, y) in px {
+                    if y < y0 || y >= y1 {
+                        continue;
+                    }
+                    let base_row = (y - y0) as usize * r;
+                    for j in 0..r {
+                        let row = (base_row + j) * cols + x as usize * r;
+                        for s in &mut buf[row..row + r] {
+                            blend(s, *color);
+                        }
+                    }
+                }
+            }
+            Prim::Poly { edges, rule, paint } => self.poly(edges, *rule, paint),
+            Prim::Tri { v, inclusive, shade } => self.tri(v, *inclusive, shade, compat),
+        }
+    }
+
+    fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint) {
+        let r = self.r;
+        let band_lo = f64::from(self.y0);
+        let band_hi = f64::from(self.y0 + self.rows_px);
+        let local: Vec<Edge> = edges.iter().filter(|e| e.y1 > band_lo && e.y0 < band_hi).copied().collect();
+        if local.is_empty() {
+            return;
+        }
+        let cols = self.cols;
+        let rf = r as f64;
+        let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
+        for j in 0..self.rows_px as usize * r {
+            let y = self.sample_y(j);
+            xs.clear();
+            for e in &local {
+                // Half-open in y: an edge owns samples with y0 <= y < y1.
+                if y >= e.y0 && y < e.y1 {
+                    xs.push((e.x0 + (y - e.y0) * e.dxdy, e.dir));
+                }
+            }
+            if xs.len() < 2 {
+                continue;
+            }
+            xs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let row = &mut self.layers.last_mut().expect("canvas")[j * cols..(j + 1) * cols];
+            let mut wind = 0;
+            for k in 0..xs.len() - 1 {
+                wind += xs[k].1;
+                let inside = match rule {
+                    FillRule::NonZero => wind != 0,
+                    FillRule::EvenOdd => wind % 2 != 0,
+                };
+                if !inside {
+                    continue;
+                }
+                // Samples with centre in [xa, xb): left edges inclusive, right exclusive.
+                let first = |x: f64| ((x * rf - 0.5).ceil().clamp(0.0, cols as f64)) as usize;
+                let (a, b) = (first(xs[k].0), first(xs[k + 1].0));
+                match paint {
+                    DevPaint::Solid(c) => {
+                        for s in &mut row[a..b] {
+                            blend(s, *c);
+                        }
+                    }
+                    g => {
+                        for (i, s) in row[a..b].iter_mut().enumerate() {
+                            let x = ((a + i) as f64 + 0.5) / rf;
+                            blend(s, g.at(x, y));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    fn tri(&mut self, v: &[DVec2; 3], inclusive: bool, shade: &TriShade, compat: bool) {
+        let r = self.r;
+        let rf = r as f64;
+        let lo = v[0].min(v[1]).min(v[2]);
+        let hi = v[0].max(v[1]).max(v[2]);
+        // Sample index ranges covering the bounding box, clipped to the band.
+        let j_lo = (((lo.y - f64::from(self.y0)) * rf - 0.5).ceil().max(0.0)) as usize;
+        let j_hi = ((((hi.y - f64::from(self.y0)) * rf - 0.5).floor() + 1.0).clamp(0.0, (self.rows_px as usize * r) as f64)) as usize;
+        let i_lo = ((lo.x * rf - 0.5).ceil().max(0.0)) as usize;
+        let i_hi = (((hi.x * rf - 0.5).floor() + 1.0).clamp(0.0, self.cols as f64)) as usize;
+        if j_lo >= j_hi || i_lo >= i_hi {
+            return;
+        }
+        let area = (v[1] - v[0]).perp_dot(v[2] - v[0]);
+        // Edge function of edge a->b at p; positive inside for counter-clockwise (area > 0).
+        let ef = |a: DVec2, b: DVec2, x: f64, y: f64| (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+        let sign = if area < 0.0 { -1.0 } else { 1.0 };
+        // Top-left rule: an edge owns its samples if it is a "top" or "left" edge.
+        let owns = |a: DVec2, b: DVec2| {
+            let (a, b) = if sign > 0.0 { (a, b) } else { (b, a) };
+            let d = b - a;
+            (d.y == 0.0 && d.x < 0.0) || d.y > 0.0
+        };
+        let edges = [(v[1], v[2]), (v[2], v[0]), (v[0], v[1])];
+        let own = [owns(edges[0].0, edges[0].1), owns(edges[1].0, edges[1].1), owns(edges[2].0, edges[2].1)];
+        if !inclusive && area == 0.0 {
+            return;
+        }
+        let cols = self.cols;
+        let y0 = self.y0;
+        let buf = self.layers.last_mut().expect("canvas");
+        for j in j_lo..j_hi {
+            let y = f64::from(y0) + (j as f64 + 0.5) / rf;
+            let yf = if compat { f64::from(y as f32) } else { y };
+            for i in i_lo..i_hi {
+                let x = (i as f64 + 0.5) / rf;
+                let w = [
+                    ef(edges[0].0, edges[0].1, x, yf),
+                    ef(edges[1].0, edges[1].1, x, yf),
+                    ef(edges[2].0, edges[2].1, x, yf),
+                ];
+                let inside = if inclusive {
+                    (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
+                } else {
+                    (0..3).all(|k| {
+                        let s = w[k] * sign;
+                        s > 0.0 || (s == 0.0 && own[k])
+                    })
+                };
+                if !inside {
+                    continue;
+                }
+                let color = match shade {
+                    TriShade::Solid(c) => *c,
+                    TriShade::Color(c) => {
+                        let (b0, b1) = if area == 0.0 { (1.0, 0.0) } else { ((w[0] / area) as f32, (w[1] / area) as f32) };
+                        let b2 = 1.0 - b0 - b1;
+                        let k = c[0] * b0 + c[1] * b1 + c[2] * b2;
+                        [k.r, k.g, k.b, 1.0]
+                    }
+                    TriShade::Tex { tex, uvs, duv_dx, duv_dy, psm, lsm, alpha } => {
+                        let (b0, b1) = if area == 0.0 { (1.0, 0.0) } else { ((w[0] / area) as f32, (w[1] / area) as f32) };
+                        let b2 = 1.0 - b0 - b1;
+                        let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
+                        let k = tex.sample(uv, *duv_dx, *duv_dy, *psm, *lsm);
+                        [k.r * alpha, k.g * alpha, k.b * alpha, *alpha]
+                    }
+                };
+                blend(&mut buf[j * cols + i], color);
+            }
+        }
+    }
+
+    /// Box-filters the canvas layer into 8-bit straight-alpha pixels.
+    fn resolve(&self, out: &mut [[u8; 4]], compat: bool) {
+        let r = self.r;
+        let n = (r * r) as f32;
+        let canvas = &self.layers[0];
+        for py in 0..self.rows_px as usize {
+            for px in 0..self.width as usize {
+                let mut acc = [0f32; 4];
+                for j in 0..r {
+                    let row = (py * r + j) * self.cols + px * r;
+                    for s in &canvas[row..row + r] {
+                        for c in 0..4 {
+                            acc[c] += s[c];
+                        }
+                    }
+                }
+                let o = &mut out[py * self.width as usize + px];
+                if compat {
+                    // The course's conversion: truncate channel * 255.
+                    for c in 0..3 {
+                        o[c] = ((acc[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
+                    }
+                    o[3] = 255;
+                } else {
+                    let a = acc[3] / n;
+                    if a <= 0.0 {
+                        *o = [0, 0, 0, 0];
+                        continue;
+                    }
+                    for c in 0..3 {
+                        o[c] = ((acc[c] / n / a).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                    }
+                    o[3] = (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                }
+            }
+        }
+    }
+}
+
+/// Renders a document to straight-alpha RGBA8.
+///
+/// # Errors
+/// [`RenderError`] for an output size, sample count or view outside the documented limits.
+pub fn render(doc: &Document, opts: &RenderOptions) -> Result<(Rgba8Image, RenderStats), RenderError> {
+    let (w, h) = (opts.width, opts.height);
+    if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
+        return Err(RenderError::BadSize(w, h));
+    }
+    let r = sample_rate(opts.samples).ok_or(RenderError::BadSamples(opts.samples))? as usize;
+    if let View::Region { cx, cy, span } = opts.view {
+        if !(cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0) {
+            return Err(RenderError::BadView(cx, cy, span));
+        }
+    }
+    let t0 = Instant::now();
+    let view = view_transform(doc, opts);
+    let prims = prepare(doc, opts, &view);
+    let prepare_time = t0.elapsed();
+    let t1 = Instant::now();
+    let cols = w as usize * r;
+    // About 4 MiB of samples per band.
+    let band_rows = ((4usize << 20) / (cols * r * 16)).clamp(1, 64);
+    let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
+    let background = if opts.compat { [1.0, 1.0, 1.0, 1.0] } else { [0.0; 4] };
+    let times: Vec<(Duration, Duration)> = pixels
+        .par_chunks_mut(band_rows * w as usize)
+        .enumerate()
+        .map(|(bi, out)| {
+            let ta = Instant::now();
+            let y0 = (bi * band_rows) as i32;
+            let rows_px = (out.len() / w as usize) as i32;
+            let mut band = Band {
+                layers: vec![vec![background; rows_px as usize * r * cols]],
+                spare: Vec::new(),
+                cols,
+                y0,
+                rows_px,
+                r,
+                width: w as i32,
+            };
+            for p in &prims {
+                if p.y1 > y0 && p.y0 < y0 + rows_px {
+                    band.draw(&p.prim, opts.compat);
+                }
+            }
+            let tb = Instant::now();
+            band.resolve(out, opts.compat);
+            (tb - ta, tb.elapsed())
+        })
+        .collect();
+    let wall = t1.elapsed();
+    let (rt, st): (Duration, Duration) = times
+        .iter()
+        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| (a + *x, b + *y));
+    let total = (rt + st).as_secs_f64().max(1e-12);
+    let stats = RenderStats {
+        prepare: prepare_time,
+        raster: wall.mul_f64(rt.as_secs_f64() / total),
+        resolve: wall.mul_f64(st.as_secs_f64() / total),
+    };
+    Ok((Rgba8Image::from_vec(w, h, pixels), stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sample_rates() {
+        assert_eq!(sample_rate(1), Some(1));
+        assert_eq!(sample_rate(16), Some(4));
+        assert_eq!(sample_rate(25), Some(5));
+        assert_eq!(sample_rate(8), None);
+        assert_eq!(sample_rate(0), None);
+        assert_eq!(sample_rate(1024), None);
+    }
+
+    /// Course behaviour: a vertical line draws floor(|dy|) + 1 pixels; identical endpoints
+    /// draw one pixel.
+    #[test]
+    fn dda_closed_forms() {
+        let mut px = Vec::new();
+        dda(3.5, 1.2, 3.5, 6.7, &mut px);
+        assert_eq!(px, (1..=6).map(|y| (3, y)).collect::<Vec<_>>());
+        px.clear();
+        dda(2.0, 2.0, 2.0, 2.0, &mut px);
+        assert_eq!(px, vec![(2, 2)]);
+        px.clear();
+        dda(0.0, 0.0, 4.0, 2.0, &mut px);
+        assert_eq!(px, vec![(0, 0), (1, 0), (2, 1), (3, 1), (4, 2)]);
+    }
+
+    #[test]
+    fn radial_t_is_distance_ratio_for_centred_focus() {
+        let c = DVec2::new(5.0, 5.0);
+        assert!((radial_t(DVec2::new(8.0, 5.0), c, 6.0, c) - 0.5).abs() < 1e-12);
+        assert!((radial_t(c, c, 6.0, c)).abs() < 1e-12);
+    }
+}

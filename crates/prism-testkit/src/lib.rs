@@ -1,0 +1,122 @@
+//! Test helpers shared by prism's crates: golden-image comparison that explains itself.
+//!
+//! [`compare_golden`] decodes both PNGs, reports the identical-pixel fraction and the largest
+//! channel error, and on failure writes an `expected | diff | actual` triptych under
+//! `target/test-diffs/`. With `MAKE_REF=1` in the environment, references the project owns
+//! are (re)written instead of compared.
+#![warn(missing_docs)]
+
+use std::path::{Path, PathBuf};
+
+use prism_image::{compare_rgb8, read_png, write_png, DiffStats, Image, Rgb8Image};
+
+/// The workspace root (two levels above this crate's manifest).
+#[must_use]
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The shared assets folder beside the checkout (`../shared/assets`).
+#[must_use]
+pub fn shared_assets() -> PathBuf {
+    workspace_root().join("../shared/assets")
+}
+
+/// Where failing comparisons leave their triptychs.
+#[must_use]
+pub fn diff_dir() -> PathBuf {
+    workspace_root().join("target/test-diffs")
+}
+
+/// True when references should be regenerated (`MAKE_REF=1`).
+#[must_use]
+pub fn make_ref() -> bool {
+    std::env::var("MAKE_REF").is_ok_and(|v| v == "1")
+}
+
+/// An `expected | diff | actual` image; the diff shows differing pixels in red over a
+/// dimmed copy of the expected image.
+#[must_use]
+pub fn triptych(expected: &Rgb8Image, actual: &Rgb8Image) -> Rgb8Image {
+    let (w, h) = (expected.width().max(actual.width()), expected.height().max(actual.height()));
+    let get = |im: &Rgb8Image, x: u32, y: u32| {
+        if x < im.width() && y < im.height() {
+            Some(im.get(x, y))
+        } else {
+            None
+        }
+    };
+    Image::from_fn(3 * w, h, |x, y| {
+        let (panel, px) = (x / w, x % w);
+        match panel {
+            0 => get(expected, px, y).unwrap_or([255, 0, 255]),
+            2 => get(actual, px, y).unwrap_or([255, 0, 255]),
+            _ => match (get(expected, px, y), get(actual, px, y)) {
+                (Some(e), Some(a)) if e == a => e.map(|c| 128 + c / 2),
+                (Some(e), Some(a)) => {
+                    let d = (0..3).map(|c| e[c].abs_diff(a[c])).max().unwrap_or(0);
+                    [255, 96u8.saturating_sub(d / 3), 0]
+                }
+                _ => [255, 0, 255],
+            },
+        }
+    })
+}
+
+/// Compares `actual` with the PNG at `expected_path`.
+///
+/// Returns the statistics; when `accept` rejects them, writes a triptych named `name` and
+/// panics with the figures. With `MAKE_REF=1` and `owned` true, writes `actual` as the new
+/// reference and returns perfect statistics.
+///
+/// # Panics
+/// If the reference is missing or unreadable, the sizes differ, or `accept` returns false.
+pub fn compare_golden(
+    name: &str,
+    expected_path: &Path,
+    actual: &Rgb8Image,
+    owned: bool,
+    accept: impl Fn(&DiffStats) -> bool,
+) -> DiffStats {
+    if owned && make_ref() {
+        if let Some(dir) = expected_path.parent() {
+            std::fs::create_dir_all(dir).expect("create reference folder");
+        }
+        write_png(expected_path, actual).expect("write reference");
+        return compare_rgb8(actual, actual).expect("same size");
+    }
+    let expected = read_png(expected_path)
+        .unwrap_or_else(|e| panic!("{name}: cannot read reference: {e}"))
+        .to_rgb8();
+    let stats = compare_rgb8(&expected, actual);
+    let ok = stats.as_ref().is_some_and(&accept);
+    if !ok {
+        let dir = diff_dir();
+        std::fs::create_dir_all(&dir).expect("create diff folder");
+        let out = dir.join(format!("{name}.png"));
+        write_png(&out, &triptych(&expected, actual)).expect("write triptych");
+        panic!(
+            "{name}: image differs from {} ({stats:?}); triptych at {}",
+            expected_path.display(),
+            out.display()
+        );
+    }
+    stats.expect("checked")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triptych_marks_differences() {
+        let a = Image::new(2, 1, [10u8, 10, 10]);
+        let mut b = a.clone();
+        b.set(1, 0, [200, 10, 10]);
+        let t = triptych(&a, &b);
+        assert_eq!((t.width(), t.height()), (6, 1));
+        assert_eq!(t.get(2, 0), [133, 133, 133]);
+        assert_eq!(t.get(3, 0)[0], 255);
+        assert_eq!(t.get(5, 0), [200, 10, 10]);
+    }
+}
