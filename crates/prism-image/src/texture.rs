@@ -39,6 +39,19 @@ pub enum LevelSampling {
 #[derive(Clone, Debug)]
 pub struct Texture {
     levels: Vec<RgbImage>,
+    uv: UvConvention,
+}
+
+/// Where uv coordinates fall on the texel grid of a level `w` texels wide.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UvConvention {
+    /// u = 0 and u = 1 are the outer edges of the first and last texels; texel `i` covers
+    /// `[i / w, (i + 1) / w)` and its centre is at `(i + 0.5) / w` (OpenGL, pbrt).
+    #[default]
+    Standard,
+    /// u = 0 and u = 1 are the centres of the first and last texels: the texel coordinate
+    /// is `u * (w - 1)`, as in the CS184 course renderer.
+    EdgeCenters,
 }
 
 /// Per-destination-index list of `(source index, weight)` for a box filter from `src` to
@@ -96,7 +109,23 @@ impl Texture {
             let next = downsample(last);
             levels.push(next);
         }
-        Texture { levels }
+        Texture {
+            levels,
+            uv: UvConvention::Standard,
+        }
+    }
+
+    /// Returns the texture with a different uv convention.
+    #[must_use]
+    pub fn with_uv_convention(mut self, uv: UvConvention) -> Texture {
+        self.uv = uv;
+        self
+    }
+
+    /// The uv convention in use.
+    #[must_use]
+    pub fn uv_convention(&self) -> UvConvention {
+        self.uv
     }
 
     /// The mip levels, finest first.
@@ -126,7 +155,8 @@ impl Texture {
         d.min((self.levels.len() - 1) as f32)
     }
 
-    /// Samples one mip level at `uv`, clamping to the edge.
+    /// Samples one mip level at `uv`, clamping to the edge. Nearest picks the texel whose
+    /// centre is closest; bilinear blends the four surrounding texel centres.
     ///
     /// # Panics
     /// If `level` is not below `levels().len()`.
@@ -134,20 +164,28 @@ impl Texture {
     pub fn sample_level(&self, uv: Vec2, level: usize, mode: PixelSampling) -> Rgb {
         let im = &self.levels[level];
         let (w, h) = (im.width() as i64, im.height() as i64);
-        let fx = f64::from(uv.x) * w as f64;
-        let fy = f64::from(uv.y) * h as f64;
+        // Continuous texel coordinates: integers are texel centres.
+        let (gx, gy) = match self.uv {
+            UvConvention::Standard => (
+                f64::from(uv.x) * w as f64 - 0.5,
+                f64::from(uv.y) * h as f64 - 0.5,
+            ),
+            UvConvention::EdgeCenters => (
+                f64::from(uv.x) * (w - 1) as f64,
+                f64::from(uv.y) * (h - 1) as f64,
+            ),
+        };
         let clamp_x = |x: i64| x.clamp(0, w - 1) as u32;
         let clamp_y = |y: i64| y.clamp(0, h - 1) as u32;
         match mode {
             PixelSampling::Nearest => {
-                let (x, y) = (fx.floor(), fy.floor());
+                let (x, y) = ((gx + 0.5).floor(), (gy + 0.5).floor());
                 if !x.is_finite() || !y.is_finite() {
                     return im.get(0, 0);
                 }
                 im.get(clamp_x(x as i64), clamp_y(y as i64))
             }
             PixelSampling::Bilinear => {
-                let (gx, gy) = (fx - 0.5, fy - 0.5);
                 if !gx.is_finite() || !gy.is_finite() {
                     return im.get(0, 0);
                 }
@@ -324,6 +362,19 @@ mod tests {
         assert!((t.level_for(Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)) - 2.0).abs() < 1e-6);
         assert_eq!(t.level_for(Vec2::new(1e9, 0.0), Vec2::ZERO), 6.0);
         assert_eq!(t.level_for(Vec2::new(f32::NAN, 0.0), Vec2::ZERO), 0.0);
+    }
+
+    /// Closed form: with edge-centred uvs, u = k / (w - 1) lands exactly on texel k.
+    #[test]
+    fn edge_centres_convention() {
+        let t = Texture::new(Image::from_fn(5, 1, |x, _| Rgb::splat(x as f32)))
+            .with_uv_convention(UvConvention::EdgeCenters);
+        for k in 0..5 {
+            let uv = Vec2::new(k as f32 / 4.0, 0.5);
+            assert_eq!(t.sample_level(uv, 0, PixelSampling::Nearest).r, k as f32);
+            assert!((t.sample_level(uv, 0, PixelSampling::Bilinear).r - k as f32).abs() < 1e-6);
+        }
+        assert!((t.sample_level(Vec2::new(0.125, 0.5), 0, PixelSampling::Bilinear).r - 0.5).abs() < 1e-6);
     }
 
     #[test]

@@ -244,6 +244,8 @@ pub enum Item {
         transform: Mat3,
         /// Line colour.
         color: Rgb,
+        /// Opacity in [0, 1] (the course renderer blends lines with `stroke-opacity`).
+        opacity: f32,
     },
     /// A single pixel at `floor` of the transformed point, every sub-sample set.
     Point {

@@ -476,7 +476,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 );
                 out.extend(place_poly(edges, FillRule::NonZero, paint));
             }
-            Item::Hairline { points, closed, transform, color } => {
+            Item::Hairline { points, closed, transform, color, opacity } => {
                 let m = view.mul(transform);
                 let n = points.len();
                 let segs = if *closed { n } else { n.saturating_sub(1) };
@@ -488,7 +488,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 }
                 px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
                 if let (Some(lo), Some(hi)) = (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max()) {
-                    out.push(Placed { y0: lo, y1: hi + 1, prim: Prim::Pixels { px, color: solid(*color, 1.0) } });
+                    out.push(Placed { y0: lo, y1: hi + 1, prim: Prim::Pixels { px, color: solid(*color, *opacity) } });
                 }
             }
             Item::Point { at, transform, color } => {

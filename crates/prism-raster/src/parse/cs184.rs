@@ -152,6 +152,10 @@ fn walk<'a>(
         };
         let fill = node.attribute("fill").map_or(Rgb::BLACK, hex_color);
         let stroke = node.attribute("stroke").map(hex_color);
+        let stroke_opacity = match node.attribute("stroke-opacity") {
+            Some(s) => number_with_unit(s, P, &loc, "stroke-opacity")?.0.clamp(0.0, 1.0) as f32,
+            None => 1.0,
+        };
         match name {
             "g" => walk(node, t, depth + 1, ctx, doc, textures)?,
             "rect" => {
@@ -178,6 +182,7 @@ fn walk<'a>(
                         closed: true,
                         transform: t,
                         color: c,
+                        opacity: stroke_opacity,
                     });
                 }
             }
@@ -190,6 +195,7 @@ fn walk<'a>(
                         closed: false,
                         transform: t,
                         color: c,
+                        opacity: stroke_opacity,
                     });
                 }
             }
@@ -200,6 +206,7 @@ fn walk<'a>(
                     closed: false,
                     transform: t,
                     color: stroke.unwrap_or(Rgb::BLACK),
+                    opacity: stroke_opacity,
                 });
             }
             "polygon" => {
@@ -215,6 +222,7 @@ fn walk<'a>(
                         closed: true,
                         transform: t,
                         color: c,
+                        opacity: stroke_opacity,
                     });
                 }
             }
@@ -238,7 +246,7 @@ fn walk<'a>(
                 let file = node
                     .attribute("filename")
                     .ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx = load_texture(ctx, doc, file, &loc)?;
+                let idx = load_texture(ctx, doc, file, &loc, prism_image::UvConvention::EdgeCenters)?;
                 textures.insert(id.to_string(), idx);
             }
             "textri" => {

@@ -11,7 +11,7 @@ use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 
 use base64::Engine;
-use prism_image::Texture;
+use prism_image::{Texture, UvConvention};
 use roxmltree::Node;
 
 pub use common::{SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_ITEMS};
@@ -64,7 +64,13 @@ pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> Loc<'a> {
 }
 
 /// Decodes an image file or `data:` URI into a texture and registers it.
-pub(crate) fn load_texture(ctx: &Ctx, doc: &mut Document, href: &str, loc: &Loc) -> Result<usize, SvgError> {
+pub(crate) fn load_texture(
+    ctx: &Ctx,
+    doc: &mut Document,
+    href: &str,
+    loc: &Loc,
+    uv: UvConvention,
+) -> Result<usize, SvgError> {
     let rgba = if let Some(data) = href.trim().strip_prefix("data:") {
         let comma = data
             .find(',')
@@ -89,7 +95,7 @@ pub(crate) fn load_texture(ctx: &Ctx, doc: &mut Document, href: &str, loc: &Loc)
         prism_image::read_image(&path).map_err(|e| loc.err(format!("texture {href:?}: {e}")))?
     };
     let rgb = rgba.to_rgb8().to_rgb_f32();
-    doc.textures.push(Arc::new(Texture::new(rgb)));
+    doc.textures.push(Arc::new(Texture::new(rgb).with_uv_convention(uv)));
     Ok(doc.textures.len() - 1)
 }
 
@@ -111,7 +117,7 @@ pub(crate) fn image_item(
             .map(|s| number_with_unit(s, p, loc, name).map(|v| v.0))
             .transpose()
     };
-    let texture = load_texture(ctx, doc, href, loc)?;
+    let texture = load_texture(ctx, doc, href, loc, UvConvention::Standard)?;
     let (tw, th) = doc.textures[texture].size();
     let (x, y) = (num("x")?.unwrap_or(0.0), num("y")?.unwrap_or(0.0));
     let (mut w, mut h) = (num("width")?, num("height")?);

@@ -523,7 +523,7 @@ impl<'a> Parser<'_, 'a> {
             "texture" => {
                 let id = node.attribute("texid").ok_or_else(|| loc.err("expected a texid attribute"))?;
                 let f = node.attribute("filename").ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx = load_texture(self.ctx, &mut self.doc, f, &loc)?;
+                let idx = load_texture(self.ctx, &mut self.doc, f, &loc, prism_image::UvConvention::EdgeCenters)?;
                 self.textures.insert(id.to_string(), idx);
                 return Ok(());
             }
