@@ -564,6 +564,21 @@ fn blend(dst: &mut [f32; 4], src: [f32; 4]) {
     }
 }
 
+/// The course renderer's translucent blend: both colours truncated to 8 bits, mixed as
+/// `a * src + (1 - a) * dst` in `f32` on the 0..255 scale, truncated again. Opaque targets
+/// only (the course's canvas is always opaque).
+fn blend_8bit(dst: &mut [f32; 4], src: [f32; 4]) {
+    let a = src[3];
+    if a <= 0.0 {
+        return;
+    }
+    for c in 0..3 {
+        let s8 = ((src[c] / a) * 255.0) as u8 as f32;
+        let d8 = (dst[c] * 255.0) as u8 as f32;
+        dst[c] = f32::from((a * s8 + (1.0 - a) * d8) as u8) / 255.0;
+    }
+}
+
 /// One band's sample storage: `rows` sample rows of `cols` samples.
 struct Band {
     /// Layer stack; the bottom is the band's canvas.
@@ -617,7 +632,11 @@ impl Band {
                     for j in 0..r {
                         let row = (base_row + j) * cols + x as usize * r;
                         for s in &mut buf[row..row + r] {
-                            blend(s, *color);
+                            if compat && color[3] < 1.0 {
+                                blend_8bit(s, *color);
+                            } else {
+                                blend(s, *color);
+                            }
                         }
                     }
                 }
