@@ -188,6 +188,17 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
     })
 }
 
+/// Writes an RGBA8 (straight alpha) image as a PNG file, atomically.
+///
+/// # Errors
+/// [`ImageError::Io`] or [`ImageError::Encode`]; on error the destination is untouched.
+pub fn write_png_rgba(path: &Path, image: &Rgba8Image) -> Result<(), ImageError> {
+    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    write_atomic(path, |w| {
+        encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgba, w)
+    })
+}
+
 /// Writes a file by streaming into a temporary file beside `path`, then renaming it over
 /// `path`, so that a failure never leaves a truncated file or clobbers an existing one.
 ///

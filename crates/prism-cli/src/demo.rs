@@ -1,0 +1,169 @@
+//! `prism demo`: a gallery of the features, drawn from built-in inputs.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use base64::Engine;
+use clap::Args;
+use prism_image::{encode_png, Image, LevelSampling, PixelSampling};
+use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+
+/// Arguments of `prism demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Folder to write the gallery into (created if missing).
+    #[arg(short, long, default_value = "gallery")]
+    pub output: PathBuf,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// A fan of thin triangles: aliasing shows at one sample per pixel.
+fn fan_svg() -> String {
+    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
+    for k in 0..36 {
+        let a0 = (k as f64) * std::f64::consts::TAU / 36.0;
+        let a1 = a0 + 0.06;
+        let _ = write!(
+            s,
+            r##"<polygon points="100,100 {:.3},{:.3} {:.3},{:.3}" fill="#{:02x}30{:02x}"/>"##,
+            100.0 + 95.0 * a0.cos(),
+            100.0 + 95.0 * a0.sin(),
+            100.0 + 95.0 * a1.cos(),
+            100.0 + 95.0 * a1.sin(),
+            (k * 7) as u8,
+            255 - (k * 7) as u8
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+/// A hexagon of barycentric colour triangles.
+fn colortri_svg() -> String {
+    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
+    let hue = |k: usize| -> [f64; 3] {
+        let t = k as f64 / 6.0 * 3.0;
+        let c = |o: f64| (((t - o).rem_euclid(3.0) - 1.0).abs() - 0.0).clamp(0.0, 1.0);
+        [1.0 - c(0.0), 1.0 - c(1.0), 1.0 - c(2.0)]
+    };
+    for k in 0..6 {
+        let a0 = k as f64 * std::f64::consts::TAU / 6.0;
+        let a1 = a0 + std::f64::consts::TAU / 6.0;
+        let (c0, c1) = (hue(k), hue((k + 1) % 6));
+        let _ = write!(
+            s,
+            r#"<colortri points="100 100 {:.3} {:.3} {:.3} {:.3}" colors="1 1 1 1 {} {} {} 1 {} {} {} 1"/>"#,
+            100.0 + 90.0 * a0.cos(),
+            100.0 + 90.0 * a0.sin(),
+            100.0 + 90.0 * a1.cos(),
+            100.0 + 90.0 * a1.sin(),
+            c0[0], c0[1], c0[2], c1[0], c1[1], c1[2]
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+/// A checkerboard plane receding into the distance, so texels are minified.
+fn texture_svg() -> Result<String> {
+    let tex = Image::from_fn(256, 256, |x, y| {
+        if (x / 16 + y / 16) % 2 == 0 {
+            [240, 240, 240]
+        } else {
+            [30, 60, 160]
+        }
+    });
+    let uri = base64::engine::general_purpose::STANDARD.encode(encode_png(&tex)?);
+    let mut s = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="200"><texture texid="c" filename="data:image/png;base64,{uri}"/>"#
+    );
+    // Rows of the plane: screen position shrinks with distance.
+    let rows = 24;
+    for j in 0..rows {
+        let z0 = 1.0 + j as f64 * 0.5;
+        let z1 = z0 + 0.5;
+        let (y0, y1) = (60.0 + 140.0 / z0, 60.0 + 140.0 / z1);
+        let (w0, w1) = (600.0 / z0, 600.0 / z1);
+        let (v0, v1) = (j as f64 / rows as f64, (j + 1) as f64 / rows as f64);
+        let (xl0, xr0, xl1, xr1) = (150.0 - w0 / 2.0, 150.0 + w0 / 2.0, 150.0 - w1 / 2.0, 150.0 + w1 / 2.0);
+        let _ = write!(
+            s,
+            r#"<textri texid="c" uvs="0 {v0} 1 {v0} 0 {v1}" points="{xl0} {y0} {xr0} {y0} {xl1} {y1}"/><textri texid="c" uvs="1 {v0} 1 {v1} 0 {v1}" points="{xr0} {y0} {xr1} {y1} {xl1} {y1}"/>"#
+        );
+    }
+    s.push_str("</svg>");
+    Ok(s)
+}
+
+/// Nested groups with every transform kind.
+fn group_svg() -> String {
+    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="240" height="240"><g transform="translate(120 120)">"#);
+    for k in 0..8 {
+        let _ = write!(
+            s,
+            r##"<g transform="rotate({})"><g transform="translate(60 0) scale(1.2 0.8)"><g transform="skewX(20)"><rect x="-18" y="-12" width="36" height="24" fill="#{:02x}a0{:02x}" stroke="#222" stroke-width="2"/><circle r="6" fill="#fff" fill-opacity="0.7"/></g></g></g>"##,
+            k * 45,
+            30 * k as u8,
+            255 - 30 * k as u8
+        );
+    }
+    s.push_str("</g></svg>");
+    s
+}
+
+struct Entry {
+    file: String,
+    caption: String,
+}
+
+fn draw(svg: &str, dialect: Dialect, opts: &RenderOptions, out: &std::path::Path) -> Result<()> {
+    let doc = parse_svg(svg, dialect, &Source { name: "<demo>".into(), base_dir: PathBuf::new() })?;
+    let (img, _) = render(&doc, opts)?;
+    let rgb = img.over_background([255, 255, 255]);
+    prism_image::write_png(out, &rgb).with_context(|| format!("writing {}", out.display()))
+}
+
+/// Runs `prism demo`.
+pub fn run(a: &DemoArgs) -> Result<()> {
+    std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
+    let mut entries = Vec::new();
+    let tex = texture_svg()?;
+    let mut jobs: Vec<(String, String, String, Dialect, RenderOptions)> = Vec::new();
+    let base = |w, h, samples| RenderOptions { width: w, height: h, samples, ..RenderOptions::default() };
+    for n in [1u32, 4, 16] {
+        jobs.push((format!("fan_{n}spp.png"), format!("Triangle fan, {n} sample(s) per pixel"), fan_svg(), Dialect::Svg, base(200, 200, n)));
+    }
+    jobs.push(("colortri.png".into(), "Barycentric colour triangles".into(), colortri_svg(), Dialect::Svg, base(200, 200, 16)));
+    for (name, lsm) in [("zero", LevelSampling::Zero), ("nearest", LevelSampling::Nearest), ("linear", LevelSampling::Linear)] {
+        let mut o = base(300, 200, 1);
+        o.pixel_sampling = PixelSampling::Bilinear;
+        o.level_sampling = lsm;
+        jobs.push((format!("texture_level_{name}.png"), format!("Minified texture, bilinear pixels, level sampling {name}"), tex.clone(), Dialect::Svg, o));
+    }
+    jobs.push(("transformed_group.png".into(), "Nested groups: rotate, translate, scale, skewX; strokes and opacity".into(), group_svg(), Dialect::Svg, base(240, 240, 16)));
+    let pb = crate::progress::bar(jobs.len() as u64, "demo", a.quiet);
+    for (file, caption, svg, dialect, opts) in jobs {
+        draw(&svg, dialect, &opts, &a.output.join(&file))?;
+        entries.push(Entry { file, caption });
+        pb.inc(1);
+    }
+    pb.finish_and_clear();
+    let mut html = String::from(
+        "<!doctype html><meta charset=\"utf-8\"><title>prism gallery</title>\
+         <style>body{font-family:sans-serif;background:#eee}figure{display:inline-block;margin:8px;background:#fff;padding:8px}\
+         img{image-rendering:pixelated;width:300px}</style><h1>prism gallery</h1>",
+    );
+    for e in &entries {
+        let _ = write!(html, "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>", e.file, e.caption, e.caption);
+    }
+    prism_image::write_atomic(&a.output.join("index.html"), |w| {
+        std::io::Write::write_all(w, html.as_bytes()).map_err(|source| prism_image::ImageError::Io { path: a.output.join("index.html"), source })
+    })?;
+    if !a.quiet {
+        eprintln!("wrote {} images and index.html to {}", entries.len(), a.output.display());
+    }
+    Ok(())
+}
