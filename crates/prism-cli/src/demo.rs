@@ -22,7 +22,8 @@ pub struct DemoArgs {
 
 /// A fan of thin triangles: aliasing shows at one sample per pixel.
 fn fan_svg() -> String {
-    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
+    let mut s =
+        String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
     for k in 0..36 {
         let a0 = (k as f64) * std::f64::consts::TAU / 36.0;
         let a1 = a0 + 0.06;
@@ -43,7 +44,8 @@ fn fan_svg() -> String {
 
 /// A hexagon of barycentric colour triangles.
 fn colortri_svg() -> String {
-    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
+    let mut s =
+        String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">"#);
     let hue = |k: usize| -> [f64; 3] {
         let t = k as f64 / 6.0 * 3.0;
         let c = |o: f64| (((t - o).rem_euclid(3.0) - 1.0).abs() - 0.0).clamp(0.0, 1.0);
@@ -60,7 +62,12 @@ fn colortri_svg() -> String {
             100.0 + 90.0 * a0.sin(),
             100.0 + 90.0 * a1.cos(),
             100.0 + 90.0 * a1.sin(),
-            c0[0], c0[1], c0[2], c1[0], c1[1], c1[2]
+            c0[0],
+            c0[1],
+            c0[2],
+            c1[0],
+            c1[1],
+            c1[2]
         );
     }
     s.push_str("</svg>");
@@ -88,7 +95,12 @@ fn texture_svg() -> Result<String> {
         let (y0, y1) = (60.0 + 140.0 / z0, 60.0 + 140.0 / z1);
         let (w0, w1) = (600.0 / z0, 600.0 / z1);
         let (v0, v1) = (j as f64 / rows as f64, (j + 1) as f64 / rows as f64);
-        let (xl0, xr0, xl1, xr1) = (150.0 - w0 / 2.0, 150.0 + w0 / 2.0, 150.0 - w1 / 2.0, 150.0 + w1 / 2.0);
+        let (xl0, xr0, xl1, xr1) = (
+            150.0 - w0 / 2.0,
+            150.0 + w0 / 2.0,
+            150.0 - w1 / 2.0,
+            150.0 + w1 / 2.0,
+        );
         let _ = write!(
             s,
             r#"<textri texid="c" uvs="0 {v0} 1 {v0} 0 {v1}" points="{xl0} {y0} {xr0} {y0} {xl1} {y1}"/><textri texid="c" uvs="1 {v0} 1 {v1} 0 {v1}" points="{xr0} {y0} {xr1} {y1} {xl1} {y1}"/>"#
@@ -100,7 +112,9 @@ fn texture_svg() -> Result<String> {
 
 /// Nested groups with every transform kind.
 fn group_svg() -> String {
-    let mut s = String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="240" height="240"><g transform="translate(120 120)">"#);
+    let mut s = String::from(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="240" height="240"><g transform="translate(120 120)">"#,
+    );
     for k in 0..8 {
         let _ = write!(
             s,
@@ -120,7 +134,14 @@ struct Entry {
 }
 
 fn draw(svg: &str, dialect: Dialect, opts: &RenderOptions, out: &std::path::Path) -> Result<()> {
-    let doc = parse_svg(svg, dialect, &Source { name: "<demo>".into(), base_dir: PathBuf::new() })?;
+    let doc = parse_svg(
+        svg,
+        dialect,
+        &Source {
+            name: "<demo>".into(),
+            base_dir: PathBuf::new(),
+        },
+    )?;
     let (img, _) = render(&doc, opts)?;
     let rgb = img.over_background([255, 255, 255]);
     prism_image::write_png(out, &rgb).with_context(|| format!("writing {}", out.display()))
@@ -128,22 +149,56 @@ fn draw(svg: &str, dialect: Dialect, opts: &RenderOptions, out: &std::path::Path
 
 /// Runs `prism demo`.
 pub fn run(a: &DemoArgs) -> Result<()> {
-    std::fs::create_dir_all(&a.output).with_context(|| format!("creating {}", a.output.display()))?;
+    std::fs::create_dir_all(&a.output)
+        .with_context(|| format!("creating {}", a.output.display()))?;
     let mut entries = Vec::new();
     let tex = texture_svg()?;
     let mut jobs: Vec<(String, String, String, Dialect, RenderOptions)> = Vec::new();
-    let base = |w, h, samples| RenderOptions { width: w, height: h, samples, ..RenderOptions::default() };
+    let base = |w, h, samples| RenderOptions {
+        width: w,
+        height: h,
+        samples,
+        ..RenderOptions::default()
+    };
     for n in [1u32, 4, 16] {
-        jobs.push((format!("fan_{n}spp.png"), format!("Triangle fan, {n} sample(s) per pixel"), fan_svg(), Dialect::Svg, base(200, 200, n)));
+        jobs.push((
+            format!("fan_{n}spp.png"),
+            format!("Triangle fan, {n} sample(s) per pixel"),
+            fan_svg(),
+            Dialect::Svg,
+            base(200, 200, n),
+        ));
     }
-    jobs.push(("colortri.png".into(), "Barycentric colour triangles".into(), colortri_svg(), Dialect::Svg, base(200, 200, 16)));
-    for (name, lsm) in [("zero", LevelSampling::Zero), ("nearest", LevelSampling::Nearest), ("linear", LevelSampling::Linear)] {
+    jobs.push((
+        "colortri.png".into(),
+        "Barycentric colour triangles".into(),
+        colortri_svg(),
+        Dialect::Svg,
+        base(200, 200, 16),
+    ));
+    for (name, lsm) in [
+        ("zero", LevelSampling::Zero),
+        ("nearest", LevelSampling::Nearest),
+        ("linear", LevelSampling::Linear),
+    ] {
         let mut o = base(300, 200, 1);
         o.pixel_sampling = PixelSampling::Bilinear;
         o.level_sampling = lsm;
-        jobs.push((format!("texture_level_{name}.png"), format!("Minified texture, bilinear pixels, level sampling {name}"), tex.clone(), Dialect::Svg, o));
+        jobs.push((
+            format!("texture_level_{name}.png"),
+            format!("Minified texture, bilinear pixels, level sampling {name}"),
+            tex.clone(),
+            Dialect::Svg,
+            o,
+        ));
     }
-    jobs.push(("transformed_group.png".into(), "Nested groups: rotate, translate, scale, skewX; strokes and opacity".into(), group_svg(), Dialect::Svg, base(240, 240, 16)));
+    jobs.push((
+        "transformed_group.png".into(),
+        "Nested groups: rotate, translate, scale, skewX; strokes and opacity".into(),
+        group_svg(),
+        Dialect::Svg,
+        base(240, 240, 16),
+    ));
     let pb = crate::progress::bar(jobs.len() as u64, "demo", a.quiet);
     for (file, caption, svg, dialect, opts) in jobs {
         draw(&svg, dialect, &opts, &a.output.join(&file))?;
@@ -157,13 +212,26 @@ pub fn run(a: &DemoArgs) -> Result<()> {
          img{image-rendering:pixelated;width:300px}</style><h1>prism gallery</h1>",
     );
     for e in &entries {
-        let _ = write!(html, "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>", e.file, e.caption, e.caption);
+        let _ = write!(
+            html,
+            "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
+            e.file, e.caption, e.caption
+        );
     }
     prism_image::write_atomic(&a.output.join("index.html"), |w| {
-        std::io::Write::write_all(w, html.as_bytes()).map_err(|source| prism_image::ImageError::Io { path: a.output.join("index.html"), source })
+        std::io::Write::write_all(w, html.as_bytes()).map_err(|source| {
+            prism_image::ImageError::Io {
+                path: a.output.join("index.html"),
+                source,
+            }
+        })
     })?;
     if !a.quiet {
-        eprintln!("wrote {} images and index.html to {}", entries.len(), a.output.display());
+        eprintln!(
+            "wrote {} images and index.html to {}",
+            entries.len(),
+            a.output.display()
+        );
     }
     Ok(())
 }

@@ -87,7 +87,10 @@ fn parse_view(s: &str) -> Result<View> {
         [cx, cy, span] if cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0 => {
             Ok(View::Region { cx, cy, span })
         }
-        _ => Err(UserError(format!("--view: expected CX,CY,SPAN with a positive span, found {s:?}")).into()),
+        _ => Err(UserError(format!(
+            "--view: expected CX,CY,SPAN with a positive span, found {s:?}"
+        ))
+        .into()),
     }
 }
 
@@ -124,7 +127,11 @@ fn ms(d: std::time::Duration) -> String {
 
 /// Renders one file; returns the warnings.
 fn render_one(input: &Path, output: &Path, a: &SvgArgs, view: Option<View>) -> Result<Vec<String>> {
-    let dialect = if a.compat.is_some() { Dialect::Cs184 } else { Dialect::Svg };
+    let dialect = if a.compat.is_some() {
+        Dialect::Cs184
+    } else {
+        Dialect::Svg
+    };
     let t0 = Instant::now();
     let doc = read_svg(input, dialect).map_err(|e| UserError(e.to_string()))?;
     let parse = t0.elapsed();
@@ -145,7 +152,8 @@ fn render_one(input: &Path, output: &Path, a: &SvgArgs, view: Option<View>) -> R
         view: view.unwrap_or_default(),
         compat: a.compat.is_some(),
     };
-    let (image, stats) = render(&doc, &opts).map_err(|e| UserError(format!("{}: {e}", input.display())))?;
+    let (image, stats) =
+        render(&doc, &opts).map_err(|e| UserError(format!("{}: {e}", input.display())))?;
     let t1 = Instant::now();
     if opts.compat {
         prism_image::write_png(output, &image.to_rgb8())
@@ -212,7 +220,8 @@ pub fn run(a: &SvgArgs) -> Result<()> {
         let rel = f.strip_prefix(&a.input).unwrap_or(f);
         let out = a.output.join(rel).with_extension("png");
         if let Some(parent) = out.parent() {
-            std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("creating {}", parent.display()))?;
         }
         match render_one(f, &out, a, view) {
             Ok(ws) => pb.suspend(|| warn(ws)),

@@ -99,9 +99,15 @@ mod tests {
         assert!(text.contains("channels\0chlist\0"));
         let table = b.len() - 2 * (8 + 36) - 16;
         for y in 0..2usize {
-            let off = u64::from_le_bytes(b[table + 8 * y..table + 8 * y + 8].try_into().unwrap()) as usize;
-            assert_eq!(i32::from_le_bytes(b[off..off + 4].try_into().unwrap()), y as i32);
-            let f = |i: usize| f32::from_le_bytes(b[off + 8 + 4 * i..off + 12 + 4 * i].try_into().unwrap());
+            let off = u64::from_le_bytes(b[table + 8 * y..table + 8 * y + 8].try_into().unwrap())
+                as usize;
+            assert_eq!(
+                i32::from_le_bytes(b[off..off + 4].try_into().unwrap()),
+                y as i32
+            );
+            let f = |i: usize| {
+                f32::from_le_bytes(b[off + 8 + 4 * i..off + 12 + 4 * i].try_into().unwrap())
+            };
             // B channel first, then G, then R.
             assert_eq!((f(0), f(3), f(6)), (0.5, y as f32, 0.0));
             assert_eq!(f(8), 2.0);

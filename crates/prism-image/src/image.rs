@@ -80,7 +80,10 @@ impl<T: Copy> Image<T> {
     /// If `(x, y)` is outside the image.
     #[must_use]
     pub fn get(&self, x: u32, y: u32) -> T {
-        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) out of range");
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) out of range"
+        );
         self.pixels[y as usize * self.width as usize + x as usize]
     }
 
@@ -89,7 +92,10 @@ impl<T: Copy> Image<T> {
     /// # Panics
     /// If `(x, y)` is outside the image.
     pub fn set(&mut self, x: u32, y: u32, value: T) {
-        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) out of range");
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) out of range"
+        );
         self.pixels[y as usize * self.width as usize + x as usize] = value;
     }
 
@@ -141,7 +147,8 @@ impl Image<[u8; 4]> {
     pub fn over_background(&self, bg: [u8; 3]) -> Rgb8Image {
         self.map(|p| {
             let a = u32::from(p[3]);
-            let mix = |c: u8, b: u8| ((u32::from(c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8;
+            let mix =
+                |c: u8, b: u8| ((u32::from(c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8;
             [mix(p[0], bg[0]), mix(p[1], bg[1]), mix(p[2], bg[2])]
         })
     }

@@ -44,7 +44,9 @@ pub fn decode_png(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
     };
     check_size(what, u64::from(w), u64::from(h))?;
     let mut buf = vec![0u8; reader.output_buffer_size()];
-    let frame = reader.next_frame(&mut buf).map_err(|e| decode_err(what, e))?;
+    let frame = reader
+        .next_frame(&mut buf)
+        .map_err(|e| decode_err(what, e))?;
     let data = &buf[..frame.buffer_size()];
     let n = w as usize * h as usize;
     let stride = frame.line_size;
@@ -59,7 +61,9 @@ pub fn decode_png(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
                     [g, g, g, a]
                 }
                 png::ColorType::Rgb => [row[3 * x], row[3 * x + 1], row[3 * x + 2], 255],
-                png::ColorType::Rgba => [row[4 * x], row[4 * x + 1], row[4 * x + 2], row[4 * x + 3]],
+                png::ColorType::Rgba => {
+                    [row[4 * x], row[4 * x + 1], row[4 * x + 2], row[4 * x + 3]]
+                }
                 png::ColorType::Indexed => {
                     return Err(decode_err(what, "palette was not expanded"));
                 }
@@ -103,7 +107,10 @@ pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
             .collect(),
     };
     if pixels.len() != n {
-        return Err(decode_err(what, "pixel data is shorter than the header says"));
+        return Err(decode_err(
+            what,
+            "pixel data is shorter than the header says",
+        ));
     }
     Ok(Rgba8Image::from_vec(
         u32::from(info.width),
@@ -173,7 +180,13 @@ fn encode_png_channels(
 pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
     let mut out = Vec::new();
     let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
-    encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgb, &mut out)?;
+    encode_png_channels(
+        image.width(),
+        image.height(),
+        &flat,
+        png::ColorType::Rgb,
+        &mut out,
+    )?;
     Ok(out)
 }
 
@@ -195,7 +208,13 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
 pub fn write_png_rgba(path: &Path, image: &Rgba8Image) -> Result<(), ImageError> {
     let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
     write_atomic(path, |w| {
-        encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgba, w)
+        encode_png_channels(
+            image.width(),
+            image.height(),
+            &flat,
+            png::ColorType::Rgba,
+            w,
+        )
     })
 }
 
@@ -225,12 +244,10 @@ pub fn write_atomic(
         let file = File::create(&tmp).map_err(io_err(&tmp))?;
         let mut w = BufWriter::new(file);
         write(&mut w)?;
-        let file = w
-            .into_inner()
-            .map_err(|e| ImageError::Io {
-                path: tmp.clone(),
-                source: e.into_error(),
-            })?;
+        let file = w.into_inner().map_err(|e| ImageError::Io {
+            path: tmp.clone(),
+            source: e.into_error(),
+        })?;
         file.sync_all().map_err(io_err(&tmp))?;
         std::fs::rename(&tmp, path).map_err(io_err(path))
     })();
@@ -277,13 +294,18 @@ mod tests {
         });
         assert!(r.is_err());
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "temp file left behind");
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            1,
+            "temp file left behind"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn reads_staged_palette_and_grey_alpha_pngs() {
-        let img = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/rasterizer/img");
+        let img =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/rasterizer/img");
         if !img.exists() {
             return;
         }

@@ -217,7 +217,9 @@ impl Texture {
                 let d = self.level_for(duv_dx, duv_dy);
                 self.sample_level(uv, d.round() as usize, pixel)
             }
-            LevelSampling::Linear => self.sample_at_level(uv, self.level_for(duv_dx, duv_dy), pixel),
+            LevelSampling::Linear => {
+                self.sample_at_level(uv, self.level_for(duv_dx, duv_dy), pixel)
+            }
         }
     }
 
@@ -226,7 +228,11 @@ impl Texture {
     #[must_use]
     pub fn sample_at_level(&self, uv: Vec2, d: f32, pixel: PixelSampling) -> Rgb {
         let max = (self.levels.len() - 1) as f32;
-        let d = if d.is_finite() { d.clamp(0.0, max) } else { 0.0 };
+        let d = if d.is_finite() {
+            d.clamp(0.0, max)
+        } else {
+            0.0
+        };
         let lo = d.floor();
         let t = d - lo;
         let lo = lo as usize;
@@ -275,7 +281,11 @@ mod tests {
             for p in l.pixels() {
                 assert!(close(*p, c, 1e-6), "level {k}");
             }
-            for uv in [Vec2::new(0.0, 0.0), Vec2::new(0.31, 0.77), Vec2::new(1.0, 1.0)] {
+            for uv in [
+                Vec2::new(0.0, 0.0),
+                Vec2::new(0.31, 0.77),
+                Vec2::new(1.0, 1.0),
+            ] {
                 for m in [PixelSampling::Nearest, PixelSampling::Bilinear] {
                     assert!(close(t.sample_level(uv, k, m), c, 1e-6));
                 }
@@ -329,7 +339,9 @@ mod tests {
     /// Property: the box filter preserves the mean of an odd-sized image exactly.
     #[test]
     fn odd_sizes_preserve_mean() {
-        let im = Image::from_fn(7, 5, |x, y| Rgb::splat(((x * 13 + y * 7) % 11) as f32 / 10.0));
+        let im = Image::from_fn(7, 5, |x, y| {
+            Rgb::splat(((x * 13 + y * 7) % 11) as f32 / 10.0)
+        });
         let mean = |im: &RgbImage| {
             im.pixels().iter().map(|p| p.r as f64).sum::<f64>() / im.pixels().len() as f64
         };
@@ -342,7 +354,9 @@ mod tests {
     /// Closed form: trilinear at level 1.5 is the average of levels 1 and 2.
     #[test]
     fn trilinear_midpoint_is_average_of_levels() {
-        let im = Image::from_fn(32, 32, |x, y| Rgb::new(x as f32 / 31.0, y as f32 / 31.0, 0.3));
+        let im = Image::from_fn(32, 32, |x, y| {
+            Rgb::new(x as f32 / 31.0, y as f32 / 31.0, 0.3)
+        });
         let t = Texture::new(im);
         let uv = Vec2::new(0.37, 0.61);
         let a = t.sample_level(uv, 1, PixelSampling::Bilinear);
@@ -351,7 +365,13 @@ mod tests {
         assert!(close(m, (a + b) * 0.5, 1e-6));
         // Derivatives of 2^1.5 texels per pixel select level 1.5.
         let d = 2f32.powf(1.5) / 32.0;
-        let s = t.sample(uv, Vec2::new(d, 0.0), Vec2::new(0.0, d), PixelSampling::Bilinear, LevelSampling::Linear);
+        let s = t.sample(
+            uv,
+            Vec2::new(d, 0.0),
+            Vec2::new(0.0, d),
+            PixelSampling::Bilinear,
+            LevelSampling::Linear,
+        );
         assert!(close(s, (a + b) * 0.5, 1e-5));
     }
 
@@ -359,7 +379,10 @@ mod tests {
     fn level_selection_closed_form() {
         let t = Texture::new(Image::new(64, 64, Rgb::WHITE));
         assert_eq!(t.level_for(Vec2::new(1.0 / 64.0, 0.0), Vec2::ZERO), 0.0);
-        assert!((t.level_for(Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)) - 2.0).abs() < 1e-6);
+        assert!(
+            (t.level_for(Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)) - 2.0).abs()
+                < 1e-6
+        );
         assert_eq!(t.level_for(Vec2::new(1e9, 0.0), Vec2::ZERO), 6.0);
         assert_eq!(t.level_for(Vec2::new(f32::NAN, 0.0), Vec2::ZERO), 0.0);
     }
@@ -374,15 +397,37 @@ mod tests {
             assert_eq!(t.sample_level(uv, 0, PixelSampling::Nearest).r, k as f32);
             assert!((t.sample_level(uv, 0, PixelSampling::Bilinear).r - k as f32).abs() < 1e-6);
         }
-        assert!((t.sample_level(Vec2::new(0.125, 0.5), 0, PixelSampling::Bilinear).r - 0.5).abs() < 1e-6);
+        assert!(
+            (t.sample_level(Vec2::new(0.125, 0.5), 0, PixelSampling::Bilinear)
+                .r
+                - 0.5)
+                .abs()
+                < 1e-6
+        );
     }
 
     #[test]
     fn nearest_clamps_to_edge() {
         let t = Texture::new(Image::from_fn(4, 1, |x, _| Rgb::splat(x as f32)));
-        assert_eq!(t.sample_level(Vec2::new(-3.0, 0.5), 0, PixelSampling::Nearest).r, 0.0);
-        assert_eq!(t.sample_level(Vec2::new(0.3, 0.5), 0, PixelSampling::Nearest).r, 1.0);
-        assert_eq!(t.sample_level(Vec2::new(9.0, 0.5), 0, PixelSampling::Nearest).r, 3.0);
-        assert_eq!(t.sample_level(Vec2::new(1.0, 0.5), 0, PixelSampling::Bilinear).r, 3.0);
+        assert_eq!(
+            t.sample_level(Vec2::new(-3.0, 0.5), 0, PixelSampling::Nearest)
+                .r,
+            0.0
+        );
+        assert_eq!(
+            t.sample_level(Vec2::new(0.3, 0.5), 0, PixelSampling::Nearest)
+                .r,
+            1.0
+        );
+        assert_eq!(
+            t.sample_level(Vec2::new(9.0, 0.5), 0, PixelSampling::Nearest)
+                .r,
+            3.0
+        );
+        assert_eq!(
+            t.sample_level(Vec2::new(1.0, 0.5), 0, PixelSampling::Bilinear)
+                .r,
+            3.0
+        );
     }
 }

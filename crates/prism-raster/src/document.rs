@@ -51,13 +51,27 @@ impl Mat3 {
     /// Skew along x by `deg` degrees.
     #[must_use]
     pub fn skew_x(deg: f64) -> Mat3 {
-        Mat3::affine(1.0, 0.0, (deg * std::f64::consts::PI / 180.0).tan(), 1.0, 0.0, 0.0)
+        Mat3::affine(
+            1.0,
+            0.0,
+            (deg * std::f64::consts::PI / 180.0).tan(),
+            1.0,
+            0.0,
+            0.0,
+        )
     }
 
     /// Skew along y by `deg` degrees.
     #[must_use]
     pub fn skew_y(deg: f64) -> Mat3 {
-        Mat3::affine(1.0, (deg * std::f64::consts::PI / 180.0).tan(), 0.0, 1.0, 0.0, 0.0)
+        Mat3::affine(
+            1.0,
+            (deg * std::f64::consts::PI / 180.0).tan(),
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+        )
     }
 
     /// The product `self * rhs` (apply `rhs` first).

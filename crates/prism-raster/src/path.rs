@@ -106,7 +106,11 @@ impl Path {
 
     /// Adds a quadratic Bezier from `from` as its exact cubic equivalent.
     pub fn quad_to(&mut self, from: DVec2, c: DVec2, p: DVec2) {
-        self.cubic_to(from + (c - from) * (2.0 / 3.0), p + (c - p) * (2.0 / 3.0), p);
+        self.cubic_to(
+            from + (c - from) * (2.0 / 3.0),
+            p + (c - p) * (2.0 / 3.0),
+            p,
+        );
     }
 
     /// Closes the current subpath.
@@ -183,7 +187,11 @@ impl Path {
         // Step 2: compute (cx', cy')
         let num = rx * rx * ry * ry - rx * rx * y1p * y1p - ry * ry * x1p * x1p;
         let den = rx * rx * y1p * y1p + ry * ry * x1p * x1p;
-        let mut coef = if den == 0.0 { 0.0 } else { (num / den).max(0.0).sqrt() };
+        let mut coef = if den == 0.0 {
+            0.0
+        } else {
+            (num / den).max(0.0).sqrt()
+        };
         if large_arc == sweep {
             coef = -coef;
         }
@@ -309,13 +317,20 @@ impl Path {
 }
 
 fn flatten_cubic(p0: DVec2, p1: DVec2, p2: DVec2, p3: DVec2, tol: f64, out: &mut Vec<DVec2>) {
-    let dd = (p0 - 2.0 * p1 + p2).length().max((p1 - 2.0 * p2 + p3).length());
+    let dd = (p0 - 2.0 * p1 + p2)
+        .length()
+        .max((p1 - 2.0 * p2 + p3).length());
     let n = (0.75 * dd / tol.max(1e-9)).sqrt().ceil();
-    let n = if n.is_finite() { n.clamp(1.0, 4096.0) as usize } else { 1 };
+    let n = if n.is_finite() {
+        n.clamp(1.0, 4096.0) as usize
+    } else {
+        1
+    };
     for i in 1..=n {
         let t = i as f64 / n as f64;
         let u = 1.0 - t;
-        let p = p0 * (u * u * u) + p1 * (3.0 * u * u * t) + p2 * (3.0 * u * t * t) + p3 * (t * t * t);
+        let p =
+            p0 * (u * u * u) + p1 * (3.0 * u * u * t) + p2 * (3.0 * u * t * t) + p3 * (t * t * t);
         out.push(if i == n { p3 } else { p });
     }
 }
@@ -539,7 +554,9 @@ mod tests {
         let mut hits = 0usize;
         for j in 0..n {
             for i in 0..n {
-                let p = lo + (hi - lo) * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+                let p = lo
+                    + (hi - lo)
+                        * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
                 let mut wind = 0i32;
                 for poly in polys {
                     for k in 0..poly.len() {
@@ -567,12 +584,23 @@ mod tests {
             points: vec![DVec2::new(0.0, 0.0), DVec2::new(10.0, 0.0)],
             closed: false,
         };
-        let polys = stroke(&[line.clone()], &StrokeStyle { width: 2.0, ..Default::default() }, 0.01);
+        let polys = stroke(
+            std::slice::from_ref(&line),
+            &StrokeStyle {
+                width: 2.0,
+                ..Default::default()
+            },
+            0.01,
+        );
         let a = area_of_union_estimate(&polys, DVec2::new(-3.0, -3.0), DVec2::new(13.0, 3.0), 400);
         assert!((a - 20.0).abs() < 0.3, "area {a}");
         let polys = stroke(
             &[line],
-            &StrokeStyle { width: 2.0, cap: LineCap::Round, ..Default::default() },
+            &StrokeStyle {
+                width: 2.0,
+                cap: LineCap::Round,
+                ..Default::default()
+            },
             0.001,
         );
         let a = area_of_union_estimate(&polys, DVec2::new(-3.0, -3.0), DVec2::new(13.0, 3.0), 400);
@@ -591,7 +619,14 @@ mod tests {
             ],
             closed: true,
         };
-        let polys = stroke(&[sq], &StrokeStyle { width: 2.0, ..Default::default() }, 0.01);
+        let polys = stroke(
+            &[sq],
+            &StrokeStyle {
+                width: 2.0,
+                ..Default::default()
+            },
+            0.01,
+        );
         let a = area_of_union_estimate(&polys, DVec2::new(-2.0, -2.0), DVec2::new(12.0, 12.0), 560);
         assert!((a - (144.0 - 64.0)).abs() < 0.3, "area {a}");
     }
@@ -610,19 +645,29 @@ mod tests {
             assert!((q.length() - 10.0).abs() < 5e-3, "{q}");
         }
         // Large sweep arc covers three quarters: passes through (0, 10) and (-10, 0).
-        assert!(pts.iter().any(|q| (*q - DVec2::new(-10.0, 0.0)).length() < 0.05));
+        assert!(pts
+            .iter()
+            .any(|q| (*q - DVec2::new(-10.0, 0.0)).length() < 0.05));
     }
 
     /// Closed form: flattening error of a cubic stays within tolerance of the true curve.
     #[test]
     fn flatten_error_bound() {
-        let (p0, p1, p2, p3) = (DVec2::ZERO, DVec2::new(0.0, 100.0), DVec2::new(100.0, 100.0), DVec2::new(100.0, 0.0));
+        let (p0, p1, p2, p3) = (
+            DVec2::ZERO,
+            DVec2::new(0.0, 100.0),
+            DVec2::new(100.0, 100.0),
+            DVec2::new(100.0, 0.0),
+        );
         let mut out = vec![p0];
         flatten_cubic(p0, p1, p2, p3, 0.1, &mut out);
         for k in 0..1000 {
             let t = k as f64 / 999.0;
             let u = 1.0 - t;
-            let b = p0 * (u * u * u) + p1 * (3.0 * u * u * t) + p2 * (3.0 * u * t * t) + p3 * (t * t * t);
+            let b = p0 * (u * u * u)
+                + p1 * (3.0 * u * u * t)
+                + p2 * (3.0 * u * t * t)
+                + p3 * (t * t * t);
             let d = out
                 .windows(2)
                 .map(|w| {
@@ -642,7 +687,10 @@ mod tests {
             closed: false,
         };
         let d = dash(&[line], &[3.0, 1.0], 0.0);
-        let xs: Vec<(f64, f64)> = d.iter().map(|l| (l.points[0].x, l.points.last().unwrap().x)).collect();
+        let xs: Vec<(f64, f64)> = d
+            .iter()
+            .map(|l| (l.points[0].x, l.points.last().unwrap().x))
+            .collect();
         assert_eq!(xs, vec![(0.0, 3.0), (4.0, 7.0), (8.0, 10.0)]);
     }
 }

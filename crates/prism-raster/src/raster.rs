@@ -110,7 +110,7 @@ pub struct RenderStats {
 #[must_use]
 pub fn sample_rate(samples: u32) -> Option<u32> {
     let r = (f64::from(samples)).sqrt().round() as u32;
-    (samples >= 1 && samples <= MAX_SAMPLES && r * r == samples).then_some(r)
+    ((1..=MAX_SAMPLES).contains(&samples) && r * r == samples).then_some(r)
 }
 
 /// The transform from document user space to output pixels for these options.
@@ -220,7 +220,11 @@ impl DevPaint {
                             (p - start).dot(d) / l2
                         }
                     }
-                    GradientKind::Radial { center, radius, focus } => radial_t(p, center, radius, focus),
+                    GradientKind::Radial {
+                        center,
+                        radius,
+                        focus,
+                    } => radial_t(p, center, radius, focus),
                 };
                 let t = match g.spread {
                     Spread::Pad => t.clamp(0.0, 1.0),
@@ -241,11 +245,21 @@ impl DevPaint {
                     let s = stops[stops.len() - 1];
                     (s.color, s.opacity)
                 } else {
-                    let k = stops.windows(2).position(|w| t >= w[0].offset && t <= w[1].offset).unwrap_or(0);
+                    let k = stops
+                        .windows(2)
+                        .position(|w| t >= w[0].offset && t <= w[1].offset)
+                        .unwrap_or(0);
                     let (s0, s1) = (stops[k], stops[k + 1]);
                     let span = s1.offset - s0.offset;
-                    let f = if span > 0.0 { (t - s0.offset) / span } else { 1.0 };
-                    (s0.color.lerp(s1.color, f), s0.opacity + (s1.opacity - s0.opacity) * f)
+                    let f = if span > 0.0 {
+                        (t - s0.offset) / span
+                    } else {
+                        1.0
+                    };
+                    (
+                        s0.color.lerp(s1.color, f),
+                        s0.opacity + (s1.opacity - s0.opacity) * f,
+                    )
                 };
                 let a = a * opacity;
                 [c.r * a, c.g * a, c.b * a, a]
@@ -390,7 +404,15 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             return None;
         }
         let (y0, y1) = rows(lo.y, hi.y)?;
-        Some(Placed { y0, y1, prim: Prim::Tri { v, inclusive, shade } })
+        Some(Placed {
+            y0,
+            y1,
+            prim: Prim::Tri {
+                v,
+                inclusive,
+                shade,
+            },
+        })
     };
     let place_poly = |edges: Vec<Edge>, rule: FillRule, paint: DevPaint| -> Option<Placed> {
         if edges.is_empty() {
@@ -399,7 +421,11 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         let lo = edges.iter().map(|e| e.y0).fold(f64::INFINITY, f64::min);
         let hi = edges.iter().map(|e| e.y1).fold(f64::NEG_INFINITY, f64::max);
         let (y0, y1) = rows(lo, hi)?;
-        Some(Placed { y0, y1, prim: Prim::Poly { edges, rule, paint } })
+        Some(Placed {
+            y0,
+            y1,
+            prim: Prim::Poly { edges, rule, paint },
+        })
     };
     let dev_paint = |paint: &Paint, m: &Mat3, opacity: f32| -> Option<DevPaint> {
         match paint {
@@ -410,7 +436,11 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 if det == 0.0 || !det.is_finite() {
                     return None;
                 }
-                Some(DevPaint::Gradient { g: g.clone(), inv: full.inverse(), opacity })
+                Some(DevPaint::Gradient {
+                    g: g.clone(),
+                    inv: full.inverse(),
+                    opacity,
+                })
             }
         }
     };
@@ -428,7 +458,15 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             let dy = (du2 * e1.x as f32 - du1 * e2.x as f32) * inv as f32;
             (dx, dy)
         };
-        TriShade::Tex { tex: tex.clone(), uvs, duv_dx, duv_dy, psm, lsm, alpha }
+        TriShade::Tex {
+            tex: tex.clone(),
+            uvs,
+            duv_dx,
+            duv_dy,
+            psm,
+            lsm,
+            alpha,
+        }
     };
     // Device vertices as the course computes them: mapped in f64, passed on as f32.
     let dev = |m: &Mat3, p: DVec2| {
@@ -442,25 +480,45 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
     let per_item = |item: &Item| -> Vec<Placed> {
         let mut out = Vec::new();
         match item {
-            Item::Triangles { tris, transform, color } => {
+            Item::Triangles {
+                tris,
+                transform,
+                color,
+            } => {
                 let m = view.mul(transform);
                 for t in tris {
                     let v = [dev(&m, t[0]), dev(&m, t[1]), dev(&m, t[2])];
                     out.extend(place_tri(v, true, TriShade::Solid(solid(*color, 1.0))));
                 }
             }
-            Item::Fill { path, transform, rule, paint, opacity } => {
+            Item::Fill {
+                path,
+                transform,
+                rule,
+                paint,
+                opacity,
+            } => {
                 let m = view.mul(transform);
-                let Some(paint) = dev_paint(paint, &m, *opacity) else { return out };
+                let Some(paint) = dev_paint(paint, &m, *opacity) else {
+                    return out;
+                };
                 let dpath: Path = path.transformed(&m.to_affine());
                 let lines = dpath.flatten(TOLERANCE);
                 let mut edges = Vec::new();
                 edges_of(lines.into_iter().map(|l| l.points), true, &mut edges);
                 out.extend(place_poly(edges, *rule, paint));
             }
-            Item::Stroke { path, transform, style, paint, opacity } => {
+            Item::Stroke {
+                path,
+                transform,
+                style,
+                paint,
+                opacity,
+            } => {
                 let m = view.mul(transform);
-                let Some(paint) = dev_paint(paint, &m, *opacity) else { return out };
+                let Some(paint) = dev_paint(paint, &m, *opacity) else {
+                    return out;
+                };
                 let affine = m.to_affine();
                 let scale = m.max_scale();
                 if !(scale > 0.0 && scale.is_finite()) {
@@ -470,13 +528,21 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 let polys = stroke(&path.flatten(tol), style, tol);
                 let mut edges = Vec::new();
                 edges_of(
-                    polys.into_iter().map(|p| p.into_iter().map(|q| affine.transform_point2(q)).collect()),
+                    polys
+                        .into_iter()
+                        .map(|p| p.into_iter().map(|q| affine.transform_point2(q)).collect()),
                     true,
                     &mut edges,
                 );
                 out.extend(place_poly(edges, FillRule::NonZero, paint));
             }
-            Item::Hairline { points, closed, transform, color, opacity } => {
+            Item::Hairline {
+                points,
+                closed,
+                transform,
+                color,
+                opacity,
+            } => {
                 let m = view.mul(transform);
                 let n = points.len();
                 let segs = if *closed { n } else { n.saturating_sub(1) };
@@ -487,45 +553,111 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                     dda(x0, y0, x1, y1, &mut px);
                 }
                 px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
-                if let (Some(lo), Some(hi)) = (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max()) {
-                    out.push(Placed { y0: lo, y1: hi + 1, prim: Prim::Pixels { px, color: solid(*color, *opacity) } });
+                if let (Some(lo), Some(hi)) =
+                    (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max())
+                {
+                    out.push(Placed {
+                        y0: lo,
+                        y1: hi + 1,
+                        prim: Prim::Pixels {
+                            px,
+                            color: solid(*color, *opacity),
+                        },
+                    });
                 }
             }
-            Item::Point { at, transform, color } => {
+            Item::Point {
+                at,
+                transform,
+                color,
+            } => {
                 let m = view.mul(transform);
                 let (x, y) = to_f32(m.apply(*at));
                 let (sx, sy) = (x.floor(), y.floor());
                 if sx >= 0.0 && sy >= 0.0 && sx < opts.width as f32 && sy < opts.height as f32 {
                     let (sx, sy) = (sx as i32, sy as i32);
-                    out.push(Placed { y0: sy, y1: sy + 1, prim: Prim::Pixels { px: vec![(sx, sy)], color: solid(*color, 1.0) } });
+                    out.push(Placed {
+                        y0: sy,
+                        y1: sy + 1,
+                        prim: Prim::Pixels {
+                            px: vec![(sx, sy)],
+                            color: solid(*color, 1.0),
+                        },
+                    });
                 }
             }
-            Item::ColorTri { points, colors, transform } => {
+            Item::ColorTri {
+                points,
+                colors,
+                transform,
+            } => {
                 let m = view.mul(transform);
                 let v = [dev(&m, points[0]), dev(&m, points[1]), dev(&m, points[2])];
                 out.extend(place_tri(v, opts.compat, TriShade::Color(*colors)));
             }
-            Item::TexTri { points, uvs, texture, transform } => {
+            Item::TexTri {
+                points,
+                uvs,
+                texture,
+                transform,
+            } => {
                 let m = view.mul(transform);
                 let v = [dev(&m, points[0]), dev(&m, points[1]), dev(&m, points[2])];
-                let shade = tex_shade(&doc.textures[*texture], v, *uvs, opts.pixel_sampling, opts.level_sampling, 1.0);
+                let shade = tex_shade(
+                    &doc.textures[*texture],
+                    v,
+                    *uvs,
+                    opts.pixel_sampling,
+                    opts.level_sampling,
+                    1.0,
+                );
                 out.extend(place_tri(v, opts.compat, shade));
             }
-            Item::Image { texture, rect, transform, opacity } => {
+            Item::Image {
+                texture,
+                rect,
+                transform,
+                opacity,
+            } => {
                 let m = view.mul(transform);
                 let [x, y, w, h] = *rect;
-                let c = [DVec2::new(x, y), DVec2::new(x + w, y), DVec2::new(x, y + h), DVec2::new(x + w, y + h)];
+                let c = [
+                    DVec2::new(x, y),
+                    DVec2::new(x + w, y),
+                    DVec2::new(x, y + h),
+                    DVec2::new(x + w, y + h),
+                ];
                 let d = c.map(|p| dev(&m, p));
-                let uv = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)];
+                let uv = [
+                    Vec2::new(0.0, 0.0),
+                    Vec2::new(1.0, 0.0),
+                    Vec2::new(0.0, 1.0),
+                    Vec2::new(1.0, 1.0),
+                ];
                 let tex = &doc.textures[*texture];
                 for (a, b, cc) in [(0, 1, 2), (2, 1, 3)] {
                     let v = [d[a], d[b], d[cc]];
-                    let shade = tex_shade(tex, v, [uv[a], uv[b], uv[cc]], PixelSampling::Bilinear, LevelSampling::Linear, *opacity);
+                    let shade = tex_shade(
+                        tex,
+                        v,
+                        [uv[a], uv[b], uv[cc]],
+                        PixelSampling::Bilinear,
+                        LevelSampling::Linear,
+                        *opacity,
+                    );
                     out.extend(place_tri(v, opts.compat, shade));
                 }
             }
-            Item::BeginLayer => out.push(Placed { y0: 0, y1: h, prim: Prim::BeginLayer }),
-            Item::EndLayer { opacity } => out.push(Placed { y0: 0, y1: h, prim: Prim::EndLayer(*opacity) }),
+            Item::BeginLayer => out.push(Placed {
+                y0: 0,
+                y1: h,
+                prim: Prim::BeginLayer,
+            }),
+            Item::EndLayer { opacity } => out.push(Placed {
+                y0: 0,
+                y1: h,
+                prim: Prim::EndLayer(*opacity),
+            }),
         }
         out
     };
@@ -546,7 +678,14 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         }
         px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
         if !px.is_empty() {
-            prims.push(Placed { y0: 0, y1: h, prim: Prim::Pixels { px, color: [0.0, 0.0, 0.0, 1.0] } });
+            prims.push(Placed {
+                y0: 0,
+                y1: h,
+                prim: Prim::Pixels {
+                    px,
+                    color: [0.0, 0.0, 0.0, 1.0],
+                },
+            });
         }
     }
     prims
@@ -642,7 +781,11 @@ impl Band {
                 }
             }
             Prim::Poly { edges, rule, paint } => self.poly(edges, *rule, paint),
-            Prim::Tri { v, inclusive, shade } => self.tri(v, *inclusive, shade, compat),
+            Prim::Tri {
+                v,
+                inclusive,
+                shade,
+            } => self.tri(v, *inclusive, shade, compat),
         }
     }
 
@@ -650,7 +793,11 @@ impl Band {
         let r = self.r;
         let band_lo = f64::from(self.y0);
         let band_hi = f64::from(self.y0 + self.rows_px);
-        let local: Vec<Edge> = edges.iter().filter(|e| e.y1 > band_lo && e.y0 < band_hi).copied().collect();
+        let local: Vec<Edge> = edges
+            .iter()
+            .filter(|e| e.y1 > band_lo && e.y0 < band_hi)
+            .copied()
+            .collect();
         if local.is_empty() {
             return;
         }
@@ -708,7 +855,8 @@ impl Band {
         let hi = v[0].max(v[1]).max(v[2]);
         // Sample index ranges covering the bounding box, clipped to the band.
         let j_lo = (((lo.y - f64::from(self.y0)) * rf - 0.5).ceil().max(0.0)) as usize;
-        let j_hi = ((((hi.y - f64::from(self.y0)) * rf - 0.5).floor() + 1.0).clamp(0.0, (self.rows_px as usize * r) as f64)) as usize;
+        let j_hi = ((((hi.y - f64::from(self.y0)) * rf - 0.5).floor() + 1.0)
+            .clamp(0.0, (self.rows_px as usize * r) as f64)) as usize;
         let i_lo = ((lo.x * rf - 0.5).ceil().max(0.0)) as usize;
         let i_hi = (((hi.x * rf - 0.5).floor() + 1.0).clamp(0.0, self.cols as f64)) as usize;
         if j_lo >= j_hi || i_lo >= i_hi {
@@ -716,7 +864,8 @@ impl Band {
         }
         let area = (v[1] - v[0]).perp_dot(v[2] - v[0]);
         // Edge function of edge a->b at p; positive inside for counter-clockwise (area > 0).
-        let ef = |a: DVec2, b: DVec2, x: f64, y: f64| (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+        let ef =
+            |a: DVec2, b: DVec2, x: f64, y: f64| (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
         let sign = if area < 0.0 { -1.0 } else { 1.0 };
         // Top-left rule: an edge owns its samples if it is a "top" or "left" edge.
         let owns = |a: DVec2, b: DVec2| {
@@ -725,7 +874,11 @@ impl Band {
             (d.y == 0.0 && d.x < 0.0) || d.y > 0.0
         };
         let edges = [(v[1], v[2]), (v[2], v[0]), (v[0], v[1])];
-        let own = [owns(edges[0].0, edges[0].1), owns(edges[1].0, edges[1].1), owns(edges[2].0, edges[2].1)];
+        let own = [
+            owns(edges[0].0, edges[0].1),
+            owns(edges[1].0, edges[1].1),
+            owns(edges[2].0, edges[2].1),
+        ];
         if !inclusive && area == 0.0 {
             return;
         }
@@ -743,7 +896,8 @@ impl Band {
                     ef(edges[2].0, edges[2].1, x, yf),
                 ];
                 let inside = if inclusive {
-                    (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0) || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
+                    (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0)
+                        || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
                 } else {
                     (0..3).all(|k| {
                         let s = w[k] * sign;
@@ -756,13 +910,29 @@ impl Band {
                 let color = match shade {
                     TriShade::Solid(c) => *c,
                     TriShade::Color(c) => {
-                        let (b0, b1) = if area == 0.0 { (1.0, 0.0) } else { ((w[0] / area) as f32, (w[1] / area) as f32) };
+                        let (b0, b1) = if area == 0.0 {
+                            (1.0, 0.0)
+                        } else {
+                            ((w[0] / area) as f32, (w[1] / area) as f32)
+                        };
                         let b2 = 1.0 - b0 - b1;
                         let k = c[0] * b0 + c[1] * b1 + c[2] * b2;
                         [k.r, k.g, k.b, 1.0]
                     }
-                    TriShade::Tex { tex, uvs, duv_dx, duv_dy, psm, lsm, alpha } => {
-                        let (b0, b1) = if area == 0.0 { (1.0, 0.0) } else { ((w[0] / area) as f32, (w[1] / area) as f32) };
+                    TriShade::Tex {
+                        tex,
+                        uvs,
+                        duv_dx,
+                        duv_dy,
+                        psm,
+                        lsm,
+                        alpha,
+                    } => {
+                        let (b0, b1) = if area == 0.0 {
+                            (1.0, 0.0)
+                        } else {
+                            ((w[0] / area) as f32, (w[1] / area) as f32)
+                        };
                         let b2 = 1.0 - b0 - b1;
                         let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
                         let k = tex.sample(uv, *duv_dx, *duv_dy, *psm, *lsm);
@@ -817,7 +987,10 @@ impl Band {
 ///
 /// # Errors
 /// [`RenderError`] for an output size, sample count or view outside the documented limits.
-pub fn render(doc: &Document, opts: &RenderOptions) -> Result<(Rgba8Image, RenderStats), RenderError> {
+pub fn render(
+    doc: &Document,
+    opts: &RenderOptions,
+) -> Result<(Rgba8Image, RenderStats), RenderError> {
     let (w, h) = (opts.width, opts.height);
     if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
         return Err(RenderError::BadSize(w, h));
@@ -837,7 +1010,11 @@ pub fn render(doc: &Document, opts: &RenderOptions) -> Result<(Rgba8Image, Rende
     // About 4 MiB of samples per band.
     let band_rows = ((4usize << 20) / (cols * r * 16)).clamp(1, 64);
     let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
-    let background = if opts.compat { [1.0, 1.0, 1.0, 1.0] } else { [0.0; 4] };
+    let background = if opts.compat {
+        [1.0, 1.0, 1.0, 1.0]
+    } else {
+        [0.0; 4]
+    };
     let times: Vec<(Duration, Duration)> = pixels
         .par_chunks_mut(band_rows * w as usize)
         .enumerate()
@@ -867,7 +1044,9 @@ pub fn render(doc: &Document, opts: &RenderOptions) -> Result<(Rgba8Image, Rende
     let wall = t1.elapsed();
     let (rt, st): (Duration, Duration) = times
         .iter()
-        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| (a + *x, b + *y));
+        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| {
+            (a + *x, b + *y)
+        });
     let total = (rt + st).as_secs_f64().max(1e-12);
     let stats = RenderStats {
         prepare: prepare_time,

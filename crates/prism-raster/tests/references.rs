@@ -10,7 +10,13 @@ use prism_testkit::{compare_golden, shared_assets, workspace_root};
 /// becomes `-` (the letter c included).
 fn reference_name(rel: &str) -> String {
     rel.chars()
-        .map(|c| if "abdefghijklmnopqrstuvwxyz0123456789".contains(c) { c } else { '-' })
+        .map(|c| {
+            if "abdefghijklmnopqrstuvwxyz0123456789".contains(c) {
+                c
+            } else {
+                '-'
+            }
+        })
         .collect::<String>()
         + ".png"
 }
@@ -18,7 +24,14 @@ fn reference_name(rel: &str) -> String {
 fn staged_svgs() -> Vec<String> {
     let root = shared_assets().join("rasterizer");
     let mut out = Vec::new();
-    for dir in ["basic", "hardcore", "illustration", "subdiv", "texmap", "transforms"] {
+    for dir in [
+        "basic",
+        "hardcore",
+        "illustration",
+        "subdiv",
+        "texmap",
+        "transforms",
+    ] {
         let mut files: Vec<String> = std::fs::read_dir(root.join("svg").join(dir))
             .expect("staged svg folder")
             .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
@@ -38,26 +51,53 @@ fn cs184_references_reproduced() {
     let mut report = Vec::new();
     let mut failures = Vec::new();
     for rel in staged_svgs() {
-        let reference = root.join("tests/outputs/reference").join(reference_name(&rel));
-        assert!(reference.exists(), "missing reference {}", reference.display());
+        let reference = root
+            .join("tests/outputs/reference")
+            .join(reference_name(&rel));
+        assert!(
+            reference.exists(),
+            "missing reference {}",
+            reference.display()
+        );
         let doc = read_svg(&root.join(&rel), Dialect::Cs184).unwrap_or_else(|e| panic!("{e}"));
-        let opts = RenderOptions { compat: true, ..RenderOptions::default() };
+        let opts = RenderOptions {
+            compat: true,
+            ..RenderOptions::default()
+        };
         let (img, _) = render(&doc, &opts).expect("render");
         let name = rel.replace('/', "_");
         let result = std::panic::catch_unwind(|| {
-            compare_golden(&name, &reference, &img.to_rgb8(), false, |s| s.identical_fraction >= 0.999)
+            compare_golden(&name, &reference, &img.to_rgb8(), false, |s| {
+                s.identical_fraction >= 0.999
+            })
         });
         match result {
-            Ok(s) => report.push(format!("{rel}: {:.4}% identical, max error {}", 100.0 * s.identical_fraction, s.max_error)),
+            Ok(s) => report.push(format!(
+                "{rel}: {:.4}% identical, max error {}",
+                100.0 * s.identical_fraction,
+                s.max_error
+            )),
             Err(_) => {
-                let s = prism_image::compare_rgb8(&prism_image::read_png(&reference).unwrap().to_rgb8(), &img.to_rgb8()).unwrap();
-                report.push(format!("{rel}: {:.4}% identical, max error {} (FAIL)", 100.0 * s.identical_fraction, s.max_error));
+                let s = prism_image::compare_rgb8(
+                    &prism_image::read_png(&reference).unwrap().to_rgb8(),
+                    &img.to_rgb8(),
+                )
+                .unwrap();
+                report.push(format!(
+                    "{rel}: {:.4}% identical, max error {} (FAIL)",
+                    100.0 * s.identical_fraction,
+                    s.max_error
+                ));
                 failures.push(rel);
             }
         }
     }
     println!("{}", report.join("\n"));
-    assert!(failures.is_empty(), "below 99.9% identical: {failures:?}\n{}", report.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "below 99.9% identical: {failures:?}\n{}",
+        report.join("\n")
+    );
 }
 
 fn data_dir() -> std::path::PathBuf {
@@ -91,7 +131,8 @@ fn standard_svgs_agree_with_resvg() {
         let (img, _) = render(&doc, &opts).expect("render");
         let actual = img.over_background([255, 255, 255]);
         let expected_rgb = expected.over_background([255, 255, 255]);
-        let tmp = std::env::temp_dir().join(format!("prism-resvg-{stem}-{}.png", std::process::id()));
+        let tmp =
+            std::env::temp_dir().join(format!("prism-resvg-{stem}-{}.png", std::process::id()));
         prism_image::write_png(&tmp, &expected_rgb).expect("write");
         let s = compare_golden(&format!("resvg_{stem}"), &tmp, &actual, false, |s| {
             s.mean_abs_error <= 1.0 && s.over_24_fraction <= 0.005

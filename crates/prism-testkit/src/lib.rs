@@ -38,7 +38,10 @@ pub fn make_ref() -> bool {
 /// dimmed copy of the expected image.
 #[must_use]
 pub fn triptych(expected: &Rgb8Image, actual: &Rgb8Image) -> Rgb8Image {
-    let (w, h) = (expected.width().max(actual.width()), expected.height().max(actual.height()));
+    let (w, h) = (
+        expected.width().max(actual.width()),
+        expected.height().max(actual.height()),
+    );
     let get = |im: &Rgb8Image, x: u32, y: u32| {
         if x < im.width() && y < im.height() {
             Some(im.get(x, y))

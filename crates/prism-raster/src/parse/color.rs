@@ -22,10 +22,7 @@ pub(crate) fn parse_color(s: &str) -> Option<(Rgb, f32)> {
             8 => (byte(3), byte(2), byte(1), byte(0)),
             _ => return None,
         };
-        return Some((
-            Rgb::from_u8([r as u8, g as u8, b as u8]),
-            a as f32 / 255.0,
-        ));
+        return Some((Rgb::from_u8([r as u8, g as u8, b as u8]), a as f32 / 255.0));
     }
     let lower = t.to_ascii_lowercase();
     if let Some(args) = lower
@@ -69,7 +66,9 @@ pub(crate) fn parse_color(s: &str) -> Option<(Rgb, f32)> {
     if lower == "transparent" {
         return Some((Rgb::BLACK, 0.0));
     }
-    let i = NAMED.binary_search_by(|(n, _)| n.cmp(&lower.as_str())).ok()?;
+    let i = NAMED
+        .binary_search_by(|(n, _)| n.cmp(&lower.as_str()))
+        .ok()?;
     let v = NAMED[i].1;
     Some((
         Rgb::from_u8([(v >> 16) as u8, (v >> 8) as u8, v as u8]),
@@ -84,14 +83,35 @@ mod tests {
     #[test]
     fn all_css_forms() {
         let red = Rgb::new(1.0, 0.0, 0.0);
-        for s in ["#f00", "#ff0000", "rgb(255,0,0)", "rgb(100%, 0%, 0%)", "red", "RED", " Red "] {
+        for s in [
+            "#f00",
+            "#ff0000",
+            "rgb(255,0,0)",
+            "rgb(100%, 0%, 0%)",
+            "red",
+            "RED",
+            " Red ",
+        ] {
             assert_eq!(parse_color(s), Some((red, 1.0)), "{s}");
         }
         assert_eq!(parse_color("#ff000080").unwrap().1, 128.0 / 255.0);
-        assert_eq!(parse_color("rgba(0,0,255,0.5)"), Some((Rgb::new(0.0, 0.0, 1.0), 0.5)));
-        assert_eq!(parse_color("rebeccapurple"), Some((Rgb::from_u8([0x66, 0x33, 0x99]), 1.0)));
+        assert_eq!(
+            parse_color("rgba(0,0,255,0.5)"),
+            Some((Rgb::new(0.0, 0.0, 1.0), 0.5))
+        );
+        assert_eq!(
+            parse_color("rebeccapurple"),
+            Some((Rgb::from_u8([0x66, 0x33, 0x99]), 1.0))
+        );
         assert_eq!(parse_color("transparent").unwrap().1, 0.0);
-        for bad in ["#ff00", "#gg0000", "rgb(1,2)", "notacolor", "", "rgb(nan,0,0)"] {
+        for bad in [
+            "#ff00",
+            "#gg0000",
+            "rgb(1,2)",
+            "notacolor",
+            "",
+            "rgb(nan,0,0)",
+        ] {
             assert_eq!(parse_color(bad), None, "{bad}");
         }
     }

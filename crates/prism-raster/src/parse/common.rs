@@ -26,7 +26,11 @@ pub struct SvgError {
 
 impl fmt::Display for SvgError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}: {}: {}", self.file, self.line, self.element, self.message)
+        write!(
+            f,
+            "{}:{}: {}: {}",
+            self.file, self.line, self.element, self.message
+        )
     }
 }
 
@@ -110,7 +114,12 @@ pub(crate) fn to_num(s: &str, p: Precision) -> Option<f64> {
 }
 
 /// Reads a whole list of numbers separated by whitespace and/or single commas.
-pub(crate) fn number_list(s: &str, p: Precision, loc: &Loc, attr: &str) -> Result<Vec<f64>, SvgError> {
+pub(crate) fn number_list(
+    s: &str,
+    p: Precision,
+    loc: &Loc,
+    attr: &str,
+) -> Result<Vec<f64>, SvgError> {
     let mut out = Vec::new();
     let mut rest = s.trim_start();
     while !rest.is_empty() {
@@ -263,14 +272,18 @@ mod tests {
         let l = number_list("10,20 30-40 .5.5", Precision::F64, &loc(), "points").unwrap();
         assert_eq!(l, vec![10.0, 20.0, 30.0, -40.0, 0.5, 0.5]);
         let e = number_list("1 2 x", Precision::F64, &loc(), "points").unwrap_err();
-        assert_eq!(e.to_string(), "t.svg:3: rect: points: expected a number, found \"x\"");
+        assert_eq!(
+            e.to_string(),
+            "t.svg:3: rect: points: expected a number, found \"x\""
+        );
         assert!(number_list("1e999", Precision::F64, &loc(), "points").is_err());
     }
 
     /// Closed form: composite transforms apply right to left to points.
     #[test]
     fn transform_lists_compose_in_document_order() {
-        let m = parse_transform("translate(10 20) scale(2)", Precision::F64, &loc(), false).unwrap();
+        let m =
+            parse_transform("translate(10 20) scale(2)", Precision::F64, &loc(), false).unwrap();
         assert_eq!(m.apply(DVec2::new(1.0, 1.0)), DVec2::new(12.0, 22.0));
         let m = parse_transform("scale(2)", Precision::F64, &loc(), true).unwrap();
         assert_eq!(m.apply(DVec2::new(1.0, 1.0)), DVec2::new(2.0, 1.0));

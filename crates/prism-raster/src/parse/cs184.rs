@@ -8,7 +8,9 @@ use std::collections::HashMap;
 use prism_math::{DVec2, Rgb, Vec2};
 use roxmltree::Node;
 
-use super::common::{number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS};
+use super::common::{
+    number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
+};
 use super::{element_loc, load_texture, Ctx};
 use crate::document::{Document, Item, Mat3};
 
@@ -44,7 +46,11 @@ pub fn ear_clip(pts: &[DVec2]) -> Vec<[DVec2; 3]> {
         p = q;
     }
     let area = area * 0.5;
-    let mut v: Vec<usize> = if area > 0.0 { (0..n).collect() } else { (0..n).rev().collect() };
+    let mut v: Vec<usize> = if area > 0.0 {
+        (0..n).collect()
+    } else {
+        (0..n).rev().collect()
+    };
     let cross = |u: Vec2, w: Vec2| u.x * w.y - u.y * w.x;
     let inside = |a: Vec2, b: Vec2, c: Vec2, p: Vec2| {
         cross(c - b, p - b) >= 0.0 && cross(b - a, p - a) >= 0.0 && cross(a - c, p - c) >= 0.0
@@ -95,12 +101,19 @@ fn num_attr(node: &Node, name: &str, loc: &Loc) -> Result<f64, SvgError> {
 fn points_attr(node: &Node, name: &str, loc: &Loc) -> Result<Vec<DVec2>, SvgError> {
     let l = number_list(node.attribute(name).unwrap_or(""), P, loc, name)?;
     if l.len() % 2 != 0 {
-        return Err(loc.err(format!("{name}: expected x,y pairs, found {} numbers", l.len())));
+        return Err(loc.err(format!(
+            "{name}: expected x,y pairs, found {} numbers",
+            l.len()
+        )));
     }
     Ok(l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect())
 }
 
-fn exact_points<const N: usize>(node: &Node, name: &str, loc: &Loc) -> Result<[DVec2; N], SvgError> {
+fn exact_points<const N: usize>(
+    node: &Node,
+    name: &str,
+    loc: &Loc,
+) -> Result<[DVec2; N], SvgError> {
     let p = points_attr(node, name, loc)?;
     p.try_into()
         .map_err(|p: Vec<DVec2>| loc.err(format!("{name}: expected {N} points, found {}", p.len())))
@@ -140,7 +153,9 @@ fn walk<'a>(
     for node in parent.children().filter(Node::is_element) {
         let loc = element_loc(ctx, &node);
         if depth >= MAX_DEPTH {
-            return Err(loc.err(format!("elements nest deeper than the limit of {MAX_DEPTH}")));
+            return Err(loc.err(format!(
+                "elements nest deeper than the limit of {MAX_DEPTH}"
+            )));
         }
         if doc.items.len() > MAX_ITEMS {
             return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
@@ -153,14 +168,22 @@ fn walk<'a>(
         let fill = node.attribute("fill").map_or(Rgb::BLACK, hex_color);
         let stroke = node.attribute("stroke").map(hex_color);
         let stroke_opacity = match node.attribute("stroke-opacity") {
-            Some(s) => number_with_unit(s, P, &loc, "stroke-opacity")?.0.clamp(0.0, 1.0) as f32,
+            Some(s) => number_with_unit(s, P, &loc, "stroke-opacity")?
+                .0
+                .clamp(0.0, 1.0) as f32,
             None => 1.0,
         };
         match name {
             "g" => walk(node, t, depth + 1, ctx, doc, textures)?,
             "rect" => {
-                let (x, y) = (num_attr(&node, "x", &loc)? as f32, num_attr(&node, "y", &loc)? as f32);
-                let (w, h) = (num_attr(&node, "width", &loc)? as f32, num_attr(&node, "height", &loc)? as f32);
+                let (x, y) = (
+                    num_attr(&node, "x", &loc)? as f32,
+                    num_attr(&node, "y", &loc)? as f32,
+                );
+                let (w, h) = (
+                    num_attr(&node, "width", &loc)? as f32,
+                    num_attr(&node, "height", &loc)? as f32,
+                );
                 if w == 0.0 && h == 0.0 {
                     doc.items.push(Item::Point {
                         at: DVec2::new(f64::from(x), f64::from(y)),
@@ -230,9 +253,13 @@ fn walk<'a>(
                 let points = exact_points::<3>(&node, "points", &loc)?;
                 let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
                 if c.len() != 12 {
-                    return Err(loc.err(format!("colors: expected 12 numbers (r g b a per vertex), found {}", c.len())));
+                    return Err(loc.err(format!(
+                        "colors: expected 12 numbers (r g b a per vertex), found {}",
+                        c.len()
+                    )));
                 }
-                let col = |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
+                let col =
+                    |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
                 doc.items.push(Item::ColorTri {
                     points,
                     colors: [col(0), col(1), col(2)],
@@ -246,16 +273,19 @@ fn walk<'a>(
                 let file = node
                     .attribute("filename")
                     .ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx = load_texture(ctx, doc, file, &loc, prism_image::UvConvention::EdgeCenters)?;
+                let idx =
+                    load_texture(ctx, doc, file, &loc, prism_image::UvConvention::EdgeCenters)?;
                 textures.insert(id.to_string(), idx);
             }
             "textri" => {
                 let points = exact_points::<3>(&node, "points", &loc)?;
                 let uv = exact_points::<3>(&node, "uvs", &loc)?;
                 let id = node.attribute("texid").unwrap_or("");
-                let texture = *textures
-                    .get(id)
-                    .ok_or_else(|| loc.err(format!("texid {id:?}: expected the id of an earlier <texture>")))?;
+                let texture = *textures.get(id).ok_or_else(|| {
+                    loc.err(format!(
+                        "texid {id:?}: expected the id of an earlier <texture>"
+                    ))
+                })?;
                 let f = |p: DVec2| Vec2::new(p.x as f32, p.y as f32);
                 doc.items.push(Item::TexTri {
                     points,

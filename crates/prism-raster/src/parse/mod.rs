@@ -14,8 +14,8 @@ use base64::Engine;
 use prism_image::{Texture, UvConvention};
 use roxmltree::Node;
 
-pub use common::{SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_ITEMS};
 use common::{number_with_unit, Loc, Precision};
+pub use common::{SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_ITEMS};
 pub use cs184::ear_clip;
 pub use pathdata::parse_path_data;
 
@@ -79,7 +79,10 @@ pub(crate) fn load_texture(
         if !meta.ends_with(";base64") {
             return Err(loc.err("href: expected a base64 data URI"));
         }
-        let payload: String = data[comma + 1..].chars().filter(|c| !c.is_whitespace()).collect();
+        let payload: String = data[comma + 1..]
+            .chars()
+            .filter(|c| !c.is_whitespace())
+            .collect();
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(payload.as_bytes())
             .map_err(|e| loc.err(format!("href: invalid base64 image data: {e}")))?;
@@ -95,7 +98,8 @@ pub(crate) fn load_texture(
         prism_image::read_image(&path).map_err(|e| loc.err(format!("texture {href:?}: {e}")))?
     };
     let rgb = rgba.to_rgb8().to_rgb_f32();
-    doc.textures.push(Arc::new(Texture::new(rgb).with_uv_convention(uv)));
+    doc.textures
+        .push(Arc::new(Texture::new(rgb).with_uv_convention(uv)));
     Ok(doc.textures.len() - 1)
 }
 
@@ -133,7 +137,9 @@ pub(crate) fn image_item(
         return Ok(None);
     }
     // preserveAspectRatio: default xMidYMid meet; "none" stretches.
-    let par = node.attribute("preserveAspectRatio").unwrap_or("xMidYMid meet");
+    let par = node
+        .attribute("preserveAspectRatio")
+        .unwrap_or("xMidYMid meet");
     let rect = if par.trim() == "none" {
         [x, y, w, h]
     } else {
@@ -164,7 +170,10 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
         message,
     };
     if text.len() > MAX_FILE_BYTES {
-        return Err(top(0, format!("file is larger than the limit of {MAX_FILE_BYTES} bytes")));
+        return Err(top(
+            0,
+            format!("file is larger than the limit of {MAX_FILE_BYTES} bytes"),
+        ));
     }
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
@@ -202,14 +211,13 @@ pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
     };
     let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
     if meta.len() > MAX_FILE_BYTES as u64 {
-        return Err(err(format!("file is larger than the limit of {MAX_FILE_BYTES} bytes")));
+        return Err(err(format!(
+            "file is larger than the limit of {MAX_FILE_BYTES} bytes"
+        )));
     }
     let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
     let text = String::from_utf8(bytes).map_err(|e| err(format!("expected UTF-8 text: {e}")))?;
-    let base_dir = path
-        .parent()
-        .map(FsPath::to_path_buf)
-        .unwrap_or_default();
+    let base_dir = path.parent().map(FsPath::to_path_buf).unwrap_or_default();
     let source = Source { name, base_dir };
     parse_svg(&text, dialect, &source)
 }

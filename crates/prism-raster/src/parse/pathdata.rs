@@ -35,8 +35,13 @@ impl<'a> Cursor<'a> {
         if n == 0 {
             return Err(format!("expected a number at offset {}", self.pos));
         }
-        let v = to_num(&rest[..n], Precision::F64)
-            .ok_or_else(|| format!("number {:?} at offset {} is not finite", &rest[..n], self.pos))?;
+        let v = to_num(&rest[..n], Precision::F64).ok_or_else(|| {
+            format!(
+                "number {:?} at offset {} is not finite",
+                &rest[..n],
+                self.pos
+            )
+        })?;
         self.pos += n;
         self.skip_sep();
         Ok(v)
@@ -46,7 +51,12 @@ impl<'a> Cursor<'a> {
         let v = match self.s.as_bytes().get(self.pos) {
             Some(b'0') => false,
             Some(b'1') => true,
-            _ => return Err(format!("expected an arc flag 0 or 1 at offset {}", self.pos)),
+            _ => {
+                return Err(format!(
+                    "expected an arc flag 0 or 1 at offset {}",
+                    self.pos
+                ))
+            }
         };
         self.pos += 1;
         self.skip_sep();
@@ -73,7 +83,9 @@ pub fn parse_path_data(d: &str) -> Result<Path, String> {
     let mut cmd: Option<u8> = None;
     loop {
         c.skip_ws();
-        let Some(&b) = c.s.as_bytes().get(c.pos) else { break };
+        let Some(&b) = c.s.as_bytes().get(c.pos) else {
+            break;
+        };
         if b.is_ascii_alphabetic() {
             c.pos += 1;
             cmd = Some(b);
@@ -201,7 +213,10 @@ mod tests {
     #[test]
     fn errors_name_offsets() {
         assert!(parse_path_data("L1 1").is_err());
-        assert_eq!(parse_path_data("M0 0 L1 x").unwrap_err(), "expected a number at offset 8");
+        assert_eq!(
+            parse_path_data("M0 0 L1 x").unwrap_err(),
+            "expected a number at offset 8"
+        );
         assert!(parse_path_data("M0 0 A1 1 0 2 0 3 3").is_err());
         assert!(parse_path_data("M0 0 L1e999 0").is_err());
         assert!(parse_path_data("M0 0 K1").is_err());

@@ -13,10 +13,14 @@ use prism_math::{DVec2, Rgb, Vec2};
 use roxmltree::Node;
 
 use super::color::parse_color;
-use super::common::{number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS};
+use super::common::{
+    number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
+};
 use super::pathdata::parse_path_data;
 use super::{element_loc, image_item, load_texture, Ctx};
-use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+use crate::document::{
+    Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop,
+};
 use crate::path::{LineCap, LineJoin, Path, StrokeStyle};
 
 const P: Precision = Precision::F64;
@@ -126,7 +130,11 @@ fn parse_paint(s: &str, loc: &Loc, attr: &str) -> Result<PaintSpec, SvgError> {
     }
     parse_color(t)
         .map(|(c, a)| PaintSpec::Color(c, a))
-        .ok_or_else(|| loc.err(format!("{attr}: expected a colour, 'none' or url(#id), found {t:?}")))
+        .ok_or_else(|| {
+            loc.err(format!(
+                "{attr}: expected a colour, 'none' or url(#id), found {t:?}"
+            ))
+        })
 }
 
 fn opacity_value(s: &str, loc: &Loc, attr: &str) -> Result<f32, SvgError> {
@@ -193,13 +201,19 @@ fn apply_declarations(
                 style.fill_rule = match v.trim() {
                     "evenodd" => FillRule::EvenOdd,
                     "nonzero" => FillRule::NonZero,
-                    other => return Err(loc.err(format!("fill-rule: expected nonzero or evenodd, found {other:?}"))),
+                    other => {
+                        return Err(loc.err(format!(
+                            "fill-rule: expected nonzero or evenodd, found {other:?}"
+                        )))
+                    }
                 }
             }
             "stroke-width" => {
                 let w = length(v, loc, k, vp, Axis::Diag)?;
                 if w < 0.0 {
-                    return Err(loc.err(format!("stroke-width: expected a non-negative length, found {v:?}")));
+                    return Err(loc.err(format!(
+                        "stroke-width: expected a non-negative length, found {v:?}"
+                    )));
                 }
                 style.stroke.width = w;
             }
@@ -208,7 +222,11 @@ fn apply_declarations(
                     "miter" | "miter-clip" | "arcs" => LineJoin::Miter,
                     "round" => LineJoin::Round,
                     "bevel" => LineJoin::Bevel,
-                    other => return Err(loc.err(format!("stroke-linejoin: expected miter, round or bevel, found {other:?}"))),
+                    other => {
+                        return Err(loc.err(format!(
+                            "stroke-linejoin: expected miter, round or bevel, found {other:?}"
+                        )))
+                    }
                 }
             }
             "stroke-linecap" => {
@@ -216,13 +234,19 @@ fn apply_declarations(
                     "butt" => LineCap::Butt,
                     "round" => LineCap::Round,
                     "square" => LineCap::Square,
-                    other => return Err(loc.err(format!("stroke-linecap: expected butt, round or square, found {other:?}"))),
+                    other => {
+                        return Err(loc.err(format!(
+                            "stroke-linecap: expected butt, round or square, found {other:?}"
+                        )))
+                    }
                 }
             }
             "stroke-miterlimit" => {
                 let m = number_with_unit(v, P, loc, k)?.0;
                 if m < 1.0 {
-                    return Err(loc.err(format!("stroke-miterlimit: expected a number >= 1, found {v:?}")));
+                    return Err(loc.err(format!(
+                        "stroke-miterlimit: expected a number >= 1, found {v:?}"
+                    )));
                 }
                 style.stroke.miter_limit = m;
             }
@@ -231,7 +255,10 @@ fn apply_declarations(
                     style.stroke.dashes.clear();
                 } else {
                     let mut d = Vec::new();
-                    for part in v.split(|c: char| c == ',' || c.is_whitespace()).filter(|p| !p.is_empty()) {
+                    for part in v
+                        .split(|c: char| c == ',' || c.is_whitespace())
+                        .filter(|p| !p.is_empty())
+                    {
                         d.push(length(part, loc, k, vp, Axis::Diag)?);
                     }
                     if d.iter().any(|x| *x < 0.0) {
@@ -259,18 +286,26 @@ fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<M
     };
     let v = number_list(vb, P, loc, "viewBox")?;
     if v.len() != 4 || v[2] <= 0.0 || v[3] <= 0.0 {
-        return Err(loc.err(format!("viewBox: expected min-x min-y width height with positive size, found {vb:?}")));
+        return Err(loc.err(format!(
+            "viewBox: expected min-x min-y width height with positive size, found {vb:?}"
+        )));
     }
-    let par = node.attribute("preserveAspectRatio").unwrap_or("xMidYMid meet");
+    let par = node
+        .attribute("preserveAspectRatio")
+        .unwrap_or("xMidYMid meet");
     let mut words = par.split_whitespace();
     let align = words.next().unwrap_or("xMidYMid");
     let slice = words.next() == Some("slice");
     let (sx, sy) = (w / v[2], h / v[3]);
     if align == "none" {
-        return Ok(Some(Mat3::scale(sx, sy).mul(&Mat3::translate(-v[0], -v[1]))));
+        return Ok(Some(
+            Mat3::scale(sx, sy).mul(&Mat3::translate(-v[0], -v[1])),
+        ));
     }
     if align.len() != 8 {
-        return Err(loc.err(format!("preserveAspectRatio: expected an alignment such as xMidYMid, found {align:?}")));
+        return Err(loc.err(format!(
+            "preserveAspectRatio: expected an alignment such as xMidYMid, found {align:?}"
+        )));
     }
     let s = if slice { sx.max(sy) } else { sx.min(sy) };
     let frac = |a: &str| match a {
@@ -291,7 +326,10 @@ fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<M
 
 pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
     let loc = element_loc(ctx, &root);
-    let vb = root.attribute("viewBox").map(|s| number_list(s, P, &loc, "viewBox")).transpose()?;
+    let vb = root
+        .attribute("viewBox")
+        .map(|s| number_list(s, P, &loc, "viewBox"))
+        .transpose()?;
     let vb_size = vb.as_ref().filter(|v| v.len() == 4).map(|v| (v[2], v[3]));
     let dim = |name: &str, axis: Axis, fallback: f64| -> Result<f64, SvgError> {
         match root.attribute(name) {
@@ -312,7 +350,8 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
     };
     let width = dim("width", Axis::X, vb_size.map_or(100.0, |s| s.0))?;
     let height = dim("height", Axis::Y, vb_size.map_or(100.0, |s| s.1))?;
-    let view_box_transform = view_box_transform(&root, &loc, width, height)?.unwrap_or(Mat3::IDENTITY);
+    let view_box_transform =
+        view_box_transform(&root, &loc, width, height)?.unwrap_or(Mat3::IDENTITY);
     let xml = ctx.xml;
     let mut ids = HashMap::new();
     for n in xml.descendants().filter(Node::is_element) {
@@ -331,7 +370,13 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
         ids,
         textures: HashMap::new(),
     };
-    let vp = vb_size.map_or(Viewport { w: width, h: height }, |(w, h)| Viewport { w, h });
+    let vp = vb_size.map_or(
+        Viewport {
+            w: width,
+            h: height,
+        },
+        |(w, h)| Viewport { w, h },
+    );
     let mut style = Style::default();
     let decls = declarations(&root);
     let (opacity, _) = apply_declarations(&mut style, &decls, &loc, vp)?;
@@ -347,7 +392,14 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
 }
 
 impl<'a> Parser<'_, 'a> {
-    fn children(&mut self, parent: Node<'a, 'a>, ctm: Mat3, style: &Style, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+    fn children(
+        &mut self,
+        parent: Node<'a, 'a>,
+        ctm: Mat3,
+        style: &Style,
+        vp: Viewport,
+        depth: usize,
+    ) -> Result<(), SvgError> {
         for node in parent.children().filter(Node::is_element) {
             self.element(node, ctm, style, vp, depth)?;
         }
@@ -358,7 +410,14 @@ impl<'a> Parser<'_, 'a> {
         self.ctx.warn_once(&mut self.doc, key, message);
     }
 
-    fn element(&mut self, node: Node<'a, 'a>, ctm: Mat3, parent_style: &Style, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+    fn element(
+        &mut self,
+        node: Node<'a, 'a>,
+        ctm: Mat3,
+        parent_style: &Style,
+        vp: Viewport,
+        depth: usize,
+    ) -> Result<(), SvgError> {
         let ctx = &*self.ctx;
         let loc = element_loc(ctx, &node);
         let loc = Loc {
@@ -374,7 +433,9 @@ impl<'a> Parser<'_, 'a> {
             element: &elem,
         };
         if depth >= MAX_DEPTH {
-            return Err(loc.err(format!("elements nest deeper than the limit of {MAX_DEPTH}")));
+            return Err(loc.err(format!(
+                "elements nest deeper than the limit of {MAX_DEPTH}"
+            )));
         }
         if self.doc.items.len() > MAX_ITEMS {
             return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
@@ -385,8 +446,9 @@ impl<'a> Parser<'_, 'a> {
         }
         let name = node.tag_name().name();
         match name {
-            "defs" | "symbol" | "linearGradient" | "radialGradient" | "stop" | "title" | "desc" | "metadata"
-            | "style" | "script" | "clipPath" | "mask" | "pattern" | "marker" | "filter" => return Ok(()),
+            "defs" | "symbol" | "linearGradient" | "radialGradient" | "stop" | "title" | "desc"
+            | "metadata" | "style" | "script" | "clipPath" | "mask" | "pattern" | "marker"
+            | "filter" => return Ok(()),
             _ => {}
         }
         let mut style = parent_style.clone();
@@ -395,8 +457,16 @@ impl<'a> Parser<'_, 'a> {
             return Ok(());
         }
         for unsupported in ["clip-path", "mask", "filter"] {
-            if node.attribute(unsupported).is_some_and(|v| v.trim() != "none") {
-                self.warn(unsupported, format!("{file}:{line}: {elem}: {unsupported} is not supported; drawn without it"));
+            if node
+                .attribute(unsupported)
+                .is_some_and(|v| v.trim() != "none")
+            {
+                self.warn(
+                    unsupported,
+                    format!(
+                        "{file}:{line}: {elem}: {unsupported} is not supported; drawn without it"
+                    ),
+                );
             }
         }
         let mut t = match node.attribute("transform") {
@@ -404,7 +474,8 @@ impl<'a> Parser<'_, 'a> {
             None => ctm,
         };
         let num = |attr: &str, axis: Axis| -> Result<f64, SvgError> {
-            node.attribute(attr).map_or(Ok(0.0), |s| length(s, &loc, attr, vp, axis))
+            node.attribute(attr)
+                .map_or(Ok(0.0), |s| length(s, &loc, attr, vp, axis))
         };
         let path = match name {
             "g" | "a" | "switch" => {
@@ -413,12 +484,17 @@ impl<'a> Parser<'_, 'a> {
             "svg" => {
                 let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
                 t = t.mul(&Mat3::translate(x, y));
-                let w = node.attribute("width").map_or(Ok(vp.w), |s| length(s, &loc, "width", vp, Axis::X))?;
-                let h = node.attribute("height").map_or(Ok(vp.h), |s| length(s, &loc, "height", vp, Axis::Y))?;
+                let w = node
+                    .attribute("width")
+                    .map_or(Ok(vp.w), |s| length(s, &loc, "width", vp, Axis::X))?;
+                let h = node
+                    .attribute("height")
+                    .map_or(Ok(vp.h), |s| length(s, &loc, "height", vp, Axis::Y))?;
                 let mut inner = vp;
                 if let Some(m) = view_box_transform(&node, &loc, w, h)? {
                     t = t.mul(&m);
-                    let v = number_list(node.attribute("viewBox").unwrap_or(""), P, &loc, "viewBox")?;
+                    let v =
+                        number_list(node.attribute("viewBox").unwrap_or(""), P, &loc, "viewBox")?;
                     inner = Viewport { w: v[2], h: v[3] };
                 }
                 return self.group(node, t, &style, opacity, inner, depth);
@@ -430,7 +506,10 @@ impl<'a> Parser<'_, 'a> {
                     .ok_or_else(|| loc.err("expected an href attribute"))?;
                 let id = href.trim().strip_prefix('#').unwrap_or(href.trim());
                 let Some(&target) = self.ids.get(id) else {
-                    self.warn(&format!("use#{id}"), format!("{file}:{line}: use: no element with id {id:?}; skipped"));
+                    self.warn(
+                        &format!("use#{id}"),
+                        format!("{file}:{line}: use: no element with id {id:?}; skipped"),
+                    );
                     return Ok(());
                 };
                 if target.ancestors().any(|a| a == node) {
@@ -458,8 +537,14 @@ impl<'a> Parser<'_, 'a> {
                 if w <= 0.0 || h <= 0.0 {
                     return Ok(());
                 }
-                let rx_attr = node.attribute("rx").map(|s| length(s, &loc, "rx", vp, Axis::X)).transpose()?;
-                let ry_attr = node.attribute("ry").map(|s| length(s, &loc, "ry", vp, Axis::Y)).transpose()?;
+                let rx_attr = node
+                    .attribute("rx")
+                    .map(|s| length(s, &loc, "rx", vp, Axis::X))
+                    .transpose()?;
+                let ry_attr = node
+                    .attribute("ry")
+                    .map(|s| length(s, &loc, "ry", vp, Axis::Y))
+                    .transpose()?;
                 let (rx, ry) = match (rx_attr, ry_attr) {
                     (None, None) => (0.0, 0.0),
                     (Some(r), None) | (None, Some(r)) => (r, r),
@@ -473,14 +558,30 @@ impl<'a> Parser<'_, 'a> {
                     p.line_to(d(x + w - rx, y));
                     p.arc_to(d(x + w - rx, y), rx, ry, 0.0, false, true, d(x + w, y + ry));
                     p.line_to(d(x + w, y + h - ry));
-                    p.arc_to(d(x + w, y + h - ry), rx, ry, 0.0, false, true, d(x + w - rx, y + h));
+                    p.arc_to(
+                        d(x + w, y + h - ry),
+                        rx,
+                        ry,
+                        0.0,
+                        false,
+                        true,
+                        d(x + w - rx, y + h),
+                    );
                     p.line_to(d(x + rx, y + h));
                     p.arc_to(d(x + rx, y + h), rx, ry, 0.0, false, true, d(x, y + h - ry));
                     p.line_to(d(x, y + ry));
                     p.arc_to(d(x, y + ry), rx, ry, 0.0, false, true, d(x + rx, y));
                     p.close();
                 } else {
-                    p = Path::polygon(&[DVec2::new(x, y), DVec2::new(x + w, y), DVec2::new(x + w, y + h), DVec2::new(x, y + h)], true);
+                    p = Path::polygon(
+                        &[
+                            DVec2::new(x, y),
+                            DVec2::new(x + w, y),
+                            DVec2::new(x + w, y + h),
+                            DVec2::new(x, y + h),
+                        ],
+                        true,
+                    );
                 }
                 p
             }
@@ -505,25 +606,50 @@ impl<'a> Parser<'_, 'a> {
             "polyline" | "polygon" => {
                 let l = number_list(node.attribute("points").unwrap_or(""), P, &loc, "points")?;
                 if l.len() % 2 != 0 {
-                    return Err(loc.err(format!("points: expected x,y pairs, found {} numbers", l.len())));
+                    return Err(loc.err(format!(
+                        "points: expected x,y pairs, found {} numbers",
+                        l.len()
+                    )));
                 }
                 let pts: Vec<DVec2> = l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect();
                 Path::polygon(&pts, name == "polygon")
             }
-            "path" => parse_path_data(node.attribute("d").unwrap_or("")).map_err(|e| loc.err(format!("d: {e}")))?,
+            "path" => parse_path_data(node.attribute("d").unwrap_or(""))
+                .map_err(|e| loc.err(format!("d: {e}")))?,
             "image" => {
                 if !style.visible {
                     return Ok(());
                 }
-                if let Some(Item::Image { texture, rect, transform, .. }) = image_item(&node, t, self.ctx, &mut self.doc, &loc, P)? {
-                    self.doc.items.push(Item::Image { texture, rect, transform, opacity });
+                if let Some(Item::Image {
+                    texture,
+                    rect,
+                    transform,
+                    ..
+                }) = image_item(&node, t, self.ctx, &mut self.doc, &loc, P)?
+                {
+                    self.doc.items.push(Item::Image {
+                        texture,
+                        rect,
+                        transform,
+                        opacity,
+                    });
                 }
                 return Ok(());
             }
             "texture" => {
-                let id = node.attribute("texid").ok_or_else(|| loc.err("expected a texid attribute"))?;
-                let f = node.attribute("filename").ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx = load_texture(self.ctx, &mut self.doc, f, &loc, prism_image::UvConvention::EdgeCenters)?;
+                let id = node
+                    .attribute("texid")
+                    .ok_or_else(|| loc.err("expected a texid attribute"))?;
+                let f = node
+                    .attribute("filename")
+                    .ok_or_else(|| loc.err("expected a filename attribute"))?;
+                let idx = load_texture(
+                    self.ctx,
+                    &mut self.doc,
+                    f,
+                    &loc,
+                    prism_image::UvConvention::EdgeCenters,
+                )?;
                 self.textures.insert(id.to_string(), idx);
                 return Ok(());
             }
@@ -532,35 +658,59 @@ impl<'a> Parser<'_, 'a> {
                 if pts.len() != 6 {
                     return Err(loc.err(format!("points: expected 6 numbers, found {}", pts.len())));
                 }
-                let points = [DVec2::new(pts[0], pts[1]), DVec2::new(pts[2], pts[3]), DVec2::new(pts[4], pts[5])];
+                let points = [
+                    DVec2::new(pts[0], pts[1]),
+                    DVec2::new(pts[2], pts[3]),
+                    DVec2::new(pts[4], pts[5]),
+                ];
                 if name == "colortri" {
                     let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
                     if c.len() != 12 {
-                        return Err(loc.err(format!("colors: expected 12 numbers, found {}", c.len())));
+                        return Err(
+                            loc.err(format!("colors: expected 12 numbers, found {}", c.len()))
+                        );
                     }
-                    let col = |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
-                    self.doc.items.push(Item::ColorTri { points, colors: [col(0), col(1), col(2)], transform: t });
+                    let col = |i: usize| {
+                        Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32)
+                    };
+                    self.doc.items.push(Item::ColorTri {
+                        points,
+                        colors: [col(0), col(1), col(2)],
+                        transform: t,
+                    });
                 } else {
                     let uv = number_list(node.attribute("uvs").unwrap_or(""), P, &loc, "uvs")?;
                     if uv.len() != 6 {
                         return Err(loc.err(format!("uvs: expected 6 numbers, found {}", uv.len())));
                     }
                     let id = node.attribute("texid").unwrap_or("");
-                    let texture = *self
-                        .textures
-                        .get(id)
-                        .ok_or_else(|| loc.err(format!("texid {id:?}: expected the id of an earlier <texture>")))?;
+                    let texture = *self.textures.get(id).ok_or_else(|| {
+                        loc.err(format!(
+                            "texid {id:?}: expected the id of an earlier <texture>"
+                        ))
+                    })?;
                     let f = |i: usize| Vec2::new(uv[2 * i] as f32, uv[2 * i + 1] as f32);
-                    self.doc.items.push(Item::TexTri { points, uvs: [f(0), f(1), f(2)], texture, transform: t });
+                    self.doc.items.push(Item::TexTri {
+                        points,
+                        uvs: [f(0), f(1), f(2)],
+                        texture,
+                        transform: t,
+                    });
                 }
                 return Ok(());
             }
             "text" | "tspan" | "textPath" => {
-                self.warn("text", format!("{file}:{line}: {name}: text is not supported; skipped"));
+                self.warn(
+                    "text",
+                    format!("{file}:{line}: {name}: text is not supported; skipped"),
+                );
                 return Ok(());
             }
             other => {
-                self.warn(&format!("elem:{other}"), format!("{file}:{line}: {other}: unknown element; skipped"));
+                self.warn(
+                    &format!("elem:{other}"),
+                    format!("{file}:{line}: {other}: unknown element; skipped"),
+                );
                 return Ok(());
             }
         };
@@ -573,7 +723,15 @@ impl<'a> Parser<'_, 'a> {
         self.shape(path, t, &style, opacity, name, &loc)
     }
 
-    fn group(&mut self, node: Node<'a, 'a>, t: Mat3, style: &Style, opacity: f32, vp: Viewport, depth: usize) -> Result<(), SvgError> {
+    fn group(
+        &mut self,
+        node: Node<'a, 'a>,
+        t: Mat3,
+        style: &Style,
+        opacity: f32,
+        vp: Viewport,
+        depth: usize,
+    ) -> Result<(), SvgError> {
         let layer = opacity < 1.0;
         if layer {
             self.doc.items.push(Item::BeginLayer);
@@ -585,10 +743,26 @@ impl<'a> Parser<'_, 'a> {
         Ok(())
     }
 
-    fn shape(&mut self, path: Path, t: Mat3, style: &Style, opacity: f32, name: &str, loc: &Loc) -> Result<(), SvgError> {
+    fn shape(
+        &mut self,
+        path: Path,
+        t: Mat3,
+        style: &Style,
+        opacity: f32,
+        name: &str,
+        loc: &Loc,
+    ) -> Result<(), SvgError> {
         let fillable = name != "line";
-        let fill = if fillable { self.resolve_paint(&style.fill, style, &path, loc)? } else { None };
-        let stroke = if style.stroke.width > 0.0 { self.resolve_paint(&style.stroke_paint, style, &path, loc)? } else { None };
+        let fill = if fillable {
+            self.resolve_paint(&style.fill, style, &path, loc)?
+        } else {
+            None
+        };
+        let stroke = if style.stroke.width > 0.0 {
+            self.resolve_paint(&style.stroke_paint, style, &path, loc)?
+        } else {
+            None
+        };
         let both = fill.is_some() && stroke.is_some();
         let layer = both && opacity < 1.0;
         let inner = if layer { 1.0 } else { opacity };
@@ -619,7 +793,13 @@ impl<'a> Parser<'_, 'a> {
         Ok(())
     }
 
-    fn resolve_paint(&mut self, spec: &PaintSpec, style: &Style, path: &Path, loc: &Loc) -> Result<Option<(Paint, f32)>, SvgError> {
+    fn resolve_paint(
+        &mut self,
+        spec: &PaintSpec,
+        style: &Style,
+        path: &Path,
+        loc: &Loc,
+    ) -> Result<Option<(Paint, f32)>, SvgError> {
         Ok(match spec {
             PaintSpec::None => None,
             PaintSpec::Color(c, a) => Some((Paint::Solid(*c), *a)),
@@ -636,7 +816,10 @@ impl<'a> Parser<'_, 'a> {
                     Some(fb) => self.resolve_paint(fb, style, path, loc)?,
                     None => {
                         if !self.ids.contains_key(id.as_str()) {
-                            let msg = format!("{}:{}: {}: paint url(#{id}) not found; not painted", loc.file, loc.line, loc.element);
+                            let msg = format!(
+                                "{}:{}: {}: paint url(#{id}) not found; not painted",
+                                loc.file, loc.line, loc.element
+                            );
                             self.warn(&format!("paint#{id}"), msg);
                         }
                         None
@@ -648,12 +831,25 @@ impl<'a> Parser<'_, 'a> {
 
     /// Resolves a gradient by id for an element whose local path is `path`, following
     /// `href` chains for stops and attributes.
-    fn gradient(&mut self, id: &str, path: &Path, loc: &Loc) -> Result<Option<Arc<Gradient>>, SvgError> {
-        let Some(&node) = self.ids.get(id) else { return Ok(None) };
+    fn gradient(
+        &mut self,
+        id: &str,
+        path: &Path,
+        loc: &Loc,
+    ) -> Result<Option<Arc<Gradient>>, SvgError> {
+        let Some(&node) = self.ids.get(id) else {
+            return Ok(None);
+        };
         let kind = node.tag_name().name();
         if kind != "linearGradient" && kind != "radialGradient" {
             if kind == "pattern" {
-                self.warn("pattern", format!("{}:{}: pattern paint is not supported; not painted", loc.file, loc.line));
+                self.warn(
+                    "pattern",
+                    format!(
+                        "{}:{}: pattern paint is not supported; not painted",
+                        loc.file, loc.line
+                    ),
+                );
             }
             return Ok(None);
         }
@@ -661,7 +857,9 @@ impl<'a> Parser<'_, 'a> {
         let mut chain = vec![node];
         while chain.len() < 16 {
             let last = chain[chain.len() - 1];
-            let href = last.attribute((XLINK_NS, "href")).or_else(|| last.attribute("href"));
+            let href = last
+                .attribute((XLINK_NS, "href"))
+                .or_else(|| last.attribute("href"));
             match href.and_then(|h| self.ids.get(h.trim().trim_start_matches('#'))) {
                 Some(&n) if !chain.contains(&n) => chain.push(n),
                 _ => break,
@@ -670,9 +868,16 @@ impl<'a> Parser<'_, 'a> {
         let attr = |name: &str| chain.iter().find_map(|n| n.attribute(name));
         let gloc = element_loc(self.ctx, &node);
         let (gfile, gline, gelem) = (gloc.file.to_string(), gloc.line, gloc.element.to_string());
-        let gloc = Loc { file: &gfile, line: gline, element: &gelem };
+        let gloc = Loc {
+            file: &gfile,
+            line: gline,
+            element: &gelem,
+        };
         let user_space = attr("gradientUnits") == Some("userSpaceOnUse");
-        let vp = Viewport { w: self.doc.width, h: self.doc.height };
+        let vp = Viewport {
+            w: self.doc.width,
+            h: self.doc.height,
+        };
         let coord = |name: &str, default: &str, axis: Axis| -> Result<f64, SvgError> {
             let s = attr(name).unwrap_or(default);
             if !user_space {
@@ -681,23 +886,43 @@ impl<'a> Parser<'_, 'a> {
             }
             length(s, &gloc, name, vp, axis)
         };
-        let stops_node = chain.iter().find(|n| n.children().any(|c| c.tag_name().name() == "stop"));
+        let stops_node = chain
+            .iter()
+            .find(|n| n.children().any(|c| c.tag_name().name() == "stop"));
         let mut stops: Vec<Stop> = Vec::new();
         if let Some(sn) = stops_node {
             for s in sn.children().filter(|c| c.tag_name().name() == "stop") {
                 let sl = element_loc(self.ctx, &s);
                 let (sfile, sline) = (sl.file.to_string(), sl.line);
-                let sloc = Loc { file: &sfile, line: sline, element: "stop" };
+                let sloc = Loc {
+                    file: &sfile,
+                    line: sline,
+                    element: "stop",
+                };
                 let decls = declarations(&s);
-                let get = |k: &str| decls.iter().rev().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
-                let offset = get("offset").map_or(Ok(0.0), |v| opacity_value(v, &sloc, "offset"))?;
+                let get = |k: &str| {
+                    decls
+                        .iter()
+                        .rev()
+                        .find(|(n, _)| n == k)
+                        .map(|(_, v)| v.as_str())
+                };
+                let offset =
+                    get("offset").map_or(Ok(0.0), |v| opacity_value(v, &sloc, "offset"))?;
                 let (color, ca) = match get("stop-color") {
                     None => (Rgb::BLACK, 1.0),
-                    Some(v) => parse_color(v).ok_or_else(|| sloc.err(format!("stop-color: expected a colour, found {v:?}")))?,
+                    Some(v) => parse_color(v).ok_or_else(|| {
+                        sloc.err(format!("stop-color: expected a colour, found {v:?}"))
+                    })?,
                 };
-                let op = get("stop-opacity").map_or(Ok(1.0), |v| opacity_value(v, &sloc, "stop-opacity"))?;
+                let op = get("stop-opacity")
+                    .map_or(Ok(1.0), |v| opacity_value(v, &sloc, "stop-opacity"))?;
                 let prev = stops.last().map_or(0.0, |s| s.offset);
-                stops.push(Stop { offset: offset.max(prev), color, opacity: op * ca });
+                stops.push(Stop {
+                    offset: offset.max(prev),
+                    color,
+                    opacity: op * ca,
+                });
             }
         }
         if stops.is_empty() {
@@ -716,7 +941,11 @@ impl<'a> Parser<'_, 'a> {
             Mat3::IDENTITY
         } else {
             // objectBoundingBox: map the unit square onto the element's bounding box.
-            let pts: Vec<DVec2> = path.flatten(0.01).into_iter().flat_map(|l| l.points).collect();
+            let pts: Vec<DVec2> = path
+                .flatten(0.01)
+                .into_iter()
+                .flat_map(|l| l.points)
+                .collect();
             let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
             for p in pts {
                 lo = lo.min(p);
@@ -744,8 +973,17 @@ impl<'a> Parser<'_, 'a> {
                 let last = stops[stops.len() - 1];
                 stops = vec![last];
             }
-            GradientKind::Radial { center, radius, focus }
+            GradientKind::Radial {
+                center,
+                radius,
+                focus,
+            }
         };
-        Ok(Some(Arc::new(Gradient { kind, stops, spread, transform: units.mul(&gt) })))
+        Ok(Some(Arc::new(Gradient {
+            kind,
+            stops,
+            spread,
+            transform: units.mul(&gt),
+        })))
     }
 }

@@ -1,0 +1,182 @@
+//! End-to-end tests of the `prism` command: bad input gives a located error and exit code 2,
+//! never a panic and never a partial output file; good input renders.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn prism() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("prism-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run_svg(dir: &Path, svg: &str, extra: &[&str]) -> (Output, PathBuf) {
+    let input = dir.join("in.svg");
+    std::fs::write(&input, svg).unwrap();
+    let out = dir.join("out.png");
+    let o = prism()
+        .arg("svg")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .args(extra)
+        .output()
+        .unwrap();
+    (o, out)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Each bad input: exit 2, a `file:line: element:` message, and no output file.
+#[test]
+fn bad_inputs_are_located_errors() {
+    let dir = scratch("bad");
+    let deep = format!(
+        "<svg xmlns='http://www.w3.org/2000/svg' width='10' height='10'>{}{}</svg>",
+        "<g>".repeat(5000),
+        "</g>".repeat(5000)
+    );
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("malformed xml", "<svg width='10' height='10'><rect></svg>".into(), ":1: xml: malformed XML"),
+        ("bad number", "<svg width='10' height='10'>\n<rect x='1' y='zz' width='3' height='3'/></svg>".into(), ":2: rect: y: expected a number"),
+        ("nan coordinate", "<svg width='10' height='10'>\n\n<polygon points='0,0 NaN,1 2,2'/></svg>".into(), ":3: polygon: points: expected a number"),
+        ("inf coordinate", "<svg width='10' height='10'><line x1='1e999' y1='0' x2='1' y2='1' stroke='red'/></svg>".into(), "line: x1"),
+        ("bad path", "<svg width='10' height='10'><path d='M0 0 L5'/></svg>".into(), "path: d: expected a number at offset"),
+        ("missing texture", "<svg width='10' height='10'><texture texid='t' filename='nope.png'/></svg>".into(), "texture: texture \"nope.png\""),
+        ("bad colour", "<svg width='10' height='10'><rect width='3' height='3' fill='#12'/></svg>".into(), "rect: fill: expected a colour"),
+        ("not svg", "<html/>".into(), "html: expected the root element to be <svg>"),
+        ("too deep", deep, "elements nest deeper than the limit of 256"),
+    ];
+    for (what, svg, expect) in cases {
+        let (o, out) = run_svg(&dir, &svg, &[]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert!(
+            err.contains(expect),
+            "{what}: expected {expect:?} in {err:?}"
+        );
+        assert!(err.contains("in.svg:"), "{what}: no file name in {err:?}");
+        assert!(!out.exists(), "{what}: output written");
+    }
+    // A corrupt texture file.
+    std::fs::write(dir.join("bad.png"), b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
+    let (o, out) = run_svg(
+        &dir,
+        "<svg width='10' height='10'><texture texid='t' filename='bad.png'/></svg>",
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad.png"));
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_options_exit_2_and_keep_old_output() {
+    let dir = scratch("opts");
+    let svg = "<svg xmlns='http://www.w3.org/2000/svg' width='10' height='10'><rect width='5' height='5'/></svg>";
+    std::fs::write(dir.join("out.png"), b"precious").unwrap();
+    for extra in [
+        &["--samples", "8"][..],
+        &["--width", "100000"],
+        &["--view", "1,2"],
+        &["--view", "0,0,-1"],
+    ] {
+        let (o, out) = run_svg(&dir, svg, extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert_eq!(std::fs::read(&out).unwrap(), b"precious", "{extra:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unknown_elements_warn_once_and_render() {
+    let dir = scratch("warn");
+    let svg = "<svg xmlns='http://www.w3.org/2000/svg' width='10' height='10'><blink/><blink/><rect width='10' height='10' fill='#00f'/></svg>";
+    let (o, out) = run_svg(&dir, svg, &["--width", "10", "--height", "10", "--stats"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(err.matches("unknown element").count(), 1, "{err}");
+    for stage in ["parse: ", "raster: ", "resolve: ", "encode: "] {
+        assert!(
+            err.lines()
+                .any(|l| l.starts_with(stage) && l.ends_with(" ms")),
+            "{stage} in {err}"
+        );
+    }
+    let img = prism_image::read_png(&out).unwrap();
+    assert_eq!(img.get(5, 5), [0, 0, 255, 255]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A directory in gives a directory out with the same tree; output is identical whatever
+/// the thread count.
+#[test]
+fn batch_directory_and_determinism() {
+    let dir = scratch("batch");
+    let input = dir.join("in");
+    std::fs::create_dir_all(input.join("sub")).unwrap();
+    let svg = "<svg xmlns='http://www.w3.org/2000/svg' width='64' height='64'><circle cx='32' cy='32' r='20' fill='red' opacity='0.5'/></svg>";
+    std::fs::write(input.join("a.svg"), svg).unwrap();
+    std::fs::write(input.join("sub/b.svg"), svg).unwrap();
+    let out = dir.join("out");
+    let o = prism()
+        .args(["svg"])
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .args(["--samples", "16"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let a = std::fs::read(out.join("a.png")).unwrap();
+    let b = std::fs::read(out.join("sub/b.png")).unwrap();
+    assert_eq!(a, b);
+    let one = dir.join("one.png");
+    let o = prism()
+        .env("RAYON_NUM_THREADS", "1")
+        .args(["svg"])
+        .arg(input.join("a.svg"))
+        .arg("-o")
+        .arg(&one)
+        .args(["--samples", "16"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert_eq!(
+        std::fs::read(&one).unwrap(),
+        a,
+        "thread count changed the bytes"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn demo_writes_gallery() {
+    let dir = scratch("demo");
+    let o = prism()
+        .args(["demo", "-q", "-o"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    for f in [
+        "fan_1spp.png",
+        "fan_16spp.png",
+        "colortri.png",
+        "texture_level_linear.png",
+        "transformed_group.png",
+    ] {
+        assert!(html.contains(f), "{f} not in index");
+        assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
