@@ -105,7 +105,7 @@ mod tests {
         );
         assert_eq!(parse_color("transparent").unwrap().1, 0.0);
         for bad in [
-            "#ff00",
+            "#ff000",
             "#gg0000",
             "rgb(1,2)",
             "notacolor",
