@@ -334,11 +334,13 @@ enum Prim {
     EndLayer(f32),
 }
 
-/// A primitive with the pixel rows it can touch, `[y0, y1)`.
+/// A primitive with the pixel rows `[y0, y1)` and columns `[x0, x1)` it can touch.
 #[derive(Clone, Debug)]
 struct Placed {
     y0: i32,
     y1: i32,
+    x0: i32,
+    x1: i32,
     prim: Prim,
 }
 
@@ -397,6 +399,11 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         (y1 > y0).then_some((y0, y1))
     };
     let xs_visible = |lo: f64, hi: f64| hi >= -1.0 && lo <= w + 1.0;
+    let cols = |lo: f64, hi: f64| -> (i32, i32) {
+        let x0 = (lo.floor() as i64).clamp(0, w as i64) as i32;
+        let x1 = ((hi.floor() as i64) + 1).clamp(0, w as i64) as i32;
+        (x0, x1)
+    };
     let place_tri = |v: [DVec2; 3], inclusive: bool, shade: TriShade| -> Option<Placed> {
         let lo = v[0].min(v[1]).min(v[2]);
         let hi = v[0].max(v[1]).max(v[2]);
@@ -404,9 +411,12 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             return None;
         }
         let (y0, y1) = rows(lo.y, hi.y)?;
+        let (x0, x1) = cols(lo.x, hi.x);
         Some(Placed {
             y0,
             y1,
+            x0,
+            x1,
             prim: Prim::Tri {
                 v,
                 inclusive,
@@ -421,9 +431,24 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         let lo = edges.iter().map(|e| e.y0).fold(f64::INFINITY, f64::min);
         let hi = edges.iter().map(|e| e.y1).fold(f64::NEG_INFINITY, f64::max);
         let (y0, y1) = rows(lo, hi)?;
+        let end_x = |e: &Edge| e.x0 + (e.y1 - e.y0) * e.dxdy;
+        let xlo = edges
+            .iter()
+            .map(|e| e.x0.min(end_x(e)))
+            .fold(f64::INFINITY, f64::min);
+        let xhi = edges
+            .iter()
+            .map(|e| e.x0.max(end_x(e)))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if !xs_visible(xlo, xhi) {
+            return None;
+        }
+        let (x0, x1) = cols(xlo, xhi);
         Some(Placed {
             y0,
             y1,
+            x0,
+            x1,
             prim: Prim::Poly { edges, rule, paint },
         })
     };
@@ -556,9 +581,13 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 if let (Some(lo), Some(hi)) =
                     (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max())
                 {
+                    let xl = px.iter().map(|p| p.0).min().unwrap_or(0);
+                    let xh = px.iter().map(|p| p.0).max().unwrap_or(0);
                     out.push(Placed {
                         y0: lo,
                         y1: hi + 1,
+                        x0: xl,
+                        x1: xh + 1,
                         prim: Prim::Pixels {
                             px,
                             color: solid(*color, *opacity),
@@ -579,6 +608,8 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                     out.push(Placed {
                         y0: sy,
                         y1: sy + 1,
+                        x0: sx,
+                        x1: sx + 1,
                         prim: Prim::Pixels {
                             px: vec![(sx, sy)],
                             color: solid(*color, 1.0),
@@ -650,12 +681,16 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             }
             Item::BeginLayer => out.push(Placed {
                 y0: 0,
-                y1: h,
+                y1: 0,
+                x0: 0,
+                x1: 0,
                 prim: Prim::BeginLayer,
             }),
             Item::EndLayer { opacity } => out.push(Placed {
                 y0: 0,
-                y1: h,
+                y1: 0,
+                x0: 0,
+                x1: 0,
                 prim: Prim::EndLayer(*opacity),
             }),
         }
@@ -681,6 +716,8 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             prims.push(Placed {
                 y0: 0,
                 y1: h,
+                x0: 0,
+                x1: opts.width as i32,
                 prim: Prim::Pixels {
                     px,
                     color: [0.0, 0.0, 0.0, 1.0],
@@ -688,7 +725,61 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             });
         }
     }
+    bound_layers(&mut prims);
     prims
+}
+
+/// Gives every layer the bounding box of what it contains, so bands skip empty layers and
+/// layer clearing and compositing touch only that box.
+fn bound_layers(prims: &mut [Placed]) {
+    let empty = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+    let mut stack: Vec<(usize, (i32, i32, i32, i32))> = Vec::new();
+    let mut cur = empty;
+    for i in 0..prims.len() {
+        match prims[i].prim {
+            Prim::BeginLayer => {
+                stack.push((i, cur));
+                cur = empty;
+            }
+            Prim::EndLayer(_) => {
+                let Some((b, outer)) = stack.pop() else {
+                    continue;
+                };
+                let inner = if cur.0 < cur.1 && cur.2 < cur.3 {
+                    cur
+                } else {
+                    (0, 0, 0, 0)
+                };
+                for k in [b, i] {
+                    prims[k].y0 = inner.0;
+                    prims[k].y1 = inner.1;
+                    prims[k].x0 = inner.2;
+                    prims[k].x1 = inner.3;
+                }
+                cur = if inner.0 < inner.1 {
+                    (
+                        outer.0.min(inner.0),
+                        outer.1.max(inner.1),
+                        outer.2.min(inner.2),
+                        outer.3.max(inner.3),
+                    )
+                } else {
+                    outer
+                };
+            }
+            _ => {
+                let p = &prims[i];
+                if p.y0 < p.y1 && p.x0 < p.x1 {
+                    cur = (
+                        cur.0.min(p.y0),
+                        cur.1.max(p.y1),
+                        cur.2.min(p.x0),
+                        cur.3.max(p.x1),
+                    );
+                }
+            }
+        }
+    }
 }
 
 #[inline]
@@ -741,22 +832,41 @@ impl Band {
         f64::from(self.y0) + (j as f64 + 0.5) / self.r as f64
     }
 
-    fn draw(&mut self, p: &Prim, compat: bool) {
+    /// Sample-index ranges (rows, columns) of a placed box within this band.
+    fn region(&self, pl: &Placed) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let r = self.r;
+        let ya = (pl.y0.max(self.y0) - self.y0).max(0) as usize * r;
+        let yb = (pl.y1.min(self.y0 + self.rows_px) - self.y0).max(0) as usize * r;
+        let xa = pl.x0.max(0) as usize * r;
+        let xb = (pl.x1.min(self.width).max(0) as usize * r).max(xa);
+        (ya..yb.max(ya), xa..xb)
+    }
+
+    fn draw(&mut self, pl: &Placed, compat: bool) {
+        let p = &pl.prim;
         match p {
             Prim::BeginLayer => {
-                let mut buf = self.spare.pop().unwrap_or_default();
-                buf.clear();
-                buf.resize(self.layers[0].len(), [0.0; 4]);
+                let (rows, cols) = self.region(pl);
+                let len = self.layers[0].len();
+                let mut buf = self.spare.pop().unwrap_or_else(|| vec![[0.0; 4]; len]);
+                for j in rows {
+                    buf[j * self.cols + cols.start..j * self.cols + cols.end].fill([0.0; 4]);
+                }
                 self.layers.push(buf);
             }
             Prim::EndLayer(op) => {
                 if self.layers.len() < 2 {
                     return;
                 }
+                let (rows, cols) = self.region(pl);
+                let stride = self.cols;
                 let src = self.layers.pop().expect("checked");
                 let dst = self.top();
-                for (d, s) in dst.iter_mut().zip(&src) {
-                    blend(d, [s[0] * op, s[1] * op, s[2] * op, s[3] * op]);
+                for j in rows {
+                    let range = j * stride + cols.start..j * stride + cols.end;
+                    for (d, s) in dst[range.clone()].iter_mut().zip(&src[range]) {
+                        blend(d, [s[0] * op, s[1] * op, s[2] * op, s[3] * op]);
+                    }
                 }
                 self.spare.push(src);
             }
@@ -1033,7 +1143,7 @@ pub fn render(
             };
             for p in &prims {
                 if p.y1 > y0 && p.y0 < y0 + rows_px {
-                    band.draw(&p.prim, opts.compat);
+                    band.draw(p, opts.compat);
                 }
             }
             let tb = Instant::now();
