@@ -211,15 +211,30 @@ impl Texture {
         pixel: PixelSampling,
         level: LevelSampling,
     ) -> Rgb {
+        let d = match level {
+            LevelSampling::Zero => 0.0,
+            _ => self.level_for(duv_dx, duv_dy),
+        };
+        self.sample_lod(uv, d, pixel, level)
+    }
+
+    /// Samples at `uv` given the continuous level `d` (from [`Texture::level_for`], which
+    /// callers with constant derivatives compute once): level 0 for `Zero`, `round(d)` for
+    /// `Nearest`, a blend of the two nearest levels for `Linear`.
+    #[must_use]
+    pub fn sample_lod(&self, uv: Vec2, d: f32, pixel: PixelSampling, level: LevelSampling) -> Rgb {
         match level {
             LevelSampling::Zero => self.sample_level(uv, 0, pixel),
             LevelSampling::Nearest => {
-                let d = self.level_for(duv_dx, duv_dy);
-                self.sample_level(uv, d.round() as usize, pixel)
+                let max = (self.levels.len() - 1) as f32;
+                let k = if d.is_finite() {
+                    d.round().clamp(0.0, max)
+                } else {
+                    0.0
+                };
+                self.sample_level(uv, k as usize, pixel)
             }
-            LevelSampling::Linear => {
-                self.sample_at_level(uv, self.level_for(duv_dx, duv_dy), pixel)
-            }
+            LevelSampling::Linear => self.sample_at_level(uv, d, pixel),
         }
     }
 

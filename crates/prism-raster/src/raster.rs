@@ -306,8 +306,7 @@ enum TriShade {
     Tex {
         tex: Arc<Texture>,
         uvs: [Vec2; 3],
-        duv_dx: Vec2,
-        duv_dy: Vec2,
+        lod: f32,
         psm: PixelSampling,
         lsm: LevelSampling,
         alpha: f32,
@@ -486,8 +485,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         TriShade::Tex {
             tex: tex.clone(),
             uvs,
-            duv_dx,
-            duv_dy,
+            lod: tex.level_for(duv_dx, duv_dy),
             psm,
             lsm,
             alpha,
@@ -995,10 +993,43 @@ impl Band {
         let cols = self.cols;
         let y0 = self.y0;
         let buf = self.layers.last_mut().expect("canvas");
+        // Textures in standard mode are shaded once per pixel, at its centre, and the colour
+        // is given to every covered sample (as multisampling does); the course shades every
+        // sample.
+        let per_pixel = !compat && matches!(shade, TriShade::Tex { .. });
+        // Colours of the current pixel row, by pixel column from i_lo / r; alpha < 0 = unset.
+        let px_lo = i_lo / r;
+        let mut row_cache: Vec<[f32; 4]> = if per_pixel {
+            vec![[0.0, 0.0, 0.0, -1.0]; (i_hi - 1) / r - px_lo + 1]
+        } else {
+            Vec::new()
+        };
+        let mut cache_row = usize::MAX;
         for j in j_lo..j_hi {
+            if per_pixel && j / r != cache_row {
+                cache_row = j / r;
+                row_cache.fill([0.0, 0.0, 0.0, -1.0]);
+            }
             let y = f64::from(y0) + (j as f64 + 0.5) / rf;
             let yf = if compat { f64::from(y as f32) } else { y };
-            for i in i_lo..i_hi {
+            // A superset of the covered samples on this row, from the three edge lines.
+            let (mut xl, mut xr) = (f64::NEG_INFINITY, f64::INFINITY);
+            if area != 0.0 {
+                for (a, b) in edges {
+                    let (c, dy) = ((b.x - a.x) * (yf - a.y) * sign, (b.y - a.y) * sign);
+                    if dy > 0.0 {
+                        xr = xr.min(a.x + c / dy);
+                    } else if dy < 0.0 {
+                        xl = xl.max(a.x + c / dy);
+                    }
+                }
+            }
+            let span_lo = ((xl * rf - 0.5).floor() - 1.0).max(i_lo as f64);
+            let span_hi = ((xr * rf - 0.5).ceil() + 2.0).min(i_hi as f64);
+            if !(span_lo < span_hi) {
+                continue;
+            }
+            for i in span_lo as usize..span_hi as usize {
                 let x = (i as f64 + 0.5) / rf;
                 let w = [
                     ef(edges[0].0, edges[0].1, x, yf),
@@ -1032,21 +1063,35 @@ impl Band {
                     TriShade::Tex {
                         tex,
                         uvs,
-                        duv_dx,
-                        duv_dy,
+                        lod,
                         psm,
                         lsm,
                         alpha,
                     } => {
                         let (b0, b1) = if area == 0.0 {
                             (1.0, 0.0)
+                        } else if per_pixel {
+                            let px = i / r;
+                            let hit = row_cache[px - px_lo];
+                            if hit[3] >= 0.0 {
+                                blend(&mut buf[j * cols + i], hit);
+                                continue;
+                            }
+                            let (cx, cy) = (px as f64 + 0.5, f64::from(y0) + (j / r) as f64 + 0.5);
+                            let w0 = ef(edges[0].0, edges[0].1, cx, cy);
+                            let w1 = ef(edges[1].0, edges[1].1, cx, cy);
+                            ((w0 / area) as f32, (w1 / area) as f32)
                         } else {
                             ((w[0] / area) as f32, (w[1] / area) as f32)
                         };
                         let b2 = 1.0 - b0 - b1;
                         let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
-                        let k = tex.sample(uv, *duv_dx, *duv_dy, *psm, *lsm);
-                        [k.r * alpha, k.g * alpha, k.b * alpha, *alpha]
+                        let k = tex.sample_lod(uv, *lod, *psm, *lsm);
+                        let c = [k.r * alpha, k.g * alpha, k.b * alpha, *alpha];
+                        if per_pixel {
+                            row_cache[i / r - px_lo] = c;
+                        }
+                        c
                     }
                 };
                 blend(&mut buf[j * cols + i], color);
