@@ -119,11 +119,28 @@ pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
     ))
 }
 
+/// The largest image file the readers open, in bytes (1 GiB).
+pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
+
 fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageError> {
-    std::fs::read(path).map_err(|source| ImageError::Io {
+    let io = |source| ImageError::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(decode_err(
+            &path.display().to_string(),
+            "expected a regular file",
+        ));
+    }
+    if meta.len() > MAX_IMAGE_FILE_BYTES {
+        return Err(decode_err(
+            &path.display().to_string(),
+            format!("file is larger than the limit of {MAX_IMAGE_FILE_BYTES} bytes"),
+        ));
+    }
+    std::fs::read(path).map_err(io)
 }
 
 /// Reads a PNG file as RGBA8.

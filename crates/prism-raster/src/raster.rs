@@ -347,12 +347,55 @@ fn solid(c: Rgb, a: f32) -> [f32; 4] {
     [c.r * a, c.g * a, c.b * a, a]
 }
 
+/// Pixels within this distance outside the image still run the course's exact DDA; longer
+/// lines are first clipped to the image grown by this margin.
+const DDA_MARGIN: f64 = 4096.0;
+
+/// Clips the segment to the rectangle `[lo, hi]` (Liang-Barsky); `None` if it misses.
+fn clip_segment(a: DVec2, b: DVec2, lo: DVec2, hi: DVec2) -> Option<(DVec2, DVec2)> {
+    let d = b - a;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [
+        (-d.x, a.x - lo.x),
+        (d.x, hi.x - a.x),
+        (-d.y, a.y - lo.y),
+        (d.y, hi.y - a.y),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    (t0 <= t1).then(|| (a + d * t0, a + d * t1))
+}
+
 /// The course's DDA line (`rasterize_line`), in `f32` with accumulated steps, appending the
-/// pixels `(floor x, floor y)` it visits.
-fn dda(mut x0: f32, mut y0: f32, mut x1: f32, mut y1: f32, out: &mut Vec<(i32, i32)>) {
-    if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite()) {
+/// pixels `(floor x, floor y)` it visits inside a `width` x `height` image. A line reaching
+/// more than [`DDA_MARGIN`] pixels outside the image is clipped to that margin first.
+fn dda(a: DVec2, b: DVec2, width: i32, height: i32, out: &mut Vec<(i32, i32)>) {
+    if !(a.is_finite() && b.is_finite()) {
         return;
     }
+    let lo = DVec2::splat(-DDA_MARGIN);
+    let hi = DVec2::new(f64::from(width), f64::from(height)) + DDA_MARGIN;
+    let inside = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
+    let (a, b) = if inside(a) && inside(b) {
+        (a, b)
+    } else {
+        match clip_segment(a, b, lo, hi) {
+            Some(s) => s,
+            None => return,
+        }
+    };
+    let (mut x0, mut y0, mut x1, mut y1) = (a.x as f32, a.y as f32, b.x as f32, b.y as f32);
     if x0 > x1 {
         std::mem::swap(&mut x0, &mut x1);
         std::mem::swap(&mut y0, &mut y1);
@@ -369,14 +412,18 @@ fn dda(mut x0: f32, mut y0: f32, mut x1: f32, mut y1: f32, out: &mut Vec<(i32, i
         }
     }
     let (mut x, mut y) = (x0, y0);
-    // Bounded by the line's extent; the cap guards against pathological input.
-    let mut guard = 0u64;
-    let limit = (2.0 * f64::from((x1 - x0).abs() + (y1 - y0).abs()) + 4.0).min(1e8) as u64;
-    while x.floor() <= x1.floor() && (y - y0).abs() <= (y1 - y0).abs() && guard < limit {
-        out.push((x.floor() as i32, y.floor() as i32));
-        x += dx;
-        y += dy;
-        guard += 1;
+    while x.floor() <= x1.floor() && (y - y0).abs() <= (y1 - y0).abs() {
+        let (px, py) = (x.floor() as i32, y.floor() as i32);
+        if px >= 0 && py >= 0 && px < width && py < height {
+            out.push((px, py));
+        }
+        let (nx, ny) = (x + dx, y + dy);
+        if nx == x && ny == y {
+            // The step vanished in f32 far from the origin: no further pixels.
+            break;
+        }
+        x = nx;
+        y = ny;
     }
 }
 
@@ -572,10 +619,8 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 let mut px = Vec::new();
                 for i in 0..segs {
                     let (a, b) = (points[i], points[(i + 1) % n]);
-                    let ((x0, y0), (x1, y1)) = (to_f32(m.apply(a)), to_f32(m.apply(b)));
-                    dda(x0, y0, x1, y1, &mut px);
+                    dda(m.apply(a), m.apply(b), opts.width as i32, h, &mut px);
                 }
-                px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
                 if let (Some(lo), Some(hi)) =
                     (px.iter().map(|p| p.1).min(), px.iter().map(|p| p.1).max())
                 {
@@ -699,7 +744,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         // The course's canvas outline, corners pushed out by one pixel.
         let corner = |x: f64, y: f64, dx: f64, dy: f64| {
             let p = view.apply(DVec2::new(x, y));
-            to_f32(DVec2::new(p.x + dx, p.y + dy))
+            DVec2::new(p.x + dx, p.y + dy)
         };
         let a = corner(0.0, 0.0, -1.0, 1.0);
         let b = corner(doc.width, 0.0, 1.0, 1.0);
@@ -707,9 +752,8 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         let d = corner(doc.width, doc.height, 1.0, -1.0);
         let mut px = Vec::new();
         for (p, q) in [(a, b), (a, c), (d, b), (d, c)] {
-            dda(p.0, p.1, q.0, q.1, &mut px);
+            dda(p, q, opts.width as i32, h, &mut px);
         }
-        px.retain(|&(x, y)| x >= 0 && y >= 0 && x < opts.width as i32 && y < h);
         if !px.is_empty() {
             prims.push(Placed {
                 y0: 0,
@@ -1230,14 +1274,22 @@ mod tests {
     #[test]
     fn dda_closed_forms() {
         let mut px = Vec::new();
-        dda(3.5, 1.2, 3.5, 6.7, &mut px);
+        let d = DVec2::new;
+        dda(d(3.5, 1.2), d(3.5, 6.7), 10, 10, &mut px);
         assert_eq!(px, (1..=6).map(|y| (3, y)).collect::<Vec<_>>());
         px.clear();
-        dda(2.0, 2.0, 2.0, 2.0, &mut px);
+        dda(d(2.0, 2.0), d(2.0, 2.0), 10, 10, &mut px);
         assert_eq!(px, vec![(2, 2)]);
         px.clear();
-        dda(0.0, 0.0, 4.0, 2.0, &mut px);
+        dda(d(0.0, 0.0), d(4.0, 2.0), 10, 10, &mut px);
         assert_eq!(px, vec![(0, 0), (1, 0), (2, 1), (3, 1), (4, 2)]);
+        // Far outside: clipped, bounded work, only in-image pixels kept.
+        px.clear();
+        dda(d(-1e12, 5.0), d(1e12, 5.0), 10, 10, &mut px);
+        assert_eq!(px, (0..10).map(|x| (x, 5)).collect::<Vec<_>>());
+        px.clear();
+        dda(d(-1e12, -1e12), d(-1e11, 3.0), 10, 10, &mut px);
+        assert!(px.is_empty());
     }
 
     #[test]

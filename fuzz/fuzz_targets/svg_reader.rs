@@ -1,0 +1,30 @@
+//! Fuzz the SVG readers (both dialects) and, for small documents, the rasterizer: any input
+//! must give a document or a located error, never a panic.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let source = Source { name: "fuzz.svg".into(), base_dir: "/nonexistent".into() };
+    for dialect in [Dialect::Svg, Dialect::Cs184] {
+        match parse_svg(text, dialect, &source) {
+            Ok(doc) => {
+                if doc.items.len() <= 64 {
+                    let opts = RenderOptions {
+                        width: 32,
+                        height: 32,
+                        samples: 4,
+                        compat: dialect == Dialect::Cs184,
+                        ..RenderOptions::default()
+                    };
+                    let _ = render(&doc, &opts);
+                }
+            }
+            Err(e) => {
+                assert!(e.to_string().starts_with("fuzz.svg:"));
+            }
+        }
+    }
+});
