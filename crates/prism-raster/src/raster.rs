@@ -200,15 +200,53 @@ enum DevPaint {
         g: Arc<Gradient>,
         /// Device pixel to gradient space.
         inv: prism_math::DAffine2,
-        opacity: f32,
+        /// Premultiplied colours for `t = i / (LUT_SIZE - 1)`.
+        lut: Vec<[f32; 4]>,
     },
 }
 
+/// Entries in a gradient's colour table: `t` in [0, 1] is quantised to 1/1023.
+const LUT_SIZE: usize = 1024;
+
+/// Premultiplied colour of a gradient's stops at `t` in [0, 1], times `opacity`; colours
+/// interpolate in stored (sRGB) values, as SVG specifies.
+fn stop_color(g: &Gradient, t: f32, opacity: f32) -> [f32; 4] {
+    let stops = &g.stops;
+    let (c, a) = if t <= stops[0].offset {
+        (stops[0].color, stops[0].opacity)
+    } else if t >= stops[stops.len() - 1].offset {
+        let s = stops[stops.len() - 1];
+        (s.color, s.opacity)
+    } else {
+        let k = stops
+            .windows(2)
+            .position(|w| t >= w[0].offset && t <= w[1].offset)
+            .unwrap_or(0);
+        let (s0, s1) = (stops[k], stops[k + 1]);
+        let span = s1.offset - s0.offset;
+        let f = if span > 0.0 { (t - s0.offset) / span } else { 1.0 };
+        (s0.color.lerp(s1.color, f), s0.opacity + (s1.opacity - s0.opacity) * f)
+    };
+    let a = a * opacity;
+    [c.r * a, c.g * a, c.b * a, a]
+}
+
 impl DevPaint {
+    fn gradient(g: &Arc<Gradient>, inv: prism_math::DAffine2, opacity: f32) -> DevPaint {
+        let lut = (0..LUT_SIZE)
+            .map(|i| stop_color(g, i as f32 / (LUT_SIZE - 1) as f32, opacity))
+            .collect();
+        DevPaint::Gradient {
+            g: g.clone(),
+            inv,
+            lut,
+        }
+    }
+
     fn at(&self, x: f64, y: f64) -> [f32; 4] {
         match self {
             DevPaint::Solid(c) => *c,
-            DevPaint::Gradient { g, inv, opacity } => {
+            DevPaint::Gradient { g, inv, lut } => {
                 let p = inv.transform_point2(DVec2::new(x, y));
                 let t = match g.kind {
                     GradientKind::Linear { start, end } => {
@@ -237,32 +275,9 @@ impl DevPaint {
                             m
                         }
                     }
-                } as f32;
-                let stops = &g.stops;
-                let (c, a) = if t <= stops[0].offset {
-                    (stops[0].color, stops[0].opacity)
-                } else if t >= stops[stops.len() - 1].offset {
-                    let s = stops[stops.len() - 1];
-                    (s.color, s.opacity)
-                } else {
-                    let k = stops
-                        .windows(2)
-                        .position(|w| t >= w[0].offset && t <= w[1].offset)
-                        .unwrap_or(0);
-                    let (s0, s1) = (stops[k], stops[k + 1]);
-                    let span = s1.offset - s0.offset;
-                    let f = if span > 0.0 {
-                        (t - s0.offset) / span
-                    } else {
-                        1.0
-                    };
-                    (
-                        s0.color.lerp(s1.color, f),
-                        s0.opacity + (s1.opacity - s0.opacity) * f,
-                    )
                 };
-                let a = a * opacity;
-                [c.r * a, c.g * a, c.b * a, a]
+                let t = if t.is_nan() { 0.0 } else { t };
+                lut[(t * (LUT_SIZE - 1) as f64 + 0.5) as usize]
             }
         }
     }
@@ -507,11 +522,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 if det == 0.0 || !det.is_finite() {
                     return None;
                 }
-                Some(DevPaint::Gradient {
-                    g: g.clone(),
-                    inv: full.inverse(),
-                    opacity,
-                })
+                Some(DevPaint::gradient(g, full.inverse(), opacity))
             }
         }
     };
