@@ -224,8 +224,15 @@ fn stop_color(g: &Gradient, t: f32, opacity: f32) -> [f32; 4] {
             .unwrap_or(0);
         let (s0, s1) = (stops[k], stops[k + 1]);
         let span = s1.offset - s0.offset;
-        let f = if span > 0.0 { (t - s0.offset) / span } else { 1.0 };
-        (s0.color.lerp(s1.color, f), s0.opacity + (s1.opacity - s0.opacity) * f)
+        let f = if span > 0.0 {
+            (t - s0.offset) / span
+        } else {
+            1.0
+        };
+        (
+            s0.color.lerp(s1.color, f),
+            s0.opacity + (s1.opacity - s0.opacity) * f,
+        )
     };
     let a = a * opacity;
     [c.r * a, c.g * a, c.b * a, a]
@@ -456,13 +463,13 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             return None;
         }
         let y0 = (lo.floor() as i64).clamp(0, i64::from(h)) as i32;
-        let y1 = ((hi.floor() as i64) + 1).clamp(0, i64::from(h)) as i32;
+        let y1 = (hi.floor() as i64).saturating_add(1).clamp(0, i64::from(h)) as i32;
         (y1 > y0).then_some((y0, y1))
     };
     let xs_visible = |lo: f64, hi: f64| hi >= -1.0 && lo <= w + 1.0;
     let cols = |lo: f64, hi: f64| -> (i32, i32) {
         let x0 = (lo.floor() as i64).clamp(0, w as i64) as i32;
-        let x1 = ((hi.floor() as i64) + 1).clamp(0, w as i64) as i32;
+        let x1 = (hi.floor() as i64).saturating_add(1).clamp(0, w as i64) as i32;
         (x0, x1)
     };
     let place_tri = |v: [DVec2; 3], inclusive: bool, shade: TriShade| -> Option<Placed> {
@@ -1158,35 +1165,42 @@ impl Band {
     fn resolve(&self, out: &mut [[u8; 4]], compat: bool) {
         let r = self.r;
         let n = (r * r) as f32;
+        let w = self.width as usize;
         let canvas = &self.layers[0];
+        let mut acc = vec![[0f32; 4]; w];
         for py in 0..self.rows_px as usize {
-            for px in 0..self.width as usize {
-                let mut acc = [0f32; 4];
-                for j in 0..r {
-                    let row = (py * r + j) * self.cols + px * r;
-                    for s in &canvas[row..row + r] {
-                        for c in 0..4 {
-                            acc[c] += s[c];
-                        }
+            acc.fill([0.0; 4]);
+            // Sum the r x r block of every pixel, one sample row at a time.
+            for j in 0..r {
+                let row = &canvas[(py * r + j) * self.cols..(py * r + j + 1) * self.cols];
+                for (a, block) in acc.iter_mut().zip(row.chunks_exact(r)) {
+                    for s in block {
+                        a[0] += s[0];
+                        a[1] += s[1];
+                        a[2] += s[2];
+                        a[3] += s[3];
                     }
                 }
-                let o = &mut out[py * self.width as usize + px];
+            }
+            let out_row = &mut out[py * w..(py + 1) * w];
+            for (o, a) in out_row.iter_mut().zip(&acc) {
                 if compat {
                     // The course's conversion: truncate channel * 255.
                     for c in 0..3 {
-                        o[c] = ((acc[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
+                        o[c] = ((a[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
                     }
                     o[3] = 255;
                 } else {
-                    let a = acc[3] / n;
-                    if a <= 0.0 {
+                    let alpha = a[3] / n;
+                    if alpha <= 0.0 {
                         *o = [0, 0, 0, 0];
                         continue;
                     }
+                    let k = 255.0 / (n * alpha);
                     for c in 0..3 {
-                        o[c] = ((acc[c] / n / a).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                        o[c] = (a[c] * k).clamp(0.0, 255.0).round() as u8;
                     }
-                    o[3] = (a.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                    o[3] = (alpha.clamp(0.0, 1.0) * 255.0).round() as u8;
                 }
             }
         }
@@ -1301,6 +1315,29 @@ mod tests {
         px.clear();
         dda(d(-1e12, -1e12), d(-1e11, 3.0), 10, 10, &mut px);
         assert!(px.is_empty());
+    }
+
+    /// Regression (found by fuzzing): coordinates near the f64 range render without panics.
+    #[test]
+    fn huge_coordinates_do_not_panic() {
+        use crate::{parse_svg, Dialect, Source};
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">
+            <rect width="1e38" height="1e38" fill="red"/>
+            <polygon points="0,0 1e38,5 5,1e38" fill="blue" stroke="green"/>
+            <line x1="-1e38" y1="0" x2="1e38" y2="9" stroke="black"/>
+            <colortri points="0 0 1e38 0 0 1e38" colors="1 0 0 1 0 1 0 1 0 0 1 1"/>
+            <path d="M0 0 C1e38 0 0 1e38 5 5 Z" stroke="red" stroke-width="1e38"/></svg>"#;
+        for dialect in [Dialect::Svg, Dialect::Cs184] {
+            let doc = parse_svg(svg, dialect, &Source::default()).unwrap();
+            let opts = RenderOptions {
+                width: 16,
+                height: 16,
+                samples: 4,
+                compat: dialect == Dialect::Cs184,
+                ..RenderOptions::default()
+            };
+            render(&doc, &opts).unwrap();
+        }
     }
 
     #[test]
