@@ -196,11 +196,11 @@ fn encode_png_channels(
 /// [`ImageError::Encode`] if the encoder fails.
 pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
     let mut out = Vec::new();
-    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    let flat = image.pixels().as_flattened();
     encode_png_channels(
         image.width(),
         image.height(),
-        &flat,
+        flat,
         png::ColorType::Rgb,
         &mut out,
     )?;
@@ -212,9 +212,9 @@ pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
 /// # Errors
 /// [`ImageError::Io`] or [`ImageError::Encode`]; on error the destination is untouched.
 pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
-    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    let flat = image.pixels().as_flattened();
     write_atomic(path, |w| {
-        encode_png_channels(image.width(), image.height(), &flat, png::ColorType::Rgb, w)
+        encode_png_channels(image.width(), image.height(), flat, png::ColorType::Rgb, w)
     })
 }
 
@@ -223,15 +223,9 @@ pub fn write_png(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
 /// # Errors
 /// [`ImageError::Io`] or [`ImageError::Encode`]; on error the destination is untouched.
 pub fn write_png_rgba(path: &Path, image: &Rgba8Image) -> Result<(), ImageError> {
-    let flat: Vec<u8> = image.pixels().iter().flatten().copied().collect();
+    let flat = image.pixels().as_flattened();
     write_atomic(path, |w| {
-        encode_png_channels(
-            image.width(),
-            image.height(),
-            &flat,
-            png::ColorType::Rgba,
-            w,
-        )
+        encode_png_channels(image.width(), image.height(), flat, png::ColorType::Rgba, w)
     })
 }
 

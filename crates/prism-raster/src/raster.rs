@@ -869,6 +869,11 @@ fn blend_8bit(dst: &mut [f32; 4], src: [f32; 4]) {
     }
 }
 
+#[inline(always)]
+fn add4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
+}
+
 /// One band's sample storage: `rows` sample rows of `cols` samples.
 struct Band {
     /// Layer stack; the bottom is the band's canvas.
@@ -1168,19 +1173,19 @@ impl Band {
         let w = self.width as usize;
         let canvas = &self.layers[0];
         let mut acc = vec![[0f32; 4]; w];
+        let stride = self.cols;
         for py in 0..self.rows_px as usize {
-            acc.fill([0.0; 4]);
-            // Sum the r x r block of every pixel, one sample row at a time.
-            for j in 0..r {
-                let row = &canvas[(py * r + j) * self.cols..(py * r + j + 1) * self.cols];
-                for (a, block) in acc.iter_mut().zip(row.chunks_exact(r)) {
-                    for s in block {
-                        a[0] += s[0];
-                        a[1] += s[1];
-                        a[2] += s[2];
-                        a[3] += s[3];
+            // Sum the r x r block of every pixel in registers.
+            let base = py * r * stride;
+            for (x, a) in acc.iter_mut().enumerate() {
+                let mut sum = [0f32; 4];
+                for j in 0..r {
+                    let start = base + j * stride + x * r;
+                    for s in &canvas[start..start + r] {
+                        sum = add4(sum, *s);
                     }
                 }
+                *a = sum;
             }
             let out_row = &mut out[py * w..(py + 1) * w];
             for (o, a) in out_row.iter_mut().zip(&acc) {
@@ -1197,10 +1202,11 @@ impl Band {
                         continue;
                     }
                     let k = 255.0 / (n * alpha);
+                    // Round to nearest (`round()` is a libm call on baseline x86-64).
                     for c in 0..3 {
-                        o[c] = (a[c] * k).clamp(0.0, 255.0).round() as u8;
+                        o[c] = ((a[c] * k).clamp(0.0, 255.0) + 0.5) as u8;
                     }
-                    o[3] = (alpha.clamp(0.0, 1.0) * 255.0).round() as u8;
+                    o[3] = (alpha.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
                 }
             }
         }
@@ -1231,39 +1237,48 @@ pub fn render(
     let prepare_time = t0.elapsed();
     let t1 = Instant::now();
     let cols = w as usize * r;
-    // About 4 MiB of samples per band.
-    let band_rows = ((4usize << 20) / (cols * r * 16)).clamp(1, 64);
+    // About 1 MiB of samples per band (and per layer of a band).
+    let band_rows = ((256usize << 10) / (cols * r * 16)).clamp(1, 64);
     let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
     let background = if opts.compat {
         [1.0, 1.0, 1.0, 1.0]
     } else {
         [0.0; 4]
     };
+    let full = band_rows * r * cols;
     let times: Vec<(Duration, Duration)> = pixels
         .par_chunks_mut(band_rows * w as usize)
         .enumerate()
-        .map(|(bi, out)| {
-            let ta = Instant::now();
-            let y0 = (bi * band_rows) as i32;
-            let rows_px = (out.len() / w as usize) as i32;
-            let mut band = Band {
-                layers: vec![vec![background; rows_px as usize * r * cols]],
+        .map_init(
+            // Sample buffers are reused from band to band on each thread.
+            || Band {
+                layers: Vec::new(),
                 spare: Vec::new(),
                 cols,
-                y0,
-                rows_px,
+                y0: 0,
+                rows_px: 0,
                 r,
                 width: w as i32,
-            };
-            for p in &prims {
-                if p.y1 > y0 && p.y0 < y0 + rows_px {
-                    band.draw(p, opts.compat);
+            },
+            |band, (bi, out)| {
+                let ta = Instant::now();
+                band.y0 = (bi * band_rows) as i32;
+                band.rows_px = (out.len() / w as usize) as i32;
+                let mut canvas = band.layers.pop().unwrap_or_else(|| vec![[0.0; 4]; full]);
+                band.spare.extend(band.layers.drain(..));
+                canvas.fill(background);
+                band.layers.push(canvas);
+                let (y0, rows_px) = (band.y0, band.rows_px);
+                for p in &prims {
+                    if p.y1 > y0 && p.y0 < y0 + rows_px {
+                        band.draw(p, opts.compat);
+                    }
                 }
-            }
-            let tb = Instant::now();
-            band.resolve(out, opts.compat);
-            (tb - ta, tb.elapsed())
-        })
+                let tb = Instant::now();
+                band.resolve(out, opts.compat);
+                (tb - ta, tb.elapsed())
+            },
+        )
         .collect();
     let wall = t1.elapsed();
     let (rt, st): (Duration, Duration) = times
