@@ -1093,7 +1093,7 @@ impl Band {
             }
             let span_lo = ((xl * rf - 0.5).floor() - 1.0).max(i_lo as f64);
             let span_hi = ((xr * rf - 0.5).ceil() + 2.0).min(i_hi as f64);
-            if !(span_lo < span_hi) {
+            if span_lo.partial_cmp(&span_hi) != Some(std::cmp::Ordering::Less) {
                 continue;
             }
             for i in span_lo as usize..span_hi as usize {
@@ -1265,7 +1265,7 @@ pub fn render(
                 band.y0 = (bi * band_rows) as i32;
                 band.rows_px = (out.len() / w as usize) as i32;
                 let mut canvas = band.layers.pop().unwrap_or_else(|| vec![[0.0; 4]; full]);
-                band.spare.extend(band.layers.drain(..));
+                band.spare.append(&mut band.layers);
                 canvas.fill(background);
                 band.layers.push(canvas);
                 let (y0, rows_px) = (band.y0, band.rows_px);
