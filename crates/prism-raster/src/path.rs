@@ -426,9 +426,13 @@ fn dash(lines: &[Polyline], dashes: &[f64], offset: f64) -> Vec<Polyline> {
     out
 }
 
+/// Most dashes one stroke may be cut into; a longer dashed stroke is drawn solid.
+pub const MAX_DASHES: f64 = 1e6;
+
 /// Outlines the stroke of `lines` as closed counter-clockwise polygons whose union (filled
 /// with the non-zero rule) is the stroked area. `tol` bounds the error of round joins and
-/// caps, in the same units as the geometry.
+/// caps, in the same units as the geometry. A dash pattern that would cut the stroke into
+/// more than [`MAX_DASHES`] pieces is ignored (the stroke is drawn solid).
 #[must_use]
 pub fn stroke(lines: &[Polyline], style: &StrokeStyle, tol: f64) -> Vec<Vec<DVec2>> {
     let hw = style.width * 0.5;
@@ -437,9 +441,22 @@ pub fn stroke(lines: &[Polyline], style: &StrokeStyle, tol: f64) -> Vec<Vec<DVec
         return out;
     }
     let dashed;
+    let pattern: f64 = style.dashes.iter().sum();
+    let length: f64 = lines
+        .iter()
+        .map(|l| {
+            let mut len: f64 = l.points.windows(2).map(|w| (w[1] - w[0]).length()).sum();
+            if l.closed && l.points.len() > 1 {
+                len += (l.points[0] - l.points[l.points.len() - 1]).length();
+            }
+            len
+        })
+        .sum();
+    let dash_count = length / pattern * style.dashes.len() as f64;
     let lines = if !style.dashes.is_empty()
         && style.dashes.iter().all(|d| *d >= 0.0 && d.is_finite())
-        && style.dashes.iter().sum::<f64>() > 0.0
+        && pattern > 0.0
+        && dash_count <= MAX_DASHES
     {
         dashed = dash(lines, &style.dashes, style.dash_offset);
         &dashed[..]
@@ -678,6 +695,20 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             assert!(d <= 0.1 + 1e-9, "deviation {d}");
         }
+    }
+
+    /// Regression (found by fuzzing): an astronomically long dashed stroke stays bounded.
+    #[test]
+    fn absurd_dash_counts_fall_back_to_solid() {
+        let line = Polyline {
+            points: vec![DVec2::new(0.0, 0.0), DVec2::new(1e78, 0.0)],
+            closed: false,
+        };
+        let style = StrokeStyle {
+            dashes: vec![20.0, 10.0],
+            ..Default::default()
+        };
+        assert_eq!(stroke(&[line], &style, 0.1).len(), 1);
     }
 
     #[test]
