@@ -1039,8 +1039,16 @@ impl Band {
         }
         let area = (v[1] - v[0]).perp_dot(v[2] - v[0]);
         // Edge function of edge a->b at p; positive inside for counter-clockwise (area > 0).
-        let ef =
-            |a: DVec2, b: DVec2, x: f64, y: f64| (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+        // In compat mode in f32, as the course's rasterizer computes it.
+        let ef = |a: DVec2, b: DVec2, x: f64, y: f64| {
+            if compat {
+                let (ax, ay, bx, by) = (a.x as f32, a.y as f32, b.x as f32, b.y as f32);
+                let (x, y) = (x as f32, y as f32);
+                f64::from((bx - ax) * (y - ay) - (by - ay) * (x - ax))
+            } else {
+                (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x)
+            }
+        };
         let sign = if area < 0.0 { -1.0 } else { 1.0 };
         // Top-left rule: an edge owns its samples if it is a "top" or "left" edge.
         let owns = |a: DVec2, b: DVec2| {
