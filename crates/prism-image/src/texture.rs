@@ -43,7 +43,7 @@ pub struct Texture {
 }
 
 /// Where uv coordinates fall on the texel grid of a level `w` texels wide.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum UvConvention {
     /// u = 0 and u = 1 are the outer edges of the first and last texels; texel `i` covers
     /// `[i / w, (i + 1) / w)` and its centre is at `(i + 0.5) / w` (OpenGL, pbrt).

@@ -323,8 +323,13 @@ pub struct Document {
     pub view_box_transform: Mat3,
     /// Drawables in painter's order.
     pub items: Vec<Item>,
-    /// Textures referenced by index from items.
+    /// Textures referenced by index from items. Colours of images with transparency are
+    /// stored premultiplied by their alpha.
     pub textures: Vec<Arc<Texture>>,
+    /// For each texture, its alpha channel (in the red channel) when the image has
+    /// transparency that is drawn (`<image>` in standard SVG); `None` when opaque or when
+    /// alpha is dropped (the course's `<texture>`).
+    pub texture_alpha: Vec<Option<Arc<Texture>>>,
     /// One line per kind of thing that was skipped or approximated.
     pub warnings: Vec<String>,
 }

@@ -327,6 +327,8 @@ enum TriShade {
     Color([Rgb; 3]),
     Tex {
         tex: Arc<Texture>,
+        /// Alpha (red channel) for images with transparency; colours are then premultiplied.
+        alpha_tex: Option<Arc<Texture>>,
         uvs: [Vec2; 3],
         lod: f32,
         psm: PixelSampling,
@@ -533,7 +535,9 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
             }
         }
     };
-    let tex_shade = |tex: &Arc<Texture>, dv: [DVec2; 3], uvs: [Vec2; 3], psm, lsm, alpha| {
+    let tex_shade = |index: usize, dv: [DVec2; 3], uvs: [Vec2; 3], psm, lsm, alpha| {
+        let tex = &doc.textures[index];
+        let alpha_tex = doc.texture_alpha.get(index).cloned().flatten();
         // uv is an affine function of screen position: its derivatives are constant.
         let e1 = dv[1] - dv[0];
         let e2 = dv[2] - dv[0];
@@ -549,6 +553,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
         };
         TriShade::Tex {
             tex: tex.clone(),
+            alpha_tex: alpha_tex.clone(),
             uvs,
             lod: tex.level_for(duv_dx, duv_dy),
             psm,
@@ -696,7 +701,7 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 let m = view.mul(transform);
                 let v = [dev(&m, points[0]), dev(&m, points[1]), dev(&m, points[2])];
                 let shade = tex_shade(
-                    &doc.textures[*texture],
+                    *texture,
                     v,
                     *uvs,
                     opts.pixel_sampling,
@@ -726,11 +731,10 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                     Vec2::new(0.0, 1.0),
                     Vec2::new(1.0, 1.0),
                 ];
-                let tex = &doc.textures[*texture];
                 for (a, b, cc) in [(0, 1, 2), (2, 1, 3)] {
                     let v = [d[a], d[b], d[cc]];
                     let shade = tex_shade(
-                        tex,
+                        *texture,
                         v,
                         [uv[a], uv[b], uv[cc]],
                         PixelSampling::Bilinear,
@@ -1137,6 +1141,7 @@ impl Band {
                     }
                     TriShade::Tex {
                         tex,
+                        alpha_tex,
                         uvs,
                         lod,
                         psm,
@@ -1162,7 +1167,11 @@ impl Band {
                         let b2 = 1.0 - b0 - b1;
                         let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
                         let k = tex.sample_lod(uv, *lod, *psm, *lsm);
-                        let c = [k.r * alpha, k.g * alpha, k.b * alpha, *alpha];
+                        let cov = match alpha_tex {
+                            Some(at) => at.sample_lod(uv, *lod, *psm, *lsm).r,
+                            None => 1.0,
+                        };
+                        let c = [k.r * alpha, k.g * alpha, k.b * alpha, cov * alpha];
                         if per_pixel {
                             row_cache[i / r - px_lo] = c;
                         }

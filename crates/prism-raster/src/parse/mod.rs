@@ -44,6 +44,9 @@ pub(crate) struct Ctx<'a> {
     pub source: &'a Source,
     pub xml: &'a roxmltree::Document<'a>,
     pub warned: std::collections::BTreeSet<String>,
+    /// Textures already decoded, by reference and uv convention: each file or data URI is
+    /// decoded once however often it is used.
+    pub textures: std::cell::RefCell<std::collections::HashMap<(String, UvConvention), usize>>,
 }
 
 impl Ctx<'_> {
@@ -71,6 +74,10 @@ pub(crate) fn load_texture(
     loc: &Loc,
     uv: UvConvention,
 ) -> Result<usize, SvgError> {
+    let key = (href.to_string(), uv);
+    if let Some(&i) = ctx.textures.borrow().get(&key) {
+        return Ok(i);
+    }
     let rgba = if let Some(data) = href.trim().strip_prefix("data:") {
         let comma = data
             .find(',')
@@ -97,9 +104,25 @@ pub(crate) fn load_texture(
         let path: PathBuf = ctx.source.base_dir.join(FsPath::new(href));
         prism_image::read_image(&path).map_err(|e| loc.err(format!("texture {href:?}: {e}")))?
     };
-    let rgb = rgba.to_rgb8().to_rgb_f32();
+    // Images keep their alpha (premultiplied, so filtering never bleeds hidden colours);
+    // the course's textures drop it.
+    let keep_alpha = uv == UvConvention::Standard && rgba.pixels().iter().any(|p| p[3] < 255);
+    let (rgb, alpha) = if keep_alpha {
+        let rgb = rgba.map(|p| {
+            let a = f32::from(p[3]) / 255.0;
+            prism_math::Rgb::from_u8([p[0], p[1], p[2]]) * a
+        });
+        let a = rgba.map(|p| prism_math::Rgb::splat(f32::from(p[3]) / 255.0));
+        (rgb, Some(Arc::new(Texture::new(a).with_uv_convention(uv))))
+    } else {
+        (rgba.to_rgb8().to_rgb_f32(), None)
+    };
     doc.textures
         .push(Arc::new(Texture::new(rgb).with_uv_convention(uv)));
+    doc.texture_alpha.push(alpha);
+    ctx.textures
+        .borrow_mut()
+        .insert(key, doc.textures.len() - 1);
     Ok(doc.textures.len() - 1)
 }
 
@@ -186,6 +209,7 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
         source,
         xml: &xml,
         warned: Default::default(),
+        textures: Default::default(),
     };
     if root.tag_name().name() != "svg" {
         let loc = element_loc(&ctx, &root);
