@@ -313,6 +313,38 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// 16-bit channels keep their high byte; grey expands to RGB.
+    #[test]
+    fn sixteen_bit_grey_png_decodes_to_high_bytes() {
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, 2, 1);
+            enc.set_color(png::ColorType::Grayscale);
+            enc.set_depth(png::BitDepth::Sixteen);
+            let mut w = enc.write_header().unwrap();
+            w.write_image_data(&[0x12, 0x34, 0xfe, 0xdc]).unwrap();
+        }
+        let im = decode_png(&bytes, "mem").unwrap();
+        assert_eq!(
+            im.pixels(),
+            &[[0x12, 0x12, 0x12, 255], [0xfe, 0xfe, 0xfe, 255]]
+        );
+    }
+
+    #[test]
+    fn reads_staged_jpeg() {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/assets/clothsim/textures/cube/posx.jpg");
+        if !p.exists() {
+            return;
+        }
+        let im = read_image(&p).unwrap();
+        assert!(im.width() > 0 && im.height() > 0);
+        assert!(im.pixels().iter().all(|p| p[3] == 255));
+        // Not every pixel is the same colour: the decoder produced an image, not a fill.
+        assert!(im.pixels().iter().any(|q| q != &im.pixels()[0]));
+    }
+
     #[test]
     fn reads_staged_palette_and_grey_alpha_pngs() {
         let img =
