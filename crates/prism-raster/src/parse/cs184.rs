@@ -11,7 +11,7 @@ use roxmltree::Node;
 use super::common::{
     number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
 };
-use super::{element_loc, load_texture, Ctx};
+use super::{element_loc, Ctx};
 use crate::document::{Document, Item, Mat3};
 
 const P: Precision = Precision::F32;
@@ -107,16 +107,6 @@ fn points_attr(node: &Node, name: &str, loc: &Loc) -> Result<Vec<DVec2>, SvgErro
         )));
     }
     Ok(l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect())
-}
-
-fn exact_points<const N: usize>(
-    node: &Node,
-    name: &str,
-    loc: &Loc,
-) -> Result<[DVec2; N], SvgError> {
-    let p = points_attr(node, name, loc)?;
-    p.try_into()
-        .map_err(|p: Vec<DVec2>| loc.err(format!("{name}: expected {N} points, found {}", p.len())))
 }
 
 pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
@@ -249,50 +239,8 @@ fn walk<'a>(
                     });
                 }
             }
-            "colortri" => {
-                let points = exact_points::<3>(&node, "points", &loc)?;
-                let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
-                if c.len() != 12 {
-                    return Err(loc.err(format!(
-                        "colors: expected 12 numbers (r g b a per vertex), found {}",
-                        c.len()
-                    )));
-                }
-                let col =
-                    |i: usize| Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32);
-                doc.items.push(Item::ColorTri {
-                    points,
-                    colors: [col(0), col(1), col(2)],
-                    transform: t,
-                });
-            }
-            "texture" => {
-                let id = node
-                    .attribute("texid")
-                    .ok_or_else(|| loc.err("expected a texid attribute"))?;
-                let file = node
-                    .attribute("filename")
-                    .ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx =
-                    load_texture(ctx, doc, file, &loc, prism_image::UvConvention::EdgeCenters)?;
-                textures.insert(id.to_string(), idx);
-            }
-            "textri" => {
-                let points = exact_points::<3>(&node, "points", &loc)?;
-                let uv = exact_points::<3>(&node, "uvs", &loc)?;
-                let id = node.attribute("texid").unwrap_or("");
-                let texture = *textures.get(id).ok_or_else(|| {
-                    loc.err(format!(
-                        "texid {id:?}: expected the id of an earlier <texture>"
-                    ))
-                })?;
-                let f = |p: DVec2| Vec2::new(p.x as f32, p.y as f32);
-                doc.items.push(Item::TexTri {
-                    points,
-                    uvs: [f(uv[0]), f(uv[1]), f(uv[2])],
-                    texture,
-                    transform: t,
-                });
+            "colortri" | "texture" | "textri" => {
+                super::course_element(&node, name, t, ctx, doc, textures, &loc, P)?;
             }
             "image" => {
                 if let Some(item) = super::image_item(&node, t, ctx, doc, &loc, P)? {

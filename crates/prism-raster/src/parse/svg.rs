@@ -9,7 +9,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use prism_math::{DVec2, Rgb, Vec2};
+use prism_math::{DVec2, Rgb};
 use roxmltree::Node;
 
 use super::color::parse_color;
@@ -17,7 +17,7 @@ use super::common::{
     number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
 };
 use super::pathdata::parse_path_data;
-use super::{element_loc, image_item, load_texture, Ctx};
+use super::{element_loc, image_item, Ctx};
 use crate::document::{
     Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop,
 };
@@ -636,67 +636,17 @@ impl<'a> Parser<'_, 'a> {
                 }
                 return Ok(());
             }
-            "texture" => {
-                let id = node
-                    .attribute("texid")
-                    .ok_or_else(|| loc.err("expected a texid attribute"))?;
-                let f = node
-                    .attribute("filename")
-                    .ok_or_else(|| loc.err("expected a filename attribute"))?;
-                let idx = load_texture(
+            "colortri" | "texture" | "textri" => {
+                super::course_element(
+                    &node,
+                    name,
+                    t,
                     self.ctx,
                     &mut self.doc,
-                    f,
+                    &mut self.textures,
                     &loc,
-                    prism_image::UvConvention::EdgeCenters,
+                    P,
                 )?;
-                self.textures.insert(id.to_string(), idx);
-                return Ok(());
-            }
-            "colortri" | "textri" => {
-                let pts = number_list(node.attribute("points").unwrap_or(""), P, &loc, "points")?;
-                if pts.len() != 6 {
-                    return Err(loc.err(format!("points: expected 6 numbers, found {}", pts.len())));
-                }
-                let points = [
-                    DVec2::new(pts[0], pts[1]),
-                    DVec2::new(pts[2], pts[3]),
-                    DVec2::new(pts[4], pts[5]),
-                ];
-                if name == "colortri" {
-                    let c = number_list(node.attribute("colors").unwrap_or(""), P, &loc, "colors")?;
-                    if c.len() != 12 {
-                        return Err(
-                            loc.err(format!("colors: expected 12 numbers, found {}", c.len()))
-                        );
-                    }
-                    let col = |i: usize| {
-                        Rgb::new(c[4 * i] as f32, c[4 * i + 1] as f32, c[4 * i + 2] as f32)
-                    };
-                    self.doc.items.push(Item::ColorTri {
-                        points,
-                        colors: [col(0), col(1), col(2)],
-                        transform: t,
-                    });
-                } else {
-                    let uv = number_list(node.attribute("uvs").unwrap_or(""), P, &loc, "uvs")?;
-                    if uv.len() != 6 {
-                        return Err(loc.err(format!("uvs: expected 6 numbers, found {}", uv.len())));
-                    }
-                    let id = node.attribute("texid").unwrap_or("");
-                    let texture = *self.textures.get(id).ok_or_else(|| {
-                        loc.err(format!(
-                            "texid {id:?}: expected the id of an earlier <texture>"
-                        ))
-                    })?;
-                    let f = |i: usize| Vec2::new(uv[2 * i] as f32, uv[2 * i + 1] as f32);
-                    self.doc.items.push(Item::TexTri {
-                        points,
-                        uvs: [f(0), f(1), f(2)],
-                        texture,
-                        transform: t,
-                    });
-                }
                 return Ok(());
             }
             "text" | "tspan" | "textPath" => {
