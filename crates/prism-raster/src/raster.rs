@@ -18,7 +18,7 @@ use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
 use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread};
-use crate::path::{stroke, Path};
+use crate::path::{stroke, Path, StrokeStyle};
 
 /// Largest output width or height in pixels.
 pub const MAX_DIMENSION: u32 = 16_384;
@@ -609,14 +609,29 @@ fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
                 opacity,
             } => {
                 let m = view.mul(transform);
-                let Some(paint) = dev_paint(paint, &m, *opacity) else {
-                    return out;
-                };
                 let affine = m.to_affine();
                 let scale = m.max_scale();
                 if !(scale > 0.0 && scale.is_finite()) {
                     return out;
                 }
+                // Strokes thinner than a pixel are drawn one pixel wide with their opacity
+                // scaled by their width (hairlines, as Skia and resvg draw them): a sample
+                // grid cannot resolve sub-pixel widths without heavy noise.
+                let device_width = style.width * scale;
+                let thin = device_width < 1.0;
+                let widened;
+                let (style, opacity) = if thin {
+                    widened = StrokeStyle {
+                        width: 1.0 / scale,
+                        ..style.clone()
+                    };
+                    (&widened, *opacity * device_width as f32)
+                } else {
+                    (style, *opacity)
+                };
+                let Some(paint) = dev_paint(paint, &m, opacity) else {
+                    return out;
+                };
                 let tol = TOLERANCE / scale;
                 let polys = stroke(&path.flatten(tol), style, tol);
                 let mut edges = Vec::new();
