@@ -1020,9 +1020,20 @@ impl Band {
         }
         let cols = self.cols;
         let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
+        // Gradients are evaluated once per pixel, at its centre, and the colour given to
+        // every covered sample (as multisampling shades); alpha < 0 marks "not yet".
+        let gradient = matches!(paint, DevPaint::Gradient { .. });
+        let mut row_cache: Vec<[f32; 4]> = Vec::new();
+        let mut cache_row = usize::MAX;
         for j in 0..self.rows_px as usize * sr {
             let y = self.sample_y(j);
             let xo = self.pat.xoff[j % sr];
+            if gradient && j / sr != cache_row {
+                cache_row = j / sr;
+                row_cache.clear();
+                row_cache.resize(self.width as usize, [0.0, 0.0, 0.0, -1.0]);
+            }
+            let y_centre = f64::from(self.y0) + (j / sr) as f64 + 0.5;
             xs.clear();
             for e in &local {
                 // Half-open in y: an edge owns samples with y0 <= y < y1.
@@ -1055,9 +1066,14 @@ impl Band {
                         }
                     }
                     g => {
+                        let sci = self.pat.sub_cols;
                         for (i, s) in row[a..b].iter_mut().enumerate() {
-                            let x = (a + i) as f64 / sc + xo;
-                            blend(s, g.at(x, y));
+                            let px = (a + i) / sci;
+                            let c = &mut row_cache[px];
+                            if c[3] < 0.0 {
+                                *c = g.at(px as f64 + 0.5, y_centre);
+                            }
+                            blend(s, *c);
                         }
                     }
                 }
