@@ -1140,6 +1140,7 @@ impl Band {
         // is given to every covered sample (as multisampling does); the course shades every
         // sample.
         let per_pixel = !compat && matches!(shade, TriShade::Tex { .. });
+        let fast_interior = !compat && (per_pixel || matches!(shade, TriShade::Solid(_)));
         // Colours of the current pixel row, by pixel column from i_lo / sc; alpha < 0 = unset.
         let px_lo = i_lo / sc;
         let mut row_cache: Vec<[f32; 4]> = if per_pixel {
@@ -1174,14 +1175,31 @@ impl Band {
             if span_lo.partial_cmp(&span_hi) != Some(std::cmp::Ordering::Less) {
                 continue;
             }
+            // Samples more than one sample spacing inside all three edge lines need no edge
+            // test (standard mode, and only when the shading does not use barycentrics).
+            let (in_lo, in_hi) = if fast_interior && xl.is_finite() && xr.is_finite() {
+                (
+                    ((xl - xo) * cf).ceil() + 1.0,
+                    ((xr - xo) * cf).floor() - 1.0,
+                )
+            } else {
+                (f64::INFINITY, f64::NEG_INFINITY)
+            };
             for i in span_lo as usize..span_hi as usize {
                 let x = i as f64 / cf + xo;
-                let w = [
-                    ef(edges[0].0, edges[0].1, x, yf),
-                    ef(edges[1].0, edges[1].1, x, yf),
-                    ef(edges[2].0, edges[2].1, x, yf),
-                ];
-                let inside = if inclusive {
+                let interior = (i as f64) >= in_lo && (i as f64) <= in_hi;
+                let w = if interior {
+                    [0.0; 3]
+                } else {
+                    [
+                        ef(edges[0].0, edges[0].1, x, yf),
+                        ef(edges[1].0, edges[1].1, x, yf),
+                        ef(edges[2].0, edges[2].1, x, yf),
+                    ]
+                };
+                let inside = if interior {
+                    true
+                } else if inclusive {
                     (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0)
                         || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
                 } else {
