@@ -1060,6 +1060,7 @@ impl Band {
                 let first = |x: f64| (((x - xo) * sc).ceil().clamp(0.0, cols as f64)) as usize;
                 let (a, b) = (first(xs[k].0), first(xs[k + 1].0));
                 match paint {
+                    DevPaint::Solid(c) if c[3] >= 1.0 => row[a..b].fill(*c),
                     DevPaint::Solid(c) => {
                         for s in &mut row[a..b] {
                             blend(s, *c);
