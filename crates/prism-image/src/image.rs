@@ -160,6 +160,32 @@ impl Image<[u8; 3]> {
     pub fn to_rgb_f32(&self) -> RgbImage {
         self.map(|&p| Rgb::from_u8(p))
     }
+
+    /// Decodes sRGB-encoded 8-bit values to linear light.
+    #[must_use]
+    pub fn srgb_to_linear(&self) -> RgbImage {
+        self.map(|p| {
+            Rgb::new(
+                crate::srgb8_to_linear(p[0]),
+                crate::srgb8_to_linear(p[1]),
+                crate::srgb8_to_linear(p[2]),
+            )
+        })
+    }
+}
+
+impl Image<Rgb> {
+    /// Encodes linear values as 8-bit sRGB (clamped to [0, 1], rounded; NaN becomes 0).
+    #[must_use]
+    pub fn linear_to_srgb8(&self) -> Rgb8Image {
+        self.map(|p| {
+            [
+                crate::linear_to_srgb8(p.r),
+                crate::linear_to_srgb8(p.g),
+                crate::linear_to_srgb8(p.b),
+            ]
+        })
+    }
 }
 
 #[cfg(test)]
@@ -172,6 +198,13 @@ mod tests {
         assert_eq!(im.pixels(), &[0, 1, 2, 10, 11, 12]);
         assert_eq!(im.row(1), &[10, 11, 12]);
         assert_eq!(im.get(2, 1), 12);
+    }
+
+    /// Property: 8-bit sRGB -> linear -> 8-bit sRGB is the identity for every value.
+    #[test]
+    fn srgb_image_round_trip() {
+        let im = Image::from_fn(256, 1, |x, _| [x as u8, 255 - x as u8, (x * 7 % 256) as u8]);
+        assert_eq!(im.srgb_to_linear().linear_to_srgb8(), im);
     }
 
     #[test]
