@@ -331,7 +331,33 @@ impl Band {
             } else {
                 (f64::INFINITY, f64::NEG_INFINITY)
             };
-            for i in span_lo as usize..span_hi as usize {
+            let end = span_hi as usize;
+            let mut i = span_lo as usize;
+            while i < end {
+                // Interior runs: solid colours and already-shaded pixels in one go.
+                if (i as f64) >= in_lo && (i as f64) <= in_hi {
+                    let run_end = (in_hi as usize + 1).min(end);
+                    if let TriShade::Solid(c) = shade {
+                        let run = &mut buf[j * cols + i..j * cols + run_end];
+                        if c[3] >= 1.0 {
+                            run.fill(*c);
+                        } else {
+                            run.iter_mut().for_each(|s| blend(s, *c));
+                        }
+                        i = run_end;
+                        continue;
+                    }
+                    let px = i / sc;
+                    if per_pixel && row_cache[px - px_lo][3] >= 0.0 {
+                        let hit = row_cache[px - px_lo];
+                        let stop = ((px + 1) * sc).min(run_end);
+                        for s in &mut buf[j * cols + i..j * cols + stop] {
+                            blend(s, hit);
+                        }
+                        i = stop;
+                        continue;
+                    }
+                }
                 let x = i as f64 / cf + xo;
                 let interior = (i as f64) >= in_lo && (i as f64) <= in_hi;
                 let w = if interior {
@@ -355,6 +381,7 @@ impl Band {
                     })
                 };
                 if !inside {
+                    i += 1;
                     continue;
                 }
                 let color = match shade {
@@ -385,6 +412,7 @@ impl Band {
                             let hit = row_cache[px - px_lo];
                             if hit[3] >= 0.0 {
                                 blend(&mut buf[j * cols + i], hit);
+                                i += 1;
                                 continue;
                             }
                             let (cx, cy) = (px as f64 + 0.5, f64::from(y0) + (j / sr) as f64 + 0.5);
@@ -409,6 +437,7 @@ impl Band {
                     }
                 };
                 blend(&mut buf[j * cols + i], color);
+                i += 1;
             }
         }
     }
