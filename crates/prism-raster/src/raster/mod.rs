@@ -40,14 +40,16 @@ pub enum View {
     /// The document's viewport (after its `viewBox`) fills the output.
     #[default]
     Fit,
-    /// The square region centred at `(cx, cy)` reaching `span` user units to each side,
-    /// centred in the output with uniform scale `min(width, height) / (2 span)`.
+    /// The square region centred at `(cx, cy)` reaching `span` units to each side, centred
+    /// in the output with uniform scale `min(width, height) / (2 span)`. Units are those of
+    /// the document's viewport (its `width` and `height`, after any `viewBox` mapping),
+    /// which for the course's files are the canvas units.
     Region {
-        /// Centre x in user units.
+        /// Centre x in viewport units.
         cx: f64,
-        /// Centre y in user units.
+        /// Centre y in viewport units.
         cy: f64,
-        /// Half the side of the visible square, in user units.
+        /// Half the side of the visible square, in viewport units.
         span: f64,
     },
 }
