@@ -258,6 +258,51 @@ mod tests {
     use crate::document::{FillRule, Item, Paint};
     use prism_math::{DVec2, Rgb};
 
+    /// Closed forms: the course's worked example (800x600 canvas shown at 800x600 maps
+    /// (x, y) to (0.625 x + 150, 0.625 y + 112.5)) and a zoom region.
+    #[test]
+    fn view_transforms_closed_form() {
+        let doc = Document {
+            width: 800.0,
+            height: 600.0,
+            ..Document::default()
+        };
+        let course = RenderOptions {
+            width: 800,
+            height: 600,
+            compat: true,
+            ..RenderOptions::default()
+        };
+        let m = view_transform(&doc, &course);
+        let p = m.apply(DVec2::new(100.0, 40.0));
+        assert!((p - DVec2::new(0.625 * 100.0 + 150.0, 0.625 * 40.0 + 112.5)).length() < 1e-9);
+        let zoom = RenderOptions {
+            width: 100,
+            height: 100,
+            view: View::Region {
+                cx: 50.0,
+                cy: 50.0,
+                span: 25.0,
+            },
+            ..RenderOptions::default()
+        };
+        let doc = Document {
+            width: 100.0,
+            height: 100.0,
+            ..Document::default()
+        };
+        let m = view_transform(&doc, &zoom);
+        assert!((m.apply(DVec2::new(25.0, 25.0)) - DVec2::ZERO).length() < 1e-9);
+        assert!((m.apply(DVec2::new(75.0, 75.0)) - DVec2::splat(100.0)).length() < 1e-9);
+        let fit = RenderOptions {
+            width: 200,
+            height: 50,
+            ..RenderOptions::default()
+        };
+        let m = view_transform(&doc, &fit);
+        assert!((m.apply(DVec2::new(100.0, 100.0)) - DVec2::new(200.0, 50.0)).length() < 1e-9);
+    }
+
     #[test]
     fn sample_rates() {
         assert_eq!(sample_rate(1), Some(1));
