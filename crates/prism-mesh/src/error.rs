@@ -1,0 +1,46 @@
+/// Everything that can go wrong reading a mesh or building its connectivity.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// A syntax or value error in a mesh file, with its location.
+    #[error("{file}:{line}: {message}")]
+    Parse {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// The polygon soup cannot be a manifold halfedge mesh.
+    #[error("face {face}: {message}")]
+    Topology {
+        /// The offending face index.
+        face: usize,
+        /// What is wrong (non-manifold edge or vertex, degenerate face, index out of range).
+        message: String,
+    },
+    /// A vertex makes the mesh non-manifold (its faces do not form one fan).
+    #[error("vertex {vertex}: {message}")]
+    NonManifoldVertex {
+        /// The offending vertex index.
+        vertex: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An operation needs triangles.
+    #[error("face {face} has {sides} sides; this operation needs triangles")]
+    NotTriangles {
+        /// The first non-triangle face.
+        face: usize,
+        /// Its side count.
+        sides: usize,
+    },
+}

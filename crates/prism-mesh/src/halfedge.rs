@@ -1,0 +1,529 @@
+//! A halfedge mesh with typed index handles. Halfedges come in pairs: the opposite of
+//! halfedge `h` is `h ^ 1`, and edge `e` owns halfedges `2e` and `2e + 1`. Boundary
+//! halfedges have no face and are linked into boundary loops, so every halfedge has a
+//! `next` and a `prev`.
+
+use std::collections::HashMap;
+
+use prism_math::glam::DVec3;
+
+use crate::{MeshError, PolyMesh};
+
+const NONE: u32 = u32::MAX;
+
+/// Index of a halfedge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct HalfedgeId(pub u32);
+/// Index of a vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct VertexId(pub u32);
+/// Index of a face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FaceId(pub u32);
+/// Index of an edge (a pair of opposite halfedges).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EdgeId(pub u32);
+
+/// A manifold polygon mesh, possibly with boundaries, in halfedge form.
+///
+/// Invariants (checked by [`HalfedgeMesh::validate`]): `next` and `prev` are inverse
+/// permutations; a halfedge ends where its `next` starts; the halfedges of a face loop back
+/// to the face's first halfedge; a vertex's outgoing halfedge starts at it, and is a
+/// boundary halfedge when the vertex is on a boundary; the faces around every vertex form a
+/// single fan.
+#[derive(Clone, Debug, Default)]
+pub struct HalfedgeMesh {
+    positions: Vec<DVec3>,
+    he_next: Vec<u32>,
+    he_prev: Vec<u32>,
+    he_origin: Vec<u32>,
+    he_face: Vec<u32>,
+    v_out: Vec<u32>,
+    f_he: Vec<u32>,
+}
+
+impl HalfedgeMesh {
+    /// Builds the halfedge structure of a polygon soup.
+    ///
+    /// # Errors
+    /// [`MeshError::Topology`] naming the face for an index out of range, a face with fewer
+    /// than three distinct vertices, or an edge used twice in the same direction (a
+    /// non-manifold edge or inconsistent orientation); [`MeshError::NonManifoldVertex`] for
+    /// a vertex whose faces form more than one fan.
+    pub fn from_polymesh(mesh: &PolyMesh) -> Result<HalfedgeMesh, MeshError> {
+        let nv = mesh.vertex_count();
+        let mut m = HalfedgeMesh {
+            positions: mesh.positions.clone(),
+            v_out: vec![NONE; nv],
+            ..HalfedgeMesh::default()
+        };
+        let mut directed: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.face_count() * 3);
+        let mut out_count = vec![0u32; nv];
+        for (fi, face) in mesh.faces().enumerate() {
+            let err = |message: String| MeshError::Topology { face: fi, message };
+            if face.len() < 3 {
+                return Err(err(format!(
+                    "has {} vertices; a face needs at least 3",
+                    face.len()
+                )));
+            }
+            for (k, &v) in face.iter().enumerate() {
+                if v as usize >= nv {
+                    return Err(err(format!(
+                        "vertex index {v} is out of range (mesh has {nv} vertices)"
+                    )));
+                }
+                if face[..k].contains(&v) {
+                    return Err(err(format!(
+                        "vertex {v} appears twice: the face is degenerate"
+                    )));
+                }
+            }
+            let mut hs = Vec::with_capacity(face.len());
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                if directed.contains_key(&(a, b)) {
+                    return Err(err(format!(
+                        "edge {a}-{b} is already used in this direction: non-manifold edge or inconsistent orientation"
+                    )));
+                }
+                let h = match directed.get(&(b, a)) {
+                    Some(&h_ba) => h_ba ^ 1,
+                    None => {
+                        let h = m.he_next.len() as u32;
+                        for (o, _) in [(a, b), (b, a)] {
+                            m.he_origin.push(o);
+                            m.he_face.push(NONE);
+                            m.he_next.push(NONE);
+                            m.he_prev.push(NONE);
+                        }
+                        h
+                    }
+                };
+                directed.insert((a, b), h);
+                m.he_face[h as usize] = fi as u32;
+                out_count[a as usize] += 1;
+                hs.push(h);
+            }
+            for k in 0..hs.len() {
+                let (h, n) = (hs[k], hs[(k + 1) % hs.len()]);
+                m.he_next[h as usize] = n;
+                m.he_prev[n as usize] = h;
+            }
+            m.f_he.push(hs[0]);
+        }
+        // Link boundary halfedges into loops.
+        let mut boundary_out: Vec<u32> = vec![NONE; nv];
+        for h in 0..m.he_next.len() as u32 {
+            if m.he_face[h as usize] == NONE {
+                let o = m.he_origin[h as usize] as usize;
+                out_count[o] += 1;
+                if boundary_out[o] != NONE {
+                    return Err(MeshError::NonManifoldVertex {
+                        vertex: o,
+                        message: "two boundary loops meet here".into(),
+                    });
+                }
+                boundary_out[o] = h;
+            }
+        }
+        for h in 0..m.he_next.len() as u32 {
+            if m.he_face[h as usize] == NONE {
+                let dest = m.he_origin[(h ^ 1) as usize] as usize;
+                let n = boundary_out[dest];
+                m.he_next[h as usize] = n;
+                m.he_prev[n as usize] = h;
+            }
+        }
+        // Outgoing halfedges: the boundary one where there is one.
+        for h in 0..m.he_next.len() as u32 {
+            let o = m.he_origin[h as usize] as usize;
+            if m.v_out[o] == NONE {
+                m.v_out[o] = h;
+            }
+        }
+        for (v, &b) in boundary_out.iter().enumerate() {
+            if b != NONE {
+                m.v_out[v] = b;
+            }
+        }
+        // Every vertex must be a single fan.
+        for (v, &count) in out_count.iter().enumerate() {
+            if m.v_out[v] == NONE {
+                continue;
+            }
+            let fan = m.outgoing(VertexId(v as u32)).count() as u32;
+            if fan != count {
+                return Err(MeshError::NonManifoldVertex {
+                    vertex: v,
+                    message: format!("its {count} outgoing halfedges form more than one fan"),
+                });
+            }
+        }
+        Ok(m)
+    }
+
+    /// Converts back to a polygon mesh: the same vertices in the same order, and each face
+    /// starting at the same vertex as when built.
+    #[must_use]
+    pub fn to_polymesh(&self) -> PolyMesh {
+        let mut p = PolyMesh::new(self.positions.clone(), &[]);
+        let mut face = Vec::new();
+        for f in 0..self.f_he.len() {
+            face.clear();
+            face.extend(
+                self.face_halfedges(FaceId(f as u32))
+                    .map(|h| self.origin(h).0),
+            );
+            p.push_face(&face);
+        }
+        p
+    }
+
+    /// Vertex count.
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+    /// Edge count.
+    #[must_use]
+    pub fn edge_count(&self) -> usize {
+        self.he_next.len() / 2
+    }
+    /// Face count.
+    #[must_use]
+    pub fn face_count(&self) -> usize {
+        self.f_he.len()
+    }
+    /// Halfedge count.
+    #[must_use]
+    pub fn halfedge_count(&self) -> usize {
+        self.he_next.len()
+    }
+    /// V - E + F.
+    #[must_use]
+    pub fn euler_characteristic(&self) -> i64 {
+        self.vertex_count() as i64 - self.edge_count() as i64 + self.face_count() as i64
+    }
+    /// Position of a vertex.
+    #[must_use]
+    pub fn position(&self, v: VertexId) -> DVec3 {
+        self.positions[v.0 as usize]
+    }
+    /// All positions.
+    #[must_use]
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+    /// The next halfedge around its face or boundary loop.
+    #[must_use]
+    pub fn next(&self, h: HalfedgeId) -> HalfedgeId {
+        HalfedgeId(self.he_next[h.0 as usize])
+    }
+    /// The previous halfedge around its face or boundary loop.
+    #[must_use]
+    pub fn prev(&self, h: HalfedgeId) -> HalfedgeId {
+        HalfedgeId(self.he_prev[h.0 as usize])
+    }
+    /// The opposite halfedge.
+    #[must_use]
+    pub fn twin(&self, h: HalfedgeId) -> HalfedgeId {
+        HalfedgeId(h.0 ^ 1)
+    }
+    /// The edge a halfedge belongs to.
+    #[must_use]
+    pub fn edge(&self, h: HalfedgeId) -> EdgeId {
+        EdgeId(h.0 >> 1)
+    }
+    /// The first halfedge of an edge.
+    #[must_use]
+    pub fn edge_halfedge(&self, e: EdgeId) -> HalfedgeId {
+        HalfedgeId(e.0 << 1)
+    }
+    /// The vertex a halfedge starts at.
+    #[must_use]
+    pub fn origin(&self, h: HalfedgeId) -> VertexId {
+        VertexId(self.he_origin[h.0 as usize])
+    }
+    /// The vertex a halfedge ends at.
+    #[must_use]
+    pub fn dest(&self, h: HalfedgeId) -> VertexId {
+        VertexId(self.he_origin[(h.0 ^ 1) as usize])
+    }
+    /// The face of a halfedge; `None` on the boundary.
+    #[must_use]
+    pub fn face(&self, h: HalfedgeId) -> Option<FaceId> {
+        let f = self.he_face[h.0 as usize];
+        (f != NONE).then_some(FaceId(f))
+    }
+    /// True for a halfedge without a face.
+    #[must_use]
+    pub fn is_boundary_halfedge(&self, h: HalfedgeId) -> bool {
+        self.he_face[h.0 as usize] == NONE
+    }
+    /// True for an edge with a boundary halfedge.
+    #[must_use]
+    pub fn is_boundary_edge(&self, e: EdgeId) -> bool {
+        let h = self.edge_halfedge(e);
+        self.is_boundary_halfedge(h) || self.is_boundary_halfedge(self.twin(h))
+    }
+    /// An outgoing halfedge of a vertex (the boundary one on a boundary); `None` if isolated.
+    #[must_use]
+    pub fn vertex_halfedge(&self, v: VertexId) -> Option<HalfedgeId> {
+        let h = self.v_out[v.0 as usize];
+        (h != NONE).then_some(HalfedgeId(h))
+    }
+    /// True for a vertex on a boundary.
+    #[must_use]
+    pub fn is_boundary_vertex(&self, v: VertexId) -> bool {
+        self.vertex_halfedge(v)
+            .is_some_and(|h| self.is_boundary_halfedge(h))
+    }
+    /// The first halfedge of a face.
+    #[must_use]
+    pub fn face_halfedge(&self, f: FaceId) -> HalfedgeId {
+        HalfedgeId(self.f_he[f.0 as usize])
+    }
+
+    /// The halfedges of a face, in order.
+    pub fn face_halfedges(&self, f: FaceId) -> impl Iterator<Item = HalfedgeId> + '_ {
+        let start = self.face_halfedge(f);
+        let mut cur = Some(start);
+        let limit = self.he_next.len();
+        let mut steps = 0;
+        std::iter::from_fn(move || {
+            let h = cur?;
+            steps += 1;
+            let n = self.next(h);
+            cur = (n != start && steps < limit).then_some(n);
+            Some(h)
+        })
+    }
+
+    /// The outgoing halfedges of a vertex, rotating from its stored halfedge.
+    pub fn outgoing(&self, v: VertexId) -> impl Iterator<Item = HalfedgeId> + '_ {
+        let start = self.vertex_halfedge(v);
+        let mut cur = start;
+        let limit = self.he_next.len();
+        let mut steps = 0;
+        std::iter::from_fn(move || {
+            let h = cur?;
+            steps += 1;
+            let n = self.twin(self.prev(h));
+            cur = (Some(n) != start && steps < limit).then_some(n);
+            Some(h)
+        })
+    }
+
+    /// Checks every invariant listed on the type.
+    ///
+    /// # Errors
+    /// A message naming the first element that breaks an invariant.
+    pub fn validate(&self) -> Result<(), String> {
+        let nh = self.he_next.len();
+        if !nh.is_multiple_of(2)
+            || self.he_prev.len() != nh
+            || self.he_origin.len() != nh
+            || self.he_face.len() != nh
+        {
+            return Err("halfedge arrays differ in length".into());
+        }
+        for h in 0..nh {
+            let (n, p) = (self.he_next[h] as usize, self.he_prev[h] as usize);
+            if n >= nh || p >= nh {
+                return Err(format!("halfedge {h}: next/prev out of range"));
+            }
+            if self.he_prev[n] as usize != h || self.he_next[p] as usize != h {
+                return Err(format!("halfedge {h}: next and prev are not inverse"));
+            }
+            if self.he_origin[n] != self.he_origin[h ^ 1] {
+                return Err(format!(
+                    "halfedge {h}: its next does not start where it ends"
+                ));
+            }
+            if self.he_face[n] != self.he_face[h] {
+                return Err(format!("halfedge {h}: its next lies in another face"));
+            }
+            if self.he_origin[h] == self.he_origin[h ^ 1] {
+                return Err(format!("halfedge {h}: starts and ends at the same vertex"));
+            }
+            if self.he_face[h] == NONE && self.he_face[h ^ 1] == NONE {
+                return Err(format!("edge {}: has no face on either side", h / 2));
+            }
+            if self.he_origin[h] as usize >= self.positions.len() {
+                return Err(format!("halfedge {h}: origin out of range"));
+            }
+        }
+        for f in 0..self.f_he.len() {
+            let hs: Vec<HalfedgeId> = self.face_halfedges(FaceId(f as u32)).collect();
+            if hs.len() < 3 || self.next(*hs.last().expect("non-empty")) != hs[0] {
+                return Err(format!(
+                    "face {f}: its halfedges do not form a loop of 3 or more"
+                ));
+            }
+            if hs.iter().any(|h| self.he_face[h.0 as usize] != f as u32) {
+                return Err(format!(
+                    "face {f}: a halfedge of its loop belongs to another face"
+                ));
+            }
+        }
+        for v in 0..self.positions.len() {
+            let Some(h) = self.vertex_halfedge(VertexId(v as u32)) else {
+                continue;
+            };
+            if self.he_origin[h.0 as usize] as usize != v {
+                return Err(format!("vertex {v}: its halfedge starts elsewhere"));
+            }
+            let out: Vec<HalfedgeId> = self.outgoing(VertexId(v as u32)).collect();
+            if out.iter().any(|o| self.origin(*o).0 as usize != v) {
+                return Err(format!("vertex {v}: rotation leaves the vertex"));
+            }
+            if out.iter().skip(1).any(|o| self.is_boundary_halfedge(*o)) {
+                return Err(format!(
+                    "vertex {v}: its stored halfedge is not its boundary halfedge"
+                ));
+            }
+        }
+        // Each vertex's outgoing halfedges are all in its one fan.
+        let mut count = vec![0usize; self.positions.len()];
+        for h in 0..nh {
+            count[self.he_origin[h] as usize] += 1;
+        }
+        for (v, &c) in count.iter().enumerate() {
+            let fan = self.outgoing(VertexId(v as u32)).count();
+            if fan != c {
+                return Err(format!(
+                    "vertex {v}: {c} outgoing halfedges but a fan of {fan}"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// An icosahedron with unit circumradius, counter-clockwise faces seen from outside.
+#[must_use]
+pub fn icosahedron() -> PolyMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let raw = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let positions = raw
+        .iter()
+        .map(|p| DVec3::from_array(*p).normalize())
+        .collect();
+    let faces: Vec<Vec<u32>> = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ]
+    .iter()
+    .map(|f| f.to_vec())
+    .collect();
+    PolyMesh::new(positions, &faces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn icosahedron_is_closed_and_valid() {
+        let m = HalfedgeMesh::from_polymesh(&icosahedron()).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (12, 30, 20)
+        );
+        assert_eq!(m.euler_characteristic(), 2);
+        assert!((0..12)
+            .all(|v| !m.is_boundary_vertex(VertexId(v)) && m.outgoing(VertexId(v)).count() == 5));
+    }
+
+    #[test]
+    fn round_trip_is_lossless() {
+        let p = icosahedron();
+        let m = HalfedgeMesh::from_polymesh(&p).unwrap();
+        assert_eq!(m.to_polymesh(), p);
+    }
+
+    /// An open fan: boundary loop linked, boundary vertices store boundary halfedges.
+    #[test]
+    fn open_mesh_has_boundary_loop() {
+        let p = PolyMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::NEG_X, DVec3::NEG_Y],
+            &[vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4], vec![0, 4, 1]],
+        );
+        let m = HalfedgeMesh::from_polymesh(&p).unwrap();
+        m.validate().unwrap();
+        assert!(!m.is_boundary_vertex(VertexId(0)));
+        assert!((1..5).all(|v| m.is_boundary_vertex(VertexId(v))));
+        assert_eq!(m.euler_characteristic(), 1);
+        let quad = PolyMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::ONE, DVec3::Y],
+            &[vec![0, 1, 2, 3]],
+        );
+        HalfedgeMesh::from_polymesh(&quad)
+            .unwrap()
+            .validate()
+            .unwrap();
+    }
+
+    #[test]
+    fn refuses_bad_soups_with_located_errors() {
+        let pts = vec![DVec3::ZERO; 6];
+        // Three faces on one edge.
+        let e = HalfedgeMesh::from_polymesh(&PolyMesh::new(
+            pts.clone(),
+            &[vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]],
+        ))
+        .unwrap_err();
+        assert!(matches!(e, MeshError::Topology { face: 2, .. }), "{e}");
+        // Bowtie: two fans meeting at vertex 0.
+        let e = HalfedgeMesh::from_polymesh(&PolyMesh::new(
+            pts.clone(),
+            &[vec![0, 1, 2], vec![0, 3, 4]],
+        ))
+        .unwrap_err();
+        assert!(
+            matches!(e, MeshError::NonManifoldVertex { vertex: 0, .. }),
+            "{e}"
+        );
+        let e =
+            HalfedgeMesh::from_polymesh(&PolyMesh::new(pts.clone(), &[vec![0, 1, 9]])).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "face 0: vertex index 9 is out of range (mesh has 6 vertices)"
+        );
+        let e = HalfedgeMesh::from_polymesh(&PolyMesh::new(pts, &[vec![0, 1, 1]])).unwrap_err();
+        assert!(e.to_string().contains("degenerate"));
+    }
+}

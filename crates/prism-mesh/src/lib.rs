@@ -1,0 +1,18 @@
+//! Floor-1 meshes for prism: an indexed polygon mesh ([`PolyMesh`]), a halfedge mesh with
+//! typed index handles ([`HalfedgeMesh`]) built from polygon soups with boundary loops,
+//! Wavefront OBJ reading and writing, area-weighted vertex normals and Loop subdivision.
+#![warn(missing_docs)]
+
+mod error;
+mod halfedge;
+mod loop_subdivision;
+mod normals;
+mod obj;
+mod polymesh;
+
+pub use error::MeshError;
+pub use halfedge::{icosahedron, EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId};
+pub use loop_subdivision::{loop_subdivide, LoopWeights};
+pub use normals::vertex_normals_area_weighted;
+pub use obj::{parse_obj, read_obj, write_obj};
+pub use polymesh::PolyMesh;
