@@ -1,6 +1,7 @@
 //! `prism`: one command for the prism graphics toolkit.
 
 mod demo;
+mod mesh;
 mod progress;
 mod svg;
 
@@ -20,6 +21,8 @@ struct Cli {
 enum Command {
     /// Rasterize SVG files to PNG (standard SVG, or the CS184 course dialect).
     Svg(svg::SvgArgs),
+    /// Inspect, convert and Loop-subdivide meshes (OBJ).
+    Mesh(mesh::MeshArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Svg(a) => svg::run(&a),
+        Command::Mesh(a) => mesh::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {
