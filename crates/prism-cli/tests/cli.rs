@@ -180,3 +180,56 @@ fn demo_writes_gallery() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `prism mesh subdivide` multiplies faces by 4 per level and `info` reports the counts;
+/// a non-manifold input is a located error with exit code 2 and no output.
+#[test]
+fn mesh_subdivide_and_errors() {
+    let dir = scratch("mesh");
+    let tet = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n";
+    std::fs::write(dir.join("tet.obj"), tet).unwrap();
+    let out = dir.join("sub.obj");
+    let o = prism()
+        .args(["mesh", "subdivide"])
+        .arg(dir.join("tet.obj"))
+        .arg("-o")
+        .arg(&out)
+        .args(["-n", "2", "--weights", "loop", "--stats"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o)
+        .lines()
+        .any(|l| l.starts_with("subdivide: ") && l.ends_with(" ms")));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("f ")).count(),
+        4 * 4 * 4
+    );
+    let o = prism().args(["mesh", "info"]).arg(&out).output().unwrap();
+    let info = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        info.contains("faces: 64") && info.contains("euler characteristic: 2"),
+        "{info}"
+    );
+    // Three faces on one edge.
+    let bad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    std::fs::write(dir.join("bad.obj"), bad).unwrap();
+    let out2 = dir.join("bad_out.obj");
+    let o = prism()
+        .args(["mesh", "subdivide"])
+        .arg(dir.join("bad.obj"))
+        .arg("-o")
+        .arg(&out2)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    // Face and vertex numbers in topology errors count from 0.
+    assert!(
+        stderr(&o).contains("bad.obj: face 2: edge 0-1"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out2.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

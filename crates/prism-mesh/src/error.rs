@@ -1,4 +1,5 @@
-/// Everything that can go wrong reading a mesh or building its connectivity.
+/// Everything that can go wrong reading a mesh or building its connectivity. Face and
+/// vertex numbers in topology errors count from 0, in file order.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshError {
     /// A file could not be read or written.
