@@ -340,6 +340,96 @@ impl HalfedgeMesh {
         })
     }
 
+    /// The edge between two vertices, if there is one.
+    #[must_use]
+    pub fn find_edge(&self, a: VertexId, b: VertexId) -> Option<EdgeId> {
+        self.outgoing(a)
+            .find(|&h| self.dest(h) == b)
+            .map(|h| self.edge(h))
+    }
+
+    /// Whether [`HalfedgeMesh::flip`] may flip edge `e`: it must be interior, both its
+    /// faces triangles, and the two opposite vertices distinct and not already joined (which
+    /// also refuses flips that would leave a vertex of valence 2).
+    ///
+    /// # Errors
+    /// Why the flip is refused.
+    pub fn can_flip(&self, e: EdgeId) -> Result<(), String> {
+        if e.0 as usize >= self.edge_count() {
+            return Err(format!(
+                "edge {} does not exist ({} edges)",
+                e.0,
+                self.edge_count()
+            ));
+        }
+        if self.is_boundary_edge(e) {
+            return Err(format!("edge {} is on the boundary", e.0));
+        }
+        let h = self.edge_halfedge(e);
+        let t = self.twin(h);
+        for side in [h, t] {
+            let f = self.face(side).expect("interior");
+            if self.face_halfedges(f).count() != 3 {
+                return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
+            }
+        }
+        let c = self.origin(self.prev(h));
+        let d = self.origin(self.prev(t));
+        if c == d {
+            return Err(format!(
+                "edge {}: both opposite vertices are vertex {}",
+                e.0, c.0
+            ));
+        }
+        if self.find_edge(c, d).is_some() {
+            return Err(format!(
+                "edge {}: vertices {} and {} are already joined",
+                e.0, c.0, d.0
+            ));
+        }
+        Ok(())
+    }
+
+    /// Flips interior edge `e` between triangles (a, b, c) and (b, a, d) to join c and d.
+    /// The edge keeps its index; the two faces keep theirs.
+    ///
+    /// # Errors
+    /// As [`HalfedgeMesh::can_flip`]; the mesh is unchanged on error.
+    pub fn flip(&mut self, e: EdgeId) -> Result<(), String> {
+        self.can_flip(e)?;
+        let h = self.edge_halfedge(e).0 as usize;
+        let t = h ^ 1;
+        let (hn, hp) = (self.he_next[h] as usize, self.he_prev[h] as usize);
+        let (tn, tp) = (self.he_next[t] as usize, self.he_prev[t] as usize);
+        let (a, b) = (self.he_origin[h], self.he_origin[t]);
+        let (c, d) = (self.he_origin[hp], self.he_origin[tp]);
+        let (f0, f1) = (self.he_face[h], self.he_face[t]);
+        // New loops: h (d->c), hp (c->a), tn (a->d); t (c->d), tp (d->b), hn (b->c).
+        self.he_origin[h] = d;
+        self.he_origin[t] = c;
+        let link = |m: &mut HalfedgeMesh, x: usize, y: usize| {
+            m.he_next[x] = y as u32;
+            m.he_prev[y] = x as u32;
+        };
+        link(self, h, hp);
+        link(self, hp, tn);
+        link(self, tn, h);
+        link(self, t, tp);
+        link(self, tp, hn);
+        link(self, hn, t);
+        self.he_face[tn] = f0;
+        self.he_face[hn] = f1;
+        self.f_he[f0 as usize] = h as u32;
+        self.f_he[f1 as usize] = t as u32;
+        if self.v_out[a as usize] == h as u32 {
+            self.v_out[a as usize] = tn as u32;
+        }
+        if self.v_out[b as usize] == t as u32 {
+            self.v_out[b as usize] = hn as u32;
+        }
+        Ok(())
+    }
+
     /// Checks every invariant listed on the type.
     ///
     /// # Errors
@@ -520,6 +610,76 @@ mod tests {
             .unwrap()
             .validate()
             .unwrap();
+    }
+
+    /// Property: any sequence of flips keeps every invariant, the counts and the Euler
+    /// characteristic, and a flip twice in a row restores the connectivity.
+    #[test]
+    fn random_flips_keep_invariants() {
+        let p = crate::loop_subdivide(
+            &HalfedgeMesh::from_polymesh(&icosahedron()).unwrap(),
+            crate::LoopWeights::Warren,
+        )
+        .unwrap();
+        let mut m = HalfedgeMesh::from_polymesh(&p).unwrap();
+        let mut seed = 12345u64;
+        let (mut flipped, mut refused) = (0, 0);
+        for _ in 0..2000 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let e = EdgeId(((seed >> 33) % m.edge_count() as u64) as u32);
+            match m.flip(e) {
+                Ok(()) => flipped += 1,
+                Err(_) => refused += 1,
+            }
+            m.validate().unwrap();
+        }
+        assert!(flipped > 100 && refused > 0, "{flipped} {refused}");
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (42, 120, 80)
+        );
+        assert_eq!(m.euler_characteristic(), 2);
+        // Double flip: the faces come back as the same vertex sets.
+        let before = m.to_polymesh();
+        let e = (0..m.edge_count() as u32)
+            .map(EdgeId)
+            .find(|&e| m.can_flip(e).is_ok())
+            .unwrap();
+        m.flip(e).unwrap();
+        m.flip(e).unwrap();
+        let after = m.to_polymesh();
+        let sorted = |p: &PolyMesh| {
+            let mut f: Vec<Vec<u32>> = p
+                .faces()
+                .map(|f| {
+                    let mut v = f.to_vec();
+                    v.sort();
+                    v
+                })
+                .collect();
+            f.sort();
+            f
+        };
+        assert_eq!(sorted(&before), sorted(&after));
+    }
+
+    #[test]
+    fn flip_refusals() {
+        let p = PolyMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::NEG_X, DVec3::NEG_Y],
+            &[vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4], vec![0, 4, 1]],
+        );
+        let mut m = HalfedgeMesh::from_polymesh(&p).unwrap();
+        let boundary = m.find_edge(VertexId(1), VertexId(2)).unwrap();
+        assert!(m.flip(boundary).unwrap_err().contains("boundary"));
+        // The centre has valence 4 here: flipping a spoke is allowed once.
+        let spoke = m.find_edge(VertexId(0), VertexId(1)).unwrap();
+        m.flip(spoke).unwrap();
+        m.validate().unwrap();
+        assert!(m.find_edge(VertexId(2), VertexId(4)).is_some());
+        assert!(m.flip(EdgeId(999)).is_err());
     }
 
     #[test]
