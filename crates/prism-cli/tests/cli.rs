@@ -231,5 +231,40 @@ fn mesh_subdivide_and_errors() {
         stderr(&o)
     );
     assert!(!out2.exists());
+    // Flip: an interior edge of the tetrahedron's subdivision flips; a tetrahedron edge
+    // cannot (its opposite vertices are already joined).
+    let flipped = dir.join("flip.obj");
+    let codes: Vec<Option<i32>> = (0..40)
+        .map(|e| {
+            prism()
+                .args(["mesh", "flip"])
+                .arg(&out)
+                .arg("-o")
+                .arg(&flipped)
+                .args(["--edge", &e.to_string()])
+                .output()
+                .unwrap()
+                .status
+                .code()
+        })
+        .collect();
+    assert!(
+        codes.contains(&Some(0)) && codes.contains(&Some(2)),
+        "{codes:?}"
+    );
+    let o = prism()
+        .args(["mesh", "flip"])
+        .arg(dir.join("tet.obj"))
+        .arg("-o")
+        .arg(&flipped)
+        .args(["--vertices", "1,2"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("cannot flip: edge 2: vertices"),
+        "{}",
+        stderr(&o)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
