@@ -40,6 +40,20 @@ enum MeshCommand {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Split an edge at its midpoint (interior or boundary edge of triangles).
+    Split {
+        /// Input mesh (.obj).
+        input: PathBuf,
+        /// Output mesh (.obj).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
+        #[arg(long, conflicts_with = "vertices")]
+        edge: Option<u32>,
+        /// The edge by its two vertex indices, counted from 1 as in the OBJ file: A,B.
+        #[arg(long, value_name = "A,B")]
+        vertices: Option<String>,
+    },
     /// Flip an interior edge between two triangles.
     Flip {
         /// Input mesh (.obj).
@@ -102,6 +116,44 @@ fn ms(d: std::time::Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
+/// Reads a mesh, applies `op` to the chosen edge and writes the result.
+fn edge_op(
+    input: &Path,
+    output: &Path,
+    edge: Option<u32>,
+    vertices: Option<&str>,
+    what: &str,
+    op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<(), String>,
+) -> Result<()> {
+    let p = read(input)?;
+    let mut m = build(input, &p)?;
+    let e = match (edge, vertices) {
+        (Some(e), _) => prism_mesh::EdgeId(e),
+        (None, Some(v)) => {
+            let n = m.vertex_count();
+            let ids: Vec<u32> = v
+                .split(',')
+                .map(|x| x.trim().parse::<u32>())
+                .collect::<Result<Vec<u32>, _>>()
+                .ok()
+                .filter(|ids| ids.len() == 2 && ids.iter().all(|&i| i >= 1 && i as usize <= n))
+                .ok_or_else(|| {
+                    UserError(format!(
+                        "--vertices: expected A,B with 1 <= A, B <= {n}, found {v:?}"
+                    ))
+                })?;
+            m.find_edge(
+                prism_mesh::VertexId(ids[0] - 1),
+                prism_mesh::VertexId(ids[1] - 1),
+            )
+            .ok_or_else(|| UserError(format!("--vertices {v}: no edge joins these vertices")))?
+        }
+        (None, None) => return Err(UserError("give --edge E or --vertices A,B".into()).into()),
+    };
+    op(&mut m, e).map_err(|msg| UserError(format!("{}: cannot {what}: {msg}", input.display())))?;
+    write(output, &m.to_polymesh())
+}
+
 /// Runs `prism mesh`.
 pub fn run(a: &MeshArgs) -> Result<()> {
     match &a.command {
@@ -129,42 +181,22 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             output,
             edge,
             vertices,
-        } => {
-            let p = read(input)?;
-            let mut m = build(input, &p)?;
-            let e = match (edge, vertices) {
-                (Some(e), _) => prism_mesh::EdgeId(*e),
-                (None, Some(v)) => {
-                    let n = m.vertex_count();
-                    let ids: Vec<u32> = v
-                        .split(',')
-                        .map(|x| x.trim().parse::<u32>())
-                        .collect::<Result<Vec<u32>, _>>()
-                        .ok()
-                        .filter(|ids| {
-                            ids.len() == 2 && ids.iter().all(|&i| i >= 1 && i as usize <= n)
-                        })
-                        .ok_or_else(|| {
-                            UserError(format!(
-                                "--vertices: expected A,B with 1 <= A, B <= {n}, found {v:?}"
-                            ))
-                        })?;
-                    m.find_edge(
-                        prism_mesh::VertexId(ids[0] - 1),
-                        prism_mesh::VertexId(ids[1] - 1),
-                    )
-                    .ok_or_else(|| {
-                        UserError(format!("--vertices {v}: no edge joins these vertices"))
-                    })?
-                }
-                (None, None) => {
-                    return Err(UserError("give --edge E or --vertices A,B".into()).into())
-                }
-            };
+        } => edge_op(input, output, *edge, vertices.as_deref(), "flip", |m, e| {
             m.flip(e)
-                .map_err(|msg| UserError(format!("{}: cannot flip: {msg}", input.display())))?;
-            write(output, &m.to_polymesh())
-        }
+        }),
+        MeshCommand::Split {
+            input,
+            output,
+            edge,
+            vertices,
+        } => edge_op(
+            input,
+            output,
+            *edge,
+            vertices.as_deref(),
+            "split",
+            |m, e| m.split(e).map(|_| ()),
+        ),
         MeshCommand::Subdivide {
             input,
             output,

@@ -430,6 +430,111 @@ impl HalfedgeMesh {
         Ok(())
     }
 
+    /// Whether [`HalfedgeMesh::split`] may split edge `e`: the edge must exist and its
+    /// faces (one on a boundary edge) must be triangles.
+    ///
+    /// # Errors
+    /// Why the split is refused.
+    pub fn can_split(&self, e: EdgeId) -> Result<(), String> {
+        if e.0 as usize >= self.edge_count() {
+            return Err(format!(
+                "edge {} does not exist ({} edges)",
+                e.0,
+                self.edge_count()
+            ));
+        }
+        let h = self.edge_halfedge(e);
+        for side in [h, self.twin(h)] {
+            if let Some(f) = self.face(side) {
+                if self.face_halfedges(f).count() != 3 {
+                    return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn new_edge(&mut self, a: u32, b: u32) -> (usize, usize) {
+        let h = self.he_next.len();
+        for o in [a, b] {
+            self.he_origin.push(o);
+            self.he_face.push(NONE);
+            self.he_next.push(NONE);
+            self.he_prev.push(NONE);
+        }
+        (h, h + 1)
+    }
+
+    fn link(&mut self, x: usize, y: usize) {
+        self.he_next[x] = y as u32;
+        self.he_prev[y] = x as u32;
+    }
+
+    fn set_face(&mut self, f: u32, hs: [usize; 3]) {
+        for k in 0..3 {
+            self.link(hs[k], hs[(k + 1) % 3]);
+            self.he_face[hs[k]] = f;
+        }
+        self.f_he[f as usize] = hs[0] as u32;
+    }
+
+    /// Splits edge `e` at its midpoint, joining the new vertex to the opposite corner of
+    /// each adjacent triangle. An interior edge gains 1 vertex, 3 edges and 2 faces; a
+    /// boundary edge 1 vertex, 2 edges and 1 face. Returns the new vertex.
+    ///
+    /// # Errors
+    /// As [`HalfedgeMesh::can_split`]; the mesh is unchanged on error.
+    pub fn split(&mut self, e: EdgeId) -> Result<VertexId, String> {
+        self.can_split(e)?;
+        // Orient so that h has a face.
+        let mut h = self.edge_halfedge(e).0 as usize;
+        if self.he_face[h] == NONE {
+            h ^= 1;
+        }
+        let t = h ^ 1;
+        let (a, b) = (self.he_origin[h], self.he_origin[t]);
+        let mid = (self.positions[a as usize] + self.positions[b as usize]) * 0.5;
+        let m = self.positions.len() as u32;
+        self.positions.push(mid);
+        self.v_out.push(NONE);
+        let (hn, hp) = (self.he_next[h] as usize, self.he_prev[h] as usize);
+        let c = self.he_origin[hp];
+        let f0 = self.he_face[h];
+        let t_boundary = self.he_face[t] == NONE;
+        let (tn, tp) = (self.he_next[t] as usize, self.he_prev[t] as usize);
+        // h becomes a -> m, t becomes m -> a.
+        self.he_origin[t] = m;
+        let (h2, t2) = self.new_edge(m, b);
+        let (h3, t3) = self.new_edge(m, c);
+        let f2 = self.f_he.len() as u32;
+        self.f_he.push(NONE);
+        self.set_face(f0, [h, h3, hp]);
+        self.set_face(f2, [h2, hn, t3]);
+        if t_boundary {
+            // Boundary loop: ... -> t2 (b -> m) -> t (m -> a) -> ...
+            self.link(tp, t2);
+            self.link(t2, t);
+            self.link(t, tn);
+            if self.v_out[b as usize] == t as u32 {
+                self.v_out[b as usize] = t2 as u32;
+            }
+            self.v_out[m as usize] = t as u32;
+        } else {
+            let d = self.he_origin[tp];
+            let f1 = self.he_face[t];
+            let (h4, t4) = self.new_edge(m, d);
+            let f3 = self.f_he.len() as u32;
+            self.f_he.push(NONE);
+            self.set_face(f1, [t, tn, t4]);
+            self.set_face(f3, [t2, h4, tp]);
+            if self.v_out[b as usize] == t as u32 {
+                self.v_out[b as usize] = t2 as u32;
+            }
+            self.v_out[m as usize] = h2 as u32;
+        }
+        Ok(VertexId(m))
+    }
+
     /// Checks every invariant listed on the type.
     ///
     /// # Errors
@@ -663,6 +768,56 @@ mod tests {
             f
         };
         assert_eq!(sorted(&before), sorted(&after));
+    }
+
+    /// Closed-form counts: an interior split adds 1 vertex, 3 edges, 2 faces; a boundary
+    /// split 1 vertex, 2 edges, 1 face. Property: random flips and splits keep every
+    /// invariant and the Euler characteristic.
+    #[test]
+    fn splits_and_flips_keep_invariants() {
+        let mut m = HalfedgeMesh::from_polymesh(&icosahedron()).unwrap();
+        let v = m.split(EdgeId(0)).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (13, 33, 22)
+        );
+        assert_eq!(m.outgoing(v).count(), 4);
+        let p = PolyMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], &[vec![0, 1, 2]]);
+        let mut open = HalfedgeMesh::from_polymesh(&p).unwrap();
+        let v = open.split(EdgeId(0)).unwrap();
+        open.validate().unwrap();
+        assert_eq!(
+            (open.vertex_count(), open.edge_count(), open.face_count()),
+            (4, 5, 2)
+        );
+        assert!(open.is_boundary_vertex(v));
+        assert_eq!(open.position(v), DVec3::new(0.5, 0.0, 0.0));
+        // Random sequences on a closed and an open mesh.
+        let fan = PolyMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::NEG_X, DVec3::NEG_Y],
+            &[vec![0, 1, 2], vec![0, 2, 3], vec![0, 3, 4], vec![0, 4, 1]],
+        );
+        for start in [icosahedron(), fan] {
+            let mut m = HalfedgeMesh::from_polymesh(&start).unwrap();
+            let chi = m.euler_characteristic();
+            let mut seed = 99u64;
+            for _ in 0..600 {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let e = EdgeId(((seed >> 33) % m.edge_count() as u64) as u32);
+                if (seed >> 20).is_multiple_of(3) {
+                    m.split(e).unwrap();
+                } else {
+                    let _ = m.flip(e);
+                }
+                m.validate().unwrap();
+                assert_eq!(m.euler_characteristic(), chi);
+            }
+            let back = HalfedgeMesh::from_polymesh(&m.to_polymesh()).unwrap();
+            back.validate().unwrap();
+        }
     }
 
     #[test]
