@@ -25,6 +25,22 @@ pub enum Weights {
     Loop,
 }
 
+/// A mesh, an output, and one edge of it.
+#[derive(Args, Debug)]
+struct EdgeArgs {
+    /// Input mesh (.obj).
+    input: PathBuf,
+    /// Output mesh (.obj).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
+    #[arg(long, conflicts_with = "vertices")]
+    edge: Option<u32>,
+    /// The edge by its two vertex indices, counted from 1 as in the OBJ file: A,B.
+    #[arg(long, value_name = "A,B")]
+    vertices: Option<String>,
+}
+
 #[derive(Subcommand, Debug)]
 enum MeshCommand {
     /// Print vertex, edge and face counts, boundary loops and the Euler characteristic.
@@ -41,33 +57,9 @@ enum MeshCommand {
         output: PathBuf,
     },
     /// Split an edge at its midpoint (interior or boundary edge of triangles).
-    Split {
-        /// Input mesh (.obj).
-        input: PathBuf,
-        /// Output mesh (.obj).
-        #[arg(short, long)]
-        output: PathBuf,
-        /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
-        #[arg(long, conflicts_with = "vertices")]
-        edge: Option<u32>,
-        /// The edge by its two vertex indices, counted from 1 as in the OBJ file: A,B.
-        #[arg(long, value_name = "A,B")]
-        vertices: Option<String>,
-    },
+    Split(EdgeArgs),
     /// Flip an interior edge between two triangles.
-    Flip {
-        /// Input mesh (.obj).
-        input: PathBuf,
-        /// Output mesh (.obj).
-        #[arg(short, long)]
-        output: PathBuf,
-        /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
-        #[arg(long, conflicts_with = "vertices")]
-        edge: Option<u32>,
-        /// The edge by its two vertex indices, counted from 1 as in the OBJ file: A,B.
-        #[arg(long, value_name = "A,B")]
-        vertices: Option<String>,
-    },
+    Flip(EdgeArgs),
     /// Loop subdivision of a triangle mesh.
     Subdivide {
         /// Input mesh (.obj).
@@ -118,13 +110,12 @@ fn ms(d: std::time::Duration) -> String {
 
 /// Reads a mesh, applies `op` to the chosen edge and writes the result.
 fn edge_op(
-    input: &Path,
-    output: &Path,
-    edge: Option<u32>,
-    vertices: Option<&str>,
+    args: &EdgeArgs,
     what: &str,
     op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<(), String>,
 ) -> Result<()> {
+    let (input, output) = (&args.input, &args.output);
+    let (edge, vertices) = (args.edge, args.vertices.as_deref());
     let p = read(input)?;
     let mut m = build(input, &p)?;
     let e = match (edge, vertices) {
@@ -176,27 +167,8 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             build(input, &p)?;
             write(output, &p)
         }
-        MeshCommand::Flip {
-            input,
-            output,
-            edge,
-            vertices,
-        } => edge_op(input, output, *edge, vertices.as_deref(), "flip", |m, e| {
-            m.flip(e)
-        }),
-        MeshCommand::Split {
-            input,
-            output,
-            edge,
-            vertices,
-        } => edge_op(
-            input,
-            output,
-            *edge,
-            vertices.as_deref(),
-            "split",
-            |m, e| m.split(e).map(|_| ()),
-        ),
+        MeshCommand::Flip(e) => edge_op(e, "flip", |m, id| m.flip(id)),
+        MeshCommand::Split(e) => edge_op(e, "split", |m, id| m.split(id).map(|_| ())),
         MeshCommand::Subdivide {
             input,
             output,
