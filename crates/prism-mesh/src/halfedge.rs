@@ -535,6 +535,196 @@ impl HalfedgeMesh {
         Ok(VertexId(m))
     }
 
+    /// Whether [`HalfedgeMesh::collapse`] may collapse edge `e`. This version collapses
+    /// interior edges between triangles whose endpoints are both interior vertices, under the
+    /// link condition (the endpoints share exactly the two opposite vertices as neighbours)
+    /// and with both opposite vertices of valence above 3, so that no face or edge
+    /// degenerates.
+    ///
+    /// # Errors
+    /// Why the collapse is refused.
+    pub fn can_collapse(&self, e: EdgeId) -> Result<(), String> {
+        if e.0 as usize >= self.edge_count() {
+            return Err(format!(
+                "edge {} does not exist ({} edges)",
+                e.0,
+                self.edge_count()
+            ));
+        }
+        if self.is_boundary_edge(e) {
+            return Err(format!(
+                "edge {} is on the boundary; boundary collapses are not supported",
+                e.0
+            ));
+        }
+        let h = self.edge_halfedge(e);
+        let t = self.twin(h);
+        for side in [h, t] {
+            let f = self.face(side).expect("interior");
+            if self.face_halfedges(f).count() != 3 {
+                return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
+            }
+        }
+        let (a, b) = (self.origin(h), self.origin(t));
+        if self.is_boundary_vertex(a) || self.is_boundary_vertex(b) {
+            return Err(format!("edge {}: an endpoint is on the boundary", e.0));
+        }
+        let c = self.origin(self.prev(h));
+        let d = self.origin(self.prev(t));
+        let ring = |v: VertexId| -> Vec<u32> { self.outgoing(v).map(|o| self.dest(o).0).collect() };
+        let (ra, rb) = (ring(a), ring(b));
+        let mut shared: Vec<u32> = ra.iter().copied().filter(|v| rb.contains(v)).collect();
+        shared.sort_unstable();
+        let mut expect = vec![c.0, d.0];
+        expect.sort_unstable();
+        if shared != expect {
+            return Err(format!(
+                "edge {}: link condition fails (the endpoints share {} neighbours, expected 2)",
+                e.0,
+                shared.len()
+            ));
+        }
+        for v in [c, d] {
+            if self.outgoing(v).count() <= 3 {
+                return Err(format!(
+                    "edge {}: vertex {} would be left with valence 2",
+                    e.0, v.0
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves the data of halfedge `from` into slot `to` and points every reference at `to`.
+    fn move_halfedge(&mut self, from: usize, to: usize) {
+        self.he_origin[to] = self.he_origin[from];
+        self.he_face[to] = self.he_face[from];
+        let (n, p) = (self.he_next[from], self.he_prev[from]);
+        self.he_next[to] = n;
+        self.he_prev[to] = p;
+        self.he_prev[n as usize] = to as u32;
+        self.he_next[p as usize] = to as u32;
+        let f = self.he_face[to];
+        if f != NONE && self.f_he[f as usize] == from as u32 {
+            self.f_he[f as usize] = to as u32;
+        }
+        let o = self.he_origin[to] as usize;
+        if self.v_out[o] == from as u32 {
+            self.v_out[o] = to as u32;
+        }
+    }
+
+    /// Removes an unreferenced edge pair by moving the last pair into its slots.
+    fn remove_edge_pair(&mut self, e: usize) {
+        let last = self.edge_count() - 1;
+        if e != last {
+            for k in 0..2 {
+                let (from, to) = (2 * last + k, 2 * e + k);
+                // A pair may link to itself (next == twin); remap before moving.
+                for arr in [0, 1] {
+                    let link = if arr == 0 {
+                        self.he_next[from]
+                    } else {
+                        self.he_prev[from]
+                    };
+                    if link as usize / 2 == last {
+                        let mapped = (2 * e + link as usize % 2) as u32;
+                        if arr == 0 {
+                            self.he_next[from] = mapped;
+                        } else {
+                            self.he_prev[from] = mapped;
+                        }
+                    }
+                }
+                self.move_halfedge(from, to);
+            }
+        }
+        for arr in [
+            &mut self.he_next,
+            &mut self.he_prev,
+            &mut self.he_origin,
+            &mut self.he_face,
+        ] {
+            arr.truncate(2 * last);
+        }
+    }
+
+    /// Removes an unreferenced face by moving the last face into its slot.
+    fn remove_face(&mut self, f: usize) {
+        let last = self.f_he.len() - 1;
+        if f != last {
+            self.f_he[f] = self.f_he[last];
+            let hs: Vec<HalfedgeId> = self.face_halfedges(FaceId(f as u32)).collect();
+            for h in hs {
+                self.he_face[h.0 as usize] = f as u32;
+            }
+        }
+        self.f_he.truncate(last);
+    }
+
+    /// Removes an unreferenced vertex by moving the last vertex into its slot.
+    fn remove_vertex(&mut self, v: usize) {
+        let last = self.positions.len() - 1;
+        if v != last {
+            self.positions[v] = self.positions[last];
+            self.v_out[v] = self.v_out[last];
+            let hs: Vec<HalfedgeId> = self.outgoing(VertexId(v as u32)).collect();
+            for h in hs {
+                self.he_origin[h.0 as usize] = v as u32;
+            }
+        }
+        self.positions.truncate(last);
+        self.v_out.truncate(last);
+    }
+
+    /// Collapses edge `e` to its midpoint: the edge's endpoints become one vertex, the two
+    /// triangles on the edge disappear and their other edges merge pairwise (1 vertex,
+    /// 3 edges and 2 faces fewer). Elements are removed by moving the last vertex, edges and
+    /// faces into the freed slots, so indices above the removed ones may change. Returns the
+    /// merged vertex.
+    ///
+    /// # Errors
+    /// As [`HalfedgeMesh::can_collapse`]; the mesh is unchanged on error.
+    pub fn collapse(&mut self, e: EdgeId) -> Result<VertexId, String> {
+        self.can_collapse(e)?;
+        let h = self.edge_halfedge(e).0 as usize;
+        let t = h ^ 1;
+        let (hn, hp) = (self.he_next[h] as usize, self.he_prev[h] as usize);
+        let (tn, tp) = (self.he_next[t] as usize, self.he_prev[t] as usize);
+        let (a, b) = (self.he_origin[h] as usize, self.he_origin[t] as usize);
+        let c = self.he_origin[hp] as usize;
+        let (f0, f1) = (self.he_face[h] as usize, self.he_face[t] as usize);
+        let mid = (self.positions[a] + self.positions[b]) * 0.5;
+        // Everything leaving a now leaves b.
+        let from_a: Vec<HalfedgeId> = self.outgoing(VertexId(a as u32)).collect();
+        for o in from_a {
+            self.he_origin[o.0 as usize] = b as u32;
+        }
+        // Merge b-c: slot hn takes the outer halfedge of c-a (now b->c).
+        let o_hp = hp ^ 1;
+        self.move_halfedge(o_hp, hn);
+        // Merge b-d: slot tp takes the outer halfedge of a-d (d->a, now d->b).
+        let o_tn = tn ^ 1;
+        self.move_halfedge(o_tn, tp);
+        self.positions[b] = mid;
+        self.v_out[b] = hn as u32;
+        if self.v_out[c] == hp as u32 {
+            self.v_out[c] = (hn ^ 1) as u32;
+        }
+        // Remove the dead edges (highest index first), faces, and vertex a.
+        let mut dead = [h / 2, hp / 2, tn / 2];
+        dead.sort_unstable_by(|x, y| y.cmp(x));
+        for d in dead {
+            self.remove_edge_pair(d);
+        }
+        let (fa, fb) = (f0.max(f1), f0.min(f1));
+        self.remove_face(fa);
+        self.remove_face(fb);
+        let merged = if b == self.positions.len() - 1 { a } else { b };
+        self.remove_vertex(a);
+        Ok(VertexId(merged as u32))
+    }
+
     /// Checks every invariant listed on the type.
     ///
     /// # Errors
@@ -818,6 +1008,69 @@ mod tests {
             let back = HalfedgeMesh::from_polymesh(&m.to_polymesh()).unwrap();
             back.validate().unwrap();
         }
+    }
+
+    /// Closed-form counts: a collapse removes 1 vertex, 3 edges and 2 faces. Property:
+    /// random sequences of flips, splits and collapses keep every invariant and the Euler
+    /// characteristic.
+    #[test]
+    fn collapses_keep_invariants() {
+        let p = crate::loop_subdivide(
+            &HalfedgeMesh::from_polymesh(&icosahedron()).unwrap(),
+            crate::LoopWeights::Warren,
+        )
+        .unwrap();
+        let mut m = HalfedgeMesh::from_polymesh(&p).unwrap();
+        let (v, e, f) = (m.vertex_count(), m.edge_count(), m.face_count());
+        let edge = (0..e as u32)
+            .map(EdgeId)
+            .find(|&x| m.can_collapse(x).is_ok())
+            .unwrap();
+        let merged = m.collapse(edge).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (v - 1, e - 3, f - 2)
+        );
+        assert!((merged.0 as usize) < m.vertex_count());
+        let mut seed = 7u64;
+        let (mut done, mut refused) = (0, 0);
+        for _ in 0..1500 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let e = EdgeId(((seed >> 33) % m.edge_count() as u64) as u32);
+            match (seed >> 20) % 4 {
+                0 => {
+                    m.split(e).unwrap();
+                }
+                1 => {
+                    let _ = m.flip(e);
+                }
+                _ => match m.collapse(e) {
+                    Ok(_) => done += 1,
+                    Err(_) => refused += 1,
+                },
+            }
+            m.validate().unwrap();
+            assert_eq!(m.euler_characteristic(), 2);
+        }
+        assert!(
+            done > 50 && refused > 0,
+            "{done} collapses, {refused} refused"
+        );
+        HalfedgeMesh::from_polymesh(&m.to_polymesh())
+            .unwrap()
+            .validate()
+            .unwrap();
+        // The tetrahedron cannot lose an edge: every opposite vertex has valence 3.
+        let tet = PolyMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            &[vec![0, 2, 1], vec![0, 1, 3], vec![1, 2, 3], vec![2, 0, 3]],
+        );
+        let mut t = HalfedgeMesh::from_polymesh(&tet).unwrap();
+        assert!(t.collapse(EdgeId(0)).is_err());
+        t.validate().unwrap();
     }
 
     #[test]
