@@ -60,6 +60,8 @@ enum MeshCommand {
     Split(EdgeArgs),
     /// Flip an interior edge between two triangles.
     Flip(EdgeArgs),
+    /// Collapse an interior edge to its midpoint (link condition checked).
+    Collapse(EdgeArgs),
     /// Loop subdivision of a triangle mesh.
     Subdivide {
         /// Input mesh (.obj).
@@ -169,6 +171,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
         }
         MeshCommand::Flip(e) => edge_op(e, "flip", |m, id| m.flip(id)),
         MeshCommand::Split(e) => edge_op(e, "split", |m, id| m.split(id).map(|_| ())),
+        MeshCommand::Collapse(e) => edge_op(e, "collapse", |m, id| m.collapse(id).map(|_| ())),
         MeshCommand::Subdivide {
             input,
             output,

@@ -252,6 +252,23 @@ fn mesh_subdivide_and_errors() {
         codes.contains(&Some(0)) && codes.contains(&Some(2)),
         "{codes:?}"
     );
+    for op in ["split", "collapse"] {
+        let codes: Vec<Option<i32>> = (0..40)
+            .map(|e| {
+                prism()
+                    .args(["mesh", op])
+                    .arg(&out)
+                    .arg("-o")
+                    .arg(&flipped)
+                    .args(["--edge", &e.to_string()])
+                    .output()
+                    .unwrap()
+                    .status
+                    .code()
+            })
+            .collect();
+        assert!(codes.contains(&Some(0)), "{op}: {codes:?}");
+    }
     let o = prism()
         .args(["mesh", "flip"])
         .arg(dir.join("tet.obj"))
