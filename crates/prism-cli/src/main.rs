@@ -21,7 +21,7 @@ struct Cli {
 enum Command {
     /// Rasterize SVG files to PNG (standard SVG, or the CS184 course dialect).
     Svg(svg::SvgArgs),
-    /// Inspect, convert and Loop-subdivide meshes (OBJ).
+    /// Inspect, convert, edit and Loop-subdivide meshes (OBJ, PLY).
     Mesh(mesh::MeshArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),

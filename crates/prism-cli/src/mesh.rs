@@ -1,4 +1,5 @@
-//! `prism mesh`: inspect, convert and subdivide meshes (OBJ).
+//! `prism mesh`: inspect, convert, edit and subdivide meshes (OBJ, PLY; PLY is written as
+//! binary little-endian).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -28,9 +29,9 @@ pub enum Weights {
 /// A mesh, an output, and one edge of it.
 #[derive(Args, Debug)]
 struct EdgeArgs {
-    /// Input mesh (.obj).
+    /// Input mesh (.obj or .ply).
     input: PathBuf,
-    /// Output mesh (.obj).
+    /// Output mesh (.obj or .ply).
     #[arg(short, long)]
     output: PathBuf,
     /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
@@ -45,14 +46,14 @@ struct EdgeArgs {
 enum MeshCommand {
     /// Print vertex, edge and face counts, boundary loops and the Euler characteristic.
     Info {
-        /// Input mesh (.obj).
+        /// Input mesh (.obj or .ply).
         input: PathBuf,
     },
     /// Read and write a mesh (checks that it builds a valid halfedge mesh).
     Convert {
-        /// Input mesh (.obj).
+        /// Input mesh (.obj or .ply).
         input: PathBuf,
-        /// Output mesh (.obj).
+        /// Output mesh (.obj or .ply).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -64,9 +65,9 @@ enum MeshCommand {
     Collapse(EdgeArgs),
     /// Loop subdivision of a triangle mesh.
     Subdivide {
-        /// Input mesh (.obj).
+        /// Input mesh (.obj or .ply).
         input: PathBuf,
-        /// Output mesh (.obj).
+        /// Output mesh (.obj or .ply).
         #[arg(short, long)]
         output: PathBuf,
         /// Number of levels.
@@ -81,14 +82,23 @@ enum MeshCommand {
     },
 }
 
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
 fn read(path: &Path) -> Result<PolyMesh> {
-    if !path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
-    {
-        return Err(UserError(format!("{}: expected an .obj file", path.display())).into());
-    }
-    read_obj(path).map_err(|e| UserError(e.to_string()).into())
+    let mesh = match extension(path).as_str() {
+        "obj" => read_obj(path),
+        "ply" => prism_mesh::read_ply(path),
+        _ => {
+            return Err(
+                UserError(format!("{}: expected an .obj or .ply file", path.display())).into(),
+            )
+        }
+    };
+    mesh.map_err(|e| UserError(e.to_string()).into())
 }
 
 fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
@@ -97,8 +107,24 @@ fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
 }
 
 fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
+    let ply = match extension(path).as_str() {
+        "obj" => false,
+        "ply" => true,
+        _ => {
+            return Err(UserError(format!(
+                "{}: expected an .obj or .ply output",
+                path.display()
+            ))
+            .into())
+        }
+    };
     prism_image::write_atomic(path, |w| {
-        write_obj(mesh, w).map_err(|source| prism_image::ImageError::Io {
+        let r = if ply {
+            prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w)
+        } else {
+            write_obj(mesh, w)
+        };
+        r.map_err(|source| prism_image::ImageError::Io {
             path: path.to_path_buf(),
             source,
         })

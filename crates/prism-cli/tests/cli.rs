@@ -206,6 +206,26 @@ fn mesh_subdivide_and_errors() {
         text.lines().filter(|l| l.starts_with("f ")).count(),
         4 * 4 * 4
     );
+    // Through PLY and back: the same mesh.
+    let ply = dir.join("sub.ply");
+    let o = prism()
+        .args(["mesh", "convert"])
+        .arg(&out)
+        .arg("-o")
+        .arg(&ply)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let back = dir.join("back.obj");
+    let o = prism()
+        .args(["mesh", "convert"])
+        .arg(&ply)
+        .arg("-o")
+        .arg(&back)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&back).unwrap(), text);
     let o = prism().args(["mesh", "info"]).arg(&out).output().unwrap();
     let info = String::from_utf8_lossy(&o.stdout);
     assert!(

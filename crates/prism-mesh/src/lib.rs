@@ -1,6 +1,6 @@
 //! Floor-1 meshes for prism: an indexed polygon mesh ([`PolyMesh`]), a halfedge mesh with
 //! typed index handles ([`HalfedgeMesh`]) built from polygon soups with boundary loops,
-//! Wavefront OBJ reading and writing, area-weighted vertex normals and Loop subdivision.
+//! Wavefront OBJ and Stanford PLY reading and writing, area-weighted vertex normals and Loop subdivision.
 #![warn(missing_docs)]
 
 mod error;
@@ -8,6 +8,7 @@ mod halfedge;
 mod loop_subdivision;
 mod normals;
 mod obj;
+mod ply;
 mod polymesh;
 
 pub use error::MeshError;
@@ -15,4 +16,5 @@ pub use halfedge::{icosahedron, EdgeId, FaceId, HalfedgeId, HalfedgeMesh, Vertex
 pub use loop_subdivision::{loop_subdivide, LoopWeights};
 pub use normals::vertex_normals_area_weighted;
 pub use obj::{parse_obj, read_obj, write_obj};
+pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};
 pub use polymesh::PolyMesh;
