@@ -1,8 +1,10 @@
 //! Floor-1 meshes for prism: an indexed polygon mesh ([`PolyMesh`]), a halfedge mesh with
 //! typed index handles ([`HalfedgeMesh`]) built from polygon soups with boundary loops,
-//! Wavefront OBJ and Stanford PLY reading and writing, area-weighted vertex normals and Loop subdivision.
+//! Bezier curves and patches (de Casteljau), Wavefront OBJ and Stanford PLY reading and
+//! writing, area-weighted vertex normals and Loop subdivision.
 #![warn(missing_docs)]
 
+mod bezier;
 mod error;
 mod halfedge;
 mod loop_subdivision;
@@ -11,6 +13,10 @@ mod obj;
 mod ply;
 mod polymesh;
 
+pub use bezier::{
+    bezier_point, de_casteljau_levels, de_casteljau_step, parse_bez, parse_bzc, tessellate,
+    BezierPatch,
+};
 pub use error::MeshError;
 pub use halfedge::{icosahedron, EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId};
 pub use loop_subdivision::{loop_subdivide, LoopWeights};
