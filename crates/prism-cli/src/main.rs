@@ -1,5 +1,6 @@
 //! `prism`: one command for the prism graphics toolkit.
 
+mod bezier;
 mod demo;
 mod mesh;
 mod progress;
@@ -21,6 +22,8 @@ struct Cli {
 enum Command {
     /// Rasterize SVG files to PNG (standard SVG, or the CS184 course dialect).
     Svg(svg::SvgArgs),
+    /// Draw a Bezier curve's de Casteljau construction, or tessellate Bezier patches.
+    Bezier(bezier::BezierArgs),
     /// Inspect, convert, edit and Loop-subdivide meshes (OBJ, PLY).
     Mesh(mesh::MeshArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Svg(a) => svg::run(&a),
+        Command::Bezier(a) => bezier::run(&a),
         Command::Mesh(a) => mesh::run(&a),
         Command::Demo(a) => demo::run(&a),
     };

@@ -106,7 +106,8 @@ fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
         .map_err(|e| UserError(format!("{}: {e}", path.display())).into())
 }
 
-fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
+/// Writes a mesh as .obj or .ply (binary little-endian), chosen by extension, atomically.
+pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
     let ply = match extension(path).as_str() {
         "obj" => false,
         "ply" => true,

@@ -305,3 +305,60 @@ fn mesh_subdivide_and_errors() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `prism bezier` draws a curve file to PNG and tessellates a patch file to a mesh; a
+/// malformed file is a located error.
+#[test]
+fn bezier_curve_and_patches() {
+    let dir = scratch("bezier");
+    std::fs::write(dir.join("c.bzc"), "4\n0.2 0.35 0.3 0.6 0.8 0.75 0.9 0.45\n").unwrap();
+    let png = dir.join("c.png");
+    let o = prism()
+        .args(["bezier"])
+        .arg(dir.join("c.bzc"))
+        .arg("-o")
+        .arg(&png)
+        .args(["--t", "0.3", "--size", "200"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = prism_image::read_png(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (200, 200));
+    assert!(img.pixels().iter().any(|p| p[0] < 100), "nothing drawn");
+    // One flat patch: 4 x 4 cells, 32 triangles, 25 welded vertices.
+    let mut bez = String::from("1\n");
+    for i in 0..4 {
+        for j in 0..4 {
+            bez += &format!("{i} {j} 0\n");
+        }
+    }
+    std::fs::write(dir.join("p.bez"), bez).unwrap();
+    let obj = dir.join("p.obj");
+    let o = prism()
+        .args(["bezier"])
+        .arg(dir.join("p.bez"))
+        .arg("-o")
+        .arg(&obj)
+        .args(["--resolution", "4"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 32);
+    assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 25);
+    std::fs::write(dir.join("bad.bzc"), "3\n0 0\n1 x\n").unwrap();
+    let o = prism()
+        .args(["bezier"])
+        .arg(dir.join("bad.bzc"))
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("bad.bzc:3: expected a finite number"),
+        "{}",
+        stderr(&o)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
