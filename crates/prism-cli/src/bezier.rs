@@ -48,7 +48,7 @@ pub fn run(a: &BezierArgs) -> Result<()> {
                 );
             }
             let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
-            draw_curve(&pts, a)
+            draw_curve(&pts, a.t, a.size, &a.output)
         }
         "bez" => {
             if a.resolution == 0 || a.resolution > 1024 {
@@ -66,7 +66,8 @@ pub fn run(a: &BezierArgs) -> Result<()> {
     }
 }
 
-fn draw_curve(pts: &[DVec2], a: &BezierArgs) -> Result<()> {
+/// Draws the curve, its control polygon and every de Casteljau level at `t` to a PNG.
+pub(crate) fn draw_curve(pts: &[DVec2], t: f64, size: u32, output: &std::path::Path) -> Result<()> {
     // Curve files use [0, 1]^2 with y up; the picture has y down.
     let flip = |p: DVec2| DVec2::new(p.x, 1.0 - p.y);
     let mut doc = Document {
@@ -105,7 +106,7 @@ fn draw_curve(pts: &[DVec2], a: &BezierArgs) -> Result<()> {
         .collect();
     doc.items
         .push(stroke(curve, 0.006, Rgb::new(0.1, 0.1, 0.1)));
-    let levels = de_casteljau_levels(pts, a.t);
+    let levels = de_casteljau_levels(pts, t);
     let n = levels.len().max(2) as f32;
     for (k, level) in levels.iter().enumerate() {
         let hue = k as f32 / (n - 1.0);
@@ -120,12 +121,12 @@ fn draw_curve(pts: &[DVec2], a: &BezierArgs) -> Result<()> {
         }
     }
     let opts = RenderOptions {
-        width: a.size,
-        height: a.size,
+        width: size,
+        height: size,
         samples: 16,
         ..RenderOptions::default()
     };
     let (img, _) = render(&doc, &opts).map_err(|e| UserError(e.to_string()))?;
-    prism_image::write_png(&a.output, &img.over_background([255, 255, 255]))
-        .with_context(|| format!("writing {}", a.output.display()))
+    prism_image::write_png(output, &img.over_background([255, 255, 255]))
+        .with_context(|| format!("writing {}", output.display()))
 }

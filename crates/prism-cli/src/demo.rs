@@ -128,6 +128,58 @@ fn group_svg() -> String {
     s
 }
 
+/// A wireframe of a mesh, rotated and projected orthographically, every edge drawn.
+fn wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> Result<()> {
+    use prism_math::glam::DVec3;
+    use prism_raster::path::{LineCap, LineJoin, Path, StrokeStyle};
+    use prism_raster::{Document, Item, Mat3, Paint};
+    let (sy, cy) = 0.6f64.sin_cos();
+    let (sx, cx) = 0.35f64.sin_cos();
+    let view = |p: DVec3| {
+        let q = DVec3::new(cy * p.x + sy * p.z, p.y, -sy * p.x + cy * p.z);
+        let q = DVec3::new(q.x, cx * q.y - sx * q.z, sx * q.y + cx * q.z);
+        prism_math::DVec2::new(0.5 + 0.4 * q.x, 0.5 - 0.4 * q.y)
+    };
+    let mut doc = Document {
+        width: 1.0,
+        height: 1.0,
+        ..Document::default()
+    };
+    let mut path = Path::default();
+    for f in mesh.faces() {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            if a < b || !mesh.faces().any(|g| g.windows(2).any(|w| w == [b, a])) {
+                path.move_to(view(mesh.positions[a as usize]));
+                path.line_to(view(mesh.positions[b as usize]));
+            }
+        }
+    }
+    doc.items.push(Item::Stroke {
+        path,
+        transform: Mat3::IDENTITY,
+        style: StrokeStyle {
+            width: 1.2 / f64::from(size),
+            join: LineJoin::Round,
+            cap: LineCap::Round,
+            ..StrokeStyle::default()
+        },
+        paint: Paint::Solid(prism_math::Rgb::new(0.1, 0.2, 0.45)),
+        opacity: 1.0,
+    });
+    let (img, _) = render(
+        &doc,
+        &RenderOptions {
+            width: size,
+            height: size,
+            samples: 16,
+            ..RenderOptions::default()
+        },
+    )?;
+    prism_image::write_png(out, &img.over_background([255, 255, 255]))
+        .with_context(|| format!("writing {}", out.display()))
+}
+
 struct Entry {
     file: String,
     caption: String,
@@ -199,10 +251,41 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         Dialect::Svg,
         base(240, 240, 16),
     ));
-    let pb = crate::progress::bar(jobs.len() as u64, "demo", a.quiet);
+    let pb = crate::progress::bar(jobs.len() as u64 + 3, "demo", a.quiet);
     for (file, caption, svg, dialect, opts) in jobs {
         draw(&svg, dialect, &opts, &a.output.join(&file))?;
         entries.push(Entry { file, caption });
+        pb.inc(1);
+    }
+    // Mesh editing: a de Casteljau construction, and Loop subdivision as wireframes.
+    let curve = [
+        prism_math::DVec2::new(0.2, 0.35),
+        prism_math::DVec2::new(0.3, 0.6),
+        prism_math::DVec2::new(0.5, 0.75),
+        prism_math::DVec2::new(0.7, 0.45),
+        prism_math::DVec2::new(1.0, 0.9),
+    ];
+    crate::bezier::draw_curve(&curve, 0.5, 300, &a.output.join("bezier_decasteljau.png"))?;
+    entries.push(Entry {
+        file: "bezier_decasteljau.png".into(),
+        caption: "Bezier curve with its de Casteljau levels at t = 0.5".into(),
+    });
+    pb.inc(1);
+    let mut mesh = prism_mesh::icosahedron();
+    for level in 0..=2 {
+        if level > 0 {
+            let he = prism_mesh::HalfedgeMesh::from_polymesh(&mesh)?;
+            mesh = prism_mesh::loop_subdivide(&he, prism_mesh::LoopWeights::Warren)?;
+        }
+        let file = format!("loop_level_{level}.png");
+        wireframe(&mesh, 300, &a.output.join(&file))?;
+        entries.push(Entry {
+            file,
+            caption: format!(
+                "Icosahedron after {level} level(s) of Loop subdivision ({} faces)",
+                mesh.face_count()
+            ),
+        });
         pb.inc(1);
     }
     pb.finish_and_clear();
