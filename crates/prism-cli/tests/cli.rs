@@ -174,6 +174,8 @@ fn demo_writes_gallery() {
         "colortri.png",
         "texture_level_linear.png",
         "transformed_group.png",
+        "bezier_decasteljau.png",
+        "loop_level_2.png",
     ] {
         assert!(html.contains(f), "{f} not in index");
         assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
