@@ -49,6 +49,14 @@ enum MeshCommand {
         /// Input mesh (.obj or .ply).
         input: PathBuf,
     },
+    /// Area-weighted vertex normals (written as `vn` in OBJ output).
+    Normals {
+        /// Input mesh (.obj or .ply).
+        input: PathBuf,
+        /// Output mesh (.obj; PLY output carries positions and faces only).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Read and write a mesh (checks that it builds a valid halfedge mesh).
     Convert {
         /// Input mesh (.obj or .ply).
@@ -190,6 +198,11 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             println!("euler characteristic: {}", m.euler_characteristic());
             println!("triangles only: {}", p.is_triangle_mesh());
             Ok(())
+        }
+        MeshCommand::Normals { input, output } => {
+            let mut p = read(input)?;
+            p.normals = Some(prism_mesh::vertex_normals_area_weighted(&p));
+            write(output, &p)
         }
         MeshCommand::Convert { input, output } => {
             let p = read(input)?;

@@ -83,7 +83,8 @@ pub fn read_obj(path: &Path) -> Result<PolyMesh, MeshError> {
     parse_obj(&text, &name)
 }
 
-/// Writes positions and faces as OBJ (shortest round-trip decimal for every coordinate).
+/// Writes positions, per-vertex normals (when present for every vertex, as `vn` lines with
+/// `v//vn` corners) and faces as OBJ, with the shortest round-trip decimal for every number.
 ///
 /// # Errors
 /// Whatever the writer returns.
@@ -91,10 +92,23 @@ pub fn write_obj(mesh: &PolyMesh, out: &mut impl Write) -> std::io::Result<()> {
     for p in &mesh.positions {
         writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
     }
+    let normals = mesh
+        .normals
+        .as_ref()
+        .filter(|n| n.len() == mesh.vertex_count());
+    if let Some(ns) = normals {
+        for n in ns {
+            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+        }
+    }
     for f in mesh.faces() {
         write!(out, "f")?;
         for v in f {
-            write!(out, " {}", v + 1)?;
+            if normals.is_some() {
+                write!(out, " {0}//{0}", v + 1)?;
+            } else {
+                write!(out, " {}", v + 1)?;
+            }
         }
         writeln!(out)?;
     }
@@ -113,6 +127,19 @@ mod tests {
         write_obj(&m, &mut buf).unwrap();
         let back = parse_obj(std::str::from_utf8(&buf).unwrap(), "mem").unwrap();
         assert_eq!(back, m);
+    }
+
+    #[test]
+    fn normals_are_written_as_vn() {
+        let mut m = icosahedron();
+        m.normals = Some(crate::vertex_normals_area_weighted(&m));
+        let mut buf = Vec::new();
+        write_obj(&m, &mut buf).unwrap();
+        let text = String::from_utf8(buf).unwrap();
+        assert_eq!(text.lines().filter(|l| l.starts_with("vn ")).count(), 12);
+        assert!(text.contains("f 1//1 12//12 6//6"));
+        let back = parse_obj(&text, "mem").unwrap();
+        assert_eq!(back.positions, m.positions);
     }
 
     #[test]
