@@ -30,6 +30,24 @@ fn run_svg(dir: &Path, svg: &str, extra: &[&str]) -> (Output, PathBuf) {
     (o, out)
 }
 
+/// Exit codes of `prism mesh OP MESH -o OUT --edge E` for edges 0..40.
+fn edge_op_codes(op: &str, mesh: &Path, out: &Path) -> Vec<Option<i32>> {
+    (0..40)
+        .map(|e| {
+            prism()
+                .args(["mesh", op])
+                .arg(mesh)
+                .arg("-o")
+                .arg(out)
+                .args(["--edge", &e.to_string()])
+                .output()
+                .unwrap()
+                .status
+                .code()
+        })
+        .collect()
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -256,39 +274,13 @@ fn mesh_subdivide_and_errors() {
     // Flip: an interior edge of the tetrahedron's subdivision flips; a tetrahedron edge
     // cannot (its opposite vertices are already joined).
     let flipped = dir.join("flip.obj");
-    let codes: Vec<Option<i32>> = (0..40)
-        .map(|e| {
-            prism()
-                .args(["mesh", "flip"])
-                .arg(&out)
-                .arg("-o")
-                .arg(&flipped)
-                .args(["--edge", &e.to_string()])
-                .output()
-                .unwrap()
-                .status
-                .code()
-        })
-        .collect();
+    let codes = edge_op_codes("flip", &out, &flipped);
     assert!(
         codes.contains(&Some(0)) && codes.contains(&Some(2)),
         "{codes:?}"
     );
     for op in ["split", "collapse"] {
-        let codes: Vec<Option<i32>> = (0..40)
-            .map(|e| {
-                prism()
-                    .args(["mesh", op])
-                    .arg(&out)
-                    .arg("-o")
-                    .arg(&flipped)
-                    .args(["--edge", &e.to_string()])
-                    .output()
-                    .unwrap()
-                    .status
-                    .code()
-            })
-            .collect();
+        let codes = edge_op_codes(op, &out, &flipped);
         assert!(codes.contains(&Some(0)), "{op}: {codes:?}");
     }
     let o = prism()

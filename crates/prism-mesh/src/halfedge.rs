@@ -348,13 +348,13 @@ impl HalfedgeMesh {
             .map(|h| self.edge(h))
     }
 
-    /// Whether [`HalfedgeMesh::flip`] may flip edge `e`: it must be interior, both its
-    /// faces triangles, and the two opposite vertices distinct and not already joined (which
-    /// also refuses flips that would leave a vertex of valence 2).
-    ///
-    /// # Errors
-    /// Why the flip is refused.
-    pub fn can_flip(&self, e: EdgeId) -> Result<(), String> {
+    /// The two halfedges of `e` if it exists, is interior, and lies between two triangles;
+    /// `boundary_note` is appended to the boundary refusal.
+    fn interior_triangle_edge(
+        &self,
+        e: EdgeId,
+        boundary_note: &str,
+    ) -> Result<(HalfedgeId, HalfedgeId), String> {
         if e.0 as usize >= self.edge_count() {
             return Err(format!(
                 "edge {} does not exist ({} edges)",
@@ -363,7 +363,7 @@ impl HalfedgeMesh {
             ));
         }
         if self.is_boundary_edge(e) {
-            return Err(format!("edge {} is on the boundary", e.0));
+            return Err(format!("edge {} is on the boundary{boundary_note}", e.0));
         }
         let h = self.edge_halfedge(e);
         let t = self.twin(h);
@@ -373,6 +373,17 @@ impl HalfedgeMesh {
                 return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
             }
         }
+        Ok((h, t))
+    }
+
+    /// Whether [`HalfedgeMesh::flip`] may flip edge `e`: it must be interior, both its
+    /// faces triangles, and the two opposite vertices distinct and not already joined (which
+    /// also refuses flips that would leave a vertex of valence 2).
+    ///
+    /// # Errors
+    /// Why the flip is refused.
+    pub fn can_flip(&self, e: EdgeId) -> Result<(), String> {
+        let (h, t) = self.interior_triangle_edge(e, "")?;
         let c = self.origin(self.prev(h));
         let d = self.origin(self.prev(t));
         if c == d {
@@ -544,27 +555,7 @@ impl HalfedgeMesh {
     /// # Errors
     /// Why the collapse is refused.
     pub fn can_collapse(&self, e: EdgeId) -> Result<(), String> {
-        if e.0 as usize >= self.edge_count() {
-            return Err(format!(
-                "edge {} does not exist ({} edges)",
-                e.0,
-                self.edge_count()
-            ));
-        }
-        if self.is_boundary_edge(e) {
-            return Err(format!(
-                "edge {} is on the boundary; boundary collapses are not supported",
-                e.0
-            ));
-        }
-        let h = self.edge_halfedge(e);
-        let t = self.twin(h);
-        for side in [h, t] {
-            let f = self.face(side).expect("interior");
-            if self.face_halfedges(f).count() != 3 {
-                return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
-            }
-        }
+        let (h, t) = self.interior_triangle_edge(e, "; boundary collapses are not supported")?;
         let (a, b) = (self.origin(h), self.origin(t));
         if self.is_boundary_vertex(a) || self.is_boundary_vertex(b) {
             return Err(format!("edge {}: an endpoint is on the boundary", e.0));
