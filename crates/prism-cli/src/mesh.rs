@@ -1,5 +1,5 @@
-//! `prism mesh`: inspect, convert, edit and subdivide meshes (OBJ, PLY; PLY is written as
-//! binary little-endian).
+//! `prism mesh`: inspect, convert, edit and subdivide meshes (OBJ, PLY, COLLADA; PLY is
+//! written as binary little-endian; COLLADA input is flattened to one Y-up world-space mesh).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -29,9 +29,9 @@ pub enum Weights {
 /// A mesh, an output, and one edge of it.
 #[derive(Args, Debug)]
 struct EdgeArgs {
-    /// Input mesh (.obj or .ply).
+    /// Input mesh (.obj, .ply or .dae).
     input: PathBuf,
-    /// Output mesh (.obj or .ply).
+    /// Output mesh (.obj, .ply or .dae).
     #[arg(short, long)]
     output: PathBuf,
     /// The edge by index (as `prism mesh info` numbers edges: in order of first use).
@@ -46,22 +46,22 @@ struct EdgeArgs {
 enum MeshCommand {
     /// Print vertex, edge and face counts, boundary loops and the Euler characteristic.
     Info {
-        /// Input mesh (.obj or .ply).
+        /// Input mesh (.obj, .ply or .dae).
         input: PathBuf,
     },
     /// Area-weighted vertex normals (written as `vn` in OBJ output).
     Normals {
-        /// Input mesh (.obj or .ply).
+        /// Input mesh (.obj, .ply or .dae).
         input: PathBuf,
-        /// Output mesh (.obj; PLY output carries positions and faces only).
+        /// Output mesh (.obj and .dae carry the normals; .ply carries positions and faces only).
         #[arg(short, long)]
         output: PathBuf,
     },
     /// Read and write a mesh (checks that it builds a valid halfedge mesh).
     Convert {
-        /// Input mesh (.obj or .ply).
+        /// Input mesh (.obj, .ply or .dae).
         input: PathBuf,
-        /// Output mesh (.obj or .ply).
+        /// Output mesh (.obj, .ply or .dae).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -73,9 +73,9 @@ enum MeshCommand {
     Collapse(EdgeArgs),
     /// Loop subdivision of a triangle mesh.
     Subdivide {
-        /// Input mesh (.obj or .ply).
+        /// Input mesh (.obj, .ply or .dae).
         input: PathBuf,
-        /// Output mesh (.obj or .ply).
+        /// Output mesh (.obj, .ply or .dae).
         #[arg(short, long)]
         output: PathBuf,
         /// Number of levels.
@@ -100,10 +100,19 @@ fn read(path: &Path) -> Result<PolyMesh> {
     let mesh = match extension(path).as_str() {
         "obj" => read_obj(path),
         "ply" => prism_mesh::read_ply(path),
+        "dae" => {
+            let doc = prism_scene::read_collada(path).map_err(|e| UserError(e.to_string()))?;
+            for w in &doc.warnings {
+                eprintln!("warning: {w}");
+            }
+            return Ok(doc.world_mesh(true));
+        }
         _ => {
-            return Err(
-                UserError(format!("{}: expected an .obj or .ply file", path.display())).into(),
-            )
+            return Err(UserError(format!(
+                "{}: expected an .obj, .ply or .dae file",
+                path.display()
+            ))
+            .into())
         }
     };
     mesh.map_err(|e| UserError(e.to_string()).into())
@@ -114,24 +123,22 @@ fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
         .map_err(|e| UserError(format!("{}: {e}", path.display())).into())
 }
 
-/// Writes a mesh as .obj or .ply (binary little-endian), chosen by extension, atomically.
+/// Writes a mesh as .obj, .ply (binary little-endian) or .dae, chosen by extension,
+/// atomically.
 pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
-    let ply = match extension(path).as_str() {
-        "obj" => false,
-        "ply" => true,
-        _ => {
-            return Err(UserError(format!(
-                "{}: expected an .obj or .ply output",
-                path.display()
-            ))
-            .into())
-        }
-    };
+    let ext = extension(path);
+    if !matches!(ext.as_str(), "obj" | "ply" | "dae") {
+        return Err(UserError(format!(
+            "{}: expected an .obj, .ply or .dae output",
+            path.display()
+        ))
+        .into());
+    }
     prism_image::write_atomic(path, |w| {
-        let r = if ply {
-            prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w)
-        } else {
-            write_obj(mesh, w)
+        let r = match ext.as_str() {
+            "ply" => prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w),
+            "dae" => prism_scene::write_collada(mesh, w),
+            _ => write_obj(mesh, w),
         };
         r.map_err(|source| prism_image::ImageError::Io {
             path: path.to_path_buf(),

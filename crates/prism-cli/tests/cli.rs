@@ -356,3 +356,55 @@ fn bezier_curve_and_patches() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `prism mesh` reads the staged COLLADA files and writes COLLADA that reads back as the same
+/// mesh; a broken file is a located error with exit code 2.
+#[test]
+fn mesh_collada_in_and_out() {
+    let dir = scratch("dae");
+    let cow = prism_testkit::shared_assets().join("meshedit/dae/cow.dae");
+    let o = prism().args(["mesh", "info"]).arg(&cow).output().unwrap();
+    let info = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        info.contains("faces: 5856") && info.contains("euler characteristic: 2"),
+        "{info}"
+    );
+    let dae = dir.join("cow1.dae");
+    let o = prism()
+        .args(["mesh", "subdivide"])
+        .arg(&cow)
+        .arg("-o")
+        .arg(&dae)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (obj_a, obj_b) = (dir.join("a.obj"), dir.join("b.obj"));
+    for (input, output) in [(&dae, &obj_a), (&obj_a, &obj_b)] {
+        let o = prism()
+            .args(["mesh", "convert"])
+            .arg(input)
+            .arg("-o")
+            .arg(output)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    }
+    let a = std::fs::read_to_string(&obj_a).unwrap();
+    assert_eq!(a.lines().filter(|l| l.starts_with("f ")).count(), 4 * 5856);
+    assert_eq!(a, std::fs::read_to_string(&obj_b).unwrap());
+
+    let text = std::fs::read_to_string(&cow).unwrap();
+    let broken = dir.join("broken.dae");
+    std::fs::write(&broken, text.replacen("<vcount>3 ", "<vcount>2 ", 1)).unwrap();
+    let o = prism()
+        .args(["mesh", "convert"])
+        .arg(&broken)
+        .arg("-o")
+        .arg(&obj_a)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("broken.dae:"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&obj_a).unwrap(), a);
+    let _ = std::fs::remove_dir_all(&dir);
+}

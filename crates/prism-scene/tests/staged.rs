@@ -1,0 +1,201 @@
+//! The staged COLLADA files (`../shared/assets/{meshedit,pathtracer}/dae`): every one loads,
+//! its meshes build as halfedge meshes with the topology `FORMATS.md` records, and the
+//! course's before/after files are reproduced by prism's flip, split and collapse.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use prism_math::glam::DVec3;
+use prism_mesh::{HalfedgeMesh, PolyMesh, VertexId};
+use prism_scene::{read_collada, Shape, UpAxis};
+use prism_testkit::shared_assets;
+
+fn dae_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            dae_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "dae") {
+            out.push(p);
+        }
+    }
+}
+
+fn load(rel: &str) -> PolyMesh {
+    read_collada(&shared_assets().join(rel))
+        .unwrap()
+        .world_mesh(false)
+}
+
+#[test]
+fn every_staged_file_loads_and_every_mesh_is_a_manifold() {
+    let mut files = Vec::new();
+    for d in ["meshedit/dae", "pathtracer/dae"] {
+        dae_files(&shared_assets().join(d), &mut files);
+    }
+    files.sort();
+    assert_eq!(files.len(), 35, "{files:?}");
+    for f in &files {
+        let c = read_collada(f).unwrap_or_else(|e| panic!("{e}"));
+        assert!(c.warnings.is_empty(), "{}: {:?}", f.display(), c.warnings);
+        let mut meshes = 0;
+        for g in &c.geometries {
+            if let Shape::Mesh(m) = &g.shape {
+                meshes += 1;
+                assert!(m.mesh.is_triangle_mesh());
+                HalfedgeMesh::from_polymesh(&m.mesh)
+                    .unwrap_or_else(|e| panic!("{}: {}: {e}", f.display(), g.id));
+            }
+        }
+        assert!(meshes > 0, "{}", f.display());
+        assert!(!c.nodes.is_empty(), "{}", f.display());
+        let pathtracer = f.components().any(|c| c.as_os_str() == "pathtracer");
+        if pathtracer {
+            assert_eq!(c.up_axis, UpAxis::Z, "{}", f.display());
+        }
+    }
+}
+
+/// Oracle: the topology facts recorded in `FORMATS.md` (boundary edges, Euler characteristic).
+#[test]
+fn meshedit_topology_matches_the_recorded_facts() {
+    let cases: &[(&str, i64, usize)] = &[
+        ("beetle.dae", -9, 586),
+        ("teapot.dae", 0, 0),
+        ("torus/input.dae", 0, 0),
+        ("peter.dae", 4, 0),
+        ("cow.dae", 2, 0),
+        ("cube.dae", 2, 0),
+        ("icosahedron/input.dae", 2, 0),
+        ("quadball.dae", 2, 0),
+        ("weird.dae", 2, 0),
+    ];
+    for &(name, chi, boundary) in cases {
+        let h = HalfedgeMesh::from_polymesh(&load(&format!("meshedit/dae/{name}"))).unwrap();
+        h.validate().unwrap();
+        let b = (0..h.edge_count())
+            .filter(|&e| h.is_boundary_edge(prism_mesh::EdgeId(e as u32)))
+            .count();
+        assert_eq!((h.euler_characteristic(), b), (chi, boundary), "{name}");
+    }
+}
+
+/// Oriented faces of `a` renumbered by `a`'s vertex -> nearest vertex of `b` (within 1e-5:
+/// the course's files store single precision), each rotated to start at its smallest index,
+/// so that two meshes compare whatever their vertex numbering.
+fn faces_in(a: &PolyMesh, b: &PolyMesh) -> BTreeSet<Vec<usize>> {
+    let map: Vec<usize> = a
+        .positions
+        .iter()
+        .map(|&p| {
+            let (i, d) = nearest(&b.positions, p);
+            assert!(d < 1e-5, "no vertex near {p}");
+            i
+        })
+        .collect();
+    a.faces()
+        .map(|f| {
+            let mut k: Vec<usize> = f.iter().map(|&v| map[v as usize]).collect();
+            let m = (0..k.len()).min_by_key(|&i| k[i]).unwrap();
+            k.rotate_left(m);
+            k
+        })
+        .collect()
+}
+
+fn same_faces(a: &PolyMesh, b: &PolyMesh) -> bool {
+    faces_in(a, b) == faces_in(b, b)
+}
+
+fn nearest(positions: &[DVec3], p: DVec3) -> (usize, f64) {
+    positions
+        .iter()
+        .enumerate()
+        .map(|(i, q)| (i, (*q - p).length()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap()
+}
+
+/// Oracle: the course's own before/after files. The edge each one operated on is recovered
+/// from the difference, prism performs the same operation on it, and the oriented face sets
+/// must then be equal (positions matched to 1e-6).
+#[test]
+fn flip_split_collapse_reproduce_the_course_examples() {
+    for model in ["cube", "icosahedron", "torus"] {
+        let input = load(&format!("meshedit/dae/{model}/input.dae"));
+        let base = HalfedgeMesh::from_polymesh(&input).unwrap();
+        let (v, e, f) = (base.vertex_count(), base.edge_count(), base.face_count());
+
+        // Flip: the two faces that changed share the flipped edge.
+        let after = load(&format!("meshedit/dae/{model}/edgeFlip.dae"));
+        let now = faces_in(&after, &input);
+        let gone: Vec<Vec<usize>> = faces_in(&input, &input).difference(&now).cloned().collect();
+        assert_eq!(gone.len(), 2, "{model}: flip changed {} faces", gone.len());
+        let shared: Vec<u32> = gone[0]
+            .iter()
+            .filter(|x| gone[1].contains(x))
+            .map(|&x| x as u32)
+            .collect();
+        let mut h = base.clone();
+        let edge = h
+            .find_edge(VertexId(shared[0]), VertexId(shared[1]))
+            .unwrap();
+        h.flip(edge).unwrap();
+        h.validate().unwrap();
+        assert_eq!(
+            (h.vertex_count(), h.edge_count(), h.face_count()),
+            (v, e, f)
+        );
+        assert!(same_faces(&h.to_polymesh(), &after), "{model}: flip");
+
+        // Split: the new vertex is the midpoint of the split edge.
+        let after = load(&format!("meshedit/dae/{model}/edgeSplit.dae"));
+        let added: Vec<DVec3> = after
+            .positions
+            .iter()
+            .copied()
+            .filter(|&p| nearest(&input.positions, p).1 > 1e-6)
+            .collect();
+        assert_eq!(added.len(), 1, "{model}: split");
+        let mut h = base.clone();
+        let edge = (0..h.edge_count() as u32)
+            .map(prism_mesh::EdgeId)
+            .find(|&e| {
+                let he = h.edge_halfedge(e);
+                let mid = (h.position(h.origin(he)) + h.position(h.dest(he))) / 2.0;
+                (mid - added[0]).length() < 1e-6
+            })
+            .unwrap();
+        h.split(edge).unwrap();
+        h.validate().unwrap();
+        assert_eq!(
+            (h.vertex_count(), h.edge_count(), h.face_count()),
+            (v + 1, e + 3, f + 2)
+        );
+        assert!(same_faces(&h.to_polymesh(), &after), "{model}: split");
+
+        // Collapse: the two vertices that vanished are the collapsed edge's ends.
+        let after = load(&format!("meshedit/dae/{model}/edgeCollapse.dae"));
+        let vanished: Vec<u32> = (0..input.vertex_count() as u32)
+            .filter(|&i| nearest(&after.positions, input.positions[i as usize]).1 > 1e-6)
+            .collect();
+        assert_eq!(vanished.len(), 2, "{model}: collapse");
+        let mut h = base.clone();
+        let edge = h
+            .find_edge(VertexId(vanished[0]), VertexId(vanished[1]))
+            .unwrap();
+        h.collapse(edge).unwrap();
+        h.validate().unwrap();
+        assert_eq!(
+            (h.vertex_count(), h.edge_count(), h.face_count()),
+            (v - 1, e - 3, f - 2)
+        );
+        assert!(same_faces(&h.to_polymesh(), &after), "{model}: collapse");
+    }
+    // The counts FORMATS.md records for the cube.
+    let cube = HalfedgeMesh::from_polymesh(&load("meshedit/dae/cube/input.dae")).unwrap();
+    assert_eq!(
+        (cube.vertex_count(), cube.face_count(), cube.edge_count()),
+        (8, 12, 18)
+    );
+}
