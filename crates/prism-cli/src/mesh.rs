@@ -69,7 +69,7 @@ enum MeshCommand {
     Split(EdgeArgs),
     /// Flip an interior edge between two triangles.
     Flip(EdgeArgs),
-    /// Collapse an interior edge to its midpoint (link condition checked).
+    /// Collapse an edge (interior or boundary) to its midpoint, if the link condition holds.
     Collapse(EdgeArgs),
     /// Loop subdivision of a triangle mesh.
     Subdivide {

@@ -546,37 +546,84 @@ impl HalfedgeMesh {
         Ok(VertexId(m))
     }
 
-    /// Whether [`HalfedgeMesh::collapse`] may collapse edge `e`. This version collapses
-    /// interior edges between triangles whose endpoints are both interior vertices, under the
-    /// link condition (the endpoints share exactly the two opposite vertices as neighbours)
-    /// and with both opposite vertices of valence above 3, so that no face or edge
-    /// degenerates.
+    /// Whether [`HalfedgeMesh::collapse`] may collapse edge `e`. The edge's faces (two, or
+    /// one on a boundary edge) must be triangles, and the result must stay a manifold:
+    /// - the link condition: the endpoints share no neighbour but the opposite vertices;
+    /// - an interior edge may not join two boundary vertices (that would pinch the surface);
+    /// - a boundary edge's boundary loop must have more than three edges;
+    /// - no opposite vertex may be left with valence 2 if interior, or with no face if on
+    ///   a boundary (so no face or edge degenerates).
     ///
     /// # Errors
     /// Why the collapse is refused.
     pub fn can_collapse(&self, e: EdgeId) -> Result<(), String> {
-        let (h, t) = self.interior_triangle_edge(e, "; boundary collapses are not supported")?;
-        let (a, b) = (self.origin(h), self.origin(t));
-        if self.is_boundary_vertex(a) || self.is_boundary_vertex(b) {
-            return Err(format!("edge {}: an endpoint is on the boundary", e.0));
+        if e.0 as usize >= self.edge_count() {
+            return Err(format!(
+                "edge {} does not exist ({} edges)",
+                e.0,
+                self.edge_count()
+            ));
         }
-        let c = self.origin(self.prev(h));
-        let d = self.origin(self.prev(t));
+        let mut h = self.edge_halfedge(e);
+        if self.face(h).is_none() {
+            h = self.twin(h);
+        }
+        let t = self.twin(h);
+        let (a, b) = (self.origin(h), self.origin(t));
+        let mut opposite = Vec::with_capacity(2);
+        for side in [h, t] {
+            if let Some(f) = self.face(side) {
+                if self.face_halfedges(f).count() != 3 {
+                    return Err(format!("edge {}: face {} is not a triangle", e.0, f.0));
+                }
+                opposite.push(self.origin(self.prev(side)));
+            }
+        }
+        let boundary_edge = opposite.len() == 1;
+        if boundary_edge {
+            let mut len = 1;
+            let mut x = self.next(t);
+            while x != t && len <= 3 {
+                len += 1;
+                x = self.next(x);
+            }
+            if len <= 3 {
+                return Err(format!(
+                    "edge {}: its boundary loop has only {len} edges",
+                    e.0
+                ));
+            }
+        } else if self.is_boundary_vertex(a) && self.is_boundary_vertex(b) {
+            return Err(format!(
+                "edge {}: an interior edge between two boundary vertices ({} and {})",
+                e.0, a.0, b.0
+            ));
+        }
         let ring = |v: VertexId| -> Vec<u32> { self.outgoing(v).map(|o| self.dest(o).0).collect() };
         let (ra, rb) = (ring(a), ring(b));
         let mut shared: Vec<u32> = ra.iter().copied().filter(|v| rb.contains(v)).collect();
         shared.sort_unstable();
-        let mut expect = vec![c.0, d.0];
+        let mut expect: Vec<u32> = opposite.iter().map(|v| v.0).collect();
         expect.sort_unstable();
+        expect.dedup();
         if shared != expect {
             return Err(format!(
-                "edge {}: link condition fails (the endpoints share {} neighbours, expected 2)",
+                "edge {}: link condition fails (the endpoints share {} neighbours, expected {})",
                 e.0,
-                shared.len()
+                shared.len(),
+                expect.len()
             ));
         }
-        for v in [c, d] {
-            if self.outgoing(v).count() <= 3 {
+        for &v in &opposite {
+            let valence = self.outgoing(v).count();
+            if self.is_boundary_vertex(v) {
+                if valence <= 2 {
+                    return Err(format!(
+                        "edge {}: boundary vertex {} would be left with no face",
+                        e.0, v.0
+                    ));
+                }
+            } else if valence <= 3 {
                 return Err(format!(
                     "edge {}: vertex {} would be left with valence 2",
                     e.0, v.0
@@ -668,49 +715,79 @@ impl HalfedgeMesh {
         self.v_out.truncate(last);
     }
 
-    /// Collapses edge `e` to its midpoint: the edge's endpoints become one vertex, the two
-    /// triangles on the edge disappear and their other edges merge pairwise (1 vertex,
-    /// 3 edges and 2 faces fewer). Elements are removed by moving the last vertex, edges and
-    /// faces into the freed slots, so indices above the removed ones may change. Returns the
-    /// merged vertex.
+    /// Collapses edge `e` to its midpoint: the edge's endpoints become one vertex, the
+    /// triangles on the edge disappear and their other edges merge pairwise. An interior edge
+    /// loses 1 vertex, 3 edges and 2 faces; a boundary edge 1 vertex, 2 edges and 1 face.
+    /// Elements are removed by moving the last vertex, edges and faces into the freed slots,
+    /// so indices above the removed ones may change. Returns the merged vertex.
     ///
     /// # Errors
     /// As [`HalfedgeMesh::can_collapse`]; the mesh is unchanged on error.
     pub fn collapse(&mut self, e: EdgeId) -> Result<VertexId, String> {
         self.can_collapse(e)?;
-        let h = self.edge_halfedge(e).0 as usize;
+        // Orient so that h has a face; t may be a boundary halfedge.
+        let mut h = self.edge_halfedge(e).0 as usize;
+        if self.he_face[h] == NONE {
+            h ^= 1;
+        }
         let t = h ^ 1;
+        let t_boundary = self.he_face[t] == NONE;
         let (hn, hp) = (self.he_next[h] as usize, self.he_prev[h] as usize);
         let (tn, tp) = (self.he_next[t] as usize, self.he_prev[t] as usize);
         let (a, b) = (self.he_origin[h] as usize, self.he_origin[t] as usize);
         let c = self.he_origin[hp] as usize;
-        let (f0, f1) = (self.he_face[h] as usize, self.he_face[t] as usize);
+        let f0 = self.he_face[h] as usize;
         let mid = (self.positions[a] + self.positions[b]) * 0.5;
+        // The merged vertex's boundary halfedge, if it will be on a boundary.
+        let boundary_out = if t_boundary {
+            Some(tn)
+        } else if self.is_boundary_vertex(VertexId(a as u32)) {
+            Some(self.v_out[a] as usize)
+        } else if self.is_boundary_vertex(VertexId(b as u32)) {
+            Some(self.v_out[b] as usize)
+        } else {
+            None
+        };
         // Everything leaving a now leaves b.
         let from_a: Vec<HalfedgeId> = self.outgoing(VertexId(a as u32)).collect();
         for o in from_a {
             self.he_origin[o.0 as usize] = b as u32;
         }
+        if let Some(o) = boundary_out {
+            self.v_out[b] = o as u32;
+        }
+        if t_boundary {
+            // The boundary loop skips t (before the move below, which may relocate tn).
+            self.link(tp, tn);
+        }
         // Merge b-c: slot hn takes the outer halfedge of c-a (now b->c).
-        let o_hp = hp ^ 1;
-        self.move_halfedge(o_hp, hn);
-        // Merge b-d: slot tp takes the outer halfedge of a-d (d->a, now d->b).
-        let o_tn = tn ^ 1;
-        self.move_halfedge(o_tn, tp);
+        self.move_halfedge(hp ^ 1, hn);
+        if !t_boundary {
+            // Merge b-d: slot tp takes the outer halfedge of a-d (d->a, now d->b).
+            self.move_halfedge(tn ^ 1, tp);
+        }
         self.positions[b] = mid;
-        self.v_out[b] = hn as u32;
+        if boundary_out.is_none() {
+            self.v_out[b] = hn as u32;
+        }
         if self.v_out[c] == hp as u32 {
             self.v_out[c] = (hn ^ 1) as u32;
         }
         // Remove the dead edges (highest index first), faces, and vertex a.
-        let mut dead = [h / 2, hp / 2, tn / 2];
+        let mut dead = vec![h / 2, hp / 2];
+        let mut faces = vec![f0];
+        if !t_boundary {
+            dead.push(tn / 2);
+            faces.push(self.he_face[t] as usize);
+        }
         dead.sort_unstable_by(|x, y| y.cmp(x));
         for d in dead {
             self.remove_edge_pair(d);
         }
-        let (fa, fb) = (f0.max(f1), f0.min(f1));
-        self.remove_face(fa);
-        self.remove_face(fb);
+        faces.sort_unstable_by(|x, y| y.cmp(x));
+        for f in faces {
+            self.remove_face(f);
+        }
         let merged = if b == self.positions.len() - 1 { a } else { b };
         self.remove_vertex(a);
         Ok(VertexId(merged as u32))
@@ -1061,6 +1138,68 @@ mod tests {
         );
         let mut t = HalfedgeMesh::from_polymesh(&tet).unwrap();
         assert!(t.collapse(EdgeId(0)).is_err());
+        t.validate().unwrap();
+    }
+
+    /// Closed-form counts of boundary collapses: a boundary edge loses 1 vertex, 2 edges and
+    /// 1 face; an interior edge with one boundary endpoint the usual 1, 3 and 2. Refusals: a
+    /// lone triangle (its boundary loop has 3 edges) and an interior edge joining two
+    /// boundary vertices.
+    #[test]
+    fn boundary_collapses() {
+        // A fan of 6 triangles around vertex 0, whose rim is the boundary.
+        let mut positions = vec![DVec3::ZERO];
+        for k in 0..6 {
+            let a = f64::from(k) * std::f64::consts::PI / 3.0;
+            positions.push(DVec3::new(a.cos(), a.sin(), 0.0));
+        }
+        let faces: Vec<Vec<u32>> = (0..6).map(|k| vec![0, 1 + k, 1 + (k + 1) % 6]).collect();
+        let fan = HalfedgeMesh::from_polymesh(&PolyMesh::new(positions, &faces)).unwrap();
+        let (v, e, f) = (fan.vertex_count(), fan.edge_count(), fan.face_count());
+
+        let mut m = fan.clone();
+        let rim = m.find_edge(VertexId(1), VertexId(2)).unwrap();
+        let merged = m.collapse(rim).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (v - 1, e - 2, f - 1)
+        );
+        assert!(m.is_boundary_vertex(merged));
+        assert!((m.position(merged) - DVec3::new(0.75, 3f64.sqrt() / 4.0, 0.0)).length() < 1e-15);
+
+        let mut m = fan.clone();
+        let spoke = m.find_edge(VertexId(0), VertexId(1)).unwrap();
+        let merged = m.collapse(spoke).unwrap();
+        m.validate().unwrap();
+        assert_eq!(
+            (m.vertex_count(), m.edge_count(), m.face_count()),
+            (v - 1, e - 3, f - 2)
+        );
+        assert!(m.is_boundary_vertex(merged));
+
+        // After a spoke collapse every vertex is on the rim, so an interior edge (a chord)
+        // joins two boundary vertices.
+        let mut m = fan.clone();
+        m.collapse(m.find_edge(VertexId(0), VertexId(1)).unwrap())
+            .unwrap();
+        let chord = (0..m.edge_count() as u32)
+            .map(EdgeId)
+            .find(|&x| {
+                let h = m.edge_halfedge(x);
+                !m.is_boundary_edge(x)
+                    && m.is_boundary_vertex(m.origin(h))
+                    && m.is_boundary_vertex(m.dest(h))
+            })
+            .unwrap();
+        assert!(m
+            .can_collapse(chord)
+            .unwrap_err()
+            .contains("two boundary vertices"));
+
+        let tri = PolyMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], &[vec![0, 1, 2]]);
+        let mut t = HalfedgeMesh::from_polymesh(&tri).unwrap();
+        assert!(t.collapse(EdgeId(0)).unwrap_err().contains("only 3 edges"));
         t.validate().unwrap();
     }
 
