@@ -173,8 +173,7 @@ proptest! {
         let mut p = if open_mesh { open() } else { closed().to_polymesh() };
         let mirror = mirror_map(&p.positions);
         let mut k = 0;
-        for i in 0..p.positions.len() {
-            let j = mirror[i];
+        for (i, &j) in mirror.iter().enumerate() {
             if j < i {
                 continue;
             }
