@@ -135,10 +135,25 @@ fn wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> R
     use prism_raster::{Document, Item, Mat3, Paint};
     let (sy, cy) = 0.6f64.sin_cos();
     let (sx, cx) = 0.35f64.sin_cos();
-    let view = |p: DVec3| {
+    let turn = |p: DVec3| {
         let q = DVec3::new(cy * p.x + sy * p.z, p.y, -sy * p.x + cy * p.z);
-        let q = DVec3::new(q.x, cx * q.y - sx * q.z, sx * q.y + cx * q.z);
-        prism_math::DVec2::new(0.5 + 0.4 * q.x, 0.5 - 0.4 * q.y)
+        prism_math::DVec2::new(q.x, cx * q.y - sx * q.z)
+    };
+    // Fit the turned mesh into the unit square with a margin.
+    let (mut lo, mut hi) = (
+        prism_math::DVec2::splat(f64::MAX),
+        prism_math::DVec2::splat(f64::MIN),
+    );
+    for &p in &mesh.positions {
+        let q = turn(p);
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    let centre = (lo + hi) * 0.5;
+    let scale = 0.9 / (hi - lo).max_element().max(1e-12);
+    let view = |p: DVec3| {
+        let q = (turn(p) - centre) * scale;
+        prism_math::DVec2::new(0.5 + q.x, 0.5 - q.y)
     };
     let mut doc = Document {
         width: 1.0,
@@ -146,10 +161,11 @@ fn wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> R
         ..Document::default()
     };
     let mut path = Path::default();
+    let mut seen = std::collections::HashSet::new();
     for f in mesh.faces() {
         for k in 0..f.len() {
             let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            if a < b || !mesh.faces().any(|g| g.windows(2).any(|w| w == [b, a])) {
+            if seen.insert((a.min(b), a.max(b))) {
                 path.move_to(view(mesh.positions[a as usize]));
                 path.line_to(view(mesh.positions[b as usize]));
             }
@@ -251,7 +267,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         Dialect::Svg,
         base(240, 240, 16),
     ));
-    let pb = crate::progress::bar(jobs.len() as u64 + 3, "demo", a.quiet);
+    let pb = crate::progress::bar(jobs.len() as u64 + 5, "demo", a.quiet);
     for (file, caption, svg, dialect, opts) in jobs {
         draw(&svg, dialect, &opts, &a.output.join(&file))?;
         entries.push(Entry { file, caption });
@@ -288,6 +304,22 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         });
         pb.inc(1);
     }
+    // The Utah teapot's 32 bicubic patches (Newell, 1975), tessellated and welded; Z up.
+    let patches = prism_mesh::parse_bez(include_str!("../data/teapot.bez"), "teapot.bez")?;
+    let mut teapot = prism_mesh::tessellate(&patches, 8);
+    for p in &mut teapot.positions {
+        *p = prism_math::glam::DVec3::new(p.x, p.z, -p.y);
+    }
+    wireframe(&teapot, 300, &a.output.join("bezier_teapot.png"))?;
+    entries.push(Entry {
+        file: "bezier_teapot.png".into(),
+        caption: format!(
+            "Utah teapot: 32 bicubic patches tessellated at 8x8 and welded ({} vertices, {} triangles)",
+            teapot.vertex_count(),
+            teapot.face_count()
+        ),
+    });
+    pb.inc(1);
     pb.finish_and_clear();
     let mut html = String::from(
         "<!doctype html><meta charset=\"utf-8\"><title>prism gallery</title>\

@@ -87,8 +87,14 @@ enum MeshCommand {
         /// Print per-stage times on stderr (`subdivide: 12.3 ms`, one line per stage).
         #[arg(long)]
         stats: bool,
+        /// No progress bar (it is drawn only on a terminal anyway).
+        #[arg(short, long)]
+        quiet: bool,
     },
 }
+
+/// Most faces `prism mesh subdivide` will produce (about 18 GB as a halfedge mesh).
+const MAX_SUBDIVIDED_FACES: u64 = 1 << 28;
 
 fn extension(path: &Path) -> String {
     path.extension()
@@ -225,6 +231,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             levels,
             weights,
             stats,
+            quiet,
         } => {
             let w = match weights {
                 Weights::Warren => LoopWeights::Warren,
@@ -233,6 +240,25 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             let t = Instant::now();
             let mut p = read(input)?;
             let read_time = t.elapsed();
+            // Refuse before allocating what cannot fit: every level makes 4 faces of one.
+            let out_faces = (p.face_count() as u128) << (2 * u128::from((*levels).min(40)));
+            if out_faces > MAX_SUBDIVIDED_FACES as u128 {
+                return Err(UserError(format!(
+                    "{}: {} levels of {} faces would make {out_faces} faces; the limit is {MAX_SUBDIVIDED_FACES}",
+                    input.display(),
+                    levels,
+                    p.face_count()
+                ))
+                .into());
+            }
+            // Progress in output faces, so the ETA weighs each level by its work.
+            let bar = crate::progress::bar(
+                (1..=*levels)
+                    .map(|l| (p.face_count() as u64) << (2 * l))
+                    .sum(),
+                "subdivide",
+                *quiet,
+            );
             let (mut build_time, mut sub_time) =
                 (std::time::Duration::ZERO, std::time::Duration::ZERO);
             for _ in 0..*levels {
@@ -243,7 +269,9 @@ pub fn run(a: &MeshArgs) -> Result<()> {
                 p = loop_subdivide(&m, w)
                     .map_err(|e| UserError(format!("{}: {e}", input.display())))?;
                 sub_time += t.elapsed();
+                bar.inc(p.face_count() as u64);
             }
+            bar.finish_and_clear();
             let t = Instant::now();
             write(output, &p)?;
             if *stats {

@@ -194,6 +194,7 @@ fn demo_writes_gallery() {
         "transformed_group.png",
         "bezier_decasteljau.png",
         "loop_level_2.png",
+        "bezier_teapot.png",
     ] {
         assert!(html.contains(f), "{f} not in index");
         assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
@@ -392,6 +393,18 @@ fn mesh_collada_in_and_out() {
     let a = std::fs::read_to_string(&obj_a).unwrap();
     assert_eq!(a.lines().filter(|l| l.starts_with("f ")).count(), 4 * 5856);
     assert_eq!(a, std::fs::read_to_string(&obj_b).unwrap());
+
+    // Nine levels would make 1.5 billion faces: refused up front, nothing written.
+    let o = prism()
+        .args(["mesh", "subdivide", "-n", "9"])
+        .arg(&cow)
+        .arg("-o")
+        .arg(&obj_a)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("the limit is 268435456"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&obj_a).unwrap(), a);
 
     let text = std::fs::read_to_string(&cow).unwrap();
     let broken = dir.join("broken.dae");
