@@ -403,7 +403,11 @@ fn mesh_collada_in_and_out() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("the limit is 268435456"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the limit is 268435456"),
+        "{}",
+        stderr(&o)
+    );
     assert_eq!(std::fs::read_to_string(&obj_a).unwrap(), a);
 
     let text = std::fs::read_to_string(&cow).unwrap();

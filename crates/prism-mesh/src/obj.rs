@@ -89,30 +89,62 @@ pub fn read_obj(path: &Path) -> Result<PolyMesh, MeshError> {
 /// # Errors
 /// Whatever the writer returns.
 pub fn write_obj(mesh: &PolyMesh, out: &mut impl Write) -> std::io::Result<()> {
-    for p in &mesh.positions {
-        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
-    }
+    let mut line = Vec::with_capacity(96);
+    let mut num = NumberWriter::default();
     let normals = mesh
         .normals
         .as_ref()
         .filter(|n| n.len() == mesh.vertex_count());
-    if let Some(ns) = normals {
-        for n in ns {
-            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+    let vectors = mesh
+        .positions
+        .iter()
+        .map(|p| (b"v" as &[u8], p))
+        .chain(normals.into_iter().flatten().map(|n| (b"vn" as &[u8], n)));
+    for (tag, p) in vectors {
+        line.clear();
+        line.extend_from_slice(tag);
+        for c in [p.x, p.y, p.z] {
+            line.push(b' ');
+            num.float(&mut line, c);
         }
+        line.push(b'\n');
+        out.write_all(&line)?;
     }
     for f in mesh.faces() {
-        write!(out, "f")?;
-        for v in f {
+        line.clear();
+        line.push(b'f');
+        for &v in f {
+            line.push(b' ');
+            num.int(&mut line, u64::from(v) + 1);
             if normals.is_some() {
-                write!(out, " {0}//{0}", v + 1)?;
-            } else {
-                write!(out, " {}", v + 1)?;
+                line.extend_from_slice(b"//");
+                num.int(&mut line, u64::from(v) + 1);
             }
         }
-        writeln!(out)?;
+        line.push(b'\n');
+        out.write_all(&line)?;
     }
     Ok(())
+}
+
+/// Shortest round-trip decimals for floats (integers print as `1.0`, tiny and huge values in
+/// exponent form) and plain decimal integers, appended to a byte buffer.
+#[derive(Default)]
+pub(crate) struct NumberWriter {
+    float: ryu::Buffer,
+    int: itoa::Buffer,
+}
+
+impl NumberWriter {
+    /// Appends the shortest decimal that reads back as `v`.
+    pub(crate) fn float(&mut self, out: &mut Vec<u8>, v: f64) {
+        out.extend_from_slice(self.float.format(v).as_bytes());
+    }
+
+    /// Appends `v` in decimal.
+    pub(crate) fn int(&mut self, out: &mut Vec<u8>, v: u64) {
+        out.extend_from_slice(self.int.format(v).as_bytes());
+    }
 }
 
 #[cfg(test)]

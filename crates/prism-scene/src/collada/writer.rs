@@ -4,7 +4,7 @@ use prism_mesh::PolyMesh;
 
 /// Writes a polygon mesh as a COLLADA 1.4.1 document (`Y_UP`): one geometry with a
 /// `<polylist>`, per-vertex normals and texture coordinates when the mesh has them, and one
-/// node instancing it. Numbers use the shortest decimal that reads back to the same `f64`.
+/// node instancing it. Numbers use the shortest decimal that reads back as the same `f64`.
 ///
 /// # Errors
 /// Whatever the writer returns.
@@ -36,11 +36,12 @@ pub fn write_collada(mesh: &PolyMesh, out: &mut impl Write) -> std::io::Result<(
             r#"      <source id="{id}"><float_array id="{id}-array" count="{}">"#,
             count * stride
         )?;
+        let mut buf = ryu::Buffer::new();
         for (i, v) in values.enumerate() {
             if i > 0 {
-                write!(out, " ")?;
+                out.write_all(b" ")?;
             }
-            write!(out, "{v}")?;
+            out.write_all(buf.format(v).as_bytes())?;
         }
         write!(
             out,
