@@ -3,37 +3,11 @@
 //! halfedges have no face and are linked into boundary loops, so every halfedge has a
 //! `next` and a `prev`.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
-
 use prism_math::glam::DVec3;
 
 use crate::{MeshError, PolyMesh};
 
 const NONE: u32 = u32::MAX;
-
-/// A multiplicative hash for directed-edge keys `(a << 32) | b`: the keys are small integers
-/// whose high bits Fibonacci hashing spreads well, at a fraction of SipHash's cost.
-#[derive(Default)]
-struct EdgeKeyHasher(u64);
-
-impl Hasher for EdgeKeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    fn write_u64(&mut self, k: u64) {
-        self.0 = (k ^ (k >> 29)).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
-}
-
-fn key(a: u32, b: u32) -> u64 {
-    (u64::from(a) << 32) | u64::from(b)
-}
 
 /// Index of a halfedge.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -76,14 +50,16 @@ impl HalfedgeMesh {
     /// a vertex whose faces form more than one fan.
     pub fn from_polymesh(mesh: &PolyMesh) -> Result<HalfedgeMesh, MeshError> {
         let nv = mesh.vertex_count();
-        let mut m = HalfedgeMesh {
-            positions: mesh.positions.clone(),
-            v_out: vec![NONE; nv],
-            ..HalfedgeMesh::default()
-        };
-        let mut directed: HashMap<u64, u32, BuildHasherDefault<EdgeKeyHasher>> =
-            HashMap::with_capacity_and_hasher(mesh.face_count() * 3, Default::default());
-        let mut out_count = vec![0u32; nv];
+        let starts = mesh.face_starts();
+        let corners = mesh.corners();
+        let nc = corners.len();
+        if nc >= (NONE / 2) as usize {
+            return Err(MeshError::Topology {
+                face: 0,
+                message: format!("{nc} face corners are more than this mesh type holds"),
+            });
+        }
+        // Faces: sizes, index ranges, repeated vertices.
         for (fi, face) in mesh.faces().enumerate() {
             let err = |message: String| MeshError::Topology { face: fi, message };
             if face.len() < 3 {
@@ -104,39 +80,98 @@ impl HalfedgeMesh {
                     )));
                 }
             }
-            let mut hs = Vec::with_capacity(face.len());
-            for k in 0..face.len() {
-                let (a, b) = (face[k], face[(k + 1) % face.len()]);
-                if directed.contains_key(&key(a, b)) {
-                    return Err(err(format!(
-                        "edge {a}-{b} is already used in this direction: non-manifold edge or inconsistent orientation"
-                    )));
-                }
-                let h = match directed.get(&key(b, a)) {
-                    Some(&h_ba) => h_ba ^ 1,
-                    None => {
-                        let h = m.he_next.len() as u32;
-                        for (o, _) in [(a, b), (b, a)] {
-                            m.he_origin.push(o);
-                            m.he_face.push(NONE);
-                            m.he_next.push(NONE);
-                            m.he_prev.push(NONE);
-                        }
-                        h
-                    }
-                };
-                directed.insert(key(a, b), h);
-                m.he_face[h as usize] = fi as u32;
-                out_count[a as usize] += 1;
-                hs.push(h);
-            }
-            for k in 0..hs.len() {
-                let (h, n) = (hs[k], hs[(k + 1) % hs.len()]);
-                m.he_next[h as usize] = n;
-                m.he_prev[n as usize] = h;
-            }
-            m.f_he.push(hs[0]);
         }
+        // Each corner c starts the directed edge corners[c] -> corners[next[c]].
+        let mut next = vec![0u32; nc];
+        let mut face_of = vec![0u32; nc];
+        for f in 0..mesh.face_count() {
+            let (s, e) = (starts[f] as usize, starts[f + 1] as usize);
+            for c in s..e {
+                next[c] = if c + 1 == e { s as u32 } else { c as u32 + 1 };
+                face_of[c] = f as u32;
+            }
+        }
+        let dest = |c: usize| corners[next[c] as usize];
+        // Directed edges grouped by origin (a counting sort), each group sorted by
+        // destination, so twins are found by binary search and repeats are neighbours.
+        let mut offset = vec![0u32; nv + 1];
+        for &v in corners {
+            offset[v as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            offset[v + 1] += offset[v];
+        }
+        let mut by_origin = vec![0u32; nc];
+        {
+            let mut fill = offset.clone();
+            for (c, &v) in corners.iter().enumerate() {
+                by_origin[fill[v as usize] as usize] = c as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let mut out_count: Vec<u32> = (0..nv).map(|v| offset[v + 1] - offset[v]).collect();
+        for v in 0..nv {
+            let group = &mut by_origin[offset[v] as usize..offset[v + 1] as usize];
+            group.sort_unstable_by_key(|&c| (dest(c as usize), c));
+            // The same directed edge twice: report the later face, as reading in order would.
+            for w in 1..group.len() {
+                let (c0, c1) = (group[w - 1] as usize, group[w] as usize);
+                if dest(c0) == dest(c1) {
+                    return Err(MeshError::Topology {
+                        face: face_of[c1] as usize,
+                        message: format!(
+                            "edge {v}-{} is already used in this direction: non-manifold edge or inconsistent orientation",
+                            dest(c1)
+                        ),
+                    });
+                }
+            }
+        }
+        let twin_corner = |c: usize| -> Option<usize> {
+            let (a, b) = (corners[c], dest(c));
+            let group = &by_origin[offset[b as usize] as usize..offset[b as usize + 1] as usize];
+            group
+                .binary_search_by_key(&a, |&d| dest(d as usize))
+                .ok()
+                .map(|i| group[i] as usize)
+        };
+        // Halfedge ids: edges numbered in order of first use, (a, b) even where first seen.
+        let mut hid = vec![NONE; nc];
+        let mut edges = 0u32;
+        for c in 0..nc {
+            if hid[c] != NONE {
+                continue;
+            }
+            let h = 2 * edges;
+            edges += 1;
+            hid[c] = h;
+            if let Some(t) = twin_corner(c) {
+                hid[t] = h + 1;
+            }
+        }
+        let nh = 2 * edges as usize;
+        let mut m = HalfedgeMesh {
+            positions: mesh.positions.clone(),
+            v_out: vec![NONE; nv],
+            he_next: vec![NONE; nh],
+            he_prev: vec![NONE; nh],
+            he_origin: vec![NONE; nh],
+            he_face: vec![NONE; nh],
+            f_he: starts[..mesh.face_count()]
+                .iter()
+                .map(|&s| hid[s as usize])
+                .collect(),
+        };
+        for c in 0..nc {
+            let h = hid[c] as usize;
+            let n = hid[next[c] as usize] as usize;
+            m.he_origin[h] = corners[c];
+            m.he_origin[h ^ 1] = dest(c);
+            m.he_face[h] = face_of[c];
+            m.he_next[h] = n as u32;
+            m.he_prev[n] = h as u32;
+        }
+        drop((next, face_of, by_origin, hid));
         // Link boundary halfedges into loops.
         let mut boundary_out: Vec<u32> = vec![NONE; nv];
         for h in 0..m.he_next.len() as u32 {

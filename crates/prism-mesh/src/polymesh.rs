@@ -66,6 +66,16 @@ impl PolyMesh {
         (0..self.face_count()).map(|f| self.face(f))
     }
 
+    /// Face start offsets into [`PolyMesh::corners`]: `face_count() + 1` entries.
+    pub(crate) fn face_starts(&self) -> &[u32] {
+        &self.face_starts
+    }
+
+    /// Every face's vertex indices, face after face.
+    pub(crate) fn corners(&self) -> &[u32] {
+        &self.face_indices
+    }
+
     /// True if every face is a triangle.
     #[must_use]
     pub fn is_triangle_mesh(&self) -> bool {
