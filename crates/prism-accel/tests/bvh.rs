@@ -1,0 +1,173 @@
+//! The BVH against brute force (proptest), and watertightness on a closed mesh.
+
+use prism_accel::{intersect_sphere, intersect_triangle, BuildOptions, Bvh, Hit, RayPre, Sphere};
+use prism_math::{Pcg32, Ray, Vec3};
+use proptest::prelude::*;
+
+fn brute_force(tris: &[[Vec3; 3]], spheres: &[Sphere], ray: &Ray, tmax: f32) -> Option<Hit> {
+    let pre = RayPre::new(ray);
+    let mut best: Option<Hit> = None;
+    for (i, t) in tris.iter().enumerate() {
+        let lim = best.map_or(tmax, |h| h.t);
+        if let Some((t, b1, b2)) = intersect_triangle(&pre, t, 0.0, lim) {
+            best = Some(Hit {
+                t,
+                prim: i as u32,
+                b1,
+                b2,
+            });
+        }
+    }
+    for (i, s) in spheres.iter().enumerate() {
+        let lim = best.map_or(tmax, |h| h.t);
+        if let Some(t) = intersect_sphere(ray, s, 0.0, lim) {
+            best = Some(Hit {
+                t,
+                prim: (tris.len() + i) as u32,
+                b1: 0.0,
+                b2: 0.0,
+            });
+        }
+    }
+    best
+}
+
+fn v3() -> impl Strategy<Value = Vec3> {
+    (-10f32..10.0, -10f32..10.0, -10f32..10.0).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn scene() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Vec<Sphere>)> {
+    (
+        prop::collection::vec(
+            (v3(), v3(), v3()).prop_map(|(a, b, c)| [a, a + 0.3 * b, a + 0.3 * c]),
+            0..300,
+        ),
+        prop::collection::vec(
+            (v3(), 0.05f32..2.0).prop_map(|(c, r)| Sphere {
+                center: c,
+                radius: r,
+            }),
+            0..20,
+        ),
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Oracle: brute force over every primitive. The closest hit has the same t (and the
+    /// same primitive unless two are hit at the same t); any-hit agrees with closest-hit.
+    #[test]
+    fn closest_hit_equals_brute_force(
+        (tris, spheres) in scene(),
+        rays in prop::collection::vec((v3(), v3()), 64),
+        max_leaf in 1usize..9,
+    ) {
+        let opts = BuildOptions { max_leaf, parallel_threshold: 64, ..BuildOptions::default() };
+        let bvh = Bvh::build(&tris, &spheres, &opts);
+        for (o, d) in rays {
+            if d.length() < 1e-3 {
+                continue;
+            }
+            let ray = Ray::new(o, d);
+            let want = brute_force(&tris, &spheres, &ray, f32::INFINITY);
+            let got = bvh.intersect(&ray, 0.0, f32::INFINITY);
+            match (want, got) {
+                (None, None) => {}
+                (Some(w), Some(g)) => {
+                    prop_assert_eq!(w.t, g.t);
+                    if w.prim != g.prim {
+                        // A tie: both primitives are hit at this t.
+                        prop_assert!(brute_force(&tris, &spheres, &ray, w.t * (1.0 + 1e-6)).is_some());
+                    }
+                }
+                _ => prop_assert!(false, "brute force {want:?} but BVH {got:?}"),
+            }
+            prop_assert_eq!(bvh.occluded(&ray, 0.0, f32::INFINITY), want.is_some());
+            if let Some(w) = want {
+                prop_assert!(!bvh.occluded(&ray, 0.0, w.t * 0.999));
+            }
+        }
+    }
+}
+
+/// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at
+/// its vertices and edge midpoints (where tests that are not watertight leak), always hit.
+#[test]
+fn closed_mesh_is_watertight() {
+    let mut verts = vec![];
+    let mut tris = vec![];
+    let (nu, nv) = (64, 32);
+    for j in 0..=nv {
+        for i in 0..nu {
+            let th = std::f32::consts::PI * j as f32 / nv as f32;
+            let ph = 2.0 * std::f32::consts::PI * i as f32 / nu as f32;
+            verts.push(Vec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()) * 3.7);
+        }
+    }
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = j * nu + i;
+            let b = j * nu + (i + 1) % nu;
+            let (c, d) = (a + nu, b + nu);
+            tris.push([verts[a], verts[b], verts[d]]);
+            tris.push([verts[a], verts[d], verts[c]]);
+        }
+    }
+    let bvh = Bvh::build(&tris, &[], &BuildOptions::default());
+    let centre = Vec3::new(1e-3, -2e-3, 0.5e-3);
+    let mut rng = Pcg32::new(3, 4);
+    let mut targets: Vec<Vec3> = verts.clone();
+    for t in &tris {
+        targets.push((t[0] + t[1]) * 0.5);
+        targets.push((t[1] + t[2]) * 0.5);
+        targets.push((t[2] + t[0]) * 0.5);
+    }
+    for p in targets {
+        for _ in 0..4 {
+            let o = centre + Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 1e-4;
+            let ray = Ray::new(o, p - o);
+            assert!(
+                bvh.intersect(&ray, 0.0, f32::INFINITY).is_some(),
+                "leak towards {p}"
+            );
+        }
+    }
+}
+
+/// Property: the hierarchy is the same whatever the thread count (same statistics and the
+/// same hits), and statistics are consistent.
+#[test]
+fn build_is_deterministic_and_stats_add_up() {
+    let mut rng = Pcg32::new(9, 1);
+    let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+    let tris: Vec<[Vec3; 3]> = (0..20_000)
+        .map(|_| {
+            let a = r();
+            [a, a + r() * 0.05, a + r() * 0.05]
+        })
+        .collect();
+    let opts = BuildOptions {
+        parallel_threshold: 256,
+        ..BuildOptions::default()
+    };
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let a = one.install(|| Bvh::build(&tris, &[], &opts));
+    let b = Bvh::build(&tris, &[], &opts);
+    assert_eq!(a.stats(), b.stats());
+    let s = a.stats();
+    assert_eq!(s.nodes, 2 * s.leaves - 1);
+    assert_eq!(s.primitives, 20_000);
+    assert!(s.depth < 64 && s.sah_cost > 0.0);
+    for k in 0..1000 {
+        let o = Vec3::splat(-1.0);
+        let d = Vec3::new(1.0, (k % 37) as f32 / 37.0, (k % 11) as f32 / 11.0);
+        assert_eq!(
+            a.intersect(&Ray::new(o, d), 0.0, f32::INFINITY),
+            b.intersect(&Ray::new(o, d), 0.0, f32::INFINITY)
+        );
+    }
+}
