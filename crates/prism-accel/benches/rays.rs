@@ -1,1 +1,126 @@
-fn main() {}
+//! `cargo bench -p prism-accel`: BVH build time and closest-hit ray throughput, set up as
+//! `../shared/bench/pathtrace/embree_rays.py` sets up Embree, so the figures compare:
+//! - primary: 1024x1024 pinhole rays looking down -z at the mesh (45 degree field of view,
+//!   eye at 1.6 half-diagonals from the centre), in scanline order;
+//! - random: 2,000,000 rays with origins uniform in the mesh's box and directions uniform
+//!   on the sphere.
+//!
+//! The mesh is `PRISM_RAYS_MESH` (.obj, .ply or .dae), by default the staged bunny
+//! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
+//! Each figure is the median of 5 runs.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use prism_accel::{BuildOptions, Bvh};
+use prism_math::{Pcg32, Ray, Vec3};
+use rayon::prelude::*;
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn load(path: &Path) -> Vec<[Vec3; 3]> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let mesh = match ext {
+        "obj" => prism_mesh::read_obj(path).expect("mesh reads"),
+        "ply" => prism_mesh::read_ply(path).expect("mesh reads"),
+        _ => prism_scene::read_collada(path)
+            .expect("mesh reads")
+            .world_mesh(true),
+    };
+    let p = |i: u32| mesh.positions[i as usize].as_vec3();
+    mesh.faces()
+        .flat_map(|f| (1..f.len() - 1).map(move |k| [p(f[0]), p(f[k]), p(f[k + 1])]))
+        .collect()
+}
+
+fn trace(bvh: &Bvh, rays: &[Ray], threads: usize) -> (Duration, f64) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    pool.install(|| {
+        let t = Instant::now();
+        let hits: usize = rays
+            .par_chunks(4096)
+            .map(|c| {
+                c.iter()
+                    .filter(|r| bvh.intersect(r, 0.0, f32::INFINITY).is_some())
+                    .count()
+            })
+            .sum();
+        (t.elapsed(), hits as f64 / rays.len() as f64)
+    })
+}
+
+fn main() {
+    let path = std::env::var_os("PRISM_RAYS_MESH").map_or_else(
+        || {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../../shared/assets/pathtracer/dae/sky/bunny.dae")
+        },
+        PathBuf::from,
+    );
+    let tris = load(&path);
+    let build = median(
+        (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                std::hint::black_box(Bvh::build(&tris, &[], &BuildOptions::default()));
+                t.elapsed()
+            })
+            .collect(),
+    );
+    let bvh = Bvh::build(&tris, &[], &BuildOptions::default());
+    let s = bvh.stats();
+    println!("mesh: {} ({} triangles)", path.display(), tris.len());
+    println!(
+        "build: {:.1} ms  nodes {}  leaves {}  depth {}  max leaf {}  SAH cost {:.1}  {:.1} bytes/triangle",
+        build.as_secs_f64() * 1e3,
+        s.nodes,
+        s.leaves,
+        s.depth,
+        s.max_leaf_size,
+        s.sah_cost,
+        s.bytes as f64 / tris.len() as f64
+    );
+
+    let b = bvh.bounds();
+    let (c, ext) = (b.centroid(), b.extent().length() / 2.0);
+    let eye = c + Vec3::new(0.0, 0.0, 1.6 * ext);
+    let res = 1024;
+    let tan = (std::f32::consts::PI / 8.0).tan();
+    let primary: Vec<Ray> = (0..res * res)
+        .map(|i| {
+            let x = ((i % res) as f32 + 0.5) / res as f32 * 2.0 - 1.0;
+            let y = -(((i / res) as f32 + 0.5) / res as f32 * 2.0 - 1.0);
+            Ray::new(eye, Vec3::new(x * tan, y * tan, -1.0).normalize())
+        })
+        .collect();
+    let mut rng = Pcg32::new(2, 0);
+    let random: Vec<Ray> = (0..2_000_000)
+        .map(|_| {
+            let o = b.min + b.extent() * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let z = 1.0 - 2.0 * rng.next_f32();
+            let phi = 2.0 * std::f32::consts::PI * rng.next_f32();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
+        })
+        .collect();
+    for (kind, rays) in [("primary", &primary), ("random", &random)] {
+        for threads in [1, 2] {
+            trace(&bvh, &rays[..10_000], threads);
+            let runs: Vec<(Duration, f64)> = (0..5).map(|_| trace(&bvh, rays, threads)).collect();
+            let hit = runs[0].1;
+            let med = median(runs.iter().map(|r| r.0).collect());
+            println!(
+                "{kind:7} threads={threads} rays={} hit={hit:.3} median={:.1} ms Mrays/s={:.2}",
+                rays.len(),
+                med.as_secs_f64() * 1e3,
+                rays.len() as f64 / med.as_secs_f64() / 1e6
+            );
+        }
+    }
+}

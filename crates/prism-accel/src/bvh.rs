@@ -1,3 +1,4 @@
+use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
 
 use crate::shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};
@@ -18,7 +19,7 @@ impl Default for BuildOptions {
     fn default() -> BuildOptions {
         BuildOptions {
             max_leaf: 8,
-            traversal_cost: 1.0,
+            traversal_cost: 2.0,
             parallel_threshold: 4096,
         }
     }
@@ -100,6 +101,42 @@ struct PrimInfo {
 }
 
 const BINS: usize = 16;
+
+/// `a.max(b)` as one instruction: if `a` is NaN the result is `b`.
+#[inline(always)]
+fn fmax(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `a.min(b)` as one instruction: if `a` is NaN the result is `b`.
+#[inline(always)]
+fn fmin(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// A ray prepared for slab tests: `t = (p - origin) * inv_dir`.
+struct SlabRay {
+    inv_dir: Vec3A,
+    origin: Vec3A,
+}
+
+impl SlabRay {
+    fn new(r: &RayPre) -> SlabRay {
+        let inv_dir = Vec3A::from(r.inv_dir);
+        SlabRay {
+            inv_dir,
+            origin: Vec3A::from(r.origin),
+        }
+    }
+}
 
 /// Depth after which splits are by median, so that no tree is deeper than this plus 32
 /// and the traversal stacks below cannot overflow.
@@ -228,14 +265,17 @@ impl Bvh {
     }
 
     #[inline]
-    fn node_hit(n: &Node, r: &RayPre, tmin: f32, tmax: f32) -> Option<f32> {
-        let t0 = (Vec3::from_array(n.min) - r.origin) * r.inv_dir;
-        let t1 = (Vec3::from_array(n.max) - r.origin) * r.inv_dir;
-        let near = t0.min(t1).max_element().max(tmin);
+    fn node_hit(n: &Node, r: &SlabRay, tmin: f32, tmax: f32) -> Option<f32> {
+        let t0 = (Vec3A::from(n.min) - r.origin) * r.inv_dir;
+        let t1 = (Vec3A::from(n.max) - r.origin) * r.inv_dir;
+        let lo = t0.min(t1);
+        let hi = t0.max(t1);
+        // NaN (0 * inf, for a ray in a slab's plane) drops out of these comparisons.
+        let near = fmax(fmax(lo.x, lo.y), fmax(lo.z, tmin));
         // Rounding in the slab test may shrink the interval by a few ulps; widening the far
         // end keeps hits on the box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-        let far = t0.max(t1).min_element() * (1.0 + 2.0 * 3.0 * f32::EPSILON);
-        let far = far.min(tmax);
+        let far = fmin(fmin(hi.x, hi.y), hi.z) * (1.0 + 2.0 * 3.0 * f32::EPSILON);
+        let far = fmin(far, tmax);
         (near <= far).then_some(near)
     }
 
@@ -267,11 +307,12 @@ impl Bvh {
             return None;
         }
         let r = RayPre::new(ray);
+        let slab = SlabRay::new(&r);
         let mut best: Option<Hit> = None;
         let mut tmax = tmax;
-        let mut stack = [(0u32, 0f32); STACK];
+        let mut stack = [(0u32, 0f32); MEDIAN_DEPTH + 34];
         let mut sp = 0usize;
-        let t_root = Self::node_hit(&self.nodes[0], &r, tmin, tmax)?;
+        let t_root = Self::node_hit(&self.nodes[0], &slab, tmin, tmax)?;
         stack[0] = (0, t_root);
         sp += 1;
         while sp > 0 {
@@ -293,8 +334,8 @@ impl Bvh {
                     break;
                 }
                 let (a, b) = (i + 1, n.index);
-                let ha = Self::node_hit(&self.nodes[a as usize], &r, tmin, tmax);
-                let hb = Self::node_hit(&self.nodes[b as usize], &r, tmin, tmax);
+                let ha = Self::node_hit(&self.nodes[a as usize], &slab, tmin, tmax);
+                let hb = Self::node_hit(&self.nodes[b as usize], &slab, tmin, tmax);
                 match (ha, hb) {
                     (Some(ta), Some(tb)) => {
                         let (near, far, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
@@ -318,13 +359,14 @@ impl Bvh {
             return false;
         }
         let r = RayPre::new(ray);
+        let slab = SlabRay::new(&r);
         let mut stack = [0u32; STACK];
         let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
             let i = stack[sp];
             let n = &self.nodes[i as usize];
-            if Self::node_hit(n, &r, tmin, tmax).is_none() {
+            if Self::node_hit(n, &slab, tmin, tmax).is_none() {
                 continue;
             }
             if n.count > 0 {

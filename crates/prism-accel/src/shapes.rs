@@ -29,11 +29,19 @@ pub struct RayPre {
     pub dir: Vec3,
     /// `1 / dir`, for slab tests.
     pub inv_dir: Vec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
+    perm: usize,
     shear: Vec3,
 }
+
+/// The axes `(kx, ky, kz)` of each permutation used by the watertight test.
+const PERMS: [[usize; 3]; 6] = [
+    [1, 2, 0],
+    [2, 1, 0],
+    [2, 0, 1],
+    [0, 2, 1],
+    [0, 1, 2],
+    [1, 0, 2],
+];
 
 impl RayPre {
     /// Precomputes the shear that maps the ray to the +z axis.
@@ -48,19 +56,28 @@ impl RayPre {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        // Keep the winding: swap kx and ky when the dominant component is negative.
+        let perm = 2 * kz + usize::from(d[kz] < 0.0);
+        let [kx, ky, kz] = PERMS[perm];
         RayPre {
             origin: ray.origin,
             dir: d,
             inv_dir: d.recip(),
-            kx,
-            ky,
-            kz,
+            perm,
             shear: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+        }
+    }
+
+    /// `v` with its axes reordered to `(kx, ky, kz)`.
+    #[inline(always)]
+    fn permute(&self, v: Vec3) -> Vec3 {
+        match self.perm {
+            0 => Vec3::new(v.y, v.z, v.x),
+            1 => Vec3::new(v.z, v.y, v.x),
+            2 => Vec3::new(v.z, v.x, v.y),
+            3 => Vec3::new(v.x, v.z, v.y),
+            4 => v,
+            _ => Vec3::new(v.y, v.x, v.z),
         }
     }
 }
@@ -77,17 +94,16 @@ pub fn intersect_triangle(
     tmin: f32,
     tmax: f32,
 ) -> Option<(f32, f32, f32)> {
-    let a = v[0] - r.origin;
-    let b = v[1] - r.origin;
-    let c = v[2] - r.origin;
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+    let a = r.permute(v[0] - r.origin);
+    let b = r.permute(v[1] - r.origin);
+    let c = r.permute(v[2] - r.origin);
     let s = r.shear;
-    let ax = a[kx] - s.x * a[kz];
-    let ay = a[ky] - s.y * a[kz];
-    let bx = b[kx] - s.x * b[kz];
-    let by = b[ky] - s.y * b[kz];
-    let cx = c[kx] - s.x * c[kz];
-    let cy = c[ky] - s.y * c[kz];
+    let ax = a.x - s.x * a.z;
+    let ay = a.y - s.y * a.z;
+    let bx = b.x - s.x * b.z;
+    let by = b.y - s.y * b.z;
+    let cx = c.x - s.x * c.z;
+    let cy = c.y - s.y * c.z;
     let mut u = cx * by - cy * bx;
     let mut vv = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
@@ -103,7 +119,7 @@ pub fn intersect_triangle(
     if det == 0.0 {
         return None;
     }
-    let t_scaled = s.z * (u * a[kz] + vv * b[kz] + w * c[kz]);
+    let t_scaled = s.z * (u * a.z + vv * b.z + w * c.z);
     let inv = 1.0 / det;
     let t = t_scaled * inv;
     if !(t > tmin && t < tmax) {
