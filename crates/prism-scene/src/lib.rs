@@ -5,13 +5,21 @@
 //! (`<polylist>`, `<triangles>`, `<polygons>`, the course's CGL spheres), the node hierarchy
 //! with its transforms (`matrix`, `translate`, `rotate`, `scale`, `lookat`) and the up axis.
 //! [`write_collada`] writes a polygon mesh back as a one-node COLLADA document.
+//!
+//! [`Scene`] is what renderers consume: world-space meshes and spheres with materials,
+//! lights and a camera, built from a document by [`Scene::from_collada`].
 #![warn(missing_docs)]
 
 mod collada;
 mod error;
+mod scene;
 
 pub use collada::{
-    parse_collada, read_collada, write_collada, Collada, Geometry, Instance, MeshData, Node, Part,
-    Shape, UpAxis, MAX_FILE_BYTES, MAX_NODE_DEPTH,
+    parse_collada, read_collada, write_collada, CameraDef, Collada, EffectDef, Geometry, Instance,
+    LightDef, LightKind, MeshData, Node, Part, Shape, UpAxis, MAX_FILE_BYTES, MAX_NODE_DEPTH,
 };
 pub use error::SceneError;
+pub use scene::{
+    Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
+    TriangleMesh,
+};

@@ -227,3 +227,108 @@ fn area_weighted_normals_match_libigl() {
         assert!(worst < 1e-9, "{name}: max difference {worst:e}");
     }
 }
+
+fn scene(name: &str) -> prism_scene::Scene {
+    let path = shared_assets().join(format!("pathtracer/dae/{name}"));
+    let doc = read_collada(&path).unwrap();
+    prism_scene::Scene::from_collada(&doc, &prism_scene::SceneOptions::default(), name).unwrap()
+}
+
+fn close(a: prism_math::Vec3, b: [f32; 3]) -> bool {
+    (a - prism_math::Vec3::from_array(b)).length() < 2e-3
+}
+
+/// Oracle: the worked example of `FORMATS.md` section 2 (box, spheres, area light and the
+/// course's camera placement for CBspheres_lambertian; CBbunny's mirrored camera).
+#[test]
+fn cornell_scenes_match_the_recorded_layout() {
+    use prism_scene::{Light, Material};
+    let s = scene("sky/CBspheres_lambertian.dae");
+    let (lo, hi) = s.bounds().unwrap();
+    assert!(
+        close(lo, [-1.0, 0.0, -1.0]) && close(hi, [1.0, 1.5, 1.0]),
+        "{lo} {hi}"
+    );
+    assert!(close(s.camera.eye, [0.0, 0.75, 4.8023]), "{:?}", s.camera);
+    assert!(close(s.camera.target, [0.0, 0.75, 0.0]));
+    let mut centres: Vec<[f32; 3]> = s.spheres.iter().map(|x| x.center.to_array()).collect();
+    centres.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    assert!(close(
+        prism_math::Vec3::from_array(centres[0]),
+        [-0.4, 0.3, -0.3]
+    ));
+    assert!(close(
+        prism_math::Vec3::from_array(centres[1]),
+        [0.4, 0.3, 0.3]
+    ));
+    assert!(s.spheres.iter().all(|x| (x.radius - 0.3).abs() < 1e-5));
+    assert_eq!(s.lights.len(), 1);
+    let Light::Area {
+        center,
+        dim_x,
+        dim_y,
+        normal,
+        radiance,
+    } = &s.lights[0]
+    else {
+        panic!("expected an area light: {:?}", s.lights)
+    };
+    assert!(close(*center, [0.0, 1.49, 0.0]) && close(*normal, [0.0, -1.0, 0.0]));
+    assert!((dim_x.cross(*dim_y).length() - 0.48).abs() < 1e-4);
+    assert_eq!(radiance.to_array(), [10.0, 10.0, 10.0]);
+    let (h, v) = s.camera.fov_for(512, 384);
+    assert!(
+        (h - 49.134).abs() < 1e-2 && (v - 37.849).abs() < 1e-2,
+        "{h} {v}"
+    );
+
+    let b = scene("sky/CBbunny.dae");
+    assert!(close(b.camera.eye, [0.0, 0.75, -4.8023]), "{:?}", b.camera);
+    assert!(matches!(
+        scene("sky/CBempty.dae").lights[..],
+        [Light::Point { .. }]
+    ));
+    assert!(matches!(
+        scene("sky/bunny.dae").lights[..],
+        [Light::Hemisphere { .. }]
+    ));
+    let m = scene("sky/CBspheres_microfacet_al_ag.dae");
+    assert!(m
+        .materials
+        .iter()
+        .any(|x| matches!(x, Material::Microfacet { alpha, .. } if (*alpha - 0.25).abs() < 1e-6)));
+    let g = scene("sky/CBspheres.dae");
+    assert!(g
+        .materials
+        .iter()
+        .any(|x| matches!(x, Material::Glass { ior, .. } if (*ior - 1.45).abs() < 1e-6)));
+    assert!(g
+        .materials
+        .iter()
+        .any(|x| matches!(x, Material::Mirror { .. })));
+}
+
+/// Every staged path-tracer file becomes a scene with geometry, a light and a camera.
+#[test]
+fn every_pathtracer_file_becomes_a_scene() {
+    let mut files = Vec::new();
+    dae_files(&shared_assets().join("pathtracer/dae"), &mut files);
+    for f in files {
+        let doc = read_collada(&f).unwrap();
+        let s = prism_scene::Scene::from_collada(&doc, &prism_scene::SceneOptions::default(), "x")
+            .unwrap();
+        assert!(!s.meshes.is_empty(), "{}", f.display());
+        assert!(s.camera.eye.is_finite());
+        let name = f.file_name().unwrap().to_string_lossy().to_string();
+        if name.starts_with("CB") || name.starts_with("bunny") {
+            assert!(!s.lights.is_empty(), "{name}");
+        }
+        for m in &s.meshes {
+            if let prism_scene::Shading::Smooth(n) = &m.shading {
+                assert!(n
+                    .iter()
+                    .all(|v| (v.length() - 1.0).abs() < 1e-4 || *v == prism_math::Vec3::ZERO));
+            }
+        }
+    }
+}

@@ -11,6 +11,7 @@
 //!   row and `<rotate>` as axis and angle in degrees. World matrices compose parent first.
 //! - `<up_axis>` is reported, not applied; [`UpAxis::to_y_up`] gives the conversion.
 
+mod library;
 mod writer;
 
 use std::collections::HashMap;
@@ -23,6 +24,7 @@ use roxmltree::{Document, Node as XmlNode};
 
 use crate::error::SceneError;
 
+pub use library::{CameraDef, EffectDef, LightDef, LightKind};
 pub use writer::write_collada;
 
 /// Largest COLLADA file read, in bytes.
@@ -48,7 +50,7 @@ impl UpAxis {
     ///
     /// - `Z_UP`: `(x, y, z) -> (-x, z, y)`, the course's conversion (a half turn about
     ///   `(0, 1, 1)`), which keeps Blender's front view facing the default camera.
-    /// - `X_UP`: `(x, y, z) -> (-y, x, z)`, a quarter turn about Z.
+    /// - `X_UP`: `(x, y, z) -> (y, x, -z)`, the course's conversion.
     /// - `Y_UP`: the identity.
     #[must_use]
     pub fn to_y_up(self) -> DMat4 {
@@ -61,8 +63,8 @@ impl UpAxis {
             )),
             UpAxis::X => DMat4::from_mat3(DMat3::from_cols(
                 DVec3::new(0.0, 1.0, 0.0),
-                DVec3::new(-1.0, 0.0, 0.0),
-                DVec3::new(0.0, 0.0, 1.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 0.0, -1.0),
             )),
         }
     }
@@ -78,10 +80,14 @@ pub struct Collada {
     /// The instanced visual scene's nodes, depth first, each with its world matrix (the up
     /// axis not applied). Empty when the file instances no visual scene.
     pub nodes: Vec<Node>,
-    /// Cameras, keyed by id: the `<camera>` elements' line numbers, for later readers.
-    pub camera_ids: Vec<String>,
-    /// Lights, keyed by id.
-    pub light_ids: Vec<String>,
+    /// Every `<camera>`, in file order.
+    pub cameras: Vec<CameraDef>,
+    /// Every `<light>` of a known kind, in file order.
+    pub lights: Vec<LightDef>,
+    /// Every `<effect>`, read as a material.
+    pub effects: Vec<EffectDef>,
+    /// Every `<material>`: its id and the index of its effect in [`Collada::effects`].
+    pub materials: Vec<(String, usize)>,
     /// Features read past without being understood, one message each.
     pub warnings: Vec<String>,
 }
@@ -313,12 +319,38 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
         }
     }
     for lib in children(root, "library_cameras") {
-        out.camera_ids
-            .extend(children(lib, "camera").map(|c| c.attribute("id").unwrap_or("").to_string()));
+        for c in children(lib, "camera") {
+            out.cameras.push(library::camera(&cx, c)?);
+        }
     }
+    let mut all_light_ids = Vec::new();
     for lib in children(root, "library_lights") {
-        out.light_ids
-            .extend(children(lib, "light").map(|c| c.attribute("id").unwrap_or("").to_string()));
+        for l in children(lib, "light") {
+            all_light_ids.push(l.attribute("id").unwrap_or("").to_string());
+            if let Some(light) = library::light(&cx, l, &mut |k, m| warn(&mut out, k, m))? {
+                out.lights.push(light);
+            }
+        }
+    }
+    for lib in children(root, "library_effects") {
+        for e in children(lib, "effect") {
+            let effect = library::effect(&cx, e, &mut |k, m| warn(&mut out, k, m))?;
+            out.effects.push(effect);
+        }
+    }
+    for lib in children(root, "library_materials") {
+        for m in children(lib, "material") {
+            let inst = child(m, "instance_effect")
+                .ok_or_else(|| cx.err(m, "expected an <instance_effect>"))?;
+            let url = reference(&cx, inst, "url")?;
+            let effect = out
+                .effects
+                .iter()
+                .position(|e| e.id == url)
+                .ok_or_else(|| cx.err(inst, format!("no <effect> with id {url:?}")))?;
+            out.materials
+                .push((m.attribute("id").unwrap_or("").to_string(), effect));
+        }
     }
 
     let mut library_nodes = HashMap::new();
@@ -350,8 +382,10 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
             cx: &cx,
             geometry_index: &geometry_index,
             library_nodes: &library_nodes,
-            camera_ids: &out.camera_ids,
-            light_ids: &out.light_ids,
+            cameras: &out.cameras,
+            lights: &out.lights,
+            materials: &out.materials,
+            unknown_lights: &all_light_ids,
         };
         let mut nodes = Vec::new();
         let mut warnings = Vec::new();
@@ -890,8 +924,11 @@ struct Walker<'a, 'b, 'i> {
     cx: &'a Cx<'a, 'i>,
     geometry_index: &'a HashMap<String, usize>,
     library_nodes: &'a HashMap<String, XmlNode<'b, 'i>>,
-    camera_ids: &'a [String],
-    light_ids: &'a [String],
+    cameras: &'a [CameraDef],
+    lights: &'a [LightDef],
+    materials: &'a [(String, usize)],
+    /// Every light id, including lights of unknown kinds (skipped with a warning).
+    unknown_lights: &'a [String],
 }
 
 impl<'b, 'i> Walker<'_, 'b, 'i> {
@@ -983,6 +1020,9 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                             .attribute("symbol")
                             .ok_or_else(|| cx.err(im, "expected a symbol attribute"))?;
                         let target = reference(cx, im, "target")?;
+                        if !self.materials.iter().any(|(id, _)| id == target) {
+                            return Err(cx.err(im, format!("no <material> with id {target:?}")));
+                        }
                         materials.push((symbol.to_string(), target.to_string()));
                     }
                     instances.push(Instance::Geometry {
@@ -992,14 +1032,18 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                 }
                 "instance_camera" => {
                     let url = reference(cx, c, "url")?;
-                    if !self.camera_ids.iter().any(|id| id == url) {
+                    if !self.cameras.iter().any(|c| c.id == url) {
                         return Err(cx.err(c, format!("no <camera> with id {url:?}")));
                     }
                     instances.push(Instance::Camera(url.to_string()));
                 }
                 "instance_light" => {
                     let url = reference(cx, c, "url")?;
-                    if !self.light_ids.iter().any(|id| id == url) {
+                    if !self.lights.iter().any(|l| l.id == url) {
+                        // A light of an unknown kind was skipped with a warning.
+                        if self.unknown_lights.iter().any(|id| id == url) {
+                            continue;
+                        }
                         return Err(cx.err(c, format!("no <light> with id {url:?}")));
                     }
                     instances.push(Instance::Light(url.to_string()));

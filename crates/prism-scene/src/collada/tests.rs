@@ -5,8 +5,13 @@ fn doc(up: &str, geometry: &str, nodes: &str) -> String {
         r##"<?xml version="1.0"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
   <asset><up_axis>{up}</up_axis></asset>
-  <library_cameras><camera id="cam"/></library_cameras>
-  <library_lights><light id="sun"/></library_lights>
+  <library_cameras><camera id="cam"><optics><technique_common><perspective><xfov>40</xfov>
+    <aspect_ratio>1.5</aspect_ratio></perspective></technique_common></optics></camera></library_cameras>
+  <library_lights><light id="sun"><technique_common><directional><color>1 1 1</color></directional>
+    </technique_common></light></library_lights>
+  <library_effects><effect id="red-fx"><profile_COMMON><technique sid="common"><phong><diffuse>
+    <color>0.8 0.1 0.1 1</color></diffuse></phong></technique></profile_COMMON></effect></library_effects>
+  <library_materials><material id="red"><instance_effect url="#red-fx"/></material></library_materials>
   <library_geometries>{geometry}</library_geometries>
   <library_visual_scenes><visual_scene id="s">{nodes}</visual_scene></library_visual_scenes>
   <scene><instance_visual_scene url="#s"/></scene>
@@ -268,7 +273,7 @@ fn bad_input_gives_located_errors() {
         &SQUARE.replace("2 0 2 3 0 3", "2 0 2 9 0 3"),
         &node(""),
     ));
-    assert!(e.starts_with("bad.dae:19: <p>:"), "{e}");
+    assert!(e.starts_with("bad.dae:24: <p>:"), "{e}");
 }
 
 #[test]

@@ -1,0 +1,302 @@
+//! The libraries a renderer needs: effects (materials), lights and cameras.
+
+use prism_math::Rgb;
+use roxmltree::Node as XmlNode;
+
+use super::{child, children, floats, Cx};
+use crate::error::SceneError;
+use crate::scene::Material;
+
+/// A `<camera>` with a perspective projection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraDef {
+    /// Its id.
+    pub id: String,
+    /// Line of its start tag.
+    pub line: u32,
+    /// Horizontal field of view in degrees, if given.
+    pub xfov: Option<f64>,
+    /// Vertical field of view in degrees, if given.
+    pub yfov: Option<f64>,
+    /// Width over height, if given.
+    pub aspect_ratio: Option<f64>,
+    /// Near clipping distance.
+    pub znear: f64,
+    /// Far clipping distance.
+    pub zfar: f64,
+}
+
+/// Which kind of light a `<light>` is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightKind {
+    /// `point`.
+    Point,
+    /// `directional`.
+    Directional,
+    /// The CGL `area` extra: a rectangle sized by its node's matrix.
+    Area,
+    /// `ambient`: the course's hemisphere light.
+    Ambient,
+    /// `spot` (the course renders it black).
+    Spot,
+}
+
+/// A `<light>`: the CGL extra technique if present, else `technique_common`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightDef {
+    /// Its id.
+    pub id: String,
+    /// Line of its start tag.
+    pub line: u32,
+    /// Kind.
+    pub kind: LightKind,
+    /// `<color>`: radiance, intensity or irradiance by kind.
+    pub color: Rgb,
+}
+
+/// An `<effect>` read as a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EffectDef {
+    /// Its id.
+    pub id: String,
+    /// Line of its start tag.
+    pub line: u32,
+    /// The material: the CGL extra's BSDF (the last one if several), else the common
+    /// profile's diffuse colour, else diffuse 0.5.
+    pub material: Material,
+}
+
+fn color3(cx: &Cx, n: XmlNode) -> Result<Rgb, SceneError> {
+    let v = floats(cx, n)?;
+    if v.len() < 3 || v.len() > 4 {
+        return Err(cx.err(
+            n,
+            format!(
+                "expected 3 colour values (or 4 with alpha), found {}",
+                v.len()
+            ),
+        ));
+    }
+    if v[..3].iter().any(|&c| c < 0.0) {
+        return Err(cx.err(n, "expected non-negative colour values"));
+    }
+    Ok(Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32))
+}
+
+fn scalar(cx: &Cx, n: XmlNode) -> Result<f64, SceneError> {
+    let v = floats(cx, n)?;
+    if v.len() != 1 {
+        return Err(cx.err(n, format!("expected one number, found {}", v.len())));
+    }
+    Ok(v[0])
+}
+
+fn required<'a, 'i>(
+    cx: &Cx,
+    n: XmlNode<'a, 'i>,
+    name: &str,
+) -> Result<XmlNode<'a, 'i>, SceneError> {
+    child(n, name).ok_or_else(|| cx.err(n, format!("expected a <{name}>")))
+}
+
+fn positive(cx: &Cx, n: XmlNode, v: f64, what: &str) -> Result<f32, SceneError> {
+    if v > 0.0 {
+        Ok(v as f32)
+    } else {
+        Err(cx.err(n, format!("expected a positive {what}, found {v}")))
+    }
+}
+
+fn cgl_bsdf(cx: &Cx, b: XmlNode) -> Result<Option<Material>, SceneError> {
+    let c = |name: &str| -> Result<Rgb, SceneError> { color3(cx, required(cx, b, name)?) };
+    let s = |name: &str| -> Result<f64, SceneError> { scalar(cx, required(cx, b, name)?) };
+    Ok(Some(match b.tag_name().name() {
+        "diffuse" => Material::Diffuse {
+            reflectance: c("albedo").or_else(|_| c("reflectance"))?,
+        },
+        "emission" => Material::Emission {
+            radiance: c("radiance")?,
+        },
+        "mirror" => Material::Mirror {
+            reflectance: c("reflectance")?,
+        },
+        "glass" => Material::Glass {
+            reflectance: c("reflectance")?,
+            transmittance: c("transmittance")?,
+            roughness: s("roughness")? as f32,
+            ior: positive(
+                cx,
+                required(cx, b, "ior")?,
+                s("ior")?,
+                "index of refraction",
+            )?,
+        },
+        "refraction" => Material::Refraction {
+            transmittance: c("transmittance")?,
+            roughness: s("roughness")? as f32,
+            ior: positive(
+                cx,
+                required(cx, b, "ior")?,
+                s("ior")?,
+                "index of refraction",
+            )?,
+        },
+        "microfacet" => Material::Microfacet {
+            alpha: positive(
+                cx,
+                required(cx, b, "alpha")?,
+                s("alpha")?,
+                "roughness alpha",
+            )?,
+            eta: c("eta")?,
+            k: c("k")?,
+        },
+        _ => return Ok(None),
+    }))
+}
+
+/// Reads one `<effect>`.
+pub(super) fn effect(
+    cx: &Cx,
+    e: XmlNode,
+    warn: &mut dyn FnMut(&str, String),
+) -> Result<EffectDef, SceneError> {
+    let mut material = None;
+    for t in e
+        .children()
+        .filter(|c| c.has_tag_name("extra"))
+        .flat_map(|x| children(x, "technique"))
+        .filter(|t| t.attribute("profile") == Some("CGL"))
+    {
+        for b in t.children().filter(|c| c.is_element()) {
+            match cgl_bsdf(cx, b)? {
+                Some(m) => material = Some(m),
+                None => warn(
+                    &format!("bsdf:{}", b.tag_name().name()),
+                    format!(
+                        "{}:{}: CGL BSDF <{}> is not known; the effect falls back to its common profile",
+                        cx.file,
+                        cx.line(b),
+                        b.tag_name().name()
+                    ),
+                ),
+            }
+        }
+    }
+    if material.is_none() {
+        let shading = child(e, "profile_COMMON")
+            .and_then(|p| child(p, "technique"))
+            .and_then(|t| {
+                t.children()
+                    .find(|c| matches!(c.tag_name().name(), "phong" | "lambert" | "blinn"))
+            });
+        if let Some(colour) = shading
+            .and_then(|s| child(s, "diffuse"))
+            .and_then(|d| child(d, "color"))
+        {
+            material = Some(Material::Diffuse {
+                reflectance: color3(cx, colour)?,
+            });
+        }
+    }
+    Ok(EffectDef {
+        id: e.attribute("id").unwrap_or("").to_string(),
+        line: cx.line(e),
+        material: material.unwrap_or(Material::Diffuse {
+            reflectance: Rgb::splat(0.5),
+        }),
+    })
+}
+
+/// Reads one `<light>`; `None` (with a warning) for a kind prism does not know.
+pub(super) fn light(
+    cx: &Cx,
+    l: XmlNode,
+    warn: &mut dyn FnMut(&str, String),
+) -> Result<Option<LightDef>, SceneError> {
+    let cgl = l
+        .children()
+        .filter(|c| c.has_tag_name("extra"))
+        .flat_map(|x| children(x, "technique"))
+        .find(|t| t.attribute("profile") == Some("CGL"));
+    let technique = cgl
+        .or_else(|| child(l, "technique_common"))
+        .ok_or_else(|| cx.err(l, "expected a <technique_common> or a CGL <extra>"))?;
+    let shape = technique
+        .children()
+        .find(|c| c.is_element())
+        .ok_or_else(|| cx.err(technique, "expected a light type element"))?;
+    let kind = match shape.tag_name().name() {
+        "point" => LightKind::Point,
+        "directional" => LightKind::Directional,
+        "area" => LightKind::Area,
+        "ambient" => LightKind::Ambient,
+        "spot" => LightKind::Spot,
+        other => {
+            warn(
+                &format!("light:{other}"),
+                format!(
+                    "{}:{}: light type <{other}> is not known; the light is skipped",
+                    cx.file,
+                    cx.line(shape)
+                ),
+            );
+            return Ok(None);
+        }
+    };
+    Ok(Some(LightDef {
+        id: l.attribute("id").unwrap_or("").to_string(),
+        line: cx.line(l),
+        kind,
+        color: color3(cx, required(cx, shape, "color")?)?,
+    }))
+}
+
+/// Reads one `<camera>`.
+pub(super) fn camera(cx: &Cx, c: XmlNode) -> Result<CameraDef, SceneError> {
+    let optics = required(cx, c, "optics")?;
+    let common = required(cx, optics, "technique_common")?;
+    let p = child(common, "perspective").ok_or_else(|| {
+        cx.err(
+            common,
+            "expected a <perspective> camera (orthographic cameras are not supported)",
+        )
+    })?;
+    let opt = |name: &str| -> Result<Option<f64>, SceneError> {
+        child(p, name).map(|n| scalar(cx, n)).transpose()
+    };
+    let xfov = opt("xfov")?;
+    let yfov = opt("yfov")?;
+    let aspect_ratio = opt("aspect_ratio")?;
+    if xfov.is_none() && yfov.is_none() {
+        return Err(cx.err(p, "expected an <xfov> or a <yfov>"));
+    }
+    for (n, v) in [("xfov", xfov), ("yfov", yfov)] {
+        if let Some(v) = v {
+            if !(v > 0.0 && v < 180.0) {
+                let node = child(p, n).unwrap_or(p);
+                return Err(cx.err(
+                    node,
+                    format!("expected a field of view between 0 and 180 degrees, found {v}"),
+                ));
+            }
+        }
+    }
+    if let Some(a) = aspect_ratio {
+        if a <= 0.0 {
+            return Err(cx.err(
+                child(p, "aspect_ratio").unwrap_or(p),
+                format!("expected a positive aspect ratio, found {a}"),
+            ));
+        }
+    }
+    Ok(CameraDef {
+        id: c.attribute("id").unwrap_or("").to_string(),
+        line: cx.line(c),
+        xfov,
+        yfov,
+        aspect_ratio,
+        znear: opt("znear")?.unwrap_or(0.001),
+        zfar: opt("zfar")?.unwrap_or(1000.0),
+    })
+}

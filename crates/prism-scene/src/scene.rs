@@ -1,0 +1,546 @@
+//! The plain scene a renderer consumes: world-space triangle meshes and spheres with
+//! materials, lights and a camera, all in a Y-up world.
+//!
+//! Conventions (the CS184 reading of `FORMATS.md` section 2, made physical where the course
+//! was not; `../shared/bench/pathtrace/dae_to_mitsuba.py` follows the same ones):
+//! - A node's world matrix is the up-axis conversion times its node transforms.
+//! - A CGL area light is a one-sided emitting rectangle, hittable by every ray.
+//! - Point lights fall off with the inverse square of the distance.
+//! - Shading normals are, by default, area-weighted vertex normals computed from the mesh
+//!   (the course's halfedge normals), ignoring the file's normals.
+//! - The camera is placed by the course's rule unless the file's own camera is asked for.
+
+use prism_math::glam::{DMat4, DVec3, DVec4};
+use prism_math::{Rgb, Vec3};
+use prism_mesh::vertex_normals_area_weighted;
+
+use crate::collada::{Collada, Instance, LightKind, Shape};
+use crate::error::SceneError;
+
+/// A surface's scattering model, with the parameters the course's files give.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Material {
+    /// Lambertian reflection.
+    Diffuse {
+        /// Albedo per channel.
+        reflectance: Rgb,
+    },
+    /// A black surface that emits `radiance` from both sides.
+    Emission {
+        /// Emitted radiance.
+        radiance: Rgb,
+    },
+    /// A perfect mirror.
+    Mirror {
+        /// Reflectance per channel.
+        reflectance: Rgb,
+    },
+    /// A smooth dielectric: Fresnel-weighted reflection and refraction.
+    Glass {
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Given by the files and unused (the course's glass is smooth).
+        roughness: f32,
+        /// Index of refraction inside (outside is 1).
+        ior: f32,
+    },
+    /// Refraction only, without Fresnel reflection (the course's `RefractionBSDF`).
+    Refraction {
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Given by the files and unused.
+        roughness: f32,
+        /// Index of refraction inside.
+        ior: f32,
+    },
+    /// A rough conductor with a Beckmann distribution of slope `alpha` and a complex index of
+    /// refraction `eta + i k` per channel.
+    Microfacet {
+        /// Beckmann roughness.
+        alpha: f32,
+        /// Real part of the index of refraction.
+        eta: Rgb,
+        /// Imaginary part (absorption).
+        k: Rgb,
+    },
+}
+
+/// How shading normals are chosen for meshes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NormalsMode {
+    /// Area-weighted vertex normals computed from the positions (the course's).
+    #[default]
+    Area,
+    /// The file's per-corner normals (falls back to `Area` for meshes without them).
+    File,
+    /// Geometric face normals.
+    Flat,
+}
+
+/// Where the camera comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CameraMode {
+    /// The course's rule: looking at the scene's bounding-box centre from 1.5 times its
+    /// diagonal away, along the file camera's direction, with +Y up.
+    #[default]
+    Course,
+    /// The file camera's own position and orientation.
+    File,
+}
+
+/// Options for turning a document into a scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SceneOptions {
+    /// Shading normals.
+    pub normals: NormalsMode,
+    /// Camera placement.
+    pub camera: CameraMode,
+}
+
+/// Shading normals of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shading {
+    /// One unit normal per vertex, interpolated.
+    Smooth(Vec<Vec3>),
+    /// Three unit normals per triangle, interpolated.
+    Corners(Vec<[Vec3; 3]>),
+    /// The geometric normal.
+    Flat,
+}
+
+/// A world-space triangle mesh with one material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    /// The node it came from, for messages.
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Shading normals.
+    pub shading: Shading,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// A world-space sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneSphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// A light source.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    /// An isotropic point light; irradiance falls off with the squared distance.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity.
+        intensity: Rgb,
+    },
+    /// Light arriving from infinitely far along one direction.
+    Directional {
+        /// The direction the light travels (unit).
+        direction: Vec3,
+        /// Irradiance on a surface facing the light.
+        irradiance: Rgb,
+    },
+    /// A one-sided emitting rectangle `center ± dim_x/2 ± dim_y/2`, emitting towards
+    /// `normal`.
+    Area {
+        /// Centre.
+        center: Vec3,
+        /// First edge (full length).
+        dim_x: Vec3,
+        /// Second edge (full length).
+        dim_y: Vec3,
+        /// Unit normal of the emitting side.
+        normal: Vec3,
+        /// Emitted radiance.
+        radiance: Rgb,
+    },
+    /// Radiance from every direction above the horizon (world y > 0), none from below; not
+    /// seen by camera rays.
+    Hemisphere {
+        /// Radiance.
+        radiance: Rgb,
+    },
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// A point looked at.
+    pub target: Vec3,
+    /// Up direction (need not be orthogonal to the view).
+    pub up: Vec3,
+    /// Horizontal field of view in degrees.
+    pub hfov: f32,
+    /// Vertical field of view in degrees.
+    pub vfov: f32,
+    /// Near clip distance.
+    pub near: f32,
+    /// Far clip distance.
+    pub far: f32,
+}
+
+impl Camera {
+    /// The fields of view widened along the too-narrow axis to the image's aspect ratio
+    /// `width / height`, as the course does: `(hfov, vfov)` in degrees.
+    #[must_use]
+    pub fn fov_for(&self, width: u32, height: u32) -> (f32, f32) {
+        let aspect = width as f32 / height as f32;
+        let th = (self.hfov.to_radians() / 2.0).tan();
+        let tv = (self.vfov.to_radians() / 2.0).tan();
+        if th / tv > aspect {
+            (self.hfov, (2.0 * (th / aspect).atan()).to_degrees())
+        } else {
+            ((2.0 * (tv * aspect).atan()).to_degrees(), self.vfov)
+        }
+    }
+}
+
+/// A scene ready to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Triangle meshes.
+    pub meshes: Vec<TriangleMesh>,
+    /// Spheres.
+    pub spheres: Vec<SceneSphere>,
+    /// Materials, indexed by meshes and spheres.
+    pub materials: Vec<Material>,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// The camera.
+    pub camera: Camera,
+    /// Things read past without being used, one message each.
+    pub warnings: Vec<String>,
+}
+
+fn v3(d: DVec3) -> Vec3 {
+    d.as_vec3()
+}
+
+impl Scene {
+    /// Builds a scene from a COLLADA document.
+    ///
+    /// # Errors
+    /// [`SceneError::Element`] for a zero-area area light or a transform that makes a
+    /// sphere's radius or a light's placement degenerate; `file` names the document.
+    pub fn from_collada(
+        doc: &Collada,
+        opts: &SceneOptions,
+        file: &str,
+    ) -> Result<Scene, SceneError> {
+        let up = doc.up_axis.to_y_up();
+        let mut scene = Scene {
+            meshes: Vec::new(),
+            spheres: Vec::new(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            camera: Camera {
+                eye: Vec3::ZERO,
+                target: Vec3::NEG_Z,
+                up: Vec3::Y,
+                hfov: 50.0,
+                vfov: 35.0,
+                near: 0.001,
+                far: 1000.0,
+            },
+            warnings: doc.warnings.clone(),
+        };
+        let err = |line: u32, element: &str, message: String| SceneError::Element {
+            file: file.to_string(),
+            line,
+            element: element.to_string(),
+            message,
+        };
+        // One scene material per effect used, plus the default diffuse.
+        let mut effect_material: Vec<Option<usize>> = vec![None; doc.effects.len()];
+        let mut default_material = None;
+        let mut file_camera = None;
+        for node in &doc.nodes {
+            let world = up * node.world;
+            for inst in &node.instances {
+                match inst {
+                    Instance::Geometry {
+                        geometry,
+                        materials,
+                    } => {
+                        let g = &doc.geometries[*geometry];
+                        // The node's first binding, as the course reads it.
+                        let effect = materials.first().and_then(|(_, target)| {
+                            doc.materials
+                                .iter()
+                                .find(|(id, _)| id == target)
+                                .map(|&(_, e)| e)
+                        });
+                        let material = match effect {
+                            Some(e) => *effect_material[e].get_or_insert_with(|| {
+                                scene.materials.push(doc.effects[e].material.clone());
+                                scene.materials.len() - 1
+                            }),
+                            None => *default_material.get_or_insert_with(|| {
+                                scene.materials.push(Material::Diffuse {
+                                    reflectance: Rgb::splat(0.5),
+                                });
+                                scene.materials.len() - 1
+                            }),
+                        };
+                        match &g.shape {
+                            Shape::Mesh(m) => {
+                                scene.meshes.push(mesh(
+                                    m,
+                                    world,
+                                    material,
+                                    &node.name,
+                                    opts.normals,
+                                ));
+                            }
+                            Shape::Sphere { radius } => {
+                                let center = world.transform_point3(DVec3::ZERO);
+                                let scale = world.transform_vector3(DVec3::X).length();
+                                let r = radius * scale;
+                                if r.is_nan() || r <= 0.0 {
+                                    return Err(err(
+                                        node.line,
+                                        "node",
+                                        format!(
+                                            "sphere {:?} has radius {r} after its transform",
+                                            g.id
+                                        ),
+                                    ));
+                                }
+                                scene.spheres.push(SceneSphere {
+                                    center: v3(center),
+                                    radius: r as f32,
+                                    material,
+                                });
+                            }
+                            Shape::Empty => {}
+                        }
+                    }
+                    Instance::Light(id) => {
+                        let Some(l) = doc.lights.iter().find(|l| &l.id == id) else {
+                            continue;
+                        };
+                        let at = |p: DVec3| world.transform_point3(p);
+                        let center = at(DVec3::ZERO);
+                        match l.kind {
+                            LightKind::Point => scene.lights.push(Light::Point {
+                                position: v3(center),
+                                intensity: l.color,
+                            }),
+                            LightKind::Directional => {
+                                // The course transforms the direction as a point.
+                                let d = at(DVec3::NEG_Z);
+                                let Some(direction) = d.try_normalize() else {
+                                    return Err(err(
+                                        node.line,
+                                        "node",
+                                        format!("directional light {id:?} has no direction"),
+                                    ));
+                                };
+                                scene.lights.push(Light::Directional {
+                                    direction: v3(direction),
+                                    irradiance: l.color,
+                                });
+                            }
+                            LightKind::Area => {
+                                let dir = at(DVec3::NEG_Z) - center;
+                                let dim_x = at(DVec3::NEG_X) - center;
+                                let dim_y = at(DVec3::Y) - center;
+                                let area = dim_x.cross(dim_y).length();
+                                let normal = dir.try_normalize();
+                                match normal {
+                                    Some(n) if area > 0.0 && area.is_finite() => scene.lights.push(Light::Area {
+                                        center: v3(center),
+                                        dim_x: v3(dim_x),
+                                        dim_y: v3(dim_y),
+                                        normal: v3(n),
+                                        radiance: l.color,
+                                    }),
+                                    _ => {
+                                        return Err(err(
+                                            node.line,
+                                            "node",
+                                            format!("area light {id:?} has zero area (its node's matrix collapses the rectangle)"),
+                                        ))
+                                    }
+                                }
+                            }
+                            LightKind::Ambient => {
+                                scene.lights.push(Light::Hemisphere { radiance: l.color })
+                            }
+                            LightKind::Spot => {
+                                let key = "spot".to_string();
+                                let msg = format!("{file}:{}: spot lights are not rendered (the course's are black); skipped", l.line);
+                                if !scene.warnings.iter().any(|w| w.contains(&key)) {
+                                    scene.warnings.push(msg);
+                                }
+                            }
+                        }
+                    }
+                    Instance::Camera(id) => {
+                        if file_camera.is_none() {
+                            if let Some(c) = doc.cameras.iter().find(|c| &c.id == id) {
+                                file_camera = Some((c.clone(), world));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        scene.camera = place_camera(&scene, file_camera.as_ref(), opts.camera);
+        Ok(scene)
+    }
+
+    /// The bounding box of every mesh vertex and sphere: `(min, max)`, or `None` if the
+    /// scene has no geometry.
+    #[must_use]
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for m in &self.meshes {
+            for &p in &m.positions {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        for s in &self.spheres {
+            lo = lo.min(s.center - Vec3::splat(s.radius));
+            hi = hi.max(s.center + Vec3::splat(s.radius));
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+}
+
+fn mesh(
+    m: &crate::collada::MeshData,
+    world: DMat4,
+    material: usize,
+    name: &str,
+    normals: NormalsMode,
+) -> TriangleMesh {
+    let positions64: Vec<DVec3> = m
+        .mesh
+        .positions
+        .iter()
+        .map(|&p| {
+            let q = world * DVec4::new(p.x, p.y, p.z, 1.0);
+            q.truncate() / q.w
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    let mut corners = Vec::new();
+    let mut k = 0;
+    for f in m.mesh.faces() {
+        // Fan triangulation (the staged files hold triangles only).
+        for i in 1..f.len() - 1 {
+            triangles.push([f[0], f[i], f[i + 1]]);
+            corners.push([k, k + i, k + i + 1]);
+        }
+        k += f.len();
+    }
+    let area = || {
+        let mut p = prism_mesh::PolyMesh::new(positions64.clone(), &[]);
+        for t in &triangles {
+            p.push_face(t);
+        }
+        Shading::Smooth(
+            vertex_normals_area_weighted(&p)
+                .into_iter()
+                .map(v3)
+                .collect(),
+        )
+    };
+    let shading = match (normals, &m.corner_normals) {
+        (NormalsMode::Flat, _) => Shading::Flat,
+        (NormalsMode::File, Some(cn)) => {
+            let nm = prism_math::glam::DMat3::from_mat4(world)
+                .inverse()
+                .transpose();
+            Shading::Corners(
+                corners
+                    .iter()
+                    .map(|c| c.map(|i| v3((nm * cn[i]).normalize_or_zero())))
+                    .collect(),
+            )
+        }
+        _ => area(),
+    };
+    TriangleMesh {
+        name: name.to_string(),
+        positions: positions64.into_iter().map(v3).collect(),
+        triangles,
+        shading,
+        material,
+    }
+}
+
+fn place_camera(
+    scene: &Scene,
+    file: Option<&(crate::collada::CameraDef, DMat4)>,
+    mode: CameraMode,
+) -> Camera {
+    let (mut hfov, mut vfov, mut near, mut far) = (50.0f64, 35.0f64, 0.001f64, 1000.0f64);
+    if let Some((c, _)) = file {
+        hfov = c.xfov.unwrap_or(50.0);
+        vfov = match (c.yfov, c.aspect_ratio) {
+            (Some(y), _) => y,
+            (None, Some(a)) => 2.0 * ((hfov.to_radians() / 2.0).tan() / a).atan().to_degrees(),
+            (None, None) => 35.0,
+        };
+        if c.xfov.is_none() {
+            if let (Some(y), Some(a)) = (c.yfov, c.aspect_ratio) {
+                hfov = 2.0 * ((y.to_radians() / 2.0).tan() * a).atan().to_degrees();
+            }
+        }
+        near = c.znear;
+        far = c.zfar;
+    }
+    let (eye, target, up) = match (mode, file) {
+        (CameraMode::File, Some((_, w))) => {
+            let eye = w.transform_point3(DVec3::ZERO);
+            let fwd = w.transform_vector3(DVec3::NEG_Z);
+            let up = w.transform_vector3(DVec3::Y);
+            (v3(eye), v3(eye + fwd), v3(up))
+        }
+        _ => {
+            // The point one unit in front of the camera, seen from the origin.
+            let c_dir = file
+                .map(|(_, w)| w.transform_point3(DVec3::NEG_Z))
+                .and_then(DVec3::try_normalize)
+                .unwrap_or(DVec3::Z);
+            let (lo, hi) = scene.bounds().unwrap_or((Vec3::splat(-1.0), Vec3::ONE));
+            let centre = ((lo + hi) * 0.5).as_dvec3();
+            let r = 1.5 * f64::from((hi - lo).length());
+            let mut phi = c_dir.y.clamp(-1.0, 1.0).acos();
+            if phi.sin() == 0.0 {
+                phi += 1e-5;
+            }
+            let theta = c_dir.x.atan2(c_dir.z);
+            let dir = DVec3::new(phi.sin() * theta.sin(), phi.cos(), phi.sin() * theta.cos());
+            (v3(centre + r * dir), v3(centre), Vec3::Y)
+        }
+    };
+    Camera {
+        eye,
+        target,
+        up,
+        hfov: hfov as f32,
+        vfov: vfov as f32,
+        near: near as f32,
+        far: far as f32,
+    }
+}
