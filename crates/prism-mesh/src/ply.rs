@@ -271,6 +271,30 @@ pub fn parse_ply(bytes: &[u8], file: &str) -> Result<PolyMesh, MeshError> {
         words: Vec::new().into_iter(),
         file,
     };
+    // Every instance of an element with properties takes at least a few bytes: a count the
+    // rest of the file cannot hold is refused before any work is done.
+    let remaining = bytes.len().saturating_sub(pos);
+    for el in &elements {
+        let min_bytes: usize = el
+            .props
+            .iter()
+            .map(|p| match (format, p.list) {
+                (PlyFormat::Ascii, _) => 2,
+                (_, Some(ct)) => ct.size(),
+                (_, None) => p.ty.size(),
+            })
+            .sum();
+        let needed = el.count.saturating_mul(min_bytes);
+        if needed > remaining {
+            return Err(perr(
+                line_no,
+                format!(
+                    "element {} declares {} instances, more than the {remaining} bytes after the header can hold",
+                    el.name, el.count
+                ),
+            ));
+        }
+    }
     let mut mesh = PolyMesh::default();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
@@ -286,7 +310,9 @@ pub fn parse_ply(bytes: &[u8], file: &str) -> Result<PolyMesh, MeshError> {
             return Err(perr(line_no, "element vertex lacks x, y or z".into()));
         }
         let mut values = vec![0.0f64; el.props.len()];
-        for _ in 0..el.count {
+        // An element without properties holds nothing to read, whatever its count.
+        let count = if el.props.is_empty() { 0 } else { el.count };
+        for _ in 0..count {
             for (k, p) in el.props.iter().enumerate() {
                 if let Some(ct) = p.list {
                     let n = body.read(ct)?;
@@ -486,5 +512,15 @@ mod tests {
         assert!(e.to_string().contains("the file ends"), "{e}");
         let nan = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 nan 0\n";
         assert!(parse_ply(nan, "a.ply").is_err());
+        // Counts the file cannot hold are refused up front; property-less elements are
+        // skipped whatever their count (both were fuzzing finds that ran for minutes).
+        let huge = b"ply\nformat ascii 1.0\nelement vertex 3000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n";
+        let e = parse_ply(huge, "h.ply").unwrap_err();
+        assert!(
+            e.to_string().contains("declares 3000000000 instances"),
+            "{e}"
+        );
+        let empty = b"ply\nformat ascii 1.0\nelement junk 18446744073709551615\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+        assert_eq!(parse_ply(empty, "e.ply").unwrap().vertex_count(), 0);
     }
 }
