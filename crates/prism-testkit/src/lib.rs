@@ -123,3 +123,31 @@ mod tests {
         assert_eq!(t.get(5, 0), [200, 10, 10]);
     }
 }
+
+/// Pearson's chi-square test of observed counts against expected counts. Cells expected to
+/// receive fewer than 5 samples are pooled into one. Returns `(statistic, critical value)`;
+/// the hypothesis "the samples follow the expected distribution" is rejected at
+/// significance 0.001 when the statistic exceeds the critical value (the chi-square
+/// quantile by the Wilson-Hilferty approximation).
+#[must_use]
+pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, f64) {
+    let (mut stat, mut cells) = (0.0, 0usize);
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    for (&o, &e) in observed.iter().zip(expected) {
+        if e < 5.0 {
+            pool_o += o;
+            pool_e += e;
+        } else {
+            stat += (o - e) * (o - e) / e;
+            cells += 1;
+        }
+    }
+    if pool_e > 0.0 {
+        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e.max(1.0);
+        cells += 1;
+    }
+    let k = cells.saturating_sub(1).max(1) as f64;
+    let z = 3.090_232; // the standard normal's 0.999 quantile
+    let c = 2.0 / (9.0 * k);
+    (stat, k * (1.0 - c + z * c.sqrt()).powi(3))
+}

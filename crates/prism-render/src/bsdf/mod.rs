@@ -1,0 +1,332 @@
+//! Scattering models in the local shading frame (the normal is +z). Every BSDF has
+//! `eval` (the BSDF times the cosine of `wi`), `pdf` (solid angle density of `sample`) and
+//! `sample`, whose weight is `eval / pdf` (or the delta lobe's weight).
+
+use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use prism_math::{Rgb, Vec2, Vec3};
+use prism_scene::Material;
+use std::f32::consts::PI;
+
+/// A BSDF ready to evaluate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bsdf {
+    /// Lambertian reflection, two-sided.
+    Diffuse {
+        /// Albedo.
+        albedo: Rgb,
+    },
+    /// A perfect mirror, two-sided.
+    Mirror {
+        /// Reflectance.
+        reflectance: Rgb,
+    },
+    /// A smooth dielectric with exact Fresnel reflection and refraction. The outside is
+    /// where the normal points (index 1).
+    Glass {
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Index of refraction inside.
+        ior: f32,
+    },
+    /// Refraction only, without Fresnel reflection; total internal reflection is black.
+    Refraction {
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Index of refraction inside.
+        ior: f32,
+    },
+    /// A rough conductor: Beckmann microfacets, Smith shadowing (Walter et al. 2007) and
+    /// the exact conductor Fresnel term per channel; two-sided.
+    Conductor {
+        /// Beckmann roughness.
+        alpha: f32,
+        /// Real part of the index of refraction.
+        eta: Rgb,
+        /// Absorption.
+        k: Rgb,
+    },
+    /// Absorbs everything (the surface of an emitter).
+    Black,
+}
+
+/// The result of sampling a BSDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Sampled incident direction (local frame).
+    pub wi: Vec3,
+    /// `eval / pdf` (for delta lobes, the lobe's weight).
+    pub weight: Rgb,
+    /// Solid-angle density (the lobe's selection probability for delta lobes).
+    pub pdf: f32,
+    /// True for a delta lobe (mirror reflection or refraction).
+    pub delta: bool,
+}
+
+impl Bsdf {
+    /// The BSDF of a scene material (emitters are black surfaces).
+    #[must_use]
+    pub fn from_material(m: &Material) -> Bsdf {
+        match *m {
+            Material::Diffuse { reflectance } => Bsdf::Diffuse {
+                albedo: reflectance,
+            },
+            Material::Emission { .. } => Bsdf::Black,
+            Material::Mirror { reflectance } => Bsdf::Mirror { reflectance },
+            Material::Glass {
+                reflectance,
+                transmittance,
+                ior,
+                ..
+            } => Bsdf::Glass {
+                reflectance,
+                transmittance,
+                ior,
+            },
+            Material::Refraction {
+                transmittance, ior, ..
+            } => Bsdf::Refraction { transmittance, ior },
+            Material::Microfacet { alpha, eta, k } => Bsdf::Conductor { alpha, eta, k },
+        }
+    }
+
+    /// True if the BSDF has a non-delta part that light sampling can reach.
+    #[must_use]
+    pub fn is_smooth(&self) -> bool {
+        matches!(self, Bsdf::Diffuse { .. } | Bsdf::Conductor { .. })
+    }
+
+    /// True for BSDFs that scatter the same on both sides of the surface.
+    #[must_use]
+    pub fn two_sided(&self) -> bool {
+        !matches!(self, Bsdf::Glass { .. } | Bsdf::Refraction { .. })
+    }
+
+    /// The BSDF times `|cos wi|`. Zero for delta lobes.
+    #[must_use]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z * wi.z <= 0.0 {
+            return Rgb::splat(0.0);
+        }
+        let (wo, wi) = upper(wo, wi);
+        match *self {
+            Bsdf::Diffuse { albedo } => albedo * (wi.z / PI),
+            Bsdf::Conductor { alpha, eta, k } => {
+                let h = (wo + wi).normalize();
+                let d = beckmann_d(h, alpha);
+                let g = smith_g1(wo, h, alpha) * smith_g1(wi, h, alpha);
+                let f = fresnel_conductor(wi.dot(h), eta, k);
+                f * (d * g / (4.0 * wo.z))
+            }
+            _ => Rgb::splat(0.0),
+        }
+    }
+
+    /// The density of [`Bsdf::sample`] choosing `wi`. Zero for delta lobes.
+    #[must_use]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z * wi.z <= 0.0 {
+            return 0.0;
+        }
+        let (wo, wi) = upper(wo, wi);
+        match *self {
+            Bsdf::Diffuse { .. } => cosine_hemisphere_pdf(wi.z),
+            Bsdf::Conductor { alpha, .. } => {
+                let h = (wo + wi).normalize();
+                beckmann_d(h, alpha) * h.z / (4.0 * wo.dot(h))
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Samples an incident direction for outgoing `wo` from `u1` (lobe choice) and `u2`.
+    #[must_use]
+    pub fn sample(&self, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let flip = |v: Vec3| {
+            if wo.z < 0.0 {
+                Vec3::new(v.x, v.y, -v.z)
+            } else {
+                v
+            }
+        };
+        match *self {
+            Bsdf::Diffuse { albedo } => {
+                let wi = cosine_hemisphere(u2);
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                Some(BsdfSample {
+                    wi: flip(wi),
+                    weight: albedo,
+                    pdf: cosine_hemisphere_pdf(wi.z),
+                    delta: false,
+                })
+            }
+            Bsdf::Mirror { reflectance } => Some(BsdfSample {
+                wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                weight: reflectance,
+                pdf: 1.0,
+                delta: true,
+            }),
+            Bsdf::Conductor { alpha, .. } => {
+                let wo_up = flip(wo);
+                let h = sample_beckmann(u2, alpha);
+                let wi = 2.0 * wo_up.dot(h) * h - wo_up;
+                if wi.z <= 0.0 || wo_up.dot(h) <= 0.0 {
+                    return None;
+                }
+                let wi = flip(wi);
+                let pdf = self.pdf(wo, wi);
+                if pdf <= 0.0 {
+                    return None;
+                }
+                Some(BsdfSample {
+                    wi,
+                    weight: self.eval(wo, wi) * (1.0 / pdf),
+                    pdf,
+                    delta: false,
+                })
+            }
+            Bsdf::Glass {
+                reflectance,
+                transmittance,
+                ior,
+            } => {
+                let f = fresnel_dielectric(wo.z, ior);
+                if u1 < f {
+                    Some(BsdfSample {
+                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                        weight: reflectance,
+                        pdf: f,
+                        delta: true,
+                    })
+                } else {
+                    let (wi, scale) = refract(wo, ior)?;
+                    Some(BsdfSample {
+                        wi,
+                        weight: transmittance * scale,
+                        pdf: 1.0 - f,
+                        delta: true,
+                    })
+                }
+            }
+            Bsdf::Refraction { transmittance, ior } => {
+                let (wi, scale) = refract(wo, ior)?;
+                Some(BsdfSample {
+                    wi,
+                    weight: transmittance * scale,
+                    pdf: 1.0,
+                    delta: true,
+                })
+            }
+            Bsdf::Black => None,
+        }
+    }
+}
+
+/// Both directions mirrored to the upper hemisphere when `wo` is below it (two-sided BSDFs).
+fn upper(wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+    if wo.z < 0.0 {
+        (Vec3::new(wo.x, wo.y, -wo.z), Vec3::new(wi.x, wi.y, -wi.z))
+    } else {
+        (wo, wi)
+    }
+}
+
+/// The Beckmann distribution of microfacet normals.
+fn beckmann_d(h: Vec3, alpha: f32) -> f32 {
+    let c2 = h.z * h.z;
+    if c2 <= 0.0 {
+        return 0.0;
+    }
+    let tan2 = (1.0 - c2) / c2;
+    (-tan2 / (alpha * alpha)).exp() / (PI * alpha * alpha * c2 * c2)
+}
+
+/// Samples a Beckmann normal with density `D(h) cos(theta_h)`.
+fn sample_beckmann(u: Vec2, alpha: f32) -> Vec3 {
+    let tan2 = -alpha * alpha * (1.0 - u.x).max(f32::MIN_POSITIVE).ln();
+    let cos = 1.0 / (1.0 + tan2).sqrt();
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+}
+
+/// Smith's masking for Beckmann with Walter's rational approximation.
+fn smith_g1(v: Vec3, h: Vec3, alpha: f32) -> f32 {
+    if v.dot(h) * v.z <= 0.0 {
+        return 0.0;
+    }
+    let tan = (1.0 - v.z * v.z).max(0.0).sqrt() / v.z;
+    if tan == 0.0 {
+        return 1.0;
+    }
+    let a = 1.0 / (alpha * tan);
+    if a >= 1.6 {
+        1.0
+    } else {
+        (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a)
+    }
+}
+
+/// Unpolarised Fresnel reflectance of a conductor with index `eta + i k` (outside index 1).
+fn fresnel_conductor(cos: f32, eta: Rgb, k: Rgb) -> Rgb {
+    let c = cos.clamp(0.0, 1.0);
+    let one = |eta: f32, k: f32| -> f32 {
+        let c2 = c * c;
+        let s2 = 1.0 - c2;
+        let t0 = eta * eta - k * k - s2;
+        let a2b2 = (t0 * t0 + 4.0 * eta * eta * k * k).max(0.0).sqrt();
+        let t1 = a2b2 + c2;
+        let a = (0.5 * (a2b2 + t0)).max(0.0).sqrt();
+        let t2 = 2.0 * c * a;
+        let rs = (t1 - t2) / (t1 + t2);
+        let t3 = c2 * a2b2 + s2 * s2;
+        let t4 = t2 * s2;
+        let rp = rs * (t3 - t4) / (t3 + t4);
+        0.5 * (rs + rp)
+    };
+    Rgb::new(one(eta.r, k.r), one(eta.g, k.g), one(eta.b, k.b))
+}
+
+/// Fresnel reflectance of a dielectric boundary for a direction with cosine `cos_o` to the
+/// normal (positive outside, index 1; negative inside, index `ior`).
+#[must_use]
+pub fn fresnel_dielectric(cos_o: f32, ior: f32) -> f32 {
+    let (eta_i, eta_t, ci) = if cos_o > 0.0 {
+        (1.0, ior, cos_o)
+    } else {
+        (ior, 1.0, -cos_o)
+    };
+    let sin_t = eta_i / eta_t * (1.0 - ci * ci).max(0.0).sqrt();
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    let ct = (1.0 - sin_t * sin_t).max(0.0).sqrt();
+    let rs = (eta_i * ci - eta_t * ct) / (eta_i * ci + eta_t * ct);
+    let rp = (eta_t * ci - eta_i * ct) / (eta_t * ci + eta_i * ct);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The refracted direction of `wo` and the radiance scale `(eta_o / eta_i)^2`, or `None`
+/// under total internal reflection.
+fn refract(wo: Vec3, ior: f32) -> Option<(Vec3, f32)> {
+    let entering = wo.z > 0.0;
+    let eta = if entering { 1.0 / ior } else { ior }; // eta_o / eta_i
+    let n = if entering { Vec3::Z } else { Vec3::NEG_Z };
+    let cos_o = wo.dot(n);
+    let sin2_i = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
+    if sin2_i >= 1.0 {
+        return None;
+    }
+    let cos_i = (1.0 - sin2_i).sqrt();
+    let wi = -eta * wo + (eta * cos_o - cos_i) * n;
+    Some((wi, eta * eta))
+}
+
+#[cfg(test)]
+mod tests;

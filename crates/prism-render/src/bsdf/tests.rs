@@ -1,0 +1,149 @@
+use super::*;
+use prism_math::Pcg32;
+
+fn dir(theta_deg: f32, phi: f32) -> Vec3 {
+    let t = theta_deg.to_radians();
+    Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
+}
+
+/// Oracle: chi-square test of `sample` against the integral of `pdf` over (cos theta, phi)
+/// cells of the sphere, for several outgoing directions; then `weight == eval / pdf`.
+fn check_sampling(b: &Bsdf, wo: Vec3) {
+    let (nc, np) = (20usize, 40usize);
+    let n = 200_000;
+    let mut rng = Pcg32::new(11, 7);
+    let mut observed = vec![0.0; nc * np];
+    let cell = |w: Vec3| -> usize {
+        let c = (((w.z + 1.0) / 2.0 * nc as f32) as usize).min(nc - 1);
+        let p = ((w.y.atan2(w.x) + PI) / (2.0 * PI) * np as f32) as usize;
+        c * np + p.min(np - 1)
+    };
+    for _ in 0..n {
+        let u1 = rng.next_f32();
+        let u2 = Vec2::new(rng.next_f32(), rng.next_f32());
+        if let Some(s) = b.sample(wo, u1, u2) {
+            assert!((s.wi.length() - 1.0).abs() < 1e-3);
+            let e = b.eval(wo, s.wi);
+            let p = b.pdf(wo, s.wi);
+            assert!(
+                (p - s.pdf).abs() <= 1e-3 * p.max(1.0),
+                "pdf {p} vs {}",
+                s.pdf
+            );
+            for (x, y) in [(e.r, s.weight.r), (e.g, s.weight.g), (e.b, s.weight.b)] {
+                assert!(
+                    (x / p - y).abs() <= 1e-3 * y.abs().max(1.0),
+                    "{x}/{p} vs {y}"
+                );
+            }
+            observed[cell(s.wi)] += 1.0;
+        }
+    }
+    // Expected counts: the pdf integrated over each cell by a 48x48 midpoint rule.
+    let mut expected = vec![0.0; nc * np];
+    let sub = 48;
+    for c in 0..nc {
+        for p in 0..np {
+            let mut acc = 0.0;
+            for i in 0..sub {
+                for j in 0..sub {
+                    let z = -1.0 + 2.0 * (c as f32 + (i as f32 + 0.5) / sub as f32) / nc as f32;
+                    let phi =
+                        -PI + 2.0 * PI * (p as f32 + (j as f32 + 0.5) / sub as f32) / np as f32;
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    acc += b.pdf(wo, Vec3::new(r * phi.cos(), r * phi.sin(), z));
+                }
+            }
+            let area = (2.0 / nc as f32) * (2.0 * PI / np as f32);
+            expected[c * np + p] = f64::from(acc / (sub * sub) as f32 * area) * n as f64;
+        }
+    }
+    let (stat, crit) = prism_testkit::chi_square(&observed, &expected);
+    assert!(stat < crit, "{b:?} wo={wo}: chi-square {stat} > {crit}");
+}
+
+#[test]
+fn diffuse_sampling_matches_its_pdf() {
+    let b = Bsdf::Diffuse {
+        albedo: Rgb::new(0.5, 0.6, 0.7),
+    };
+    for wo in [dir(10.0, 0.3), dir(70.0, 2.0), -dir(30.0, 1.0)] {
+        check_sampling(&b, wo);
+    }
+}
+
+#[test]
+fn conductor_sampling_matches_its_pdf() {
+    for alpha in [0.1, 0.25, 0.6] {
+        let b = Bsdf::Conductor {
+            alpha,
+            eta: Rgb::new(0.2, 0.9, 1.1),
+            k: Rgb::new(3.9, 2.4, 2.2),
+        };
+        for wo in [
+            dir(5.0, 0.0),
+            dir(45.0, 1.0),
+            dir(80.0, -2.0),
+            -dir(40.0, 0.5),
+        ] {
+            check_sampling(&b, wo);
+        }
+    }
+}
+
+/// Closed forms: a white Lambertian reflects everything (the integral of eval over the
+/// hemisphere is 1); a conductor is reciprocal and reflects at most everything; the Fresnel
+/// terms at normal incidence equal ((n-1)/(n+1))^2 and ((n-1)^2+k^2)/((n+1)^2+k^2).
+#[test]
+fn closed_forms() {
+    let white = Bsdf::Diffuse { albedo: Rgb::WHITE };
+    let wo = dir(30.0, 0.0);
+    let mut rng = Pcg32::new(1, 2);
+    let n = 100_000;
+    let mut total = 0.0;
+    for _ in 0..n {
+        let wi = prism_math::warp::uniform_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+        total += white.eval(wo, wi).r / prism_math::warp::uniform_hemisphere_pdf();
+    }
+    assert!(
+        (total / n as f32 - 1.0).abs() < 0.01,
+        "{}",
+        total / n as f32
+    );
+    let c = Bsdf::Conductor {
+        alpha: 0.3,
+        eta: Rgb::splat(0.2),
+        k: Rgb::splat(3.0),
+    };
+    let (a, b) = (dir(20.0, 0.1), dir(50.0, 2.5));
+    assert!((c.eval(a, b).r / b.z - c.eval(b, a).r / a.z).abs() < 1e-5);
+    let f = fresnel_dielectric(1.0, 1.5);
+    assert!((f - 0.04).abs() < 1e-6);
+    assert!((fresnel_dielectric(-1.0, 1.5) - 0.04).abs() < 1e-6);
+    assert_eq!(fresnel_dielectric(-0.2, 1.5), 1.0); // total internal reflection
+    let fc = fresnel_conductor(1.0, Rgb::splat(0.2), Rgb::splat(3.0));
+    assert!((fc.r - (0.64 + 9.0) / (1.44 + 9.0)).abs() < 1e-5);
+}
+
+/// Property: glass reflects with probability F and refracts by Snell's law with the radiance
+/// scale (eta_o / eta_i)^2; refraction back out undoes it.
+#[test]
+fn glass_sampling() {
+    let g = Bsdf::Glass {
+        reflectance: Rgb::WHITE,
+        transmittance: Rgb::WHITE,
+        ior: 1.5,
+    };
+    let wo = dir(40.0, 0.7);
+    let f = fresnel_dielectric(wo.z, 1.5);
+    let r = g.sample(wo, f * 0.5, Vec2::ZERO).unwrap();
+    assert!(r.delta && (r.pdf - f).abs() < 1e-6 && r.wi.z > 0.0);
+    let t = g.sample(wo, (f + 1.0) * 0.5, Vec2::ZERO).unwrap();
+    assert!(t.wi.z < 0.0 && (t.pdf - (1.0 - f)).abs() < 1e-6);
+    let sin_i = (1.0 - t.wi.z * t.wi.z).sqrt();
+    let sin_o = (1.0 - wo.z * wo.z).sqrt();
+    assert!((sin_o - 1.5 * sin_i).abs() < 1e-5);
+    assert!((t.weight.r - 1.0 / 2.25).abs() < 1e-5);
+    let back = g.sample(t.wi, 0.999, Vec2::ZERO).unwrap();
+    assert!((back.wi - wo).length() < 1e-4 && (back.weight.r - 2.25).abs() < 1e-4);
+}

@@ -1,0 +1,11 @@
+//! Floor-3 rendering for prism: a pinhole camera, a deterministic sampler, BSDFs, lights and
+//! the integrators (`normals`, `direct`, `path`) over a scene from prism-scene.
+#![warn(missing_docs)]
+
+pub mod bsdf;
+mod camera;
+mod sampler;
+
+pub use bsdf::{Bsdf, BsdfSample};
+pub use camera::Pinhole;
+pub use sampler::Sampler;
