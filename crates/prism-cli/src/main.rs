@@ -4,13 +4,14 @@ mod bezier;
 mod demo;
 mod mesh;
 mod progress;
+mod render;
 mod svg;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// A computer-graphics toolkit on the CPU: SVG rasterization and more.
+/// A computer-graphics toolkit on the CPU: SVG rasterization, mesh editing, path tracing.
 #[derive(Parser)]
 #[command(name = "prism", version, about, long_about = None)]
 struct Cli {
@@ -24,8 +25,10 @@ enum Command {
     Svg(svg::SvgArgs),
     /// Draw a Bezier curve's de Casteljau construction, or tessellate Bezier patches.
     Bezier(bezier::BezierArgs),
-    /// Inspect, convert, edit and Loop-subdivide meshes (OBJ, PLY).
+    /// Inspect, convert, edit and Loop-subdivide meshes (OBJ, PLY, COLLADA).
     Mesh(mesh::MeshArgs),
+    /// Path-trace a CS184 COLLADA scene, or the built-in Cornell box.
+    Render(render::RenderArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Svg(a) => svg::run(&a),
         Command::Bezier(a) => bezier::run(&a),
         Command::Mesh(a) => mesh::run(&a),
+        Command::Render(a) => render::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

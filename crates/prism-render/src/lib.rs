@@ -9,3 +9,8 @@ mod sampler;
 pub use bsdf::{Bsdf, BsdfSample};
 pub use camera::Pinhole;
 pub use sampler::Sampler;
+mod prepare;
+mod render;
+
+pub use prepare::{Interaction, Light, LightSample, RenderScene};
+pub use render::{radiance, render, Integrator, RenderOptions, Rendered};

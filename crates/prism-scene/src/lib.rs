@@ -10,10 +10,12 @@
 //! lights and a camera, built from a document by [`Scene::from_collada`].
 #![warn(missing_docs)]
 
+mod builtin;
 mod collada;
 mod error;
 mod scene;
 
+pub use builtin::cornell_box;
 pub use collada::{
     parse_collada, read_collada, write_collada, CameraDef, Collada, EffectDef, Geometry, Instance,
     LightDef, LightKind, MeshData, Node, Part, Shape, UpAxis, MAX_FILE_BYTES, MAX_NODE_DEPTH,

@@ -332,3 +332,27 @@ fn every_pathtracer_file_becomes_a_scene() {
         }
     }
 }
+
+/// Oracle: the built-in Cornell box is the staged CBspheres_lambertian (same box, spheres,
+/// light and camera; materials equal up to the file's duplicated sphere material).
+#[test]
+fn built_in_cornell_box_matches_the_staged_file() {
+    let file = scene("sky/CBspheres_lambertian.dae");
+    let ours = prism_scene::cornell_box();
+    let (a, b) = (file.bounds().unwrap(), ours.bounds().unwrap());
+    assert!((a.0 - b.0).length() < 1e-5 && (a.1 - b.1).length() < 1e-5);
+    assert_eq!(file.lights, ours.lights);
+    assert!((file.camera.eye - ours.camera.eye).length() < 1e-5);
+    assert!((file.camera.vfov - ours.camera.vfov).abs() < 1e-3);
+    for (f, o) in file.spheres.iter().zip(&ours.spheres) {
+        assert!((f.center - o.center).length() < 1e-6 && f.radius == o.radius);
+        assert_eq!(file.materials[f.material], ours.materials[o.material]);
+    }
+    for (f, o) in file.meshes.iter().zip(&ours.meshes) {
+        assert_eq!(f.name, o.name);
+        assert_eq!(file.materials[f.material], ours.materials[o.material]);
+        for (p, q) in f.positions.iter().zip(&o.positions) {
+            assert!((*p - *q).length() < 1e-5, "{}: {p} {q}", f.name);
+        }
+    }
+}

@@ -1,0 +1,245 @@
+//! `prism render`: path-trace a CS184 COLLADA scene (or the built-in Cornell box).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use prism_render::{render, Integrator, RenderOptions, RenderScene};
+use prism_scene::{CameraMode, NormalsMode, SceneOptions};
+
+use crate::UserError;
+
+/// The estimator.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum IntegratorArg {
+    /// Path tracing with next-event estimation, MIS and Russian roulette.
+    Path,
+    /// Emission plus one bounce of direct light.
+    Direct,
+    /// Shading normals as colours.
+    Normals,
+}
+
+/// Where shading normals come from.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum NormalsArg {
+    /// Area-weighted vertex normals computed from the mesh (the course's).
+    Area,
+    /// The file's normals.
+    File,
+    /// Face normals.
+    Flat,
+}
+
+/// Where the camera comes from.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CameraArg {
+    /// The course's placement: looking at the scene's centre along the file camera's
+    /// direction from 1.5 scene diagonals away.
+    Course,
+    /// The file camera's own position and orientation.
+    File,
+}
+
+/// Arguments of `prism render`.
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A CS184 COLLADA scene (.dae); without one, the built-in Cornell box with two spheres.
+    scene: Option<PathBuf>,
+    /// Output PNG (sRGB, clamped).
+    #[arg(short, long, default_value = "render.png")]
+    output: PathBuf,
+    /// Also write linear radiance to this OpenEXR file.
+    #[arg(long, value_name = "FILE")]
+    exr: Option<PathBuf>,
+    /// Samples per pixel (the most, with --adaptive).
+    #[arg(short = 's', long = "spp", default_value_t = 64)]
+    spp: u32,
+    /// Samples per area light (and hemisphere light) at each shading point.
+    #[arg(short = 'l', long = "light-samples", default_value_t = 1)]
+    light_samples: u32,
+    /// Most bounces a path takes: 0 shows emitters only, 1 adds direct light.
+    #[arg(short = 'm', long = "max-bounces", default_value_t = 7)]
+    max_bounces: u32,
+    /// Image size: WIDTH HEIGHT.
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [512, 384])]
+    resolution: Vec<u32>,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    threads: Option<usize>,
+    /// The estimator.
+    #[arg(long, value_enum, default_value_t = IntegratorArg::Path)]
+    integrator: IntegratorArg,
+    /// With --integrator direct: sample the hemisphere uniformly instead of the lights.
+    #[arg(long)]
+    hemisphere: bool,
+    /// Keep only light that took exactly this many bounces (0: emitters seen directly).
+    #[arg(long, value_name = "M")]
+    bounce: Option<u32>,
+    /// Adaptive sampling: stop a pixel once its 95% confidence interval is within TOL of
+    /// its mean illuminance (checked every --batch samples).
+    #[arg(long, value_name = "TOL")]
+    adaptive: Option<f32>,
+    /// Samples between adaptive-sampling checks.
+    #[arg(long, default_value_t = 32)]
+    batch: u32,
+    /// Write the sample-count heat map (blue: few, red: the most) to this PNG.
+    #[arg(long, value_name = "FILE")]
+    heatmap: Option<PathBuf>,
+    /// Seed of every random number: the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Shading normals.
+    #[arg(long, value_enum, default_value_t = NormalsArg::Area)]
+    normals: NormalsArg,
+    /// Camera placement.
+    #[arg(long, value_enum, default_value_t = CameraArg::Course)]
+    camera: CameraArg,
+    /// Print BVH statistics, per-stage times (`render: 12.3 ms`) and samples/s on stderr.
+    #[arg(long)]
+    stats: bool,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Largest image side.
+const MAX_SIDE: u32 = 16384;
+
+/// Runs `prism render`.
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let (w, h) = (a.resolution[0], a.resolution[1]);
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(UserError(format!(
+            "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
+        ))
+        .into());
+    }
+    if a.spp == 0 || a.spp > 1 << 20 {
+        return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 20, a.spp)).into());
+    }
+    if let Some(t) = a.adaptive {
+        if !(t > 0.0 && t.is_finite()) {
+            return Err(UserError(format!(
+                "--adaptive: expected a positive tolerance, found {t}"
+            ))
+            .into());
+        }
+    }
+    let t0 = Instant::now();
+    let opts = SceneOptions {
+        normals: match a.normals {
+            NormalsArg::Area => NormalsMode::Area,
+            NormalsArg::File => NormalsMode::File,
+            NormalsArg::Flat => NormalsMode::Flat,
+        },
+        camera: match a.camera {
+            CameraArg::Course => CameraMode::Course,
+            CameraArg::File => CameraMode::File,
+        },
+    };
+    let scene = match &a.scene {
+        None => prism_scene::cornell_box(),
+        Some(path) => {
+            let doc = prism_scene::read_collada(path).map_err(|e| UserError(e.to_string()))?;
+            prism_scene::Scene::from_collada(&doc, &opts, &path.display().to_string())
+                .map_err(|e| UserError(e.to_string()))?
+        }
+    };
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let read = t0.elapsed();
+    let t1 = Instant::now();
+    let prepared = RenderScene::new(&scene);
+    let build = t1.elapsed();
+    let options = RenderOptions {
+        width: w,
+        height: h,
+        spp: a.spp,
+        light_samples: a.light_samples.max(1),
+        max_bounces: a.max_bounces,
+        integrator: match a.integrator {
+            IntegratorArg::Path => Integrator::Path,
+            IntegratorArg::Direct => Integrator::Direct {
+                hemisphere: a.hemisphere,
+            },
+            IntegratorArg::Normals => Integrator::Normals,
+        },
+        only_bounce: a.bounce,
+        adaptive: a.adaptive,
+        batch: a.batch.max(1),
+        seed: a.seed,
+        ..RenderOptions::default()
+    };
+    let pool = {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(t) = a.threads {
+            b = b.num_threads(t.max(1));
+        }
+        b.build().context("starting worker threads")?
+    };
+    let bar = crate::progress::bar(u64::from(w) * u64::from(h), "render", a.quiet);
+    let t2 = Instant::now();
+    let out = pool.install(|| render(&prepared, &options, &|done| bar.set_position(done)));
+    let render_time = t2.elapsed();
+    bar.finish_and_clear();
+    let t3 = Instant::now();
+    prism_image::write_png(&a.output, &out.image.linear_to_srgb8())
+        .with_context(|| format!("writing {}", a.output.display()))?;
+    if let Some(exr) = &a.exr {
+        prism_image::write_exr(exr, &out.image)
+            .with_context(|| format!("writing {}", exr.display()))?;
+    }
+    if let Some(path) = &a.heatmap {
+        let max = out
+            .samples
+            .pixels()
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(1)
+            .max(1);
+        let heat = out.samples.map(|&n| heat_colour(n as f32 / max as f32));
+        prism_image::write_png(path, &heat)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    let write = t3.elapsed();
+    if a.stats {
+        let s = prepared.bvh_stats();
+        eprintln!(
+            "bvh: {} primitives, {} nodes, {} leaves, depth {}, largest leaf {}, SAH cost {:.2}, {:.1} bytes/primitive",
+            s.primitives,
+            s.nodes,
+            s.leaves,
+            s.depth,
+            s.max_leaf_size,
+            s.sah_cost,
+            s.bytes as f64 / s.primitives.max(1) as f64
+        );
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read: {:.1} ms", ms(read));
+        eprintln!("build: {:.1} ms", ms(build));
+        eprintln!("render: {:.1} ms", ms(render_time));
+        eprintln!("write: {:.1} ms", ms(write));
+        eprintln!("samples: {}", out.total_samples);
+        eprintln!(
+            "samples/s: {:.0}",
+            out.total_samples as f64 / render_time.as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+/// Blue (0) through cyan, green and yellow to red (1).
+fn heat_colour(t: f32) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0) * 4.0;
+    let (r, g, b) = match t {
+        t if t < 1.0 => (0.0, t, 1.0),
+        t if t < 2.0 => (0.0, 1.0, 2.0 - t),
+        t if t < 3.0 => (t - 2.0, 1.0, 0.0),
+        t => (1.0, 4.0 - t, 0.0),
+    };
+    [(r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8]
+}
