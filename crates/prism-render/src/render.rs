@@ -162,7 +162,7 @@ fn pixel(
         s2 += i * i;
         n += 1;
         if let Some(tol) = opts.adaptive {
-            if n % opts.batch.max(1) == 0 && n > 1 {
+            if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
                 let mean = s1 / f64::from(n);
                 let var = ((s2 - s1 * s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
                 let interval = 1.96 * (var / f64::from(n)).sqrt();
@@ -398,7 +398,7 @@ fn path(
             if sampler.next_1d() >= q {
                 break;
             }
-            beta = beta * (1.0 / q);
+            beta *= 1.0 / q;
         }
     }
     l

@@ -107,23 +107,6 @@ pub fn compare_golden(
     stats.expect("checked")
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn triptych_marks_differences() {
-        let a = Image::new(2, 1, [10u8, 10, 10]);
-        let mut b = a.clone();
-        b.set(1, 0, [200, 10, 10]);
-        let t = triptych(&a, &b);
-        assert_eq!((t.width(), t.height()), (6, 1));
-        assert_eq!(t.get(2, 0), [133, 133, 133]);
-        assert_eq!(t.get(3, 0)[0], 255);
-        assert_eq!(t.get(5, 0), [200, 10, 10]);
-    }
-}
-
 /// Pearson's chi-square test of observed counts against expected counts. Cells expected to
 /// receive fewer than 5 samples are pooled into one. Returns `(statistic, critical value)`;
 /// the hypothesis "the samples follow the expected distribution" is rejected at
@@ -150,4 +133,21 @@ pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, f64) {
     let z = 3.090_232; // the standard normal's 0.999 quantile
     let c = 2.0 / (9.0 * k);
     (stat, k * (1.0 - c + z * c.sqrt()).powi(3))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triptych_marks_differences() {
+        let a = Image::new(2, 1, [10u8, 10, 10]);
+        let mut b = a.clone();
+        b.set(1, 0, [200, 10, 10]);
+        let t = triptych(&a, &b);
+        assert_eq!((t.width(), t.height()), (6, 1));
+        assert_eq!(t.get(2, 0), [133, 133, 133]);
+        assert_eq!(t.get(3, 0)[0], 255);
+        assert_eq!(t.get(5, 0), [200, 10, 10]);
+    }
 }
