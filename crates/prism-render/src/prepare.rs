@@ -2,7 +2,9 @@
 //! rectangle, BSDFs, and lights with their sampling routines.
 
 use prism_accel::{BuildOptions, Bvh, BvhStats, Sphere};
-use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use prism_math::warp::{
+    cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf,
+};
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 use prism_scene::{Light as SceneLight, Scene, Shading};
 
@@ -42,6 +44,11 @@ pub enum Light {
     },
     /// Radiance from the upper hemisphere (world +Y), hidden from camera rays.
     Hemisphere {
+        /// Radiance.
+        radiance: Rgb,
+    },
+    /// Radiance from every direction, seen by every ray.
+    Environment {
         /// Radiance.
         radiance: Rgb,
     },
@@ -124,6 +131,13 @@ impl Light {
                     delta: false,
                 })
             }
+            Light::Environment { radiance } => Some(LightSample {
+                wi: uniform_sphere(u),
+                dist: f32::INFINITY,
+                li: radiance,
+                pdf: uniform_sphere_pdf(),
+                delta: false,
+            }),
             Light::Hemisphere { radiance } => {
                 let frame = Frame::from_normal(Vec3::Y);
                 let local = cosine_hemisphere(u);
@@ -139,7 +153,7 @@ impl Light {
     }
 
     /// The density with which [`Light::sample`] picks direction `wi` that reaches the light
-    /// at distance `dist` (area lights) or escapes (hemisphere lights).
+    /// at distance `dist` (area lights) or escapes (hemisphere and environment lights).
     #[must_use]
     pub fn pdf(&self, wi: Vec3, dist: f32) -> f32 {
         match *self {
@@ -152,6 +166,7 @@ impl Light {
                 }
             }
             Light::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
+            Light::Environment { .. } => uniform_sphere_pdf(),
             _ => 0.0,
         }
     }
@@ -206,8 +221,8 @@ pub struct RenderScene {
     pub lights: Vec<Light>,
     /// The scene's camera.
     pub camera: prism_scene::Camera,
-    /// Index of the hemisphere light, if any.
-    pub hemisphere: Option<usize>,
+    /// Index of the light that rays escaping the scene see (hemisphere or environment).
+    pub infinite: Option<usize>,
 }
 
 impl RenderScene {
@@ -226,7 +241,7 @@ impl RenderScene {
             }
         }
         let mut lights = Vec::new();
-        let mut hemisphere = None;
+        let mut infinite = None;
         for l in &scene.lights {
             match *l {
                 SceneLight::Point {
@@ -272,8 +287,12 @@ impl RenderScene {
                     });
                 }
                 SceneLight::Hemisphere { radiance } => {
-                    hemisphere = Some(lights.len());
+                    infinite = Some(lights.len());
                     lights.push(Light::Hemisphere { radiance });
+                }
+                SceneLight::Environment { radiance } => {
+                    infinite = Some(lights.len());
+                    lights.push(Light::Environment { radiance });
                 }
             }
         }
@@ -317,7 +336,18 @@ impl RenderScene {
                 .collect(),
             lights,
             camera: scene.camera,
-            hemisphere,
+            infinite,
+        }
+    }
+
+    /// Radiance arriving along `dir` from outside the scene; camera rays see only
+    /// environment lights, not the course's hidden hemisphere light.
+    #[must_use]
+    pub fn escaped(&self, dir: Vec3, camera_ray: bool) -> Rgb {
+        match self.infinite.map(|i| self.lights[i]) {
+            Some(Light::Environment { radiance }) => radiance,
+            Some(Light::Hemisphere { radiance }) if !camera_ray && dir.y > 0.0 => radiance,
+            _ => Rgb::BLACK,
         }
     }
 

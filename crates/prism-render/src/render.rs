@@ -192,7 +192,11 @@ pub fn radiance(
     opts: &RenderOptions,
 ) -> Rgb {
     let Some(hit) = scene.intersect(ray) else {
-        return Rgb::BLACK;
+        return if opts.only_bounce.is_none_or(|m| m == 0) {
+            scene.escaped(ray.dir, true)
+        } else {
+            Rgb::BLACK
+        };
     };
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
     match opts.integrator {
@@ -313,12 +317,7 @@ fn direct_hemisphere(
         let ray = spawn(hit.p, hit.ng, wi);
         let le = match scene.intersect(&ray) {
             Some(h) => h.emitted,
-            None => scene
-                .hemisphere
-                .map_or(Rgb::BLACK, |i| match scene.lights[i] {
-                    crate::prepare::Light::Hemisphere { radiance } if wi.y > 0.0 => radiance,
-                    _ => Rgb::BLACK,
-                }),
+            None => scene.escaped(wi, false),
         };
         acc += f * le * (1.0 / prism_math::warp::uniform_hemisphere_pdf());
     }
@@ -365,16 +364,15 @@ fn path(
         let nlights = opts.light_samples.max(1) as f32;
         match scene.intersect(&next) {
             None => {
-                if let Some(i) = scene.hemisphere {
-                    if let crate::prepare::Light::Hemisphere { radiance } = scene.lights[i] {
-                        if wi.y > 0.0 && keep(bounce) {
-                            let w = if s.delta || !hit.bsdf.is_smooth() {
-                                1.0
-                            } else {
-                                power(1.0, s.pdf, nlights * scene.lights[i].pdf(wi, f32::INFINITY))
-                            };
-                            l += beta * radiance * w;
-                        }
+                if let (Some(i), true) = (scene.infinite, keep(bounce)) {
+                    let le = scene.escaped(wi, false);
+                    if le.max_channel() > 0.0 {
+                        let w = if s.delta || !hit.bsdf.is_smooth() {
+                            1.0
+                        } else {
+                            power(1.0, s.pdf, nlights * scene.lights[i].pdf(wi, f32::INFINITY))
+                        };
+                        l += beta * le * w;
                     }
                 }
                 break;

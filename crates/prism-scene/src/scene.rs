@@ -173,6 +173,11 @@ pub enum Light {
         /// Radiance.
         radiance: Rgb,
     },
+    /// The same radiance from every direction, seen by every ray (a furnace).
+    Environment {
+        /// Radiance.
+        radiance: Rgb,
+    },
 }
 
 /// A pinhole camera.
