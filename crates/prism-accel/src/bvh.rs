@@ -1,4 +1,4 @@
-use prism_math::glam::Vec3A;
+use prism_math::glam::Vec4;
 use prism_math::{Aabb, Ray, Vec3};
 
 use crate::shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};
@@ -59,27 +59,34 @@ pub struct BvhStats {
     pub bytes: usize,
 }
 
-/// A flattened node: 32 bytes. Interior nodes keep their first child right after them and
-/// the second at `index`; leaves hold `count > 0` primitives from `index` in the order array.
+/// A flattened 4-wide node: 128 bytes holding its children's boxes in SIMD-friendly order
+/// (x minima of the four children, then y minima, ...). A child reference is a node index,
+/// or for a leaf `LEAF | start << 4 | (count - 1)`; unused slots hold empty boxes.
 #[derive(Clone, Copy, Debug)]
-#[repr(C)]
-struct Node {
-    min: [f32; 3],
-    index: u32,
-    max: [f32; 3],
-    count: u32,
+#[repr(C, align(16))]
+struct Node4 {
+    bounds: [Vec4; 6],
+    child: [u32; 4],
+    /// Bit i is set when slot i holds a child.
+    used: u32,
+    _pad: [u32; 3],
 }
+
+const LEAF: u32 = 1 << 31;
+/// Largest leaf a reference can encode (4 bits of count).
+const MAX_LEAF_REF: usize = 16;
 
 /// A bounding volume hierarchy over triangles and spheres.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    nodes: Vec<Node4>,
     /// Primitive numbers in leaf order.
     order: Vec<u32>,
     /// Triangle vertices in leaf order (unused slots where spheres sit).
     tris: Vec<[Vec3; 3]>,
     spheres: Vec<Sphere>,
     triangle_count: u32,
+    bounds: Aabb,
     stats: BvhStats,
 }
 
@@ -102,38 +109,26 @@ struct PrimInfo {
 
 const BINS: usize = 16;
 
-/// `a.max(b)` as one instruction: if `a` is NaN the result is `b`.
-#[inline(always)]
-fn fmax(a: f32, b: f32) -> f32 {
-    if a > b {
-        a
-    } else {
-        b
-    }
+/// A ray prepared for 4-wide slab tests: `t = (p - origin) * inv_dir`, each component
+/// broadcast to four lanes.
+struct SlabRay4 {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
 }
 
-/// `a.min(b)` as one instruction: if `a` is NaN the result is `b`.
-#[inline(always)]
-fn fmin(a: f32, b: f32) -> f32 {
-    if a < b {
-        a
-    } else {
-        b
-    }
-}
-
-/// A ray prepared for slab tests: `t = (p - origin) * inv_dir`.
-struct SlabRay {
-    inv_dir: Vec3A,
-    origin: Vec3A,
-}
-
-impl SlabRay {
-    fn new(r: &RayPre) -> SlabRay {
-        let inv_dir = Vec3A::from(r.inv_dir);
-        SlabRay {
-            inv_dir,
-            origin: Vec3A::from(r.origin),
+impl SlabRay4 {
+    fn new(r: &RayPre) -> SlabRay4 {
+        SlabRay4 {
+            origin: [
+                Vec4::splat(r.origin.x),
+                Vec4::splat(r.origin.y),
+                Vec4::splat(r.origin.z),
+            ],
+            inv_dir: [
+                Vec4::splat(r.inv_dir.x),
+                Vec4::splat(r.inv_dir.y),
+                Vec4::splat(r.inv_dir.z),
+            ],
         }
     }
 }
@@ -141,7 +136,7 @@ impl SlabRay {
 /// Depth after which splits are by median, so that no tree is deeper than this plus 32
 /// and the traversal stacks below cannot overflow.
 const MEDIAN_DEPTH: usize = 64;
-const STACK: usize = 2 * (MEDIAN_DEPTH + 34);
+const STACK: usize = 3 * (MEDIAN_DEPTH + 34) + 4;
 
 impl Bvh {
     /// Builds the hierarchy. Degenerate triangles (zero area or non-finite) and spheres with
@@ -175,7 +170,11 @@ impl Bvh {
         let root = if ids.is_empty() {
             None
         } else {
-            Some(build_node(&info, &mut ids, 0, 0, opts))
+            let opts = BuildOptions {
+                max_leaf: opts.max_leaf.clamp(1, MAX_LEAF_REF),
+                ..*opts
+            };
+            Some(build_node(&info, &mut ids, 0, 0, &opts))
         };
         let mut bvh = Bvh {
             spheres: spheres.to_vec(),
@@ -183,9 +182,20 @@ impl Bvh {
             ..Bvh::default()
         };
         if let Some(root) = root {
-            bvh.nodes.reserve(2 * ids.len() / 2 + 1);
             let root_area = root_bounds(&root).surface_area().max(f32::MIN_POSITIVE);
-            bvh.flatten(&root, 0, root_area, opts.traversal_cost);
+            bvh.statistics(&root, 0, root_area, opts.traversal_cost);
+            bvh.bounds = root_bounds(&root);
+            match &root {
+                BuildNode::Leaf { .. } => {
+                    // A lone leaf still sits under a node.
+                    let mut n = Node4::empty();
+                    n.set(0, root_bounds(&root), leaf_ref(&root));
+                    bvh.nodes.push(n);
+                }
+                BuildNode::Interior { .. } => {
+                    bvh.collapse(&root);
+                }
+            }
         }
         bvh.tris = ids
             .iter()
@@ -200,46 +210,66 @@ impl Bvh {
         bvh.stats.primitives = ids.len();
         bvh.order = ids;
         bvh.stats.nodes = bvh.nodes.len();
-        bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node>()
+        bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node4>()
             + bvh.tris.len() * std::mem::size_of::<[Vec3; 3]>()
             + bvh.order.len() * 4
             + bvh.spheres.len() * std::mem::size_of::<Sphere>();
         bvh
     }
 
-    fn flatten(&mut self, n: &BuildNode, depth: usize, root_area: f32, trav: f32) -> usize {
-        let i = self.nodes.len();
+    /// Leaf count, depth and SAH cost of the binary tree the 4-wide one is collapsed from.
+    fn statistics(&mut self, n: &BuildNode, depth: usize, root_area: f32, trav: f32) {
         match n {
-            BuildNode::Leaf {
-                bounds,
-                start,
-                count,
-            } => {
-                self.nodes.push(Node {
-                    min: bounds.min.to_array(),
-                    index: *start as u32,
-                    max: bounds.max.to_array(),
-                    count: *count as u32,
-                });
+            BuildNode::Leaf { bounds, count, .. } => {
                 self.stats.leaves += 1;
                 self.stats.depth = self.stats.depth.max(depth);
                 self.stats.max_leaf_size = self.stats.max_leaf_size.max(*count);
                 self.stats.sah_cost += bounds.surface_area() / root_area * *count as f32;
             }
             BuildNode::Interior { bounds, children } => {
-                self.nodes.push(Node {
-                    min: bounds.min.to_array(),
-                    index: 0,
-                    max: bounds.max.to_array(),
-                    count: 0,
-                });
                 self.stats.sah_cost += bounds.surface_area() / root_area * trav;
-                self.flatten(&children[0], depth + 1, root_area, trav);
-                let second = self.flatten(&children[1], depth + 1, root_area, trav);
-                self.nodes[i].index = second as u32;
+                self.statistics(&children[0], depth + 1, root_area, trav);
+                self.statistics(&children[1], depth + 1, root_area, trav);
             }
         }
-        i
+    }
+
+    /// Flattens an interior binary node and its subtree into 4-wide nodes: each takes up to
+    /// four descendants, opening the interior child of largest area first. Returns the
+    /// node's index.
+    fn collapse(&mut self, n: &BuildNode) -> u32 {
+        let mut kids: Vec<&BuildNode> = match n {
+            BuildNode::Interior { children, .. } => vec![&children[0], &children[1]],
+            BuildNode::Leaf { .. } => vec![n],
+        };
+        while kids.len() < 4 {
+            let widest = kids
+                .iter()
+                .enumerate()
+                .filter(|(_, k)| matches!(k, BuildNode::Interior { .. }))
+                .max_by(|a, b| {
+                    root_bounds(a.1)
+                        .surface_area()
+                        .total_cmp(&root_bounds(b.1).surface_area())
+                })
+                .map(|(i, _)| i);
+            let Some(i) = widest else { break };
+            let BuildNode::Interior { children, .. } = kids[i] else {
+                unreachable!("filtered to interior nodes")
+            };
+            kids[i] = &children[0];
+            kids.insert(i + 1, &children[1]);
+        }
+        let index = self.nodes.len();
+        self.nodes.push(Node4::empty());
+        for (slot, k) in kids.into_iter().enumerate() {
+            let r = match k {
+                BuildNode::Leaf { .. } => leaf_ref(k),
+                BuildNode::Interior { .. } => self.collapse(k),
+            };
+            self.nodes[index].set(slot, root_bounds(k), r);
+        }
+        index as u32
     }
 
     /// Build statistics.
@@ -251,10 +281,7 @@ impl Bvh {
     /// The bounds of everything in the hierarchy (empty if nothing).
     #[must_use]
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, |n| Aabb {
-            min: Vec3::from_array(n.min),
-            max: Vec3::from_array(n.max),
-        })
+        self.bounds
     }
 
     /// Number of triangles the hierarchy was built from (primitive numbers below this are
@@ -264,19 +291,28 @@ impl Bvh {
         self.triangle_count
     }
 
-    #[inline]
-    fn node_hit(n: &Node, r: &SlabRay, tmin: f32, tmax: f32) -> Option<f32> {
-        let t0 = (Vec3A::from(n.min) - r.origin) * r.inv_dir;
-        let t1 = (Vec3A::from(n.max) - r.origin) * r.inv_dir;
-        let lo = t0.min(t1);
-        let hi = t0.max(t1);
-        // NaN (0 * inf, for a ray in a slab's plane) drops out of these comparisons.
-        let near = fmax(fmax(lo.x, lo.y), fmax(lo.z, tmin));
+    /// Entry distances of the ray into a node's four child boxes, and which it enters.
+    #[inline(always)]
+    fn node_hit(n: &Node4, r: &SlabRay4, tmin: f32, tmax: f32) -> (Vec4, u32) {
+        let b = &n.bounds;
+        let x0 = (b[0] - r.origin[0]) * r.inv_dir[0];
+        let x1 = (b[3] - r.origin[0]) * r.inv_dir[0];
+        let y0 = (b[1] - r.origin[1]) * r.inv_dir[1];
+        let y1 = (b[4] - r.origin[1]) * r.inv_dir[1];
+        let z0 = (b[2] - r.origin[2]) * r.inv_dir[2];
+        let z1 = (b[5] - r.origin[2]) * r.inv_dir[2];
+        // NaN (0 * inf, for a ray in a slab's plane) drops out of SSE min and max, which
+        // return their second operand then.
+        let near = x0
+            .min(x1)
+            .max(y0.min(y1))
+            .max(z0.min(z1))
+            .max(Vec4::splat(tmin));
         // Rounding in the slab test may shrink the interval by a few ulps; widening the far
         // end keeps hits on the box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-        let far = fmin(fmin(hi.x, hi.y), hi.z) * (1.0 + 2.0 * 3.0 * f32::EPSILON);
-        let far = fmin(far, tmax);
-        (near <= far).then_some(near)
+        let far = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + 2.0 * 3.0 * f32::EPSILON))
+            .min(Vec4::splat(tmax));
+        (near, near.cmple(far).bitmask() & n.used)
     }
 
     #[inline]
@@ -300,6 +336,13 @@ impl Bvh {
         }
     }
 
+    /// The primitives of a leaf reference.
+    #[inline(always)]
+    fn leaf_range(r: u32) -> std::ops::Range<usize> {
+        let start = ((r & !LEAF) >> 4) as usize;
+        start..start + (r & 15) as usize + 1
+    }
+
     /// The closest hit with `tmin < t < tmax`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
@@ -307,46 +350,47 @@ impl Bvh {
             return None;
         }
         let r = RayPre::new(ray);
-        let slab = SlabRay::new(&r);
+        let slab = SlabRay4::new(&r);
         let mut best: Option<Hit> = None;
         let mut tmax = tmax;
-        let mut stack = [(0u32, 0f32); MEDIAN_DEPTH + 34];
-        let mut sp = 0usize;
-        let t_root = Self::node_hit(&self.nodes[0], &slab, tmin, tmax)?;
-        stack[0] = (0, t_root);
-        sp += 1;
+        let mut stack = Stack::<(u32, f32)>::new();
+        stack.push(0, (0, tmin));
+        let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
-            let (mut i, t_near) = stack[sp];
+            let (node_ref, t_near) = stack.get(sp);
             if t_near > tmax {
                 continue;
             }
-            loop {
-                let n = &self.nodes[i as usize];
-                if n.count > 0 {
-                    let start = n.index as usize;
-                    for k in start..start + n.count as usize {
-                        if let Some(h) = self.leaf_prim(k, &r, ray, tmin, tmax) {
-                            tmax = h.t;
-                            best = Some(h);
-                        }
+            if node_ref & LEAF != 0 {
+                for k in Self::leaf_range(node_ref) {
+                    if let Some(h) = self.leaf_prim(k, &r, ray, tmin, tmax) {
+                        tmax = h.t;
+                        best = Some(h);
                     }
-                    break;
                 }
-                let (a, b) = (i + 1, n.index);
-                let ha = Self::node_hit(&self.nodes[a as usize], &slab, tmin, tmax);
-                let hb = Self::node_hit(&self.nodes[b as usize], &slab, tmin, tmax);
-                match (ha, hb) {
-                    (Some(ta), Some(tb)) => {
-                        let (near, far, tf) = if ta <= tb { (a, b, tb) } else { (b, a, ta) };
-                        stack[sp] = (far, tf);
-                        sp += 1;
-                        i = near;
-                    }
-                    (Some(_), None) => i = a,
-                    (None, Some(_)) => i = b,
-                    (None, None) => break,
+                continue;
+            }
+            let n = &self.nodes[node_ref as usize];
+            let (near, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+            // Push the children entered, farthest first, so the nearest is popped next.
+            let near = near.to_array();
+            let mut hits = [(0u32, 0f32); 4];
+            let mut count = 0;
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let mut j = count;
+                while j > 0 && hits[j - 1].1 < near[i] {
+                    hits[j] = hits[j - 1];
+                    j -= 1;
                 }
+                hits[j] = (n.child[i], near[i]);
+                count += 1;
+            }
+            for &h in &hits[..count] {
+                stack.push(sp, h);
+                sp += 1;
             }
         }
         best
@@ -359,31 +403,95 @@ impl Bvh {
             return false;
         }
         let r = RayPre::new(ray);
-        let slab = SlabRay::new(&r);
-        let mut stack = [0u32; STACK];
+        let slab = SlabRay4::new(&r);
+        let mut stack = Stack::<u32>::new();
+        stack.push(0, 0);
         let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
-            let i = stack[sp];
-            let n = &self.nodes[i as usize];
-            if Self::node_hit(n, &slab, tmin, tmax).is_none() {
-                continue;
-            }
-            if n.count > 0 {
-                let start = n.index as usize;
-                for k in start..start + n.count as usize {
+            let node_ref = stack.get(sp);
+            if node_ref & LEAF != 0 {
+                for k in Self::leaf_range(node_ref) {
                     if self.leaf_prim(k, &r, ray, tmin, tmax).is_some() {
                         return true;
                     }
                 }
-            } else {
-                stack[sp] = n.index;
-                stack[sp + 1] = i + 1;
-                sp += 2;
+                continue;
+            }
+            let n = &self.nodes[node_ref as usize];
+            let (_, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.push(sp, n.child[i]);
+                sp += 1;
             }
         }
         false
     }
+}
+
+/// A traversal stack that is not cleared before use (clearing a few kilobytes per ray
+/// costs more than a small BVH's whole traversal). Entries are written before they are read:
+/// `get(i)` is only called for `i` below the highest index pushed.
+struct Stack<T: Copy> {
+    items: [std::mem::MaybeUninit<T>; STACK],
+}
+
+impl<T: Copy> Stack<T> {
+    #[inline(always)]
+    fn new() -> Stack<T> {
+        Stack {
+            items: [const { std::mem::MaybeUninit::uninit() }; STACK],
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, i: usize, v: T) {
+        self.items[i] = std::mem::MaybeUninit::new(v);
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> T {
+        // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
+        // passes the highest slot written), so it holds an initialized value.
+        unsafe { self.items[i].assume_init() }
+    }
+}
+
+impl Node4 {
+    fn empty() -> Node4 {
+        Node4 {
+            bounds: [
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+                Vec4::splat(f32::NEG_INFINITY),
+            ],
+            child: [u32::MAX; 4],
+            used: 0,
+            _pad: [0; 3],
+        }
+    }
+
+    fn set(&mut self, slot: usize, b: Aabb, child: u32) {
+        for axis in 0..3 {
+            self.bounds[axis][slot] = b.min[axis];
+            self.bounds[3 + axis][slot] = b.max[axis];
+        }
+        self.child[slot] = child;
+        self.used |= 1 << slot;
+    }
+}
+
+fn leaf_ref(n: &BuildNode) -> u32 {
+    let BuildNode::Leaf { start, count, .. } = *n else {
+        unreachable!("only leaves have leaf references")
+    };
+    debug_assert!((1..=MAX_LEAF_REF).contains(&count) && start < 1 << 27);
+    LEAF | (start as u32) << 4 | (count as u32 - 1)
 }
 
 fn root_bounds(n: &BuildNode) -> Aabb {
@@ -478,7 +586,7 @@ fn build_node(
             }
         }
         // Every centroid coincides: nothing separates them.
-        None if n <= opts.max_leaf.max(16) => return leaf(),
+        None if n <= MAX_LEAF_REF => return leaf(),
         None => n / 2,
     };
     let (l, r) = ids.split_at_mut(mid);

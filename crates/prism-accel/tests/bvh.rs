@@ -159,7 +159,7 @@ fn build_is_deterministic_and_stats_add_up() {
     let b = Bvh::build(&tris, &[], &opts);
     assert_eq!(a.stats(), b.stats());
     let s = a.stats();
-    assert_eq!(s.nodes, 2 * s.leaves - 1);
+    assert!(s.nodes < s.leaves && s.nodes >= s.leaves / 4);
     assert_eq!(s.primitives, 20_000);
     assert!(s.depth < 64 && s.sah_cost > 0.0);
     for k in 0..1000 {
