@@ -19,7 +19,7 @@ impl Default for BuildOptions {
     fn default() -> BuildOptions {
         BuildOptions {
             max_leaf: 8,
-            traversal_cost: 2.0,
+            traversal_cost: 1.0,
             parallel_threshold: 4096,
         }
     }
@@ -315,7 +315,7 @@ impl Bvh {
         (near, near.cmple(far).bitmask() & n.used)
     }
 
-    #[inline]
+    #[inline(always)]
     fn leaf_prim(&self, k: usize, r: &RayPre, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
         let p = self.order[k];
         if p < self.triangle_count {

@@ -128,40 +128,36 @@ pub fn intersect_triangle(
     Some((t, vv * inv, w * inv))
 }
 
-/// Ray-sphere intersection: the nearest root in `(tmin, tmax)`, computed in double precision
-/// with the cancellation-free discriminant (the distance from the centre to the ray's line).
+/// Ray-sphere intersection: the nearest root in `(tmin, tmax)`, with the discriminant
+/// computed from the distance between the centre and the ray's line (no cancellation for
+/// rays far from small spheres) and the roots from the numerically stable quadratic form.
 #[must_use]
 #[inline]
 pub fn intersect_sphere(ray: &Ray, s: &Sphere, tmin: f32, tmax: f32) -> Option<f32> {
-    let o = (ray.origin - s.center).as_dvec3();
-    let d = ray.dir.as_dvec3();
-    let r = f64::from(s.radius);
+    let o = ray.origin - s.center;
+    let d = ray.dir;
+    let r = s.radius;
     let a = d.length_squared();
     let b = 2.0 * o.dot(d);
     let c = o.length_squared() - r * r;
-    let closest = o - (b / (2.0 * a)) * d;
-    let l = closest.length();
+    let l = (o - (b / (2.0 * a)) * d).length();
     let disc = 4.0 * a * (r + l) * (r - l);
     if disc < 0.0 {
         return None;
     }
     let root = disc.sqrt();
-    let q = if b < 0.0 {
-        -0.5 * (b - root)
-    } else {
-        -0.5 * (b + root)
-    };
+    let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
     let (mut t0, mut t1) = (q / a, c / q);
     if t0 > t1 {
         std::mem::swap(&mut t0, &mut t1);
     }
-    for t in [t0, t1] {
-        let t = t as f32;
-        if t > tmin && t < tmax {
-            return Some(t);
-        }
+    if t0 > tmin && t0 < tmax {
+        Some(t0)
+    } else if t1 > tmin && t1 < tmax {
+        Some(t1)
+    } else {
+        None
     }
-    None
 }
 
 #[cfg(test)]
