@@ -146,7 +146,11 @@ pub fn intersect_sphere(ray: &Ray, s: &Sphere, tmin: f32, tmax: f32) -> Option<f
         return None;
     }
     let root = disc.sqrt();
-    let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
+    let q = if b < 0.0 {
+        -0.5 * (b - root)
+    } else {
+        -0.5 * (b + root)
+    };
     let (mut t0, mut t1) = (q / a, c / q);
     if t0 > t1 {
         std::mem::swap(&mut t0, &mut t1);

@@ -18,6 +18,31 @@ pub struct DemoArgs {
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
+    /// The course's staged assets, for the pictures that need their files (the bunny); those
+    /// pictures are left out when the folder is missing.
+    #[arg(long, default_value = "../shared/assets")]
+    pub assets: PathBuf,
+}
+
+/// Path-traces a scene for the gallery and writes the PNG (and, if asked, the heat map).
+fn trace(
+    scene: &prism_scene::Scene,
+    opts: &prism_render::RenderOptions,
+    out: &std::path::Path,
+    heat: Option<&std::path::Path>,
+) -> Result<()> {
+    let prepared = prism_render::RenderScene::new(scene);
+    let r = prism_render::render(&prepared, opts, &|_| {});
+    prism_image::write_png(out, &r.image.linear_to_srgb8())
+        .with_context(|| format!("writing {}", out.display()))?;
+    if let Some(h) = heat {
+        let max = r.samples.pixels().iter().copied().max().unwrap_or(1).max(1);
+        let img = r
+            .samples
+            .map(|&n| crate::render::heat_colour(n as f32 / max as f32));
+        prism_image::write_png(h, &img).with_context(|| format!("writing {}", h.display()))?;
+    }
+    Ok(())
 }
 
 /// A fan of thin triangles: aliasing shows at one sample per pixel.
@@ -267,7 +292,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         Dialect::Svg,
         base(240, 240, 16),
     ));
-    let pb = crate::progress::bar(jobs.len() as u64 + 5, "demo", a.quiet);
+    let pb = crate::progress::bar(jobs.len() as u64 + 11, "demo", a.quiet);
     for (file, caption, svg, dialect, opts) in jobs {
         draw(&svg, dialect, &opts, &a.output.join(&file))?;
         entries.push(Entry { file, caption });
@@ -304,6 +329,70 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         });
         pb.inc(1);
     }
+    // Path tracing: the Cornell box, its sample-rate heat map and its bounce decomposition.
+    let cornell = prism_scene::cornell_box();
+    let base = prism_render::RenderOptions {
+        width: 256,
+        height: 192,
+        spp: 64,
+        ..prism_render::RenderOptions::default()
+    };
+    trace(&cornell, &base, &a.output.join("render_cornell.png"), None)?;
+    entries.push(Entry {
+        file: "render_cornell.png".into(),
+        caption: "Cornell box path-traced: 64 samples per pixel, next-event estimation with MIS"
+            .into(),
+    });
+    pb.inc(1);
+    let adaptive = prism_render::RenderOptions {
+        spp: 256,
+        adaptive: Some(0.05),
+        ..base
+    };
+    trace(
+        &cornell,
+        &adaptive,
+        &a.output.join("render_adaptive.png"),
+        Some(&a.output.join("render_heatmap.png")),
+    )?;
+    entries.push(Entry {
+        file: "render_heatmap.png".into(),
+        caption: "Adaptive sampling (tolerance 0.05, at most 256 samples): samples per pixel, blue few, red many".into(),
+    });
+    pb.inc(1);
+    for (m, name) in [
+        (1, "direct light"),
+        (2, "second bounce"),
+        (3, "third bounce"),
+    ] {
+        let file = format!("render_bounce_{m}.png");
+        let opts = prism_render::RenderOptions {
+            only_bounce: Some(m),
+            ..base
+        };
+        trace(&cornell, &opts, &a.output.join(&file), None)?;
+        entries.push(Entry {
+            file,
+            caption: format!("Only the {name} (--bounce {m})"),
+        });
+        pb.inc(1);
+    }
+    let bunny = a.assets.join("pathtracer/dae/sky/CBbunny.dae");
+    if bunny.is_file() {
+        let doc = prism_scene::read_collada(&bunny).map_err(|e| crate::UserError(e.to_string()))?;
+        let scene = prism_scene::Scene::from_collada(
+            &doc,
+            &prism_scene::SceneOptions::default(),
+            &bunny.display().to_string(),
+        )
+        .map_err(|e| crate::UserError(e.to_string()))?;
+        trace(&scene, &base, &a.output.join("render_bunny.png"), None)?;
+        entries.push(Entry {
+            file: "render_bunny.png".into(),
+            caption: "CBbunny.dae from the course, 64 samples per pixel".into(),
+        });
+    }
+    pb.inc(1);
     // The Utah teapot's 32 bicubic patches (Newell, 1975), tessellated and welded; Z up.
     let patches = prism_mesh::parse_bez(include_str!("../data/teapot.bez"), "teapot.bez")?;
     let mut teapot = prism_mesh::tessellate(&patches, 8);

@@ -233,7 +233,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 }
 
 /// Blue (0) through cyan, green and yellow to red (1).
-fn heat_colour(t: f32) -> [u8; 3] {
+pub(crate) fn heat_colour(t: f32) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0) * 4.0;
     let (r, g, b) = match t {
         t if t < 1.0 => (0.0, t, 1.0),

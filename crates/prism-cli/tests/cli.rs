@@ -195,6 +195,9 @@ fn demo_writes_gallery() {
         "bezier_decasteljau.png",
         "loop_level_2.png",
         "bezier_teapot.png",
+        "render_cornell.png",
+        "render_heatmap.png",
+        "render_bounce_2.png",
     ] {
         assert!(html.contains(f), "{f} not in index");
         assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
@@ -423,5 +426,141 @@ fn mesh_collada_in_and_out() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("broken.dae:"), "{}", stderr(&o));
     assert_eq!(std::fs::read_to_string(&obj_a).unwrap(), a);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `prism render` renders the built-in Cornell box and a staged scene; every kind of broken
+/// scene is a located error with exit code 2 that leaves the previous output untouched.
+#[test]
+fn render_scenes_and_errors() {
+    let dir = scratch("render");
+    let out = dir.join("cb.png");
+    let exr = dir.join("cb.exr");
+    let heat = dir.join("heat.png");
+    let o = prism()
+        .args([
+            "render",
+            "-q",
+            "-s",
+            "4",
+            "-r",
+            "64",
+            "48",
+            "--adaptive",
+            "0.5",
+            "--batch",
+            "2",
+            "--stats",
+            "-o",
+        ])
+        .arg(&out)
+        .arg("--exr")
+        .arg(&exr)
+        .arg("--heatmap")
+        .arg(&heat)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = prism_image::read_png(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    assert!(prism_image::read_png(&heat).is_ok());
+    assert!(std::fs::metadata(&exr).unwrap().len() > 64 * 48 * 12);
+    let err = stderr(&o);
+    for stage in [
+        "bvh: ",
+        "read: ",
+        "build: ",
+        "render: ",
+        "write: ",
+        "samples/s: ",
+    ] {
+        assert!(
+            err.lines().any(|l| l.starts_with(stage)),
+            "{stage} missing: {err}"
+        );
+    }
+    let bunny = prism_testkit::shared_assets().join("pathtracer/dae/sky/CBbunny.dae");
+    let o = prism()
+        .args([
+            "render",
+            "-q",
+            "-s",
+            "1",
+            "-r",
+            "32",
+            "24",
+            "--integrator",
+            "normals",
+            "-o",
+        ])
+        .arg(dir.join("bunny.png"))
+        .arg(&bunny)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+
+    let good = std::fs::read_to_string(
+        prism_testkit::shared_assets().join("pathtracer/dae/sky/CBspheres_lambertian.dae"),
+    )
+    .unwrap();
+    let before = std::fs::read(&out).unwrap();
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "broken XML",
+            good.replacen("</library_lights>", "", 1),
+            "bad.dae: ",
+        ),
+        (
+            "dangling material",
+            good.replacen("target=\"#lambertian\"", "target=\"#nothing\"", 1),
+            "no <material> with id \"nothing\"",
+        ),
+        (
+            "dangling geometry",
+            good.replacen("url=\"#Sphere1-data\"", "url=\"#Sphere9-data\"", 1),
+            "no <geometry> with id \"Sphere9-data\"",
+        ),
+        (
+            "zero-area light",
+            good.replacen(
+                "<matrix sid=\"transform\">0.6 0 0 0 0 0.8 0 0 0 0 1 1.49 0 0 0 1</matrix>",
+                "<matrix sid=\"transform\">0 0 0 0 0 0.8 0 0 0 0 1 1.49 0 0 0 1</matrix>",
+                1,
+            ),
+            "zero area",
+        ),
+        (
+            "NaN matrix",
+            good.replacen(
+                "0.6 0 0 0 0 0.8 0 0 0 0 1 1.49 0 0 0 1",
+                "0.6 0 0 0 0 NaN 0 0 0 0 1 1.49 0 0 0 1",
+                1,
+            ),
+            "expected a finite value",
+        ),
+        (
+            "camera without fov",
+            good.replacen("<xfov sid=\"xfov\">49.13434</xfov>", "", 1),
+            "expected an <xfov> or a <yfov>",
+        ),
+    ];
+    for (what, text, want) in cases {
+        assert_ne!(text, good, "{what}: the edit did not apply");
+        let bad = dir.join("bad.dae");
+        std::fs::write(&bad, text).unwrap();
+        let o = prism()
+            .args(["render", "-q", "-s", "1", "-r", "16", "12", "-o"])
+            .arg(&out)
+            .arg(&bad)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{what}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{what}: {}", stderr(&o));
+        assert_eq!(
+            std::fs::read(&out).unwrap(),
+            before,
+            "{what}: output changed"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
