@@ -180,7 +180,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
         b.build().context("starting worker threads")?
     };
-    let bar = crate::progress::bar(u64::from(w) * u64::from(h), "render", a.quiet);
+    let bar = crate::progress::samples_bar(u64::from(w) * u64::from(h) * u64::from(a.spp), a.quiet);
     let t2 = Instant::now();
     let out = pool.install(|| render(&prepared, &options, &|done| bar.set_position(done)));
     let render_time = t2.elapsed();

@@ -84,7 +84,7 @@ pub struct Rendered {
 
 const TILE: u32 = 32;
 
-/// Renders the scene. `progress` is called with the number of pixels finished so far after
+/// Renders the scene. `progress` is called with the number of samples taken so far after
 /// each tile (from worker threads). The image is the same whatever the thread count.
 pub fn render(
     scene: &RenderScene,
@@ -106,7 +106,7 @@ pub fn render(
                     out.push(pixel(scene, &camera, opts, x, y));
                 }
             }
-            let n = out.len() as u64;
+            let n: u64 = out.iter().map(|&(_, k)| u64::from(k)).sum();
             progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
             out
         })
