@@ -59,12 +59,14 @@ impl RayPre {
         // Keep the winding: swap kx and ky when the dominant component is negative.
         let perm = 2 * kz + usize::from(d[kz] < 0.0);
         let [kx, ky, kz] = PERMS[perm];
+        let inv_dir = d.recip();
+        let inv_z = inv_dir[kz];
         RayPre {
             origin: ray.origin,
             dir: d,
-            inv_dir: d.recip(),
+            inv_dir,
             perm,
-            shear: Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]),
+            shear: Vec3::new(d[kx] * inv_z, d[ky] * inv_z, inv_z),
         }
     }
 

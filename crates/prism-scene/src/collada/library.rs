@@ -190,13 +190,20 @@ pub(super) fn effect(
                 t.children()
                     .find(|c| matches!(c.tag_name().name(), "phong" | "lambert" | "blinn"))
             });
-        if let Some(colour) = shading
-            .and_then(|s| child(s, "diffuse"))
-            .and_then(|d| child(d, "color"))
-        {
+        let diffuse = shading.and_then(|s| child(s, "diffuse"));
+        if let Some(colour) = diffuse.and_then(|d| child(d, "color")) {
             material = Some(Material::Diffuse {
                 reflectance: color3(cx, colour)?,
             });
+        } else if let Some(t) = diffuse.and_then(|d| child(d, "texture")) {
+            warn(
+                "diffuse:texture",
+                format!(
+                    "{}:{}: diffuse textures are not read; the effect is diffuse 0.5",
+                    cx.file,
+                    cx.line(t)
+                ),
+            );
         }
     }
     Ok(EffectDef {

@@ -302,3 +302,26 @@ fn writer_round_trips() {
     let c = parse_collada(std::str::from_utf8(&bytes).unwrap(), "rt.dae").unwrap();
     assert_eq!(c.world_mesh(true), m);
 }
+
+/// Unsupported features warn once each instead of vanishing silently.
+#[test]
+fn unsupported_features_warn() {
+    let text = doc("Y_UP", SQUARE, &node(""))
+        .replace(
+            "<directional><color>1 1 1</color></directional>",
+            "<spotlight><color>1 1 1</color></spotlight>",
+        )
+        .replace(
+            "<color>0.8 0.1 0.1 1</color>",
+            "<texture texture=\"img\" texcoord=\"uv\"/>",
+        )
+        .replace(
+            "</effect>",
+            "<extra><technique profile=\"CGL\"><velvet><x>1</x></velvet></technique></extra></effect>",
+        );
+    let c = parse_collada(&text, "w.dae").unwrap();
+    let all = c.warnings.join("\n");
+    for want in ["<spotlight>", "diffuse textures", "<velvet>"] {
+        assert!(all.contains(want), "{want} not warned: {all}");
+    }
+}
