@@ -59,11 +59,11 @@ pub struct BvhStats {
     pub bytes: usize,
 }
 
-/// A flattened 4-wide node: 128 bytes holding its children's boxes in SIMD-friendly order
+/// A flattened 4-wide node: 128 bytes (two whole cache lines) holding its children's boxes in SIMD-friendly order
 /// (x minima of the four children, then y minima, ...). A child reference is a node index,
 /// or for a leaf `LEAF | start << 4 | (count - 1)`; unused slots hold empty boxes.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(64))]
 struct Node4 {
     bounds: [Vec4; 6],
     child: [u32; 4],

@@ -210,7 +210,8 @@ pub fn radiance(
                 l += if hemisphere {
                     direct_hemisphere(scene, &hit, -ray.dir, sampler, opts)
                 } else {
-                    direct_lights(scene, &hit, -ray.dir, sampler, opts, false)
+                    let (frame, wo_l) = local(&hit, -ray.dir);
+                    direct_lights(scene, &hit, (&frame, -ray.dir, wo_l), sampler, opts, false)
                 };
             }
             l
@@ -236,7 +237,7 @@ fn consistent(hit: &Interaction, wo: Vec3, wi: Vec3) -> bool {
 fn direct_lights(
     scene: &RenderScene,
     hit: &Interaction,
-    wo: Vec3,
+    (frame, wo, wo_l): (&Frame, Vec3, Vec3),
     sampler: &mut Sampler,
     opts: &RenderOptions,
     mis: bool,
@@ -244,7 +245,6 @@ fn direct_lights(
     if !hit.bsdf.is_smooth() {
         return Rgb::BLACK;
     }
-    let (frame, wo_l) = local(hit, wo);
     let mut total = Rgb::BLACK;
     for light in &scene.lights {
         let count = if light.is_delta() {
@@ -343,10 +343,10 @@ fn path(
         if hit.bsdf == crate::bsdf::Bsdf::Black {
             break;
         }
-        if keep(bounce) {
-            l += beta * direct_lights(scene, &hit, wo, sampler, opts, true);
-        }
         let (frame, wo_l) = local(&hit, wo);
+        if keep(bounce) {
+            l += beta * direct_lights(scene, &hit, (&frame, wo, wo_l), sampler, opts, true);
+        }
         let u1 = sampler.next_1d();
         let u2 = sampler.next_2d();
         let Some(s) = hit.bsdf.sample(wo_l, u1, u2) else {
