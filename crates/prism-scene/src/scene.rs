@@ -407,6 +407,15 @@ impl Scene {
             }
         }
         scene.camera = place_camera(&scene, file_camera.as_ref(), opts.camera);
+        let emitters = scene
+            .materials
+            .iter()
+            .any(|m| matches!(m, Material::Emission { .. }));
+        if scene.lights.is_empty() && !emitters {
+            scene.warnings.push(format!(
+                "{file}: the scene has no light and no emitting surface; it renders black"
+            ));
+        }
         Ok(scene)
     }
 
