@@ -1,4 +1,4 @@
-use prism_math::glam::Vec4;
+use prism_math::glam::{Vec3A, Vec4};
 use prism_math::{Aabb, Ray, Vec3};
 
 use crate::shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};
@@ -103,8 +103,58 @@ enum BuildNode {
 }
 
 struct PrimInfo {
-    bounds: Aabb,
-    centroid: Vec3,
+    bounds: B3,
+    centroid: Vec3A,
+}
+
+/// A box in SIMD registers, for the build's many unions.
+#[derive(Clone, Copy, Debug)]
+struct B3 {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl B3 {
+    const EMPTY: B3 = B3 {
+        min: Vec3A::splat(f32::INFINITY),
+        max: Vec3A::splat(f32::NEG_INFINITY),
+    };
+
+    fn from_aabb(b: Aabb) -> B3 {
+        B3 {
+            min: b.min.into(),
+            max: b.max.into(),
+        }
+    }
+
+    fn to_aabb(self) -> Aabb {
+        Aabb {
+            min: self.min.into(),
+            max: self.max.into(),
+        }
+    }
+
+    #[inline(always)]
+    fn union(self, o: B3) -> B3 {
+        B3 {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    #[inline(always)]
+    fn grow(self, p: Vec3A) -> B3 {
+        B3 {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    #[inline(always)]
+    fn area(self) -> f32 {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
 }
 
 const BINS: usize = 16;
@@ -153,8 +203,8 @@ impl Bvh {
                 ids.push(i as u32);
             }
             info.push(PrimInfo {
-                bounds: b,
-                centroid: b.centroid(),
+                bounds: B3::from_aabb(b),
+                centroid: b.centroid().into(),
             });
         }
         for (i, s) in spheres.iter().enumerate() {
@@ -163,8 +213,8 @@ impl Bvh {
                 ids.push((nt + i) as u32);
             }
             info.push(PrimInfo {
-                bounds: b,
-                centroid: s.center,
+                bounds: B3::from_aabb(b),
+                centroid: s.center.into(),
             });
         }
         let root = if ids.is_empty() {
@@ -508,12 +558,13 @@ fn build_node(
     depth: usize,
     opts: &BuildOptions,
 ) -> BuildNode {
-    let mut bounds = Aabb::EMPTY;
-    let mut cbounds = Aabb::EMPTY;
+    let mut b3 = B3::EMPTY;
+    let mut cb = B3::EMPTY;
     for &p in ids.iter() {
-        bounds = bounds.union(info[p as usize].bounds);
-        cbounds = cbounds.extend(info[p as usize].centroid);
+        b3 = b3.union(info[p as usize].bounds);
+        cb = cb.grow(info[p as usize].centroid);
     }
+    let bounds = b3.to_aabb();
     let n = ids.len();
     let leaf = || BuildNode::Leaf {
         bounds,
@@ -523,43 +574,48 @@ fn build_node(
     if n == 1 {
         return leaf();
     }
-    // Binned SAH on every axis with a non-degenerate centroid extent.
+    // Binned SAH on every axis with a non-degenerate centroid extent, all three axes binned
+    // in one pass.
+    let extent = cb.max - cb.min;
+    let scale = Vec3A::select(
+        extent.cmpgt(Vec3A::ZERO),
+        Vec3A::splat(BINS as f32) / extent,
+        Vec3A::ZERO,
+    );
+    let mut counts = [[0u32; BINS]; 3];
+    let mut boxes = [[B3::EMPTY; BINS]; 3];
+    for &p in ids.iter() {
+        let pi = &info[p as usize];
+        let bin = ((pi.centroid - cb.min) * scale).to_array();
+        for axis in 0..3 {
+            let k = (bin[axis] as usize).min(BINS - 1);
+            counts[axis][k] += 1;
+            boxes[axis][k] = boxes[axis][k].union(pi.bounds);
+        }
+    }
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, split bin)
-    let extent = cbounds.extent();
     for axis in 0..3 {
         if extent[axis] <= 0.0 {
             continue;
         }
-        let scale = BINS as f32 / extent[axis];
-        let bin_of = |p: u32| -> usize {
-            let b = ((info[p as usize].centroid[axis] - cbounds.min[axis]) * scale) as usize;
-            b.min(BINS - 1)
-        };
-        let mut counts = [0usize; BINS];
-        let mut boxes = [Aabb::EMPTY; BINS];
-        for &p in ids.iter() {
-            let b = bin_of(p);
-            counts[b] += 1;
-            boxes[b] = boxes[b].union(info[p as usize].bounds);
-        }
         // Sweep from the right, then from the left.
         let mut right_area = [0f32; BINS];
-        let mut right_count = [0usize; BINS];
-        let (mut acc, mut c) = (Aabb::EMPTY, 0);
+        let mut right_count = [0u32; BINS];
+        let (mut acc, mut c) = (B3::EMPTY, 0);
         for b in (1..BINS).rev() {
-            acc = acc.union(boxes[b]);
-            c += counts[b];
-            right_area[b] = acc.surface_area();
+            acc = acc.union(boxes[axis][b]);
+            c += counts[axis][b];
+            right_area[b] = acc.area();
             right_count[b] = c;
         }
-        let (mut acc, mut c) = (Aabb::EMPTY, 0);
+        let (mut acc, mut c) = (B3::EMPTY, 0);
         for b in 1..BINS {
-            acc = acc.union(boxes[b - 1]);
-            c += counts[b - 1];
+            acc = acc.union(boxes[axis][b - 1]);
+            c += counts[axis][b - 1];
             if c == 0 || right_count[b] == 0 {
                 continue;
             }
-            let cost = acc.surface_area() * c as f32 + right_area[b] * right_count[b] as f32;
+            let cost = acc.area() * c as f32 + right_area[b] * right_count[b] as f32;
             if best.is_none_or(|(bc, _, _)| cost < bc) {
                 best = Some((cost, axis, b));
             }
@@ -574,9 +630,9 @@ fn build_node(
             if n <= opts.max_leaf && n as f32 <= split_cost {
                 return leaf();
             }
-            let scale = BINS as f32 / extent[axis];
+            let (lo, sc) = (cb.min[axis], scale[axis]);
             let left = partition(ids, |p| {
-                let b = ((info[p as usize].centroid[axis] - cbounds.min[axis]) * scale) as usize;
+                let b = ((info[p as usize].centroid[axis] - lo) * sc) as usize;
                 b.min(BINS - 1) < split
             });
             if left == 0 || left == n {
