@@ -1,7 +1,17 @@
 use prism_math::glam::{Vec3A, Vec4};
 use prism_math::{Aabb, Ray, Vec3};
 
-use crate::shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};
+use crate::shapes::{intersect_sphere, RayPre, Sphere};
+use crate::tri4::Tri4;
+
+/// A leaf: `packs` triangle packs from `pack_start`, `spheres` spheres from `sphere_start`.
+#[derive(Clone, Copy, Debug, Default)]
+struct LeafRec {
+    pack_start: u32,
+    sphere_start: u32,
+    packs: u16,
+    spheres: u16,
+}
 
 /// Build parameters.
 #[derive(Clone, Copy, Debug)]
@@ -82,8 +92,12 @@ pub struct Bvh {
     nodes: Vec<Node4>,
     /// Primitive numbers in leaf order.
     order: Vec<u32>,
-    /// Triangle vertices in leaf order (unused slots where spheres sit).
-    tris: Vec<[Vec3; 3]>,
+    /// Triangles in packs of four, leaf by leaf.
+    packs: Vec<Tri4>,
+    /// Leaves: their packs, and their spheres in `leaf_spheres`.
+    leaves: Vec<LeafRec>,
+    /// Sphere primitive numbers, leaf by leaf.
+    leaf_spheres: Vec<u32>,
     spheres: Vec<Sphere>,
     triangle_count: u32,
     bounds: Aabb,
@@ -235,33 +249,26 @@ impl Bvh {
             let root_area = root_bounds(&root).surface_area().max(f32::MIN_POSITIVE);
             bvh.statistics(&root, 0, root_area, opts.traversal_cost);
             bvh.bounds = root_bounds(&root);
+            bvh.order = ids.clone();
             match &root {
                 BuildNode::Leaf { .. } => {
                     // A lone leaf still sits under a node.
                     let mut n = Node4::empty();
-                    n.set(0, root_bounds(&root), leaf_ref(&root));
+                    let r = bvh.make_leaf(&root, triangles);
+                    n.set(0, root_bounds(&root), r);
                     bvh.nodes.push(n);
                 }
                 BuildNode::Interior { .. } => {
-                    bvh.collapse(&root);
+                    bvh.collapse(&root, triangles);
                 }
             }
         }
-        bvh.tris = ids
-            .iter()
-            .map(|&p| {
-                if (p as usize) < nt {
-                    triangles[p as usize]
-                } else {
-                    [Vec3::ZERO; 3]
-                }
-            })
-            .collect();
         bvh.stats.primitives = ids.len();
-        bvh.order = ids;
         bvh.stats.nodes = bvh.nodes.len();
         bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node4>()
-            + bvh.tris.len() * std::mem::size_of::<[Vec3; 3]>()
+            + bvh.packs.len() * std::mem::size_of::<Tri4>()
+            + bvh.leaves.len() * std::mem::size_of::<LeafRec>()
+            + bvh.leaf_spheres.len() * 4
             + bvh.order.len() * 4
             + bvh.spheres.len() * std::mem::size_of::<Sphere>();
         bvh
@@ -287,7 +294,7 @@ impl Bvh {
     /// Flattens an interior binary node and its subtree into 4-wide nodes: each takes up to
     /// four descendants, opening the interior child of largest area first. Returns the
     /// node's index.
-    fn collapse(&mut self, n: &BuildNode) -> u32 {
+    fn collapse(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]]) -> u32 {
         let mut kids: Vec<&BuildNode> = match n {
             BuildNode::Interior { children, .. } => vec![&children[0], &children[1]],
             BuildNode::Leaf { .. } => vec![n],
@@ -314,12 +321,37 @@ impl Bvh {
         self.nodes.push(Node4::empty());
         for (slot, k) in kids.into_iter().enumerate() {
             let r = match k {
-                BuildNode::Leaf { .. } => leaf_ref(k),
-                BuildNode::Interior { .. } => self.collapse(k),
+                BuildNode::Leaf { .. } => self.make_leaf(k, triangles),
+                BuildNode::Interior { .. } => self.collapse(k, triangles),
             };
             self.nodes[index].set(slot, root_bounds(k), r);
         }
         index as u32
+    }
+
+    /// Stores a leaf's triangles in packs of four and its spheres; returns its reference.
+    fn make_leaf(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]]) -> u32 {
+        let BuildNode::Leaf { start, count, .. } = *n else {
+            unreachable!("only leaves are stored as leaves")
+        };
+        let nt = self.triangle_count;
+        let prims = &self.order[start..start + count];
+        let tris: Vec<([Vec3; 3], u32)> = prims
+            .iter()
+            .filter(|&&p| p < nt)
+            .map(|&p| (triangles[p as usize], p))
+            .collect();
+        let rec = LeafRec {
+            pack_start: self.packs.len() as u32,
+            sphere_start: self.leaf_spheres.len() as u32,
+            packs: tris.len().div_ceil(4) as u16,
+            spheres: (count - tris.len()) as u16,
+        };
+        self.packs.extend(tris.chunks(4).map(Tri4::new));
+        let spheres: Vec<u32> = prims.iter().copied().filter(|&p| p >= nt).collect();
+        self.leaf_spheres.extend(spheres);
+        self.leaves.push(rec);
+        LEAF | (self.leaves.len() - 1) as u32
     }
 
     /// Build statistics.
@@ -365,32 +397,52 @@ impl Bvh {
         (near, near.cmple(far).bitmask() & n.used)
     }
 
+    /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
+    /// the first hit.
     #[inline(always)]
-    fn leaf_prim(&self, k: usize, r: &RayPre, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        let p = self.order[k];
-        if p < self.triangle_count {
-            intersect_triangle(r, &self.tris[k], tmin, tmax).map(|(t, b1, b2)| Hit {
-                t,
-                prim: p,
-                b1,
-                b2,
-            })
-        } else {
-            let s = &self.spheres[(p - self.triangle_count) as usize];
-            intersect_sphere(ray, s, tmin, tmax).map(|t| Hit {
-                t,
-                prim: p,
-                b1: 0.0,
-                b2: 0.0,
-            })
+    fn leaf(
+        &self,
+        r: u32,
+        pre: &RayPre,
+        ray: &Ray,
+        tmin: f32,
+        tmax: &mut f32,
+        any: bool,
+    ) -> Option<Hit> {
+        let rec = self.leaves[(r & !LEAF) as usize];
+        let mut best = None;
+        let p0 = rec.pack_start as usize;
+        for pack in &self.packs[p0..p0 + rec.packs as usize] {
+            if let Some((t, lane, b1, b2)) = pack.intersect(pre, tmin, *tmax) {
+                *tmax = t;
+                best = Some(Hit {
+                    t,
+                    prim: pack.prim[lane],
+                    b1,
+                    b2,
+                });
+                if any {
+                    return best;
+                }
+            }
         }
-    }
-
-    /// The primitives of a leaf reference.
-    #[inline(always)]
-    fn leaf_range(r: u32) -> std::ops::Range<usize> {
-        let start = ((r & !LEAF) >> 4) as usize;
-        start..start + (r & 15) as usize + 1
+        let s0 = rec.sphere_start as usize;
+        for &p in &self.leaf_spheres[s0..s0 + rec.spheres as usize] {
+            let s = &self.spheres[(p - self.triangle_count) as usize];
+            if let Some(t) = intersect_sphere(ray, s, tmin, *tmax) {
+                *tmax = t;
+                best = Some(Hit {
+                    t,
+                    prim: p,
+                    b1: 0.0,
+                    b2: 0.0,
+                });
+                if any {
+                    return best;
+                }
+            }
+        }
+        best
     }
 
     /// The closest hit with `tmin < t < tmax`.
@@ -413,11 +465,8 @@ impl Bvh {
                 continue;
             }
             if node_ref & LEAF != 0 {
-                for k in Self::leaf_range(node_ref) {
-                    if let Some(h) = self.leaf_prim(k, &r, ray, tmin, tmax) {
-                        tmax = h.t;
-                        best = Some(h);
-                    }
+                if let Some(h) = self.leaf(node_ref, &r, ray, tmin, &mut tmax, false) {
+                    best = Some(h);
                 }
                 continue;
             }
@@ -461,10 +510,9 @@ impl Bvh {
             sp -= 1;
             let node_ref = stack.get(sp);
             if node_ref & LEAF != 0 {
-                for k in Self::leaf_range(node_ref) {
-                    if self.leaf_prim(k, &r, ray, tmin, tmax).is_some() {
-                        return true;
-                    }
+                let mut t = tmax;
+                if self.leaf(node_ref, &r, ray, tmin, &mut t, true).is_some() {
+                    return true;
                 }
                 continue;
             }
@@ -534,14 +582,6 @@ impl Node4 {
         self.child[slot] = child;
         self.used |= 1 << slot;
     }
-}
-
-fn leaf_ref(n: &BuildNode) -> u32 {
-    let BuildNode::Leaf { start, count, .. } = *n else {
-        unreachable!("only leaves have leaf references")
-    };
-    debug_assert!((1..=MAX_LEAF_REF).contains(&count) && start < 1 << 27);
-    LEAF | (start as u32) << 4 | (count as u32 - 1)
 }
 
 fn root_bounds(n: &BuildNode) -> Aabb {
@@ -615,7 +655,7 @@ fn build_node(
             if c == 0 || right_count[b] == 0 {
                 continue;
             }
-            let cost = acc.area() * c as f32 + right_area[b] * right_count[b] as f32;
+            let cost = acc.area() * packs(c) + right_area[b] * packs(right_count[b]);
             if best.is_none_or(|(bc, _, _)| cost < bc) {
                 best = Some((cost, axis, b));
             }
@@ -627,7 +667,7 @@ fn build_node(
         Some(_) if depth >= MEDIAN_DEPTH => n / 2,
         Some((cost, axis, split)) => {
             let split_cost = opts.traversal_cost + cost / area;
-            if n <= opts.max_leaf && n as f32 <= split_cost {
+            if n <= opts.max_leaf && packs(n as u32) <= split_cost {
                 return leaf();
             }
             let (lo, sc) = (cb.min[axis], scale[axis]);
@@ -661,6 +701,11 @@ fn build_node(
         bounds,
         children: Box::new([a, b]),
     }
+}
+
+/// Cost of testing `n` primitives: they are tested four at a time.
+fn packs(n: u32) -> f32 {
+    n.div_ceil(4) as f32
 }
 
 /// Moves the elements satisfying `pred` to the front (stable for neither side); returns

@@ -29,12 +29,12 @@ pub struct RayPre {
     pub dir: Vec3,
     /// `1 / dir`, for slab tests.
     pub inv_dir: Vec3,
-    perm: usize,
-    shear: Vec3,
+    pub(crate) perm: usize,
+    pub(crate) shear: Vec3,
 }
 
 /// The axes `(kx, ky, kz)` of each permutation used by the watertight test.
-const PERMS: [[usize; 3]; 6] = [
+pub(crate) const PERMS: [[usize; 3]; 6] = [
     [1, 2, 0],
     [2, 1, 0],
     [2, 0, 1],
