@@ -36,11 +36,8 @@ fn trace(
     prism_image::write_png(out, &r.image.linear_to_srgb8())
         .with_context(|| format!("writing {}", out.display()))?;
     if let Some(h) = heat {
-        let max = r.samples.pixels().iter().copied().max().unwrap_or(1).max(1);
-        let img = r
-            .samples
-            .map(|&n| crate::render::heat_colour(n as f32 / max as f32));
-        prism_image::write_png(h, &img).with_context(|| format!("writing {}", h.display()))?;
+        prism_image::write_png(h, &crate::render::heatmap(&r.samples))
+            .with_context(|| format!("writing {}", h.display()))?;
     }
     Ok(())
 }

@@ -193,16 +193,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", exr.display()))?;
     }
     if let Some(path) = &a.heatmap {
-        let max = out
-            .samples
-            .pixels()
-            .iter()
-            .copied()
-            .max()
-            .unwrap_or(1)
-            .max(1);
-        let heat = out.samples.map(|&n| heat_colour(n as f32 / max as f32));
-        prism_image::write_png(path, &heat)
+        prism_image::write_png(path, &heatmap(&out.samples))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let write = t3.elapsed();
@@ -232,8 +223,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The sample-count heat map: blue for no samples, red for the most any pixel took.
+pub(crate) fn heatmap(samples: &prism_image::Image<u32>) -> prism_image::Rgb8Image {
+    let max = samples.pixels().iter().copied().max().unwrap_or(1).max(1);
+    samples.map(|&n| heat_colour(n as f32 / max as f32))
+}
+
 /// Blue (0) through cyan, green and yellow to red (1).
-pub(crate) fn heat_colour(t: f32) -> [u8; 3] {
+fn heat_colour(t: f32) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0) * 4.0;
     let (r, g, b) = match t {
         t if t < 1.0 => (0.0, t, 1.0),

@@ -110,6 +110,14 @@ fn positive(cx: &Cx, n: XmlNode, v: f64, what: &str) -> Result<f32, SceneError> 
 fn cgl_bsdf(cx: &Cx, b: XmlNode) -> Result<Option<Material>, SceneError> {
     let c = |name: &str| -> Result<Rgb, SceneError> { color3(cx, required(cx, b, name)?) };
     let s = |name: &str| -> Result<f64, SceneError> { scalar(cx, required(cx, b, name)?) };
+    let ior = || {
+        positive(
+            cx,
+            required(cx, b, "ior")?,
+            s("ior")?,
+            "index of refraction",
+        )
+    };
     Ok(Some(match b.tag_name().name() {
         "diffuse" => Material::Diffuse {
             reflectance: c("albedo").or_else(|_| c("reflectance"))?,
@@ -124,22 +132,12 @@ fn cgl_bsdf(cx: &Cx, b: XmlNode) -> Result<Option<Material>, SceneError> {
             reflectance: c("reflectance")?,
             transmittance: c("transmittance")?,
             roughness: s("roughness")? as f32,
-            ior: positive(
-                cx,
-                required(cx, b, "ior")?,
-                s("ior")?,
-                "index of refraction",
-            )?,
+            ior: ior()?,
         },
         "refraction" => Material::Refraction {
             transmittance: c("transmittance")?,
             roughness: s("roughness")? as f32,
-            ior: positive(
-                cx,
-                required(cx, b, "ior")?,
-                s("ior")?,
-                "index of refraction",
-            )?,
+            ior: ior()?,
         },
         "microfacet" => Material::Microfacet {
             alpha: positive(

@@ -845,36 +845,32 @@ fn read_mesh(
                         ));
                     }
                     face.push(v as u32);
+                    // The attribute index of this corner: its own input, or the vertex's.
+                    let index = |(o, src): (usize, &Source), what: &str| {
+                        let i = if o == usize::MAX {
+                            v
+                        } else {
+                            corner[o] as usize
+                        };
+                        if i < src.count {
+                            Ok(i)
+                        } else {
+                            Err(cx.err(
+                                p,
+                                format!("polygon {poly}: {what} index {i} is out of range (there are {})", src.count),
+                            ))
+                        }
+                    };
                     match inputs.normal {
-                        Some((o, s)) => {
-                            let i = if o == usize::MAX {
-                                v
-                            } else {
-                                corner[o] as usize
-                            };
-                            if i >= s.count {
-                                return Err(cx.err(
-                                    p,
-                                    format!("polygon {poly}: normal index {i} is out of range (there are {})", s.count),
-                                ));
-                            }
+                        Some(input) => {
+                            let (i, s) = (index(input, "normal")?, input.1);
                             corner_normals.push(DVec3::new(s.get(i, 0), s.get(i, 1), s.get(i, 2)));
                         }
                         None => all_normals = false,
                     }
                     match inputs.uv {
-                        Some((o, s)) => {
-                            let i = if o == usize::MAX {
-                                v
-                            } else {
-                                corner[o] as usize
-                            };
-                            if i >= s.count {
-                                return Err(cx.err(
-                                    p,
-                                    format!("polygon {poly}: texture coordinate index {i} is out of range (there are {})", s.count),
-                                ));
-                            }
+                        Some(input) => {
+                            let (i, s) = (index(input, "texture coordinate")?, input.1);
                             corner_uvs.push(DVec2::new(s.get(i, 0), s.get(i, 1)));
                         }
                         None => all_uvs = false,
