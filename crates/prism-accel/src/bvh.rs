@@ -71,7 +71,7 @@ pub struct BvhStats {
 
 /// A flattened 4-wide node: 128 bytes (two whole cache lines) holding its children's boxes in SIMD-friendly order
 /// (x minima of the four children, then y minima, ...). A child reference is a node index,
-/// or for a leaf `LEAF | start << 4 | (count - 1)`; unused slots hold empty boxes.
+/// or for a leaf `LEAF | index` into the leaf table; unused slots hold empty boxes.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node4 {
@@ -83,7 +83,7 @@ struct Node4 {
 }
 
 const LEAF: u32 = 1 << 31;
-/// Largest leaf a reference can encode (4 bits of count).
+/// Largest leaf the build makes, even when primitives cannot be separated.
 const MAX_LEAF_REF: usize = 16;
 
 /// A bounding volume hierarchy over triangles and spheres.

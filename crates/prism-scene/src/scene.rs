@@ -274,6 +274,7 @@ impl Scene {
         let mut effect_material: Vec<Option<usize>> = vec![None; doc.effects.len()];
         let mut default_material = None;
         let mut file_camera = None;
+        let mut warned_spot = false;
         for node in &doc.nodes {
             let world = up * node.world;
             for inst in &node.instances {
@@ -387,13 +388,14 @@ impl Scene {
                             LightKind::Ambient => {
                                 scene.lights.push(Light::Hemisphere { radiance: l.color })
                             }
-                            LightKind::Spot => {
-                                let key = "spot".to_string();
-                                let msg = format!("{file}:{}: spot lights are not rendered (the course's are black); skipped", l.line);
-                                if !scene.warnings.iter().any(|w| w.contains(&key)) {
-                                    scene.warnings.push(msg);
-                                }
+                            LightKind::Spot if !warned_spot => {
+                                warned_spot = true;
+                                scene.warnings.push(format!(
+                                    "{file}:{}: spot lights are not rendered (the course's are black); skipped",
+                                    l.line
+                                ));
                             }
+                            LightKind::Spot => {}
                         }
                     }
                     Instance::Camera(id) => {
