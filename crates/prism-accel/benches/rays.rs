@@ -7,7 +7,8 @@
 //!
 //! The mesh is `PRISM_RAYS_MESH` (.obj, .ply or .dae), by default the staged bunny
 //! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
-//! Each figure is the median of 5 runs.
+//! Each figure is the median of 5 runs. `PRISM_RAYS_QUICK=1` traces each set once on one
+//! thread, for instruction counts under `valgrind --tool=callgrind`.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -65,7 +66,11 @@ fn main() {
     );
     let tris = load(&path);
     let build = median(
-        (0..3)
+        (0..if std::env::var_os("PRISM_RAYS_QUICK").is_some() {
+            1
+        } else {
+            3
+        })
             .map(|_| {
                 let t = Instant::now();
                 std::hint::black_box(Bvh::build(&tris, &[], &BuildOptions::default()));
@@ -109,10 +114,15 @@ fn main() {
             Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
         })
         .collect();
+    let quick = std::env::var_os("PRISM_RAYS_QUICK").is_some();
+    let (thread_counts, n_runs): (&[usize], usize) = if quick { (&[1], 1) } else { (&[1, 2], 5) };
     for (kind, rays) in [("primary", &primary), ("random", &random)] {
-        for threads in [1, 2] {
-            trace(&bvh, &rays[..10_000], threads);
-            let runs: Vec<(Duration, f64)> = (0..5).map(|_| trace(&bvh, rays, threads)).collect();
+        for &threads in thread_counts {
+            if !quick {
+                trace(&bvh, &rays[..10_000], threads);
+            }
+            let runs: Vec<(Duration, f64)> =
+                (0..n_runs).map(|_| trace(&bvh, rays, threads)).collect();
             let hit = runs[0].1;
             let med = median(runs.iter().map(|r| r.0).collect());
             println!(

@@ -83,6 +83,11 @@ struct Node4 {
 }
 
 const LEAF: u32 = 1 << 31;
+/// In a leaf reference, bits 28 to 30 hold the number of triangle packs of a leaf with
+/// triangles only (the low bits are then its first pack); zero means the low bits index
+/// the leaf table.
+const PACKS_SHIFT: u32 = 28;
+const LOW_BITS: u32 = (1 << PACKS_SHIFT) - 1;
 /// Largest leaf the build makes, even when primitives cannot be separated.
 const MAX_LEAF_REF: usize = 16;
 
@@ -174,14 +179,20 @@ impl B3 {
 const BINS: usize = 16;
 
 /// A ray prepared for 4-wide slab tests: `t = (p - origin) * inv_dir`, each component
-/// broadcast to four lanes.
+/// broadcast to four lanes, and for each axis which bound of a box the ray meets first
+/// (`near[axis]` indexes `Node4::bounds`; `far[axis]` is the other one).
 struct SlabRay4 {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 impl SlabRay4 {
+    #[inline(always)]
     fn new(r: &RayPre) -> SlabRay4 {
+        let neg = |axis: usize| usize::from(r.inv_dir[axis].is_sign_negative());
+        let near = [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)];
         SlabRay4 {
             origin: [
                 Vec4::splat(r.origin.x),
@@ -193,6 +204,8 @@ impl SlabRay4 {
                 Vec4::splat(r.inv_dir.y),
                 Vec4::splat(r.inv_dir.z),
             ],
+            near,
+            far: [(near[0] + 3) % 6, (near[1] + 3) % 6, (near[2] + 3) % 6],
         }
     }
 }
@@ -348,6 +361,13 @@ impl Bvh {
             spheres: (count - tris.len()) as u16,
         };
         self.packs.extend(tris.chunks(4).map(Tri4::new));
+        assert!(
+            self.packs.len() <= LOW_BITS as usize && self.leaves.len() < LOW_BITS as usize,
+            "BVH over 2^30 triangles"
+        );
+        if rec.spheres == 0 && rec.packs < 8 {
+            return LEAF | u32::from(rec.packs) << PACKS_SHIFT | rec.pack_start;
+        }
         let spheres: Vec<u32> = prims.iter().copied().filter(|&p| p >= nt).collect();
         self.leaf_spheres.extend(spheres);
         self.leaves.push(rec);
@@ -377,23 +397,15 @@ impl Bvh {
     #[inline(always)]
     fn node_hit(n: &Node4, r: &SlabRay4, tmin: f32, tmax: f32) -> (Vec4, u32) {
         let b = &n.bounds;
-        let x0 = (b[0] - r.origin[0]) * r.inv_dir[0];
-        let x1 = (b[3] - r.origin[0]) * r.inv_dir[0];
-        let y0 = (b[1] - r.origin[1]) * r.inv_dir[1];
-        let y1 = (b[4] - r.origin[1]) * r.inv_dir[1];
-        let z0 = (b[2] - r.origin[2]) * r.inv_dir[2];
-        let z1 = (b[5] - r.origin[2]) * r.inv_dir[2];
-        // NaN (0 * inf, for a ray in a slab's plane) drops out of SSE min and max, which
-        // return their second operand then.
-        let near = x0
-            .min(x1)
-            .max(y0.min(y1))
-            .max(z0.min(z1))
-            .max(Vec4::splat(tmin));
+        let t = |bound: usize, axis: usize| (b[bound] - r.origin[axis]) * r.inv_dir[axis];
+        // A slab distance is NaN (0 * inf) for a ray lying in a slab's plane. SSE min and
+        // max return their second operand when either is NaN, so with the slab value first
+        // a NaN drops out and that slab does not cut the interval.
+        let near = t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))));
+        let far = t(r.far[2], 2).min(t(r.far[1], 1).min(t(r.far[0], 0).min(Vec4::INFINITY)));
         // Rounding in the slab test may shrink the interval by a few ulps; widening the far
         // end keeps hits on the box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-        let far = (x0.max(x1).min(y0.max(y1)).min(z0.max(z1)) * (1.0 + 2.0 * 3.0 * f32::EPSILON))
-            .min(Vec4::splat(tmax));
+        let far = (far * (1.0 + 2.0 * 3.0 * f32::EPSILON)).min(Vec4::splat(tmax));
         (near, near.cmple(far).bitmask() & n.used)
     }
 
@@ -409,7 +421,16 @@ impl Bvh {
         tmax: &mut f32,
         any: bool,
     ) -> Option<Hit> {
-        let rec = self.leaves[(r & !LEAF) as usize];
+        let in_ref = (r >> PACKS_SHIFT) & 7;
+        let rec = if in_ref != 0 {
+            LeafRec {
+                pack_start: r & LOW_BITS,
+                packs: in_ref as u16,
+                ..LeafRec::default()
+            }
+        } else {
+            self.leaves[(r & LOW_BITS) as usize]
+        };
         let mut best = None;
         let p0 = rec.pack_start as usize;
         for pack in &self.packs[p0..p0 + rec.packs as usize] {
@@ -456,43 +477,62 @@ impl Bvh {
         let mut best: Option<Hit> = None;
         let mut tmax = tmax;
         let mut stack = Stack::<(u32, f32)>::new();
-        stack.push(0, (0, tmin));
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let (node_ref, t_near) = stack.get(sp);
-            if t_near > tmax {
-                continue;
-            }
+        let mut sp = 0usize;
+        let mut node_ref = 0u32;
+        loop {
             if node_ref & LEAF != 0 {
                 if let Some(h) = self.leaf(node_ref, &r, ray, tmin, &mut tmax, false) {
                     best = Some(h);
                 }
-                continue;
-            }
-            let n = &self.nodes[node_ref as usize];
-            let (near, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
-            // Push the children entered, farthest first, so the nearest is popped next.
-            let near = near.to_array();
-            let mut hits = [(0u32, 0f32); 4];
-            let mut count = 0;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let mut j = count;
-                while j > 0 && hits[j - 1].1 < near[i] {
-                    hits[j] = hits[j - 1];
-                    j -= 1;
+            } else {
+                let n = &self.nodes[node_ref as usize];
+                let (near, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if mask == 0 {
+                        // One child entered: go on to it without the stack.
+                        node_ref = n.child[i];
+                        continue;
+                    }
+                    // Sort the children entered, nearest first; push all but the nearest,
+                    // farthest first, and go on to the nearest.
+                    let near = near.to_array();
+                    let mut hits = [(0u32, 0f32); 4];
+                    hits[0] = (n.child[i], near[i]);
+                    let mut count = 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let mut j = count;
+                        while j > 0 && hits[j - 1].1 > near[i] {
+                            hits[j] = hits[j - 1];
+                            j -= 1;
+                        }
+                        hits[j] = (n.child[i], near[i]);
+                        count += 1;
+                    }
+                    for k in (1..count).rev() {
+                        stack.push(sp, hits[k]);
+                        sp += 1;
+                    }
+                    node_ref = hits[0].0;
+                    continue;
                 }
-                hits[j] = (n.child[i], near[i]);
-                count += 1;
             }
-            for &h in &hits[..count] {
-                stack.push(sp, h);
-                sp += 1;
+            // Pop the nearest pending child that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    return best;
+                }
+                sp -= 1;
+                let (next, t_near) = stack.get(sp);
+                if t_near <= tmax {
+                    node_ref = next;
+                    break;
+                }
             }
         }
-        best
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
@@ -504,28 +544,36 @@ impl Bvh {
         let r = RayPre::new(ray);
         let slab = SlabRay4::new(&r);
         let mut stack = Stack::<u32>::new();
-        stack.push(0, 0);
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let node_ref = stack.get(sp);
+        let mut sp = 0usize;
+        let mut node_ref = 0u32;
+        loop {
             if node_ref & LEAF != 0 {
                 let mut t = tmax;
                 if self.leaf(node_ref, &r, ray, tmin, &mut t, true).is_some() {
                     return true;
                 }
-                continue;
+            } else {
+                let n = &self.nodes[node_ref as usize];
+                let (_, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+                if mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        let k = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack.push(sp, n.child[k]);
+                        sp += 1;
+                    }
+                    node_ref = n.child[i];
+                    continue;
+                }
             }
-            let n = &self.nodes[node_ref as usize];
-            let (_, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                stack.push(sp, n.child[i]);
-                sp += 1;
+            if sp == 0 {
+                return false;
             }
+            sp -= 1;
+            node_ref = stack.get(sp);
         }
-        false
     }
 }
 

@@ -1,13 +1,14 @@
 //! Four triangles tested against one ray at once: the watertight test of `shapes` on SIMD
 //! lanes.
 
-use prism_math::glam::{BVec4A, Vec4};
+use prism_math::glam::Vec4;
 use prism_math::Vec3;
 
 use crate::shapes::{intersect_triangle, RayPre};
 
 /// Four triangles in structure-of-arrays form: `v[i][axis]` holds coordinate `axis` of
-/// vertex `i` of the four triangles. Unused lanes hold degenerate triangles and never hit.
+/// vertex `i` of the four triangles. Unused lanes hold NaN vertices, which fail every
+/// comparison of the test, so they never hit.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
 pub(crate) struct Tri4 {
@@ -20,7 +21,7 @@ impl Tri4 {
     /// Packs up to four triangles with their primitive numbers.
     pub(crate) fn new(tris: &[([Vec3; 3], u32)]) -> Tri4 {
         debug_assert!(tris.len() <= 4);
-        let mut v = [[Vec4::ZERO; 3]; 3];
+        let mut v = [[Vec4::NAN; 3]; 3];
         let mut prim = [u32::MAX; 4];
         for (lane, (t, p)) in tris.iter().enumerate() {
             for (i, vertex) in t.iter().enumerate() {
@@ -64,13 +65,7 @@ impl Tri4 {
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
         let zero = Vec4::ZERO;
-        let used = BVec4A::new(
-            self.prim[0] != u32::MAX,
-            self.prim[1] != u32::MAX,
-            self.prim[2] != u32::MAX,
-            self.prim[3] != u32::MAX,
-        );
-        let any_zero = (u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero)) & used;
+        let any_zero = u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero);
         if any_zero.any() {
             // An edge function is exactly zero in single precision: decide these lanes with
             // the scalar test, which recomputes them in double precision.
@@ -80,11 +75,11 @@ impl Tri4 {
         let pos = u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero);
         let det = u + v + w;
         let t = sz * (u * az + v * bz + w * cz) * (Vec4::ONE / det);
+        // NaN lanes: `t` is NaN, so its comparisons are false.
         let hit = !(neg & pos)
             & det.cmpne(zero)
             & t.cmpgt(Vec4::splat(tmin))
-            & t.cmplt(Vec4::splat(tmax))
-            & used;
+            & t.cmplt(Vec4::splat(tmax));
         let mut mask = hit.bitmask();
         if mask == 0 {
             return None;

@@ -171,3 +171,67 @@ fn build_is_deterministic_and_stats_add_up() {
         );
     }
 }
+
+/// Oracle: brute force. Axis-aligned squares on an integer grid give flat boxes, and
+/// axis-aligned rays (zero and negative-zero direction components) starting on box planes
+/// make slab distances of 0 * inf; the BVH must still find exactly the brute-force hits.
+#[test]
+fn axis_aligned_rays_on_box_planes_match_brute_force() {
+    let mut tris = vec![];
+    for i in 0..6 {
+        for j in 0..6 {
+            let (x, y) = (i as f32, j as f32);
+            let z = ((i * 7 + j * 3) % 5) as f32;
+            let quad = [
+                Vec3::new(x, y, z),
+                Vec3::new(x + 1.0, y, z),
+                Vec3::new(x + 1.0, y + 1.0, z),
+                Vec3::new(x, y + 1.0, z),
+            ];
+            // Alternate the plane the square lies in.
+            let quad = quad.map(|p| match (i + j) % 3 {
+                0 => p,
+                1 => Vec3::new(p.z, p.x, p.y),
+                _ => Vec3::new(p.y, p.z, p.x),
+            });
+            tris.push([quad[0], quad[1], quad[2]]);
+            tris.push([quad[0], quad[2], quad[3]]);
+        }
+    }
+    let bvh = Bvh::build(
+        &tris,
+        &[],
+        &BuildOptions {
+            max_leaf: 2,
+            ..BuildOptions::default()
+        },
+    );
+    let dirs = [
+        Vec3::X,
+        -Vec3::X,
+        Vec3::Y,
+        -Vec3::Y,
+        Vec3::Z,
+        -Vec3::Z,
+        Vec3::new(1.0, -0.0, 0.0),
+        Vec3::new(-0.0, 1.0, -0.0),
+        Vec3::new(0.0, -0.0, -1.0),
+    ];
+    let mut checked = 0;
+    for a in -1..8 {
+        for b in -1..8 {
+            for c in -1..8 {
+                let o = Vec3::new(a as f32 * 0.5, b as f32, c as f32 * 0.75);
+                for d in dirs {
+                    let ray = Ray::new(o, d);
+                    let want = brute_force(&tris, &[], &ray, f32::INFINITY);
+                    let got = bvh.intersect(&ray, 0.0, f32::INFINITY);
+                    assert_eq!(want.map(|h| h.t), got.map(|h| h.t), "ray {o} {d}");
+                    assert_eq!(bvh.occluded(&ray, 0.0, f32::INFINITY), want.is_some());
+                    checked += usize::from(want.is_some());
+                }
+            }
+        }
+    }
+    assert!(checked > 500, "only {checked} rays hit");
+}
