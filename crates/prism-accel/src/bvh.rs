@@ -1,6 +1,7 @@
-use prism_math::glam::{Vec3A, Vec4};
+use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
 
+use crate::node8::{self, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
 use crate::tri4::Tri4;
 
@@ -69,19 +70,6 @@ pub struct BvhStats {
     pub bytes: usize,
 }
 
-/// A flattened 4-wide node: 128 bytes (two whole cache lines) holding its children's boxes in SIMD-friendly order
-/// (x minima of the four children, then y minima, ...). A child reference is a node index,
-/// or for a leaf `LEAF | index` into the leaf table; unused slots hold empty boxes.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct Node4 {
-    bounds: [Vec4; 6],
-    child: [u32; 4],
-    /// Bit i is set when slot i holds a child.
-    used: u32,
-    _pad: [u32; 3],
-}
-
 const LEAF: u32 = 1 << 31;
 /// In a leaf reference, bits 28 to 30 hold the number of triangle packs of a leaf with
 /// triangles only (the low bits are then its first pack); zero means the low bits index
@@ -94,7 +82,7 @@ const MAX_LEAF_REF: usize = 16;
 /// A bounding volume hierarchy over triangles and spheres.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<Node8>,
     /// Primitive numbers in leaf order.
     order: Vec<u32>,
     /// Triangles in packs of four, leaf by leaf.
@@ -178,42 +166,10 @@ impl B3 {
 
 const BINS: usize = 16;
 
-/// A ray prepared for 4-wide slab tests: `t = (p - origin) * inv_dir`, each component
-/// broadcast to four lanes, and for each axis which bound of a box the ray meets first
-/// (`near[axis]` indexes `Node4::bounds`; `far[axis]` is the other one).
-struct SlabRay4 {
-    origin: [Vec4; 3],
-    inv_dir: [Vec4; 3],
-    near: [usize; 3],
-    far: [usize; 3],
-}
-
-impl SlabRay4 {
-    #[inline(always)]
-    fn new(r: &RayPre) -> SlabRay4 {
-        let neg = |axis: usize| usize::from(r.inv_dir[axis].is_sign_negative());
-        let near = [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)];
-        SlabRay4 {
-            origin: [
-                Vec4::splat(r.origin.x),
-                Vec4::splat(r.origin.y),
-                Vec4::splat(r.origin.z),
-            ],
-            inv_dir: [
-                Vec4::splat(r.inv_dir.x),
-                Vec4::splat(r.inv_dir.y),
-                Vec4::splat(r.inv_dir.z),
-            ],
-            near,
-            far: [(near[0] + 3) % 6, (near[1] + 3) % 6, (near[2] + 3) % 6],
-        }
-    }
-}
-
 /// Depth after which splits are by median, so that no tree is deeper than this plus 32
 /// and the traversal stacks below cannot overflow.
 const MEDIAN_DEPTH: usize = 64;
-const STACK: usize = 3 * (MEDIAN_DEPTH + 34) + 4;
+const STACK: usize = 7 * (MEDIAN_DEPTH + 34) + 8;
 
 impl Bvh {
     /// Builds the hierarchy. Degenerate triangles (zero area or non-finite) and spheres with
@@ -266,7 +222,7 @@ impl Bvh {
             match &root {
                 BuildNode::Leaf { .. } => {
                     // A lone leaf still sits under a node.
-                    let mut n = Node4::empty();
+                    let mut n = Node8::empty();
                     let r = bvh.make_leaf(&root, triangles);
                     n.set(0, root_bounds(&root), r);
                     bvh.nodes.push(n);
@@ -278,7 +234,7 @@ impl Bvh {
         }
         bvh.stats.primitives = ids.len();
         bvh.stats.nodes = bvh.nodes.len();
-        bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node4>()
+        bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node8>()
             + bvh.packs.len() * std::mem::size_of::<Tri4>()
             + bvh.leaves.len() * std::mem::size_of::<LeafRec>()
             + bvh.leaf_spheres.len() * 4
@@ -287,7 +243,7 @@ impl Bvh {
         bvh
     }
 
-    /// Leaf count, depth and SAH cost of the binary tree the 4-wide one is collapsed from.
+    /// Leaf count, depth and SAH cost of the binary tree the 8-wide one is collapsed from.
     fn statistics(&mut self, n: &BuildNode, depth: usize, root_area: f32, trav: f32) {
         match n {
             BuildNode::Leaf { bounds, count, .. } => {
@@ -304,15 +260,15 @@ impl Bvh {
         }
     }
 
-    /// Flattens an interior binary node and its subtree into 4-wide nodes: each takes up to
-    /// four descendants, opening the interior child of largest area first. Returns the
+    /// Flattens an interior binary node and its subtree into 8-wide nodes: each takes up to
+    /// eight descendants, opening the interior child of largest area first. Returns the
     /// node's index.
     fn collapse(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]]) -> u32 {
         let mut kids: Vec<&BuildNode> = match n {
             BuildNode::Interior { children, .. } => vec![&children[0], &children[1]],
             BuildNode::Leaf { .. } => vec![n],
         };
-        while kids.len() < 4 {
+        while kids.len() < 8 {
             let widest = kids
                 .iter()
                 .enumerate()
@@ -331,7 +287,7 @@ impl Bvh {
             kids.insert(i + 1, &children[1]);
         }
         let index = self.nodes.len();
-        self.nodes.push(Node4::empty());
+        self.nodes.push(Node8::empty());
         for (slot, k) in kids.into_iter().enumerate() {
             let r = match k {
                 BuildNode::Leaf { .. } => self.make_leaf(k, triangles),
@@ -393,20 +349,16 @@ impl Bvh {
         self.triangle_count
     }
 
-    /// Entry distances of the ray into a node's four child boxes, and which it enters.
+    /// Entry distances of the ray into a node's eight child boxes, and which it enters.
     #[inline(always)]
-    fn node_hit(n: &Node4, r: &SlabRay4, tmin: f32, tmax: f32) -> (Vec4, u32) {
-        let b = &n.bounds;
-        let t = |bound: usize, axis: usize| (b[bound] - r.origin[axis]) * r.inv_dir[axis];
-        // A slab distance is NaN (0 * inf) for a ray lying in a slab's plane. SSE min and
-        // max return their second operand when either is NaN, so with the slab value first
-        // a NaN drops out and that slab does not cut the interval.
-        let near = t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))));
-        let far = t(r.far[2], 2).min(t(r.far[1], 1).min(t(r.far[0], 0).min(Vec4::INFINITY)));
-        // Rounding in the slab test may shrink the interval by a few ulps; widening the far
-        // end keeps hits on the box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-        let far = (far * (1.0 + 2.0 * 3.0 * f32::EPSILON)).min(Vec4::splat(tmax));
-        (near, near.cmple(far).bitmask() & n.used)
+    fn node_hit<const AVX: bool>(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: `AVX` is true only in the traversals `intersect` and `occluded` call
+            // after detecting AVX.
+            return unsafe { node8::hit_avx(n, r, tmin, tmax) };
+        }
+        node8::hit_sse(n, r, tmin, tmax)
     }
 
     /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
@@ -472,8 +424,28 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.intersect_avx(ray, tmin, tmax) };
+        }
+        self.intersect_with::<false>(ray, tmin, tmax)
+    }
+
+    /// [`Bvh::intersect`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.intersect_with::<true>(ray, tmin, tmax)
+    }
+
+    #[inline(always)]
+    fn intersect_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
         let r = RayPre::new(ray);
-        let slab = SlabRay4::new(&r);
+        let slab = SlabRay::new(&r);
         let mut best: Option<Hit> = None;
         let mut tmax = tmax;
         let mut stack = Stack::<(u32, f32)>::new();
@@ -486,7 +458,7 @@ impl Bvh {
                 }
             } else {
                 let n = &self.nodes[node_ref as usize];
-                let (near, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+                let (near, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
                 if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -497,8 +469,7 @@ impl Bvh {
                     }
                     // Sort the children entered, nearest first; push all but the nearest,
                     // farthest first, and go on to the nearest.
-                    let near = near.to_array();
-                    let mut hits = [(0u32, 0f32); 4];
+                    let mut hits = [(0u32, 0f32); 8];
                     hits[0] = (n.child[i], near[i]);
                     let mut count = 1;
                     while mask != 0 {
@@ -541,8 +512,28 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.occluded_avx(ray, tmin, tmax) };
+        }
+        self.occluded_with::<false>(ray, tmin, tmax)
+    }
+
+    /// [`Bvh::occluded`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+        self.occluded_with::<true>(ray, tmin, tmax)
+    }
+
+    #[inline(always)]
+    fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
         let r = RayPre::new(ray);
-        let slab = SlabRay4::new(&r);
+        let slab = SlabRay::new(&r);
         let mut stack = Stack::<u32>::new();
         let mut sp = 0usize;
         let mut node_ref = 0u32;
@@ -554,7 +545,7 @@ impl Bvh {
                 }
             } else {
                 let n = &self.nodes[node_ref as usize];
-                let (_, mut mask) = Self::node_hit(n, &slab, tmin, tmax);
+                let (_, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
                 if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -602,33 +593,6 @@ impl<T: Copy> Stack<T> {
         // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
         // passes the highest slot written), so it holds an initialized value.
         unsafe { self.items[i].assume_init() }
-    }
-}
-
-impl Node4 {
-    fn empty() -> Node4 {
-        Node4 {
-            bounds: [
-                Vec4::splat(f32::INFINITY),
-                Vec4::splat(f32::INFINITY),
-                Vec4::splat(f32::INFINITY),
-                Vec4::splat(f32::NEG_INFINITY),
-                Vec4::splat(f32::NEG_INFINITY),
-                Vec4::splat(f32::NEG_INFINITY),
-            ],
-            child: [u32::MAX; 4],
-            used: 0,
-            _pad: [0; 3],
-        }
-    }
-
-    fn set(&mut self, slot: usize, b: Aabb, child: u32) {
-        for axis in 0..3 {
-            self.bounds[axis][slot] = b.min[axis];
-            self.bounds[3 + axis][slot] = b.max[axis];
-        }
-        self.child[slot] = child;
-        self.used |= 1 << slot;
     }
 }
 
@@ -767,4 +731,51 @@ fn partition(ids: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
         }
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_math::Pcg32;
+
+    /// Property: the AVX and SSE node tests are the same computation, so both traversals
+    /// return bit-identical hits (checked on random rays, and on axis-aligned rays, whose
+    /// slab distances include NaN).
+    #[test]
+    fn avx_and_sse_traversals_agree() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            let mut rng = Pcg32::new(5, 6);
+            let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let tris: Vec<[Vec3; 3]> = (0..3000)
+                .map(|_| {
+                    let a = r() * 8.0;
+                    [a, a + r() * 0.5, a + r() * 0.5]
+                })
+                .collect();
+            let spheres = [Sphere {
+                center: Vec3::splat(4.0),
+                radius: 0.7,
+            }];
+            let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+            let mut hits = 0;
+            for k in 0..20_000 {
+                let o = r() * 10.0 - 1.0;
+                let d = if k % 4 == 0 {
+                    [Vec3::X, -Vec3::Y, Vec3::Z][k % 3]
+                } else {
+                    r() - 0.5
+                };
+                let ray = Ray::new(o.floor(), d);
+                // SAFETY: AVX was detected above.
+                let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
+                assert_eq!(avx, bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY));
+                // SAFETY: as above.
+                let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
+                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0));
+                hits += usize::from(avx.is_some());
+            }
+            assert!(hits > 2000, "{hits} hits");
+        }
+    }
 }

@@ -5,7 +5,8 @@
 //!   a shared edge or vertex of a closed mesh hits at least one of the triangles.
 //! - The BVH is built top-down with a binned surface area heuristic (16 bins on each axis,
 //!   leaves costed in packs of four triangles), in parallel above a size threshold, then
-//!   collapsed into 4-wide nodes whose four child boxes are tested at once with SIMD. Leaf
+//!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD (AVX
+//!   when the processor has it, else two SSE halves). Leaf
 //!   triangles are stored in packs of four, also tested at once. The layout is a pure
 //!   function of the input, whatever the thread count.
 //! - [`Bvh::intersect`] finds the closest hit, visiting the nearer child first;
@@ -13,6 +14,7 @@
 #![warn(missing_docs)]
 
 mod bvh;
+mod node8;
 mod shapes;
 mod tri4;
 

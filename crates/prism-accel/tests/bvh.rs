@@ -159,7 +159,8 @@ fn build_is_deterministic_and_stats_add_up() {
     let b = Bvh::build(&tris, &[], &opts);
     assert_eq!(a.stats(), b.stats());
     let s = a.stats();
-    assert!(s.nodes < s.leaves && s.nodes >= s.leaves / 4);
+    // An 8-wide tree: every node holds at most eight children.
+    assert!(s.nodes < s.leaves && 7 * s.nodes + 1 >= s.leaves);
     assert_eq!(s.primitives, 20_000);
     assert!(s.depth < 64 && s.sah_cost > 0.0);
     for k in 0..1000 {

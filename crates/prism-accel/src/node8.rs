@@ -1,0 +1,151 @@
+//! The 8-wide BVH node and the ray-box test of its eight children: with 256-bit AVX
+//! instructions when the processor has them, else as two 4-wide SSE halves. Both compute the
+//! same operations in the same order, so they enter the same children with the same
+//! distances and traversal is identical either way.
+
+use prism_math::glam::Vec4;
+use prism_math::Aabb;
+
+use crate::shapes::RayPre;
+
+/// A flattened 8-wide node: 256 bytes (four whole cache lines). `bounds[plane]` holds one
+/// plane of the eight child boxes (planes: x, y, z minima, then x, y, z maxima) as two
+/// halves of four lanes. A child reference is a node index or a leaf reference; unused
+/// slots hold empty boxes and are left out of `used`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Node8 {
+    bounds: [[Vec4; 2]; 6],
+    pub(crate) child: [u32; 8],
+    /// Bit i is set when slot i holds a child.
+    used: u32,
+    _pad: [u32; 7],
+}
+
+impl Node8 {
+    /// A node with no children.
+    pub(crate) fn empty() -> Node8 {
+        let inf = [Vec4::INFINITY; 2];
+        let neg = [Vec4::NEG_INFINITY; 2];
+        Node8 {
+            bounds: [inf, inf, inf, neg, neg, neg],
+            child: [u32::MAX; 8],
+            used: 0,
+            _pad: [0; 7],
+        }
+    }
+
+    /// Puts a child with box `b` in `slot`.
+    pub(crate) fn set(&mut self, slot: usize, b: Aabb, child: u32) {
+        let (half, lane) = (slot / 4, slot % 4);
+        for axis in 0..3 {
+            self.bounds[axis][half][lane] = b.min[axis];
+            self.bounds[3 + axis][half][lane] = b.max[axis];
+        }
+        self.child[slot] = child;
+        self.used |= 1 << slot;
+    }
+}
+
+/// A ray prepared for slab tests, `t = (p - origin) * inv_dir`: for each axis, the plane of
+/// a box the ray meets first (`near[axis]` indexes `Node8::bounds`; `far[axis]` is the
+/// other one).
+pub(crate) struct SlabRay {
+    origin: [f32; 3],
+    inv_dir: [f32; 3],
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl SlabRay {
+    #[inline(always)]
+    pub(crate) fn new(r: &RayPre) -> SlabRay {
+        let neg = |axis: usize| usize::from(r.inv_dir[axis].is_sign_negative());
+        let near = [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)];
+        SlabRay {
+            origin: r.origin.to_array(),
+            inv_dir: r.inv_dir.to_array(),
+            near,
+            far: [3 * (1 - neg(0)), 1 + 3 * (1 - neg(1)), 2 + 3 * (1 - neg(2))],
+        }
+    }
+}
+
+/// Rounding in the slab test may shrink the interval by a few ulps; widening the far end by
+/// this factor keeps hits on box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
+const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
+
+/// Entry distances of the ray into the eight child boxes, and which it enters (with an entry
+/// in `[tmin, tmax]`), by 4-wide SSE halves.
+///
+/// A slab distance is NaN (0 * inf) for a ray lying in a slab's plane. SSE and AVX min and
+/// max return their second operand when either is NaN, so with the slab value first a NaN
+/// drops out and that slab does not cut the interval.
+#[inline(always)]
+pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+    let mut near_out = [0f32; 8];
+    let mut mask = 0;
+    for half in 0..2 {
+        let t = |plane: usize, axis: usize| {
+            (n.bounds[plane][half] - Vec4::splat(r.origin[axis])) * Vec4::splat(r.inv_dir[axis])
+        };
+        let near = t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))));
+        let far = t(r.far[2], 2).min(t(r.far[1], 1).min(t(r.far[0], 0).min(Vec4::INFINITY)));
+        let far = (far * FAR_WIDEN).min(Vec4::splat(tmax));
+        near_out[4 * half..4 * half + 4].copy_from_slice(&near.to_array());
+        mask |= near.cmple(far).bitmask() << (4 * half);
+    }
+    (near_out, mask & n.used)
+}
+
+/// [`hit_sse`] with 256-bit AVX instructions: the same operations in the same order.
+///
+/// # Safety
+/// The processor must support AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline]
+pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+    use std::arch::x86_64::{
+        _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ,
+    };
+    // SAFETY: `bounds[plane]` is 32 bytes at a 32-byte aligned offset of a 64-byte aligned
+    // node, as `_mm256_load_ps` requires; the store writes eight floats into an array of
+    // eight.
+    unsafe {
+        macro_rules! t {
+            ($plane:expr, $axis:expr) => {
+                _mm256_mul_ps(
+                    _mm256_sub_ps(
+                        _mm256_load_ps(n.bounds[$plane].as_ptr().cast::<f32>()),
+                        _mm256_set1_ps(r.origin[$axis]),
+                    ),
+                    _mm256_set1_ps(r.inv_dir[$axis]),
+                )
+            };
+        }
+        let near = _mm256_max_ps(
+            t!(r.near[2], 2),
+            _mm256_max_ps(
+                t!(r.near[1], 1),
+                _mm256_max_ps(t!(r.near[0], 0), _mm256_set1_ps(tmin)),
+            ),
+        );
+        let far = _mm256_min_ps(
+            t!(r.far[2], 2),
+            _mm256_min_ps(
+                t!(r.far[1], 1),
+                _mm256_min_ps(t!(r.far[0], 0), _mm256_set1_ps(f32::INFINITY)),
+            ),
+        );
+        let far = _mm256_min_ps(
+            _mm256_mul_ps(far, _mm256_set1_ps(FAR_WIDEN)),
+            _mm256_set1_ps(tmax),
+        );
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
+        let mut near_out = [0f32; 8];
+        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        (near_out, mask & n.used)
+    }
+}
