@@ -46,27 +46,25 @@ pub(crate) const PERMS: [[usize; 3]; 6] = [
 impl RayPre {
     /// Precomputes the shear that maps the ray to the +z axis.
     #[must_use]
+    #[inline]
     pub fn new(ray: &Ray) -> RayPre {
         let d = ray.dir;
         let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
+        // The dominant axis, without branches (ties go to the lower axis).
+        let x_wins = (a.x >= a.y) & (a.x >= a.z);
+        let kz = usize::from(!x_wins) * (2 - usize::from(a.y >= a.z));
+        let da = d.to_array();
         // Keep the winding: swap kx and ky when the dominant component is negative.
-        let perm = 2 * kz + usize::from(d[kz] < 0.0);
+        let perm = 2 * kz + usize::from(da[kz] < 0.0);
         let [kx, ky, kz] = PERMS[perm];
         let inv_dir = d.recip();
-        let inv_z = inv_dir[kz];
+        let inv_z = 1.0 / da[kz];
         RayPre {
             origin: ray.origin,
             dir: d,
             inv_dir,
             perm,
-            shear: Vec3::new(d[kx] * inv_z, d[ky] * inv_z, inv_z),
+            shear: Vec3::new(da[kx] * inv_z, da[ky] * inv_z, inv_z),
         }
     }
 
