@@ -99,12 +99,13 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
 }
 
 /// [`hit_sse`] with 256-bit AVX instructions: the same operations in the same order.
+/// Inlined into the callers compiled for AVX (a `target_feature` function could not be
+/// inlined always, and a call per node costs a tenth of the traversal).
 ///
 /// # Safety
 /// The processor must support AVX.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-#[inline]
+#[inline(always)]
 pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
     use std::arch::x86_64::{
         _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
