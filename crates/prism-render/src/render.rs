@@ -48,7 +48,8 @@ pub struct RenderOptions {
     pub adaptive: Option<f32>,
     /// Samples between convergence checks.
     pub batch: u32,
-    /// Path depth (in bounces) from which Russian roulette may end paths.
+    /// Russian roulette may end a path once it has this many bounces: after the BSDF sample
+    /// at that surface, before its ray is traced (Mitsuba's `rr_depth`, default 5).
     pub rr_bounces: u32,
     /// Seed of every random number.
     pub seed: u64,
@@ -66,7 +67,7 @@ impl Default for RenderOptions {
             only_bounce: None,
             adaptive: None,
             batch: 32,
-            rr_bounces: 4,
+            rr_bounces: 5,
             seed: 0,
         }
     }
@@ -360,6 +361,14 @@ fn path(
         if beta.max_channel() <= 0.0 {
             break;
         }
+        // Russian roulette, decided before the ray is traced (Mitsuba's rule and depth).
+        if bounce >= opts.rr_bounces {
+            let q = beta.max_channel().min(0.95);
+            if sampler.next_1d() >= q {
+                break;
+            }
+            beta *= 1.0 / q;
+        }
         let next = spawn(hit.p, hit.ng, wi);
         let nlights = opts.light_samples.max(1) as f32;
         match scene.intersect(&next) {
@@ -390,13 +399,6 @@ fn path(
                 hit = h;
                 wo = -wi;
             }
-        }
-        if bounce >= opts.rr_bounces {
-            let q = beta.max_channel().min(0.95);
-            if sampler.next_1d() >= q {
-                break;
-            }
-            beta *= 1.0 / q;
         }
     }
     l
