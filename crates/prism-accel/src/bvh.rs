@@ -264,31 +264,44 @@ impl Bvh {
     /// eight descendants, opening the interior child of largest area first. Returns the
     /// node's index.
     fn collapse(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]], order: &[u32]) -> u32 {
-        let mut kids: Vec<&BuildNode> = match n {
-            BuildNode::Interior { children, .. } => vec![&children[0], &children[1]],
-            BuildNode::Leaf { .. } => vec![n],
+        let mut kids: [&BuildNode; 8] = [n; 8];
+        let mut area = [0f32; 8];
+        let mut len = 1;
+        if let BuildNode::Interior { children, .. } = n {
+            kids[0] = &children[0];
+            kids[1] = &children[1];
+            len = 2;
+        }
+        let interior_area = |k: &BuildNode| match k {
+            BuildNode::Interior { bounds, .. } => bounds.surface_area(),
+            BuildNode::Leaf { .. } => f32::NEG_INFINITY,
         };
-        while kids.len() < 8 {
-            let widest = kids
-                .iter()
-                .enumerate()
-                .filter(|(_, k)| matches!(k, BuildNode::Interior { .. }))
-                .max_by(|a, b| {
-                    root_bounds(a.1)
-                        .surface_area()
-                        .total_cmp(&root_bounds(b.1).surface_area())
-                })
-                .map(|(i, _)| i);
+        for i in 0..len {
+            area[i] = interior_area(kids[i]);
+        }
+        while len < 8 {
+            // The interior child of largest area (the first of equals).
+            let mut widest = None;
+            for i in 0..len {
+                if area[i] > f32::NEG_INFINITY && widest.is_none_or(|w: usize| area[i] > area[w]) {
+                    widest = Some(i);
+                }
+            }
             let Some(i) = widest else { break };
             let BuildNode::Interior { children, .. } = kids[i] else {
-                unreachable!("filtered to interior nodes")
+                unreachable!("only interior children have a finite area here")
             };
+            kids.copy_within(i + 1..len, i + 2);
+            area.copy_within(i + 1..len, i + 2);
             kids[i] = &children[0];
-            kids.insert(i + 1, &children[1]);
+            kids[i + 1] = &children[1];
+            area[i] = interior_area(kids[i]);
+            area[i + 1] = interior_area(kids[i + 1]);
+            len += 1;
         }
         let index = self.nodes.len();
         self.nodes.push(Node8::empty());
-        for (slot, k) in kids.into_iter().enumerate() {
+        for (slot, &k) in kids[..len].iter().enumerate() {
             let r = match k {
                 BuildNode::Leaf { .. } => self.make_leaf(k, triangles, order),
                 BuildNode::Interior { .. } => self.collapse(k, triangles, order),
@@ -305,18 +318,19 @@ impl Bvh {
         };
         let nt = self.triangle_count;
         let prims = &order[start..start + count];
-        let tris: Vec<([Vec3; 3], u32)> = prims
-            .iter()
-            .filter(|&&p| p < nt)
-            .map(|&p| (triangles[p as usize], p))
-            .collect();
+        let mut tris = [([Vec3::ZERO; 3], 0u32); MAX_LEAF_REF];
+        let mut nt_leaf = 0;
+        for &p in prims.iter().filter(|&&p| p < nt) {
+            tris[nt_leaf] = (triangles[p as usize], p);
+            nt_leaf += 1;
+        }
         let rec = LeafRec {
             pack_start: self.packs.len() as u32,
             sphere_start: self.leaf_spheres.len() as u32,
-            packs: tris.len().div_ceil(4) as u16,
-            spheres: (count - tris.len()) as u16,
+            packs: nt_leaf.div_ceil(4) as u16,
+            spheres: (count - nt_leaf) as u16,
         };
-        self.packs.extend(tris.chunks(4).map(Tri4::new));
+        self.packs.extend(tris[..nt_leaf].chunks(4).map(Tri4::new));
         assert!(
             self.packs.len() <= LOW_BITS as usize && self.leaves.len() < LOW_BITS as usize,
             "BVH over 2^30 triangles"
@@ -324,8 +338,8 @@ impl Bvh {
         if rec.spheres == 0 && rec.packs < 8 {
             return LEAF | u32::from(rec.packs) << PACKS_SHIFT | rec.pack_start;
         }
-        let spheres: Vec<u32> = prims.iter().copied().filter(|&p| p >= nt).collect();
-        self.leaf_spheres.extend(spheres);
+        self.leaf_spheres
+            .extend(prims.iter().copied().filter(|&p| p >= nt));
         self.leaves.push(rec);
         LEAF | (self.leaves.len() - 1) as u32
     }
