@@ -243,6 +243,9 @@ impl Bvh {
         if let Some(root) = root {
             let root_area = root_bounds(&root).surface_area().max(f32::MIN_POSITIVE);
             bvh.statistics(&root, 0, root_area, opts.traversal_cost);
+            bvh.packs.reserve_exact(pack_count(&root));
+            // About one 8-wide node per seven leaves.
+            bvh.nodes.reserve(bvh.stats.leaves / 7 + 1);
             bvh.bounds = root_bounds(&root);
             match &root {
                 BuildNode::Leaf { .. } => {
@@ -661,6 +664,14 @@ impl<T: Copy> Stack<T> {
     }
 }
 
+/// Packs of four the leaves under `n` need at most (spheres counted as triangles).
+fn pack_count(n: &BuildNode) -> usize {
+    match n {
+        BuildNode::Leaf { count, .. } => count.div_ceil(4),
+        BuildNode::Interior { children, .. } => pack_count(&children[0]) + pack_count(&children[1]),
+    }
+}
+
 fn root_bounds(n: &BuildNode) -> Aabb {
     match n {
         BuildNode::Leaf { bounds, .. } | BuildNode::Interior { bounds, .. } => *bounds,
@@ -695,13 +706,13 @@ fn build_node(
         Vec3A::splat(BINS as f32) / extent,
         Vec3A::ZERO,
     );
-    let bin_of = |p: &PrimRef| ((p.centroid2() - cb.min) * scale).to_array();
+    let bin_of = |p: &PrimRef| bins((p.centroid2() - cb.min) * scale);
     let mut counts = [[0u32; BINS]; 3];
     let mut boxes = [[B3::EMPTY; BINS]; 3];
     for p in prims.iter() {
         let bin = bin_of(p);
         for axis in 0..3 {
-            let k = (bin[axis] as usize).min(BINS - 1);
+            let k = bin[axis];
             counts[axis][k] += 1;
             boxes[axis][k] = boxes[axis][k].union(p.bounds);
         }
@@ -711,26 +722,33 @@ fn build_node(
         if extent[axis] <= 0.0 {
             continue;
         }
+        // Only non-empty bins matter: every split between two of them gives the same
+        // sides, and the first such split is kept, as a sweep over all bins would.
+        let mut full = [0usize; BINS];
+        let mut m = 0;
+        for (b, &count) in counts[axis].iter().enumerate() {
+            if count > 0 {
+                full[m] = b;
+                m += 1;
+            }
+        }
         // Sweep from the right, then from the left.
         let mut right_area = [0f32; BINS];
         let mut right_count = [0u32; BINS];
         let (mut acc, mut c) = (B3::EMPTY, 0);
-        for b in (1..BINS).rev() {
-            acc = acc.union(boxes[axis][b]);
-            c += counts[axis][b];
-            right_area[b] = acc.area();
-            right_count[b] = c;
+        for i in (1..m).rev() {
+            acc = acc.union(boxes[axis][full[i]]);
+            c += counts[axis][full[i]];
+            right_area[i] = acc.area();
+            right_count[i] = c;
         }
         let (mut acc, mut c) = (B3::EMPTY, 0);
-        for b in 1..BINS {
-            acc = acc.union(boxes[axis][b - 1]);
-            c += counts[axis][b - 1];
-            if c == 0 || right_count[b] == 0 {
-                continue;
-            }
-            let cost = acc.area() * packs(c) + right_area[b] * packs(right_count[b]);
+        for i in 1..m {
+            acc = acc.union(boxes[axis][full[i - 1]]);
+            c += counts[axis][full[i - 1]];
+            let cost = acc.area() * packs(c) + right_area[i] * packs(right_count[i]);
             if best.is_none_or(|(bc, _, _)| cost < bc) {
-                best = Some((cost, axis, b));
+                best = Some((cost, axis, full[i - 1] + 1));
             }
         }
     }
@@ -755,7 +773,7 @@ fn build_node(
     if let Some((axis, split)) = split {
         for j in 0..n {
             let p = prims[j];
-            let left = ((bin_of(&p)[axis] as usize).min(BINS - 1) < split) as usize;
+            let left = usize::from(bin_of(&p)[axis] < split);
             let side = &mut sides[1 - left];
             side.0 = side.0.union(p.bounds);
             side.1 = side.1.grow(p.centroid2());
@@ -790,6 +808,26 @@ fn build_node(
     BuildNode::Interior {
         bounds,
         children: Box::new([a, b]),
+    }
+}
+
+/// The bins (`0..BINS`) of scaled centroid offsets on the three axes: the integer parts,
+/// with NaN taken as 0 and anything past the last bin put in it.
+#[inline(always)]
+fn bins(scaled: Vec3A) -> [usize; 3] {
+    let b = scaled.max(Vec3A::ZERO).min(Vec3A::splat((BINS - 1) as f32));
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128i, _mm_cvttps_epi32};
+        // SAFETY: SSE2 is part of x86_64; the lanes are in [0, BINS - 1], so truncation is
+        // exact and the i32 lanes are non-negative.
+        let i: [i32; 4] =
+            unsafe { std::mem::transmute::<__m128i, [i32; 4]>(_mm_cvttps_epi32(b.into())) };
+        [i[0] as usize, i[1] as usize, i[2] as usize]
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        [b.x as usize, b.y as usize, b.z as usize]
     }
 }
 
