@@ -5,12 +5,12 @@
 //!   a shared edge or vertex of a closed mesh hits at least one of the triangles.
 //! - The BVH is built top-down with a binned surface area heuristic (16 bins on each axis,
 //!   leaves costed in packs of four triangles), in parallel above a size threshold, then
-//!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD (AVX
-//!   when the processor has it, else two SSE halves). Leaf
-//!   triangles are stored in packs of four, also tested at once. The layout is a pure
-//!   function of the input, whatever the thread count.
-//! - [`Bvh::intersect`] finds the closest hit, visiting the nearer child first;
-//!   [`Bvh::occluded`] stops at the first hit, for shadow rays.
+//!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD: AVX
+//!   when the processor has it (detected at run time), else two SSE halves, with identical
+//!   results. Leaf triangles are stored in packs of four, also tested at once. The layout is
+//!   a pure function of the input, whatever the thread count.
+//! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
+//!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays.
 #![warn(missing_docs)]
 
 mod bvh;
