@@ -262,7 +262,8 @@ fn direct_lights(
             if !consistent(hit, wo, ls.wi) {
                 continue;
             }
-            let f = hit.bsdf.eval(wo_l, frame.to_local(ls.wi));
+            let wi_l = frame.to_local(ls.wi);
+            let f = hit.bsdf.eval(wo_l, wi_l);
             if f.max_channel() <= 0.0 {
                 continue;
             }
@@ -279,7 +280,7 @@ fn direct_lights(
                 power(
                     count as f32,
                     ls.pdf,
-                    hit.bsdf.pdf(wo_l, frame.to_local(ls.wi)),
+                    hit.bsdf.pdf(wo_l, wi_l),
                 )
             } else {
                 1.0
