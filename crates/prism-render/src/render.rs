@@ -277,11 +277,7 @@ fn direct_lights(
                 continue;
             }
             let w = if mis && !ls.delta {
-                power(
-                    count as f32,
-                    ls.pdf,
-                    hit.bsdf.pdf(wo_l, wi_l),
-                )
+                power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
             } else {
                 1.0
             };
