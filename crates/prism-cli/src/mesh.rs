@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use prism_mesh::{loop_subdivide, read_obj, write_obj, HalfedgeMesh, LoopWeights, PolyMesh};
+use prism_mesh::{
+    loop_subdivide, read_obj, write_obj, HalfedgeMesh, LoopWeights, PolyMesh, TopologyError,
+};
 
 use crate::UserError;
 
@@ -162,7 +164,7 @@ fn ms(d: std::time::Duration) -> String {
 fn edge_op(
     args: &EdgeArgs,
     what: &str,
-    op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<(), String>,
+    op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<(), TopologyError>,
 ) -> Result<()> {
     let (input, output) = (&args.input, &args.output);
     let (edge, vertices) = (args.edge, args.vertices.as_deref());
@@ -191,7 +193,7 @@ fn edge_op(
         }
         (None, None) => return Err(UserError("give --edge E or --vertices A,B".into()).into()),
     };
-    op(&mut m, e).map_err(|msg| UserError(format!("{}: cannot {what}: {msg}", input.display())))?;
+    op(&mut m, e).map_err(|err| UserError(format!("{}: cannot {what}: {err}", input.display())))?;
     write(output, &m.to_polymesh())
 }
 

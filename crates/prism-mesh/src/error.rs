@@ -1,14 +1,17 @@
+//! [`MeshError`], what can go wrong reading a mesh file or building its connectivity.
+
 /// Everything that can go wrong reading a mesh or building its connectivity. Face and
 /// vertex numbers in topology errors count from 0, in file order.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     /// A file could not be read or written.
-    #[error("{path}: {message}")]
+    #[error("{path}: {source}")]
     Io {
         /// The file.
         path: String,
-        /// What went wrong.
-        message: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
     },
     /// A syntax or value error in a mesh file, with its location.
     #[error("{file}:{line}: {message}")]

@@ -1,7 +1,9 @@
 //! Floor-1 meshes for prism: an indexed polygon mesh ([`PolyMesh`]), a halfedge mesh with
 //! typed index handles ([`HalfedgeMesh`]) built from polygon soups with boundary loops,
+//! edge flips, splits and collapses that check first and refuse with a [`TopologyError`],
 //! Bezier curves and patches (de Casteljau), Wavefront OBJ and Stanford PLY reading and
-//! writing, area-weighted vertex normals and Loop subdivision.
+//! writing, area-weighted vertex normals, Loop subdivision and procedural shapes
+//! ([`icosahedron`]).
 #![warn(missing_docs)]
 
 mod bezier;
@@ -12,15 +14,19 @@ mod normals;
 mod obj;
 mod ply;
 mod polymesh;
+mod shapes;
 
 pub use bezier::{
     bezier_point, de_casteljau_levels, de_casteljau_step, parse_bez, parse_bzc, tessellate,
     BezierPatch,
 };
 pub use error::MeshError;
-pub use halfedge::{icosahedron, EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId};
+pub use halfedge::{
+    EdgeId, FaceId, HalfedgeId, HalfedgeMesh, TopologyError, ValidationError, VertexId,
+};
 pub use loop_subdivision::{loop_subdivide, LoopWeights};
 pub use normals::vertex_normals_area_weighted;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};
 pub use polymesh::PolyMesh;
+pub use shapes::icosahedron;

@@ -1,3 +1,5 @@
+//! Area-weighted vertex normals of a polygon mesh.
+
 use prism_math::glam::DVec3;
 
 use crate::PolyMesh;

@@ -76,9 +76,9 @@ pub fn parse_obj(text: &str, file: &str) -> Result<PolyMesh, MeshError> {
 /// [`MeshError::Io`] if unreadable, else as [`parse_obj`].
 pub fn read_obj(path: &Path) -> Result<PolyMesh, MeshError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| MeshError::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
         path: name.clone(),
-        message: e.to_string(),
+        source,
     })?;
     parse_obj(&text, &name)
 }

@@ -383,9 +383,9 @@ pub fn parse_ply(bytes: &[u8], file: &str) -> Result<PolyMesh, MeshError> {
 /// [`MeshError::Io`] if unreadable, else as [`parse_ply`].
 pub fn read_ply(path: &Path) -> Result<PolyMesh, MeshError> {
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: name.clone(),
-        message: e.to_string(),
+        source,
     })?;
     parse_ply(&bytes, &name)
 }

@@ -1,3 +1,5 @@
+//! [`PolyMesh`], the indexed polygon mesh that readers produce and writers consume.
+
 use prism_math::glam::{DVec2, DVec3};
 
 /// An indexed polygon mesh: positions and faces as vertex-index lists (compressed rows).
