@@ -45,6 +45,21 @@ impl std::fmt::Display for UserError {
 
 impl std::error::Error for UserError {}
 
+/// An error and its causes on one line, `a: b: c`, leaving out a cause whose text the line
+/// already holds (library errors often show their source in their own message).
+fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut line = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !line.contains(&text) {
+            line = format!("{line}: {text}");
+        }
+        cause = c.source();
+    }
+    line
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -67,7 +82,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("prism: error: {e:#}");
+            eprintln!("prism: error: {}", error_chain(e.as_ref()));
             if e.downcast_ref::<UserError>().is_some() {
                 ExitCode::from(2)
             } else {

@@ -20,8 +20,8 @@ mod raster;
 
 pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
 pub use parse::{
-    ear_clip, parse_path_data, parse_svg, read_svg, Dialect, Source, SvgError, MAX_DEPTH,
-    MAX_FILE_BYTES, MAX_ITEMS,
+    ear_clip, parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError,
+    MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RenderError, RenderOptions, RenderStats, View,

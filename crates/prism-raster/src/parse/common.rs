@@ -1,7 +1,8 @@
 //! Pieces shared by both SVG dialects: errors with locations, limits, numbers, transforms.
 
-use std::fmt;
+use std::sync::Arc;
 
+use super::pathdata::PathDataError;
 use crate::document::Mat3;
 
 /// Deepest element nesting a document may have.
@@ -10,31 +11,175 @@ pub const MAX_DEPTH: usize = 256;
 pub const MAX_FILE_BYTES: usize = 256 << 20;
 /// Most drawables (after expanding points and triangles) a document may produce.
 pub const MAX_ITEMS: usize = 20_000_000;
+/// Most elements that `use` references may create when expanded (each reference copies
+/// its target's whole subtree, references inside it included), as usvg limits them.
+pub const MAX_USE_ELEMENTS: usize = 1_000_000;
+/// Most gradients a gradient's `href` chain may hold (itself included).
+pub const MAX_HREF_CHAIN: usize = 16;
 
-/// A reader error with its location: `file:line: element: message`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SvgError {
-    /// The file (or `<memory>`).
-    pub file: String,
-    /// 1-based line of the offending element or token; 0 when unknown.
-    pub line: u32,
-    /// The element name, or `xml` for syntax errors.
-    pub element: String,
-    /// What was expected and what was found.
-    pub message: String,
+/// A reader error with its location, shown as `file:line: element: message`.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum SvgError {
+    /// The file cannot be read.
+    #[error("{file}:0: file: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What the operating system said.
+        #[source]
+        source: Arc<std::io::Error>,
+    },
+    /// The file is not UTF-8 text.
+    #[error("{file}:0: file: expected UTF-8 text: {source}")]
+    Encoding {
+        /// The file.
+        file: String,
+        /// Where the first invalid byte is.
+        #[source]
+        source: std::str::Utf8Error,
+    },
+    /// The file is larger than [`MAX_FILE_BYTES`].
+    #[error("{file}:0: file: file is larger than the limit of {limit} bytes")]
+    FileTooLarge {
+        /// The file.
+        file: String,
+        /// The limit, in bytes.
+        limit: usize,
+    },
+    /// The text is not well-formed XML.
+    #[error("{file}:{line}: xml: malformed XML: {source}")]
+    Xml {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the syntax error.
+        line: u32,
+        /// The XML parser's error.
+        #[source]
+        source: roxmltree::Error,
+    },
+    /// An element or attribute is missing, malformed or refers to nothing.
+    #[error("{file}:{line}: {element}: {message}")]
+    Element {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the element's start tag.
+        line: u32,
+        /// The element's name.
+        element: String,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// An element's `d` attribute is not valid path data.
+    #[error("{file}:{line}: {element}: d: {source}")]
+    PathData {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the element's start tag.
+        line: u32,
+        /// The element's name.
+        element: String,
+        /// What is wrong, and where in the attribute.
+        #[source]
+        source: PathDataError,
+    },
+    /// Elements nest deeper than [`MAX_DEPTH`] (counting `use` references).
+    #[error("{file}:{line}: {element}: elements nest deeper than the limit of {limit}")]
+    NestingLimit {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the first element past the limit.
+        line: u32,
+        /// Its name.
+        element: String,
+        /// The limit.
+        limit: usize,
+    },
+    /// The document produces more than [`MAX_ITEMS`] drawables.
+    #[error("{file}:{line}: {element}: more than {limit} drawables")]
+    ItemsLimit {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the element that passed the limit.
+        line: u32,
+        /// Its name.
+        element: String,
+        /// The limit.
+        limit: usize,
+    },
+    /// Expanding `use` references would create more than [`MAX_USE_ELEMENTS`] elements.
+    #[error("{file}:{line}: {element}: use references would expand to more than {limit} elements")]
+    UseLimit {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the element whose expansion passes the limit.
+        line: u32,
+        /// Its name.
+        element: String,
+        /// The limit.
+        limit: usize,
+    },
+    /// A gradient's `href` chain holds more than [`MAX_HREF_CHAIN`] gradients.
+    #[error("{file}:{line}: {element}: href chain is longer than the limit of {limit} gradients")]
+    HrefChainLimit {
+        /// The file (or `<memory>`).
+        file: String,
+        /// 1-based line of the gradient that starts the chain.
+        line: u32,
+        /// Its name.
+        element: String,
+        /// The limit.
+        limit: usize,
+    },
 }
 
-impl fmt::Display for SvgError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}: {}: {}",
-            self.file, self.line, self.element, self.message
-        )
+impl SvgError {
+    /// The file the error is in.
+    #[must_use]
+    pub fn file(&self) -> &str {
+        match self {
+            SvgError::Io { file, .. }
+            | SvgError::Encoding { file, .. }
+            | SvgError::FileTooLarge { file, .. }
+            | SvgError::Xml { file, .. }
+            | SvgError::Element { file, .. }
+            | SvgError::PathData { file, .. }
+            | SvgError::NestingLimit { file, .. }
+            | SvgError::ItemsLimit { file, .. }
+            | SvgError::UseLimit { file, .. }
+            | SvgError::HrefChainLimit { file, .. } => file,
+        }
+    }
+
+    /// The 1-based line the error is on, or 0 for errors about the whole file.
+    #[must_use]
+    pub fn line(&self) -> u32 {
+        match self {
+            SvgError::Io { .. } | SvgError::Encoding { .. } | SvgError::FileTooLarge { .. } => 0,
+            SvgError::Xml { line, .. }
+            | SvgError::Element { line, .. }
+            | SvgError::PathData { line, .. }
+            | SvgError::NestingLimit { line, .. }
+            | SvgError::ItemsLimit { line, .. }
+            | SvgError::UseLimit { line, .. }
+            | SvgError::HrefChainLimit { line, .. } => *line,
+        }
     }
 }
 
-impl std::error::Error for SvgError {}
+/// Attribute lookup by plain name, as SVG's own attributes carry no namespace: an editor's
+/// `sodipodi:cx` is not `cx`.
+pub(crate) trait PlainAttribute<'a> {
+    /// The value of the attribute named `name` that has no namespace.
+    fn attr(&self, name: &str) -> Option<&'a str>;
+}
+
+impl<'a, 'i> PlainAttribute<'a> for roxmltree::Node<'a, 'i> {
+    fn attr(&self, name: &str) -> Option<&'a str> {
+        self.attributes()
+            .find(|a| a.namespace().is_none() && a.name() == name)
+            .map(|a| a.value())
+    }
+}
 
 /// Where the element being read sits, for error messages.
 #[derive(Clone, Copy)]
@@ -46,11 +191,56 @@ pub(crate) struct Loc<'a> {
 
 impl Loc<'_> {
     pub fn err(&self, message: impl Into<String>) -> SvgError {
-        SvgError {
+        SvgError::Element {
             file: self.file.to_string(),
             line: self.line,
             element: self.element.to_string(),
             message: message.into(),
+        }
+    }
+
+    pub fn path_data(&self, source: PathDataError) -> SvgError {
+        SvgError::PathData {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            source,
+        }
+    }
+
+    pub fn nesting_limit(&self) -> SvgError {
+        SvgError::NestingLimit {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            limit: MAX_DEPTH,
+        }
+    }
+
+    pub fn items_limit(&self) -> SvgError {
+        SvgError::ItemsLimit {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            limit: MAX_ITEMS,
+        }
+    }
+
+    pub fn href_chain_limit(&self) -> SvgError {
+        SvgError::HrefChainLimit {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            limit: MAX_HREF_CHAIN,
+        }
+    }
+
+    pub fn use_limit(&self) -> SvgError {
+        SvgError::UseLimit {
+            file: self.file.to_string(),
+            line: self.line,
+            element: self.element.to_string(),
+            limit: MAX_USE_ELEMENTS,
         }
     }
 }

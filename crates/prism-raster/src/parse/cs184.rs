@@ -9,7 +9,8 @@ use prism_math::{DVec2, Rgb, Vec2};
 use roxmltree::Node;
 
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
+    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, Precision, SvgError,
+    MAX_DEPTH, MAX_ITEMS,
 };
 use super::{element_loc, Ctx};
 use crate::document::{Document, Item, Mat3};
@@ -92,14 +93,14 @@ pub fn ear_clip(pts: &[DVec2]) -> Vec<[DVec2; 3]> {
 }
 
 fn num_attr(node: &Node, name: &str, loc: &Loc) -> Result<f64, SvgError> {
-    match node.attribute(name) {
+    match node.attr(name) {
         None => Ok(0.0),
         Some(s) => Ok(number_with_unit(s, P, loc, name)?.0),
     }
 }
 
 fn points_attr(node: &Node, name: &str, loc: &Loc) -> Result<Vec<DVec2>, SvgError> {
-    let l = number_list(node.attribute(name).unwrap_or(""), P, loc, name)?;
+    let l = number_list(node.attr(name).unwrap_or(""), P, loc, name)?;
     if l.len() % 2 != 0 {
         return Err(loc.err(format!(
             "{name}: expected x,y pairs, found {} numbers",
@@ -113,7 +114,7 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
     let loc = element_loc(ctx, &root);
     let size = |name: &str| -> Result<f64, SvgError> {
         let s = root
-            .attribute(name)
+            .attr(name)
             .ok_or_else(|| loc.err(format!("expected a {name} attribute on the root svg")))?;
         let v = number_with_unit(s, P, &loc, name)?.0;
         if v > 0.0 {
@@ -128,7 +129,7 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
         ..Document::default()
     };
     let mut textures = HashMap::new();
-    walk(root, Mat3::IDENTITY, 0, ctx, &mut doc, &mut textures)?;
+    walk(root, Mat3::IDENTITY, 1, ctx, &mut doc, &mut textures)?;
     Ok(doc)
 }
 
@@ -143,21 +144,19 @@ fn walk<'a>(
     for node in parent.children().filter(Node::is_element) {
         let loc = element_loc(ctx, &node);
         if depth >= MAX_DEPTH {
-            return Err(loc.err(format!(
-                "elements nest deeper than the limit of {MAX_DEPTH}"
-            )));
+            return Err(loc.nesting_limit());
         }
         if doc.items.len() > MAX_ITEMS {
-            return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
+            return Err(loc.items_limit());
         }
         let name = node.tag_name().name();
-        let t = match node.attribute("transform") {
+        let t = match node.attr("transform") {
             Some(s) => ctm.mul(&parse_transform(s, P, &loc, true)?),
             None => ctm,
         };
-        let fill = node.attribute("fill").map_or(Rgb::BLACK, hex_color);
-        let stroke = node.attribute("stroke").map(hex_color);
-        let stroke_opacity = match node.attribute("stroke-opacity") {
+        let fill = node.attr("fill").map_or(Rgb::BLACK, hex_color);
+        let stroke = node.attr("stroke").map(hex_color);
+        let stroke_opacity = match node.attr("stroke-opacity") {
             Some(s) => number_with_unit(s, P, &loc, "stroke-opacity")?
                 .0
                 .clamp(0.0, 1.0) as f32,

@@ -14,10 +14,12 @@ use base64::Engine;
 use prism_image::{Texture, UvConvention};
 use roxmltree::Node;
 
-use common::{number_list, number_with_unit, Loc, Precision};
-pub use common::{SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_ITEMS};
+use common::{number_list, number_with_unit, Loc, PlainAttribute, Precision};
+pub use common::{
+    SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
+};
 pub use cs184::ear_clip;
-pub use pathdata::parse_path_data;
+pub use pathdata::{parse_path_data, PathDataError};
 
 use std::collections::HashMap;
 
@@ -138,7 +140,7 @@ fn exact_numbers(
     loc: &Loc,
     p: Precision,
 ) -> Result<Vec<f64>, SvgError> {
-    let v = number_list(node.attribute(attr).unwrap_or(""), p, loc, attr)?;
+    let v = number_list(node.attr(attr).unwrap_or(""), p, loc, attr)?;
     if v.len() != n {
         return Err(loc.err(format!("{attr}: expected {n} numbers, found {}", v.len())));
     }
@@ -181,10 +183,10 @@ pub(crate) fn course_element(
         }
         "texture" => {
             let id = node
-                .attribute("texid")
+                .attr("texid")
                 .ok_or_else(|| loc.err("expected a texid attribute"))?;
             let file = node
-                .attribute("filename")
+                .attr("filename")
                 .ok_or_else(|| loc.err("expected a filename attribute"))?;
             let idx = load_texture(ctx, doc, file, loc, UvConvention::EdgeCenters)?;
             textures.insert(id.to_string(), idx);
@@ -192,7 +194,7 @@ pub(crate) fn course_element(
         "textri" => {
             let points = tri(&exact_numbers(node, "points", 6, loc, p)?);
             let uv = exact_numbers(node, "uvs", 6, loc, p)?;
-            let id = node.attribute("texid").unwrap_or("");
+            let id = node.attr("texid").unwrap_or("");
             let texture = *textures.get(id).ok_or_else(|| {
                 loc.err(format!(
                     "texid {id:?}: expected the id of an earlier <texture>"
@@ -222,10 +224,10 @@ pub(crate) fn image_item(
 ) -> Result<Option<Item>, SvgError> {
     let href = node
         .attribute(("http://www.w3.org/1999/xlink", "href"))
-        .or_else(|| node.attribute("href"))
+        .or_else(|| node.attr("href"))
         .ok_or_else(|| loc.err("expected an xlink:href attribute"))?;
     let num = |name: &str| -> Result<Option<f64>, SvgError> {
-        node.attribute(name)
+        node.attr(name)
             .map(|s| number_with_unit(s, p, loc, name).map(|v| v.0))
             .transpose()
     };
@@ -245,9 +247,7 @@ pub(crate) fn image_item(
         return Ok(None);
     }
     // preserveAspectRatio: default xMidYMid meet; "none" stretches.
-    let par = node
-        .attribute("preserveAspectRatio")
-        .unwrap_or("xMidYMid meet");
+    let par = node.attr("preserveAspectRatio").unwrap_or("xMidYMid meet");
     let rect = if par.trim() == "none" {
         [x, y, w, h]
     } else {
@@ -269,26 +269,24 @@ pub(crate) fn image_item(
 /// [`SvgError`] naming the file, line and element: malformed XML, a root that is not
 /// `<svg>`, bad numbers, colours or path data, non-finite coordinates, a missing or corrupt
 /// texture, or a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_FILE_BYTES`],
-/// [`MAX_ITEMS`]).
+/// [`MAX_ITEMS`], [`MAX_USE_ELEMENTS`], [`MAX_HREF_CHAIN`]), each its own variant.
 pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Document, SvgError> {
-    let top = |line: u32, message: String| SvgError {
-        file: source.name.clone(),
-        line,
-        element: "xml".into(),
-        message,
-    };
     if text.len() > MAX_FILE_BYTES {
-        return Err(top(
-            0,
-            format!("file is larger than the limit of {MAX_FILE_BYTES} bytes"),
-        ));
+        return Err(SvgError::FileTooLarge {
+            file: source.name.clone(),
+            limit: MAX_FILE_BYTES,
+        });
     }
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
         nodes_limit: 50_000_000,
+        ..Default::default()
     };
-    let xml = roxmltree::Document::parse_with_options(text, opts)
-        .map_err(|e| top(e.pos().row, format!("malformed XML: {e}")))?;
+    let xml = roxmltree::Document::parse_with_options(text, opts).map_err(|e| SvgError::Xml {
+        file: source.name.clone(),
+        line: e.pos().row,
+        source: e,
+    })?;
     let root = xml.root_element();
     let mut ctx = Ctx {
         source,
@@ -312,21 +310,26 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
 /// As [`parse_svg`], plus an unreadable or non-UTF-8 file.
 pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
     let name = path.display().to_string();
-    let err = |message: String| SvgError {
+    let io = |e: std::io::Error| SvgError::Io {
         file: name.clone(),
-        line: 0,
-        element: "file".into(),
-        message,
+        source: Arc::new(e),
     };
-    let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
+    let meta = std::fs::metadata(path).map_err(io)?;
     if meta.len() > MAX_FILE_BYTES as u64 {
-        return Err(err(format!(
-            "file is larger than the limit of {MAX_FILE_BYTES} bytes"
-        )));
+        return Err(SvgError::FileTooLarge {
+            file: name,
+            limit: MAX_FILE_BYTES,
+        });
     }
-    let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
-    let text = String::from_utf8(bytes).map_err(|e| err(format!("expected UTF-8 text: {e}")))?;
+    let bytes = std::fs::read(path).map_err(io)?;
+    let text = String::from_utf8(bytes).map_err(|e| SvgError::Encoding {
+        file: name.clone(),
+        source: e.utf8_error(),
+    })?;
     let base_dir = path.parent().map(FsPath::to_path_buf).unwrap_or_default();
     let source = Source { name, base_dir };
     parse_svg(&text, dialect, &source)
 }
+
+#[cfg(test)]
+mod tests;

@@ -5,6 +5,62 @@ use prism_math::DVec2;
 use super::common::{number_prefix_len, to_num, Precision};
 use crate::path::Path;
 
+/// What is wrong with path data, at a byte offset into the `d` attribute.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PathDataError {
+    /// A coordinate or radius is missing or malformed.
+    #[error("expected a number at offset {offset}")]
+    ExpectedNumber {
+        /// Byte offset of the token.
+        offset: usize,
+    },
+    /// A number overflows to infinity.
+    #[error("number {text:?} at offset {offset} is not finite")]
+    NotFinite {
+        /// The number as written.
+        text: String,
+        /// Byte offset of the number.
+        offset: usize,
+    },
+    /// An arc's large-arc or sweep flag is not `0` or `1`.
+    #[error("expected an arc flag 0 or 1 at offset {offset}")]
+    ExpectedFlag {
+        /// Byte offset of the token.
+        offset: usize,
+    },
+    /// Numbers before any command letter.
+    #[error("expected a command letter at offset {offset}")]
+    ExpectedCommand {
+        /// Byte offset of the token.
+        offset: usize,
+    },
+    /// A character that is neither a command nor a number.
+    #[error("unexpected {found:?} at offset {offset}")]
+    Unexpected {
+        /// The character found.
+        found: char,
+        /// Its byte offset.
+        offset: usize,
+    },
+    /// Numbers after a `Z`, which takes none.
+    #[error("expected a command after Z at offset {offset}")]
+    ExpectedCommandAfterClose {
+        /// Byte offset of the number.
+        offset: usize,
+    },
+    /// A letter that is not a path command.
+    #[error("unknown path command {found:?} at offset {offset}")]
+    UnknownCommand {
+        /// The letter found.
+        found: char,
+        /// Its byte offset.
+        offset: usize,
+    },
+    /// The first command is not a moveto.
+    #[error("path data must begin with a moveto")]
+    NoInitialMoveTo,
+}
+
 struct Cursor<'a> {
     s: &'a str,
     pos: usize,
@@ -28,41 +84,33 @@ impl<'a> Cursor<'a> {
         self.skip_ws();
         matches!(self.s.as_bytes().get(self.pos), Some(c) if c.is_ascii_digit() || matches!(c, b'-' | b'+' | b'.'))
     }
-    fn number(&mut self) -> Result<f64, String> {
+    fn number(&mut self) -> Result<f64, PathDataError> {
         self.skip_ws();
         let rest = &self.s[self.pos..];
         let n = number_prefix_len(rest);
         if n == 0 {
-            return Err(format!("expected a number at offset {}", self.pos));
+            return Err(PathDataError::ExpectedNumber { offset: self.pos });
         }
-        let v = to_num(&rest[..n], Precision::F64).ok_or_else(|| {
-            format!(
-                "number {:?} at offset {} is not finite",
-                &rest[..n],
-                self.pos
-            )
+        let v = to_num(&rest[..n], Precision::F64).ok_or_else(|| PathDataError::NotFinite {
+            text: rest[..n].to_string(),
+            offset: self.pos,
         })?;
         self.pos += n;
         self.skip_sep();
         Ok(v)
     }
-    fn flag(&mut self) -> Result<bool, String> {
+    fn flag(&mut self) -> Result<bool, PathDataError> {
         self.skip_ws();
         let v = match self.s.as_bytes().get(self.pos) {
             Some(b'0') => false,
             Some(b'1') => true,
-            _ => {
-                return Err(format!(
-                    "expected an arc flag 0 or 1 at offset {}",
-                    self.pos
-                ))
-            }
+            _ => return Err(PathDataError::ExpectedFlag { offset: self.pos }),
         };
         self.pos += 1;
         self.skip_sep();
         Ok(v)
     }
-    fn point(&mut self) -> Result<DVec2, String> {
+    fn point(&mut self) -> Result<DVec2, PathDataError> {
         Ok(DVec2::new(self.number()?, self.number()?))
     }
 }
@@ -70,9 +118,9 @@ impl<'a> Cursor<'a> {
 /// Parses SVG path data into a [`Path`] (quadratics as exact cubics, arcs as cubics).
 ///
 /// # Errors
-/// A message with the byte offset of the first malformed token; the SVG spec's "render up to
+/// [`PathDataError`] with the byte offset of the first malformed token; the SVG spec's "render up to
 /// the error" is not applied, so bad data is reported rather than silently truncated.
-pub fn parse_path_data(d: &str) -> Result<Path, String> {
+pub fn parse_path_data(d: &str) -> Result<Path, PathDataError> {
     let mut c = Cursor { s: d, pos: 0 };
     let mut path = Path::default();
     let mut cur = DVec2::ZERO;
@@ -90,9 +138,12 @@ pub fn parse_path_data(d: &str) -> Result<Path, String> {
             c.pos += 1;
             cmd = Some(b);
         } else if cmd.is_none() {
-            return Err(format!("expected a command letter at offset {}", c.pos));
+            return Err(PathDataError::ExpectedCommand { offset: c.pos });
         } else if !c.at_number() {
-            return Err(format!("unexpected {:?} at offset {}", b as char, c.pos));
+            return Err(PathDataError::Unexpected {
+                found: b as char,
+                offset: c.pos,
+            });
         }
         let k = cmd.expect("set above");
         let rel = k.is_ascii_lowercase();
@@ -160,15 +211,14 @@ pub fn parse_path_data(d: &str) -> Result<Path, String> {
                 // A command letter must follow.
                 c.skip_ws();
                 if c.at_number() {
-                    return Err(format!("expected a command after Z at offset {}", c.pos));
+                    return Err(PathDataError::ExpectedCommandAfterClose { offset: c.pos });
                 }
             }
             other => {
-                return Err(format!(
-                    "unknown path command {:?} at offset {}",
-                    other as char,
-                    c.pos - 1
-                ))
+                return Err(PathDataError::UnknownCommand {
+                    found: other as char,
+                    offset: c.pos - 1,
+                })
             }
         }
         last_cubic_ctrl = cubic_ctrl;
@@ -177,7 +227,7 @@ pub fn parse_path_data(d: &str) -> Result<Path, String> {
     if let Some(crate::path::Segment::MoveTo(_)) | None = path.segments.first() {
         Ok(path)
     } else {
-        Err("path data must begin with a moveto".to_string())
+        Err(PathDataError::NoInitialMoveTo)
     }
 }
 
@@ -215,6 +265,10 @@ mod tests {
         assert!(parse_path_data("L1 1").is_err());
         assert_eq!(
             parse_path_data("M0 0 L1 x").unwrap_err(),
+            PathDataError::ExpectedNumber { offset: 8 }
+        );
+        assert_eq!(
+            parse_path_data("M0 0 L1 x").unwrap_err().to_string(),
             "expected a number at offset 8"
         );
         assert!(parse_path_data("M0 0 A1 1 0 2 0 3 3").is_err());

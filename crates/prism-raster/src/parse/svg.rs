@@ -14,7 +14,8 @@ use roxmltree::Node;
 
 use super::color::parse_color;
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, Precision, SvgError, MAX_DEPTH, MAX_ITEMS,
+    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, Precision, SvgError,
+    MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
 use super::pathdata::parse_path_data;
 use super::{element_loc, image_item, Ctx};
@@ -154,7 +155,7 @@ fn declarations<'a>(node: &Node<'a, 'a>) -> Vec<(String, String)> {
         .filter(|a| a.namespace().is_none())
         .map(|a| (a.name().to_string(), a.value().to_string()))
         .collect();
-    if let Some(style) = node.attribute("style") {
+    if let Some(style) = node.attr("style") {
         for decl in style.split(';') {
             if let Some((k, v)) = decl.split_once(':') {
                 let v = v.trim().trim_end_matches("!important").trim();
@@ -281,7 +282,7 @@ fn apply_declarations(
 }
 
 fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<Mat3>, SvgError> {
-    let Some(vb) = node.attribute("viewBox") else {
+    let Some(vb) = node.attr("viewBox") else {
         return Ok(None);
     };
     let v = number_list(vb, P, loc, "viewBox")?;
@@ -290,9 +291,7 @@ fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<M
             "viewBox: expected min-x min-y width height with positive size, found {vb:?}"
         )));
     }
-    let par = node
-        .attribute("preserveAspectRatio")
-        .unwrap_or("xMidYMid meet");
+    let par = node.attr("preserveAspectRatio").unwrap_or("xMidYMid meet");
     let mut words = par.split_whitespace();
     let align = words.next().unwrap_or("xMidYMid");
     let slice = words.next() == Some("slice");
@@ -327,12 +326,12 @@ fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<M
 pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
     let loc = element_loc(ctx, &root);
     let vb = root
-        .attribute("viewBox")
+        .attr("viewBox")
         .map(|s| number_list(s, P, &loc, "viewBox"))
         .transpose()?;
     let vb_size = vb.as_ref().filter(|v| v.len() == 4).map(|v| (v[2], v[3]));
     let dim = |name: &str, axis: Axis, fallback: f64| -> Result<f64, SvgError> {
-        match root.attribute(name) {
+        match root.attr(name) {
             Some(s) if s.trim().ends_with('%') => {
                 let pc = number_with_unit(s, P, &loc, name)?.0 / 100.0;
                 Ok(fallback * pc)
@@ -355,10 +354,11 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
     let xml = ctx.xml;
     let mut ids = HashMap::new();
     for n in xml.descendants().filter(Node::is_element) {
-        if let Some(id) = n.attribute("id") {
+        if let Some(id) = n.attr("id") {
             ids.entry(id).or_insert(n);
         }
     }
+    check_use_expansion(root, &ids, ctx)?;
     let mut p = Parser {
         ctx,
         doc: Document {
@@ -389,6 +389,111 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
         p.doc.items.push(Item::EndLayer { opacity });
     }
     Ok(p.doc)
+}
+
+/// The id a `use` element refers to (`xlink:href` or `href`, without the `#`).
+fn use_href<'a>(node: &Node<'a, 'a>) -> Option<&'a str> {
+    let href = node
+        .attribute((XLINK_NS, "href"))
+        .or_else(|| node.attr("href"))?
+        .trim();
+    Some(href.strip_prefix('#').unwrap_or(href))
+}
+
+/// Whether the walk reads this element's children: groups, links, switches, nested `svg`.
+fn is_container(node: &Node) -> bool {
+    matches!(node.tag_name().name(), "g" | "a" | "switch" | "svg")
+}
+
+/// Counts, without expanding anything, the elements that `use` references would create,
+/// and refuses a document that would create more than [`MAX_USE_ELEMENTS`] or whose
+/// references lead back to themselves. It follows what [`Parser::element`] follows
+/// (containers' children and `use` targets, a `symbol` by its children), each element once,
+/// with an explicit stack: time and memory grow with the file, not with its expansion.
+fn check_use_expansion<'a>(
+    root: Node<'a, 'a>,
+    ids: &HashMap<&'a str, Node<'a, 'a>>,
+    ctx: &Ctx<'a>,
+) -> Result<(), SvgError> {
+    #[derive(Clone, Copy)]
+    enum Mark {
+        New,
+        Open,
+        /// Elements in the expansion (this one included) and elements created by `use` in it.
+        Done(u64, u64),
+    }
+    let in_svg = |n: &Node| matches!(n.tag_name().namespace(), None | Some(SVG_NS));
+    // What an element expands to, and whether that is a `use` copy.
+    let expansion = |n: Node<'a, 'a>| -> (Vec<Node<'a, 'a>>, bool) {
+        if !in_svg(&n) {
+            return (Vec::new(), false);
+        }
+        if n.tag_name().name() == "use" {
+            let target = use_href(&n).and_then(|id| ids.get(id)).copied();
+            return match target {
+                Some(t) if t.tag_name().name() == "symbol" => {
+                    (t.children().filter(Node::is_element).collect(), true)
+                }
+                Some(t) => (vec![t], true),
+                None => (Vec::new(), true),
+            };
+        }
+        if n == root || is_container(&n) {
+            return (n.children().filter(Node::is_element).collect(), false);
+        }
+        (Vec::new(), false)
+    };
+    let mut marks = vec![Mark::New; ctx.xml.descendants().count() + 1];
+    // (element, the `use` that led to it, children already pushed)
+    let mut stack = vec![(root, None::<Node<'a, 'a>>, false)];
+    while let Some((n, via, expanded)) = stack.pop() {
+        let i = n.id().get_usize();
+        match (marks[i], expanded) {
+            (Mark::Done(..), false) => {}
+            (Mark::Open, false) => {
+                let message = match via {
+                    Some(u) if n.descendants().any(|d| d == u) => {
+                        format!(
+                            "href #{} refers to its own ancestor",
+                            use_href(&u).unwrap_or("")
+                        )
+                    }
+                    Some(u) => format!(
+                        "href #{} leads back to itself through other references",
+                        use_href(&u).unwrap_or("")
+                    ),
+                    None => "its use references lead back to its own ancestor".to_string(),
+                };
+                let loc = element_loc(ctx, &via.unwrap_or(n));
+                return Err(loc.err(message));
+            }
+            (Mark::New, _) => {
+                marks[i] = Mark::Open;
+                stack.push((n, via, true));
+                let (parts, is_use) = expansion(n);
+                let via = if is_use { Some(n) } else { None };
+                stack.extend(parts.into_iter().map(|c| (c, via, false)));
+            }
+            (_, true) => {
+                let (parts, is_use) = expansion(n);
+                let (mut size, mut created) = (0u64, 0u64);
+                for c in parts {
+                    if let Mark::Done(s, k) = marks[c.id().get_usize()] {
+                        size = size.saturating_add(s);
+                        created = created.saturating_add(k);
+                    }
+                }
+                if is_use {
+                    created = size;
+                }
+                if created > MAX_USE_ELEMENTS as u64 {
+                    return Err(element_loc(ctx, &n).use_limit());
+                }
+                marks[i] = Mark::Done(size.saturating_add(1), created);
+            }
+        }
+    }
+    Ok(())
 }
 
 impl<'a> Parser<'_, 'a> {
@@ -433,12 +538,10 @@ impl<'a> Parser<'_, 'a> {
             element: &elem,
         };
         if depth >= MAX_DEPTH {
-            return Err(loc.err(format!(
-                "elements nest deeper than the limit of {MAX_DEPTH}"
-            )));
+            return Err(loc.nesting_limit());
         }
         if self.doc.items.len() > MAX_ITEMS {
-            return Err(loc.err(format!("more than {MAX_ITEMS} drawables")));
+            return Err(loc.items_limit());
         }
         match node.tag_name().namespace() {
             None | Some(SVG_NS) => {}
@@ -457,10 +560,7 @@ impl<'a> Parser<'_, 'a> {
             return Ok(());
         }
         for unsupported in ["clip-path", "mask", "filter"] {
-            if node
-                .attribute(unsupported)
-                .is_some_and(|v| v.trim() != "none")
-            {
+            if node.attr(unsupported).is_some_and(|v| v.trim() != "none") {
                 self.warn(
                     unsupported,
                     format!(
@@ -469,12 +569,12 @@ impl<'a> Parser<'_, 'a> {
                 );
             }
         }
-        let mut t = match node.attribute("transform") {
+        let mut t = match node.attr("transform") {
             Some(s) => ctm.mul(&parse_transform(s, P, &loc, false)?),
             None => ctm,
         };
         let num = |attr: &str, axis: Axis| -> Result<f64, SvgError> {
-            node.attribute(attr)
+            node.attr(attr)
                 .map_or(Ok(0.0), |s| length(s, &loc, attr, vp, axis))
         };
         let path = match name {
@@ -485,16 +585,15 @@ impl<'a> Parser<'_, 'a> {
                 let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
                 t = t.mul(&Mat3::translate(x, y));
                 let w = node
-                    .attribute("width")
+                    .attr("width")
                     .map_or(Ok(vp.w), |s| length(s, &loc, "width", vp, Axis::X))?;
                 let h = node
-                    .attribute("height")
+                    .attr("height")
                     .map_or(Ok(vp.h), |s| length(s, &loc, "height", vp, Axis::Y))?;
                 let mut inner = vp;
                 if let Some(m) = view_box_transform(&node, &loc, w, h)? {
                     t = t.mul(&m);
-                    let v =
-                        number_list(node.attribute("viewBox").unwrap_or(""), P, &loc, "viewBox")?;
+                    let v = number_list(node.attr("viewBox").unwrap_or(""), P, &loc, "viewBox")?;
                     inner = Viewport { w: v[2], h: v[3] };
                 }
                 return self.group(node, t, &style, opacity, inner, depth);
@@ -502,7 +601,7 @@ impl<'a> Parser<'_, 'a> {
             "use" => {
                 let href = node
                     .attribute((XLINK_NS, "href"))
-                    .or_else(|| node.attribute("href"))
+                    .or_else(|| node.attr("href"))
                     .ok_or_else(|| loc.err("expected an href attribute"))?;
                 let id = href.trim().strip_prefix('#').unwrap_or(href.trim());
                 let Some(&target) = self.ids.get(id) else {
@@ -538,11 +637,11 @@ impl<'a> Parser<'_, 'a> {
                     return Ok(());
                 }
                 let rx_attr = node
-                    .attribute("rx")
+                    .attr("rx")
                     .map(|s| length(s, &loc, "rx", vp, Axis::X))
                     .transpose()?;
                 let ry_attr = node
-                    .attribute("ry")
+                    .attr("ry")
                     .map(|s| length(s, &loc, "ry", vp, Axis::Y))
                     .transpose()?;
                 let (rx, ry) = match (rx_attr, ry_attr) {
@@ -604,7 +703,7 @@ impl<'a> Parser<'_, 'a> {
                 Path::polygon(&[a, b], false)
             }
             "polyline" | "polygon" => {
-                let l = number_list(node.attribute("points").unwrap_or(""), P, &loc, "points")?;
+                let l = number_list(node.attr("points").unwrap_or(""), P, &loc, "points")?;
                 if l.len() % 2 != 0 {
                     return Err(loc.err(format!(
                         "points: expected x,y pairs, found {} numbers",
@@ -614,8 +713,9 @@ impl<'a> Parser<'_, 'a> {
                 let pts: Vec<DVec2> = l.chunks_exact(2).map(|c| DVec2::new(c[0], c[1])).collect();
                 Path::polygon(&pts, name == "polygon")
             }
-            "path" => parse_path_data(node.attribute("d").unwrap_or(""))
-                .map_err(|e| loc.err(format!("d: {e}")))?,
+            "path" => {
+                parse_path_data(node.attr("d").unwrap_or("")).map_err(|e| loc.path_data(e))?
+            }
             "image" => {
                 if !style.visible {
                     return Ok(());
@@ -803,19 +903,24 @@ impl<'a> Parser<'_, 'a> {
             }
             return Ok(None);
         }
-        // The chain of referenced gradients, nearest first.
+        // The chain of referenced gradients, nearest first; a link back into it ends it.
         let mut chain = vec![node];
-        while chain.len() < 16 {
+        loop {
             let last = chain[chain.len() - 1];
             let href = last
                 .attribute((XLINK_NS, "href"))
-                .or_else(|| last.attribute("href"));
+                .or_else(|| last.attr("href"));
             match href.and_then(|h| self.ids.get(h.trim().trim_start_matches('#'))) {
-                Some(&n) if !chain.contains(&n) => chain.push(n),
+                Some(&n) if !chain.contains(&n) => {
+                    if chain.len() == MAX_HREF_CHAIN {
+                        return Err(element_loc(self.ctx, &node).href_chain_limit());
+                    }
+                    chain.push(n);
+                }
                 _ => break,
             }
         }
-        let attr = |name: &str| chain.iter().find_map(|n| n.attribute(name));
+        let attr = |name: &str| chain.iter().find_map(|n| n.attr(name));
         let gloc = element_loc(self.ctx, &node);
         let (gfile, gline, gelem) = (gloc.file.to_string(), gloc.line, gloc.element.to_string());
         let gloc = Loc {
