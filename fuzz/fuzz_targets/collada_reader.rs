@@ -12,9 +12,13 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     match parse_collada(text, "fuzz.dae") {
         Ok(doc) => {
-            let mesh = doc.world_mesh(true);
-            if let Ok(h) = HalfedgeMesh::from_polymesh(&mesh) {
-                h.validate().expect("a built mesh validates");
+            match doc.world_mesh(true) {
+                Ok(mesh) => {
+                    if let Ok(h) = HalfedgeMesh::from_polymesh(&mesh) {
+                        h.validate().expect("a built mesh validates");
+                    }
+                }
+                Err(e) => assert!(e.to_string().starts_with("fuzz.dae"), "{e}"),
             }
             match Scene::from_collada(&doc, &SceneOptions::default(), "fuzz.dae") {
                 Ok(scene) => {

@@ -29,7 +29,8 @@ fn load(path: &Path) -> Vec<[Vec3; 3]> {
         "ply" => prism_mesh::read_ply(path).expect("mesh reads"),
         _ => prism_scene::read_collada(path)
             .expect("mesh reads")
-            .world_mesh(true),
+            .world_mesh(true)
+            .expect("mesh places"),
     };
     let p = |i: u32| mesh.positions[i as usize].as_vec3();
     mesh.faces()

@@ -110,10 +110,11 @@ fn read(path: &Path) -> Result<PolyMesh> {
         "ply" => prism_mesh::read_ply(path),
         "dae" => {
             let doc = prism_scene::read_collada(path).map_err(|e| UserError(e.to_string()))?;
+            let mesh = doc.world_mesh(true).map_err(|e| UserError(e.to_string()))?;
             for w in &doc.warnings {
                 eprintln!("warning: {w}");
             }
-            return Ok(doc.world_mesh(true));
+            return Ok(mesh);
         }
         _ => {
             return Err(UserError(format!(
@@ -142,17 +143,22 @@ pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
         ))
         .into());
     }
-    prism_image::write_atomic(path, |w| {
-        let r = match ext.as_str() {
-            "ply" => prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w),
-            "dae" => prism_scene::write_collada(mesh, w),
-            _ => write_obj(mesh, w),
-        };
-        r.map_err(|source| prism_image::ImageError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    })
+    let io = |p: &Path, source| prism_mesh::MeshError::Io {
+        path: p.display().to_string(),
+        source,
+    };
+    prism_image::write_atomic_with(
+        path,
+        |w| {
+            match ext.as_str() {
+                "ply" => prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w),
+                "dae" => prism_scene::write_collada(mesh, w),
+                _ => write_obj(mesh, w),
+            }
+            .map_err(|e| io(path, e))
+        },
+        io,
+    )
     .with_context(|| format!("writing {}", path.display()))
 }
 

@@ -231,17 +231,16 @@ pub fn write_png_rgba(path: &Path, image: &Rgba8Image) -> Result<(), ImageError>
 
 /// Writes a file by streaming into a temporary file beside `path`, then renaming it over
 /// `path`, so that a failure never leaves a truncated file or clobbers an existing one.
+/// The caller's error type carries file-system errors too: `io_error` builds one from the
+/// file involved and the OS error.
 ///
 /// # Errors
-/// [`ImageError::Io`] for file-system errors, or whatever `write` returns.
-pub fn write_atomic(
+/// `io_error(..)` for file-system errors, or whatever `write` returns.
+pub fn write_atomic_with<E>(
     path: &Path,
-    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
-) -> Result<(), ImageError> {
-    let io_err = |p: &Path| {
-        let p: PathBuf = p.to_path_buf();
-        move |source| ImageError::Io { path: p, source }
-    };
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
+    io_error: impl Fn(&Path, std::io::Error) -> E,
+) -> Result<(), E> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -252,20 +251,31 @@ pub fn write_atomic(
         .unwrap_or_else(|| "out".to_string());
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
     let result = (|| {
-        let file = File::create(&tmp).map_err(io_err(&tmp))?;
+        let file = File::create(&tmp).map_err(|e| io_error(&tmp, e))?;
         let mut w = BufWriter::new(file);
         write(&mut w)?;
-        let file = w.into_inner().map_err(|e| ImageError::Io {
-            path: tmp.clone(),
-            source: e.into_error(),
-        })?;
-        file.sync_all().map_err(io_err(&tmp))?;
-        std::fs::rename(&tmp, path).map_err(io_err(path))
+        let file = w.into_inner().map_err(|e| io_error(&tmp, e.into_error()))?;
+        file.sync_all().map_err(|e| io_error(&tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| io_error(path, e))
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// [`write_atomic_with`] for image files: file-system errors are [`ImageError::Io`].
+///
+/// # Errors
+/// [`ImageError::Io`] for file-system errors, or whatever `write` returns.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
+) -> Result<(), ImageError> {
+    write_atomic_with(path, write, |p, source| ImageError::Io {
+        path: p.to_path_buf(),
+        source,
+    })
 }
 
 #[cfg(test)]

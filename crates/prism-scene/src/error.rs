@@ -1,21 +1,43 @@
+//! [`SceneError`], what can go wrong reading a scene, each with its file and location.
+
+use std::sync::Arc;
+
 /// Everything that can go wrong reading a scene.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum SceneError {
     /// A file could not be read.
-    #[error("{path}: {message}")]
+    #[error("{path}: {source}")]
     Io {
         /// The file.
         path: String,
-        /// What went wrong.
-        message: String,
+        /// What the operating system said.
+        #[source]
+        source: Arc<std::io::Error>,
+    },
+    /// The path is not a regular file (a directory, say).
+    #[error("{path}: expected a regular file")]
+    NotAFile {
+        /// The path.
+        path: String,
+    },
+    /// The file is larger than the reader's limit.
+    #[error("{path}: {bytes} bytes is over the {limit}-byte limit")]
+    TooLarge {
+        /// The file.
+        path: String,
+        /// Its size.
+        bytes: u64,
+        /// The limit.
+        limit: u64,
     },
     /// The file is not well-formed XML.
-    #[error("{file}: {message}")]
+    #[error("{file}: {source}")]
     Xml {
         /// The file (or `<memory>`).
         file: String,
-        /// The XML parser's message, which carries the line and column.
-        message: String,
+        /// The XML parser's error, which carries the line and column.
+        #[source]
+        source: roxmltree::Error,
     },
     /// An element is missing, malformed or refers to something that does not exist.
     #[error("{file}:{line}: <{element}>: {message}")]
@@ -29,4 +51,20 @@ pub enum SceneError {
         /// What was expected and what was found.
         message: String,
     },
+}
+
+/// Errors are equal when they say the same thing about the same place; OS errors compare
+/// by kind.
+impl PartialEq for SceneError {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (SceneError::Io { path, source }, SceneError::Io { path: p, source: s }) => {
+                path == p && source.kind() == s.kind()
+            }
+            (SceneError::Xml { file, source }, SceneError::Xml { file: f, source: s }) => {
+                file == f && source == s
+            }
+            _ => self.to_string() == other.to_string() && !matches!(self, SceneError::Io { .. }),
+        }
+    }
 }

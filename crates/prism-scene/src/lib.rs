@@ -18,7 +18,8 @@ mod scene;
 pub use builtin::cornell_box;
 pub use collada::{
     parse_collada, read_collada, write_collada, CameraDef, Collada, EffectDef, Geometry, Instance,
-    LightDef, LightKind, MeshData, Node, Part, Shape, UpAxis, MAX_FILE_BYTES, MAX_NODE_DEPTH,
+    LightDef, LightKind, MeshData, Node, Part, Shape, UpAxis, MAX_COLLADA_BYTES, MAX_NODES,
+    MAX_NODE_DEPTH, MAX_PLACED_FACES,
 };
 pub use error::SceneError;
 pub use scene::{

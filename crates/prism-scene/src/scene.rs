@@ -282,15 +282,30 @@ impl Scene {
                     Instance::Geometry {
                         geometry,
                         materials,
+                        defect,
                     } => {
                         let g = &doc.geometries[*geometry];
+                        if let Some(e) = g.defect.as_ref().or(node.defect.as_ref()) {
+                            return Err(e.clone());
+                        }
                         // The node's first binding, as the course reads it.
-                        let effect = materials.first().and_then(|(_, target)| {
-                            doc.materials
-                                .iter()
-                                .find(|(id, _)| id == target)
-                                .map(|&(_, e)| e)
-                        });
+                        let effect = match materials.first() {
+                            None => None,
+                            Some((_, target)) => {
+                                match doc.materials.iter().find(|(id, _)| id == target) {
+                                    Some((_, Ok(e))) => Some(*e),
+                                    Some((_, Err(e))) => return Err(e.clone()),
+                                    // A missing first target is the binding's defect.
+                                    None => match defect {
+                                        Some(e) => return Err(e.clone()),
+                                        None => None,
+                                    },
+                                }
+                            }
+                        };
+                        if let Some(e) = effect.and_then(|e| doc.effects[e].defect.as_ref()) {
+                            return Err(e.clone());
+                        }
                         let material = match effect {
                             Some(e) => *effect_material[e].get_or_insert_with(|| {
                                 scene.materials.push(doc.effects[e].material.clone());
@@ -340,6 +355,9 @@ impl Scene {
                         let Some(l) = doc.lights.iter().find(|l| &l.id == id) else {
                             continue;
                         };
+                        if let Some(e) = l.defect.as_ref().or(node.defect.as_ref()) {
+                            return Err(e.clone());
+                        }
                         let at = |p: DVec3| world.transform_point3(p);
                         let center = at(DVec3::ZERO);
                         match l.kind {
@@ -401,10 +419,26 @@ impl Scene {
                     Instance::Camera(id) => {
                         if file_camera.is_none() {
                             if let Some(c) = doc.cameras.iter().find(|c| &c.id == id) {
+                                if let Some(e) = &c.defect {
+                                    return Err(e.clone());
+                                }
+                                if let Some(e) = &node.defect {
+                                    if opts.camera == CameraMode::File {
+                                        return Err(e.clone());
+                                    }
+                                    scene.warnings.push(format!(
+                                        "{file}:{}: camera node {:?}: its transform is malformed; \
+                                         the course's placement reads its direction from the \
+                                         numbers given, in order",
+                                        node.line, node.name
+                                    ));
+                                }
                                 file_camera = Some((c.clone(), world));
                             }
                         }
                     }
+                    // Every camera and light instance is read, to find the first camera.
+                    Instance::Missing(e) => return Err(e.clone()),
                 }
             }
         }

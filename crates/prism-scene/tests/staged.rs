@@ -25,6 +25,7 @@ fn load(rel: &str) -> PolyMesh {
     read_collada(&shared_assets().join(rel))
         .unwrap()
         .world_mesh(false)
+        .unwrap()
 }
 
 #[test]
@@ -354,5 +355,43 @@ fn built_in_cornell_box_matches_the_staged_file() {
         for (p, q) in f.positions.iter().zip(&o.positions) {
             assert!((*p - *q).length() < 1e-5, "{}: {p} {q}", f.name);
         }
+    }
+}
+
+/// Real course files with the harmless defect some distributed copies have: the camera
+/// node's `<matrix>` lacks its final number. Oracle: the intact file. The course's
+/// placement reads the numbers in order, so the scene (camera included) is the intact one,
+/// with a warning naming the line; the file's own camera (`CameraMode::File`) refuses it.
+#[test]
+fn course_files_with_a_short_camera_matrix_load_as_the_intact_ones() {
+    for name in ["sky/CBspheres_lambertian.dae", "sky/CBbunny.dae"] {
+        let path = shared_assets().join(format!("pathtracer/dae/{name}"));
+        let text = std::fs::read_to_string(&path).expect("staged scene");
+        let start = text.find("<node id=\"Camera\"").expect("a camera node");
+        let open = start + text[start..].find("<matrix").unwrap();
+        let close = open + text[open..].find("</matrix>").unwrap();
+        let matrix = &text[open..close];
+        let short = format!(
+            "{}{}",
+            &text[..open],
+            &text[open..].replacen(matrix, matrix.trim_end_matches(" 1"), 1)
+        );
+        assert_ne!(short, text, "{name}: the matrix did not end in 1");
+        let options = prism_scene::SceneOptions::default();
+        let doc = prism_scene::parse_collada(&short, name).unwrap();
+        let line = 1 + text[..open].matches('\n').count();
+        assert!(
+            doc.warnings[0].starts_with(&format!("{name}:{line}: <matrix>: expected 16 numbers")),
+            "{:?}",
+            doc.warnings
+        );
+        let got = prism_scene::Scene::from_collada(&doc, &options, name).unwrap();
+        assert_eq!(got.camera, scene(name).camera, "{name}");
+        assert_eq!(got.lights, scene(name).lights, "{name}");
+        let file_camera = prism_scene::SceneOptions {
+            camera: prism_scene::CameraMode::File,
+            ..options
+        };
+        assert!(prism_scene::Scene::from_collada(&doc, &file_camera, name).is_err());
     }
 }

@@ -24,6 +24,25 @@ pub struct CameraDef {
     pub znear: f64,
     /// Far clipping distance.
     pub zfar: f64,
+    /// Why it cannot be read, if it cannot (the other fields are then the defaults); using
+    /// it is then an error.
+    pub defect: Option<SceneError>,
+}
+
+impl CameraDef {
+    /// A camera whose optics could not be read: its id and line, default optics.
+    pub(super) fn unread(cx: &Cx, c: XmlNode) -> CameraDef {
+        CameraDef {
+            id: c.attribute("id").unwrap_or("").to_string(),
+            line: cx.line(c),
+            xfov: None,
+            yfov: None,
+            aspect_ratio: None,
+            znear: 0.001,
+            zfar: 1000.0,
+            defect: None,
+        }
+    }
 }
 
 /// Which kind of light a `<light>` is.
@@ -52,6 +71,22 @@ pub struct LightDef {
     pub kind: LightKind,
     /// `<color>`: radiance, intensity or irradiance by kind.
     pub color: Rgb,
+    /// Why it cannot be read, if it cannot (the kind and colour are then placeholders);
+    /// using it is then an error.
+    pub defect: Option<SceneError>,
+}
+
+impl LightDef {
+    /// A light that could not be read: its id and line, a black point light.
+    pub(super) fn unread(cx: &Cx, l: XmlNode) -> LightDef {
+        LightDef {
+            id: l.attribute("id").unwrap_or("").to_string(),
+            line: cx.line(l),
+            kind: LightKind::Point,
+            color: Rgb::BLACK,
+            defect: None,
+        }
+    }
 }
 
 /// An `<effect>` read as a material.
@@ -64,6 +99,23 @@ pub struct EffectDef {
     /// The material: the CGL extra's BSDF (the last one if several), else the common
     /// profile's diffuse colour, else diffuse 0.5.
     pub material: Material,
+    /// Why it cannot be read, if it cannot (the material is then diffuse 0.5); using it is
+    /// then an error.
+    pub defect: Option<SceneError>,
+}
+
+impl EffectDef {
+    /// An effect that could not be read: its id and line, diffuse 0.5.
+    pub(super) fn unread(cx: &Cx, e: XmlNode) -> EffectDef {
+        EffectDef {
+            id: e.attribute("id").unwrap_or("").to_string(),
+            line: cx.line(e),
+            material: Material::Diffuse {
+                reflectance: Rgb::splat(0.5),
+            },
+            defect: None,
+        }
+    }
 }
 
 fn color3(cx: &Cx, n: XmlNode) -> Result<Rgb, SceneError> {
@@ -210,6 +262,7 @@ pub(super) fn effect(
         material: material.unwrap_or(Material::Diffuse {
             reflectance: Rgb::splat(0.5),
         }),
+        defect: None,
     })
 }
 
@@ -254,6 +307,7 @@ pub(super) fn light(
         line: cx.line(l),
         kind,
         color: color3(cx, required(cx, shape, "color")?)?,
+        defect: None,
     }))
 }
 
@@ -303,5 +357,6 @@ pub(super) fn camera(cx: &Cx, c: XmlNode) -> Result<CameraDef, SceneError> {
         aspect_ratio,
         znear: opt("znear")?.unwrap_or(0.001),
         zfar: opt("zfar")?.unwrap_or(1000.0),
+        defect: None,
     })
 }

@@ -10,6 +10,14 @@
 //!   (`T·R_Y·R_X·R_Z` for the usual modo `translate, rotate ×3`), with `<matrix>` read row by
 //!   row and `<rotate>` as axis and angle in degrees. World matrices compose parent first.
 //! - `<up_axis>` is reported, not applied; [`UpAxis::to_y_up`] gives the conversion.
+//!
+//! Malformed values are read past, not refused: each library entry, node or binding that
+//! cannot be read carries its error as a `defect` (with a warning naming file, line and
+//! element), and whoever uses it ([`Collada::world_mesh`], [`crate::Scene::from_collada`])
+//! returns that error. A defect in something nothing uses stays a warning, as in the
+//! course's own renderer. Malformed XML, a wrong root, a reference to a missing geometry
+//! and the limits ([`MAX_COLLADA_BYTES`], [`MAX_NODE_DEPTH`], [`MAX_NODES`],
+//! [`MAX_PLACED_FACES`]) are errors at once.
 
 mod library;
 mod writer;
@@ -28,10 +36,18 @@ pub use library::{CameraDef, EffectDef, LightDef, LightKind};
 pub use writer::write_collada;
 
 /// Largest COLLADA file read, in bytes.
-pub const MAX_FILE_BYTES: u64 = 1 << 30;
+pub const MAX_COLLADA_BYTES: u64 = 1 << 30;
 
-/// Deepest node nesting followed (also bounds `instance_node` cycles).
+/// Deepest node nesting followed, `instance_node` references included.
 pub const MAX_NODE_DEPTH: usize = 64;
+
+/// Most nodes the visual scene may expand to, each `instance_node` copying its target's
+/// whole subtree.
+pub const MAX_NODES: usize = 1_000_000;
+
+/// Most polygons the instanced geometries may place in the world, counted over every
+/// instance.
+pub const MAX_PLACED_FACES: usize = 50_000_000;
 
 /// The document's up axis (`<asset><up_axis>`), `Y` when absent.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -86,8 +102,9 @@ pub struct Collada {
     pub lights: Vec<LightDef>,
     /// Every `<effect>`, read as a material.
     pub effects: Vec<EffectDef>,
-    /// Every `<material>`: its id and the index of its effect in [`Collada::effects`].
-    pub materials: Vec<(String, usize)>,
+    /// Every `<material>`: its id and the index of its effect in [`Collada::effects`], or
+    /// why it has none (a user of the material refuses it with that error).
+    pub materials: Vec<(String, Result<usize, SceneError>)>,
     /// Features read past without being understood, one message each.
     pub warnings: Vec<String>,
 }
@@ -101,8 +118,10 @@ pub struct Geometry {
     pub name: String,
     /// Line of its start tag.
     pub line: u32,
-    /// What it holds.
+    /// What it holds ([`Shape::Empty`] when it is malformed).
     pub shape: Shape,
+    /// Why it cannot be read, if it cannot; placing it is then an error.
+    pub defect: Option<SceneError>,
 }
 
 /// What a geometry holds.
@@ -151,8 +170,14 @@ pub struct Node {
     pub name: String,
     /// Line of its start tag.
     pub line: u32,
-    /// Local-to-world matrix: the parents' transforms, then its own.
+    /// Local-to-world matrix: the parents' transforms, then its own. When the node has a
+    /// defect, this is the lenient reading: a `<matrix>` with fewer than 16 numbers takes
+    /// them in order over the identity (as the course's renderer reads it), and any other
+    /// malformed transform element is left out.
     pub world: DMat4,
+    /// The first malformed transform element of this node or an ancestor, if any: a user of
+    /// [`Node::world`] that needs it exactly refuses the node with this error.
+    pub defect: Option<SceneError>,
     /// What it instances.
     pub instances: Vec<Instance>,
 }
@@ -167,20 +192,28 @@ pub enum Instance {
         geometry: usize,
         /// `bind_material` pairs: the part's symbol and the `<material>` id (no `#`).
         materials: Vec<(String, String)>,
+        /// The first binding whose target is missing, if any: a user of that binding
+        /// refuses it with this error.
+        defect: Option<SceneError>,
     },
     /// `<instance_camera>`, by camera id.
     Camera(String),
     /// `<instance_light>`, by light id.
     Light(String),
+    /// An `<instance_camera>` or `<instance_light>` whose target does not exist: a user of
+    /// cameras and lights refuses it with this error.
+    Missing(SceneError),
 }
 
 impl Collada {
     /// Every instanced mesh in world space merged into one polygon mesh, converted to a Y-up
     /// world when `y_up` is set. Per-vertex normals (transformed by the inverse transpose) and
-    /// texture coordinates are kept when every merged mesh has them. A document that instances no visual scene
-    /// contributes each mesh geometry once, untransformed.
-    #[must_use]
-    pub fn world_mesh(&self, y_up: bool) -> PolyMesh {
+    /// texture coordinates are kept when every merged mesh has them. A document that
+    /// instances no visual scene contributes each mesh geometry once, untransformed.
+    ///
+    /// # Errors
+    /// The defect of a placed geometry, or of the node that places it.
+    pub fn world_mesh(&self, y_up: bool) -> Result<PolyMesh, SceneError> {
         let up = if y_up {
             self.up_axis.to_y_up()
         } else {
@@ -189,6 +222,9 @@ impl Collada {
         let mut placed: Vec<(&MeshData, DMat4)> = Vec::new();
         if self.nodes.is_empty() {
             for g in &self.geometries {
+                if let Some(e) = &g.defect {
+                    return Err(e.clone());
+                }
                 if let Shape::Mesh(m) = &g.shape {
                     placed.push((m, up));
                 }
@@ -197,7 +233,11 @@ impl Collada {
             for n in &self.nodes {
                 for i in &n.instances {
                     if let Instance::Geometry { geometry, .. } = i {
-                        if let Shape::Mesh(m) = &self.geometries[*geometry].shape {
+                        let g = &self.geometries[*geometry];
+                        if let Some(e) = g.defect.as_ref().or(n.defect.as_ref()) {
+                            return Err(e.clone());
+                        }
+                        if let Shape::Mesh(m) = &g.shape {
                             placed.push((m, up * n.world));
                         }
                     }
@@ -231,32 +271,34 @@ impl Collada {
         }
         out.normals = normals.filter(|n| !n.is_empty());
         out.uvs = uvs.filter(|t| !t.is_empty());
-        out
+        Ok(out)
     }
 }
 
 /// Reads a COLLADA file.
 ///
 /// # Errors
-/// [`SceneError::Io`] if the file cannot be read or exceeds [`MAX_FILE_BYTES`]; otherwise as
+/// [`SceneError::Io`], [`SceneError::NotAFile`] or [`SceneError::TooLarge`] (over
+/// [`MAX_COLLADA_BYTES`]); otherwise as
 /// [`parse_collada`].
 pub fn read_collada(path: &Path) -> Result<Collada, SceneError> {
     let name = path.display().to_string();
-    let io = |message: String| SceneError::Io {
+    let io = |e: std::io::Error| SceneError::Io {
         path: name.clone(),
-        message,
+        source: std::sync::Arc::new(e),
     };
-    let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
+    let meta = std::fs::metadata(path).map_err(io)?;
     if !meta.is_file() {
-        return Err(io("expected a regular file".into()));
+        return Err(SceneError::NotAFile { path: name });
     }
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(io(format!(
-            "{} bytes is over the {MAX_FILE_BYTES}-byte limit",
-            meta.len()
-        )));
+    if meta.len() > MAX_COLLADA_BYTES {
+        return Err(SceneError::TooLarge {
+            path: name,
+            bytes: meta.len(),
+            limit: MAX_COLLADA_BYTES,
+        });
     }
-    let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+    let text = std::fs::read_to_string(path).map_err(io)?;
     parse_collada(&text, &name)
 }
 
@@ -276,7 +318,7 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
     )
     .map_err(|e| SceneError::Xml {
         file: file.to_string(),
-        message: e.to_string(),
+        source: e,
     })?;
     let root = xml.root_element();
     let cx = Cx { xml: &xml, file };
@@ -289,6 +331,12 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
         if warned.insert(key.to_string()) {
             out.warnings.push(message);
         }
+    };
+    // A malformed entry is kept with its error, which is an error only for its users.
+    let defect = |out: &mut Collada, e: SceneError| {
+        out.warnings
+            .push(format!("{e}; read past: an error only where it is used"));
+        Some(e)
     };
 
     if let Some(up) = child(root, "asset").and_then(|a| child(a, "up_axis")) {
@@ -306,7 +354,11 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
     for lib in children(root, "library_geometries") {
         for g in children(lib, "geometry") {
             let id = g.attribute("id").unwrap_or("").to_string();
-            let shape = read_geometry(&cx, g, &mut |key, msg| warn(&mut out, key, msg))?;
+            let (shape, fault) =
+                match read_geometry(&cx, g, &mut |key, msg| warn(&mut out, key, msg)) {
+                    Ok(shape) => (shape, None),
+                    Err(e) => (Shape::Empty, defect(&mut out, e)),
+                };
             if !id.is_empty() {
                 geometry_index.insert(id.clone(), out.geometries.len());
             }
@@ -315,39 +367,62 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
                 id,
                 line: cx.line(g),
                 shape,
+                defect: fault,
             });
         }
     }
     for lib in children(root, "library_cameras") {
         for c in children(lib, "camera") {
-            out.cameras.push(library::camera(&cx, c)?);
+            let camera = library::camera(&cx, c).unwrap_or_else(|e| CameraDef {
+                defect: defect(&mut out, e),
+                ..CameraDef::unread(&cx, c)
+            });
+            out.cameras.push(camera);
         }
     }
     let mut all_light_ids = Vec::new();
     for lib in children(root, "library_lights") {
         for l in children(lib, "light") {
             all_light_ids.push(l.attribute("id").unwrap_or("").to_string());
-            if let Some(light) = library::light(&cx, l, &mut |k, m| warn(&mut out, k, m))? {
-                out.lights.push(light);
+            match library::light(&cx, l, &mut |k, m| warn(&mut out, k, m)) {
+                Ok(Some(light)) => out.lights.push(light),
+                Ok(None) => {}
+                Err(e) => {
+                    let light = LightDef {
+                        defect: defect(&mut out, e),
+                        ..LightDef::unread(&cx, l)
+                    };
+                    out.lights.push(light);
+                }
             }
         }
     }
     for lib in children(root, "library_effects") {
         for e in children(lib, "effect") {
-            let effect = library::effect(&cx, e, &mut |k, m| warn(&mut out, k, m))?;
+            let effect = match library::effect(&cx, e, &mut |k, m| warn(&mut out, k, m)) {
+                Ok(effect) => effect,
+                Err(err) => EffectDef {
+                    defect: defect(&mut out, err),
+                    ..EffectDef::unread(&cx, e)
+                },
+            };
             out.effects.push(effect);
         }
     }
     for lib in children(root, "library_materials") {
         for m in children(lib, "material") {
-            let inst = child(m, "instance_effect")
-                .ok_or_else(|| cx.err(m, "expected an <instance_effect>"))?;
-            let url = reference(&cx, inst, "url")?;
-            let effect = out
-                .effects
-                .iter()
-                .position(|e| e.id == url)
-                .ok_or_else(|| cx.err(inst, format!("no <effect> with id {url:?}")))?;
+            let effect = child(m, "instance_effect")
+                .ok_or_else(|| cx.err(m, "expected an <instance_effect>"))
+                .and_then(|inst| {
+                    let url = reference(&cx, inst, "url")?;
+                    out.effects
+                        .iter()
+                        .position(|e| e.id == url)
+                        .ok_or_else(|| cx.err(inst, format!("no <effect> with id {url:?}")))
+                });
+            if let Err(e) = &effect {
+                defect(&mut out, e.clone());
+            }
             out.materials
                 .push((m.attribute("id").unwrap_or("").to_string(), effect));
         }
@@ -387,17 +462,116 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
             materials: &out.materials,
             unknown_lights: &all_light_ids,
         };
+        count_nodes(&cx, scene, &library_nodes)?;
         let mut nodes = Vec::new();
         let mut warnings = Vec::new();
         for n in children(scene, "node") {
-            walker.node(n, DMat4::IDENTITY, 0, &mut nodes, &mut warnings)?;
+            walker.node(n, DMat4::IDENTITY, None, 0, &mut nodes, &mut warnings)?;
         }
         for (key, msg) in warnings {
             warn(&mut out, &key, msg);
         }
         out.nodes = nodes;
     }
+    // Instances copy their geometry's faces: bound the total before anyone places them.
+    let mut placed = 0usize;
+    for n in &out.nodes {
+        for i in &n.instances {
+            if let Instance::Geometry { geometry, .. } = i {
+                if let Shape::Mesh(m) = &out.geometries[*geometry].shape {
+                    placed = placed.saturating_add(m.mesh.face_count());
+                }
+            }
+        }
+        if placed > MAX_PLACED_FACES {
+            return Err(SceneError::Element {
+                file: file.to_string(),
+                line: n.line,
+                element: "node".into(),
+                message: format!(
+                    "the instances place more than {MAX_PLACED_FACES} polygons in the world"
+                ),
+            });
+        }
+    }
     Ok(out)
+}
+
+/// Counts the nodes the visual scene expands to, without expanding it, and refuses more
+/// than [`MAX_NODES`] or an `instance_node` that leads back to a node containing it. Each
+/// node is visited once, with an explicit stack.
+fn count_nodes<'b, 'i>(
+    cx: &Cx<'_, 'i>,
+    scene: XmlNode<'b, 'i>,
+    library_nodes: &HashMap<String, XmlNode<'b, 'i>>,
+) -> Result<(), SceneError> {
+    #[derive(Clone, Copy)]
+    enum Mark {
+        Open,
+        Done(u64),
+    }
+    // A node's parts: its child nodes and the targets of its instance_node references.
+    let parts = |n: XmlNode<'b, 'i>| -> Vec<(XmlNode<'b, 'i>, Option<XmlNode<'b, 'i>>)> {
+        n.children()
+            .filter_map(|c| match c.tag_name().name() {
+                "node" => Some((c, None)),
+                "instance_node" => c
+                    .attribute("url")
+                    .and_then(|u| u.strip_prefix('#'))
+                    .and_then(|u| library_nodes.get(u))
+                    .map(|&t| (t, Some(c))),
+                _ => None,
+            })
+            .collect()
+    };
+    let mut marks: HashMap<roxmltree::NodeId, Mark> = HashMap::new();
+    let mut stack: Vec<(XmlNode, Option<XmlNode>, bool)> =
+        children(scene, "node").map(|n| (n, None, false)).collect();
+    let mut total = 0u64;
+    while let Some((n, via, finished)) = stack.pop() {
+        match (marks.get(&n.id()).copied(), finished) {
+            (Some(Mark::Done(_)), false) => {}
+            (Some(Mark::Open), false) => {
+                let at = via.unwrap_or(n);
+                return Err(cx.err(
+                    at,
+                    "the node instances a node that contains it (its own ancestor)",
+                ));
+            }
+            (None, _) => {
+                marks.insert(n.id(), Mark::Open);
+                stack.push((n, via, true));
+                stack.extend(parts(n).into_iter().map(|(c, via)| (c, via, false)));
+            }
+            (Some(_), true) => {
+                let mut size = 1u64;
+                for (c, _) in parts(n) {
+                    if let Some(Mark::Done(k)) = marks.get(&c.id()) {
+                        size = size.saturating_add(*k);
+                    }
+                }
+                if size > MAX_NODES as u64 {
+                    return Err(cx.err(
+                        n,
+                        format!("the node expands to more than {MAX_NODES} nodes"),
+                    ));
+                }
+                marks.insert(n.id(), Mark::Done(size));
+            }
+        }
+    }
+    for n in children(scene, "node") {
+        if let Some(Mark::Done(k)) = marks.get(&n.id()) {
+            total = total.saturating_add(*k);
+        }
+    }
+    if total > MAX_NODES as u64 {
+        return Err(cx.err(
+            scene,
+            format!("the scene expands to more than {MAX_NODES} nodes"),
+        ));
+    }
+    Ok(())
 }
 
 struct Cx<'a, 'input> {
@@ -922,77 +1096,52 @@ struct Walker<'a, 'b, 'i> {
     library_nodes: &'a HashMap<String, XmlNode<'b, 'i>>,
     cameras: &'a [CameraDef],
     lights: &'a [LightDef],
-    materials: &'a [(String, usize)],
+    materials: &'a [(String, Result<usize, SceneError>)],
     /// Every light id, including lights of unknown kinds (skipped with a warning).
     unknown_lights: &'a [String],
 }
 
 impl<'b, 'i> Walker<'_, 'b, 'i> {
+    /// Reads node `n` under a parent with world matrix `parent` (and the parent's defect),
+    /// then its children, depth first. The depth is checked before going deeper.
     fn node(
         &self,
         n: XmlNode<'b, 'i>,
         parent: DMat4,
+        parent_defect: Option<&SceneError>,
         depth: usize,
         out: &mut Vec<Node>,
         warnings: &mut Vec<(String, String)>,
     ) -> Result<(), SceneError> {
         let cx = self.cx;
         if depth >= MAX_NODE_DEPTH {
-            return Err(cx.err(
-                n,
-                format!("nodes nest deeper than {MAX_NODE_DEPTH} (or instance themselves)"),
-            ));
+            return Err(cx.err(n, format!("nodes nest deeper than {MAX_NODE_DEPTH}")));
         }
         let mut local = DMat4::IDENTITY;
+        let mut defect = parent_defect.cloned();
         let mut instances = Vec::new();
         let mut kids = Vec::new();
+        let note = |e: SceneError, warnings: &mut Vec<(String, String)>| {
+            let message = format!("{e}; read past: an error only where it is used");
+            warnings.push((message.clone(), message));
+            e
+        };
         for c in n.children().filter(|c| c.is_element()) {
-            match c.tag_name().name() {
-                "matrix" => {
-                    let v = floats_n(cx, c, 16)?;
-                    let mut cols = [0.0; 16];
-                    cols.copy_from_slice(&v);
-                    local *= DMat4::from_cols_array(&cols).transpose();
-                }
-                "translate" => {
-                    let v = floats_n(cx, c, 3)?;
-                    local *= DMat4::from_translation(DVec3::new(v[0], v[1], v[2]));
-                }
-                "scale" => {
-                    let v = floats_n(cx, c, 3)?;
-                    local *= DMat4::from_scale(DVec3::new(v[0], v[1], v[2]));
-                }
-                "rotate" => {
-                    let v = floats_n(cx, c, 4)?;
-                    let axis = DVec3::new(v[0], v[1], v[2]);
-                    if v[3] != 0.0 {
-                        let axis = axis
-                            .try_normalize()
-                            .ok_or_else(|| cx.err(c, "expected a non-zero rotation axis"))?;
-                        local *= DMat4::from_axis_angle(axis, v[3].to_radians());
+            let name = c.tag_name().name();
+            if matches!(name, "matrix" | "translate" | "scale" | "rotate" | "lookat") {
+                match transform(cx, c) {
+                    Ok(m) => local *= m,
+                    Err(e) => {
+                        if name == "matrix" {
+                            local *= lenient_matrix(c);
+                        }
+                        let e = note(e, warnings);
+                        defect.get_or_insert(e);
                     }
                 }
-                "lookat" => {
-                    let v = floats_n(cx, c, 9)?;
-                    let eye = DVec3::new(v[0], v[1], v[2]);
-                    let target = DVec3::new(v[3], v[4], v[5]);
-                    let up = DVec3::new(v[6], v[7], v[8]);
-                    let forward = (target - eye).try_normalize();
-                    let right = forward.and_then(|f| f.cross(up).try_normalize());
-                    let (Some(f), Some(r)) = (forward, right) else {
-                        return Err(cx.err(
-                            c,
-                            "expected distinct eye and target and an up not along the view",
-                        ));
-                    };
-                    let u = r.cross(f);
-                    local *= DMat4::from_cols(
-                        r.extend(0.0),
-                        u.extend(0.0),
-                        (-f).extend(0.0),
-                        DVec4::new(eye.x, eye.y, eye.z, 1.0),
-                    );
-                }
+                continue;
+            }
+            match name {
                 "skew" => warnings.push((
                     "transform:skew".into(),
                     format!(
@@ -1008,41 +1157,72 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                         .get(url)
                         .ok_or_else(|| cx.err(c, format!("no <geometry> with id {url:?}")))?;
                     let mut materials = Vec::new();
+                    let mut binding_defect = None;
                     for im in c
                         .descendants()
                         .filter(|d| d.has_tag_name("instance_material"))
                     {
-                        let symbol = im
+                        let binding = im
                             .attribute("symbol")
-                            .ok_or_else(|| cx.err(im, "expected a symbol attribute"))?;
-                        let target = reference(cx, im, "target")?;
-                        if !self.materials.iter().any(|(id, _)| id == target) {
-                            return Err(cx.err(im, format!("no <material> with id {target:?}")));
+                            .ok_or_else(|| cx.err(im, "expected a symbol attribute"))
+                            .and_then(|symbol| {
+                                let target = reference(cx, im, "target")?;
+                                if !self.materials.iter().any(|(id, _)| id == target) {
+                                    return Err(
+                                        cx.err(im, format!("no <material> with id {target:?}"))
+                                    );
+                                }
+                                Ok((symbol.to_string(), target.to_string()))
+                            });
+                        match binding {
+                            Ok(b) => materials.push(b),
+                            Err(e) => {
+                                // Kept in place, so that "the first binding" still means it.
+                                let symbol = im.attribute("symbol").unwrap_or("").to_string();
+                                let target = im.attribute("target").unwrap_or("").to_string();
+                                materials.push((symbol, target));
+                                let e = note(e, warnings);
+                                binding_defect.get_or_insert(e);
+                            }
                         }
-                        materials.push((symbol.to_string(), target.to_string()));
                     }
                     instances.push(Instance::Geometry {
                         geometry,
                         materials,
+                        defect: binding_defect,
                     });
                 }
                 "instance_camera" => {
-                    let url = reference(cx, c, "url")?;
-                    if !self.cameras.iter().any(|c| c.id == url) {
-                        return Err(cx.err(c, format!("no <camera> with id {url:?}")));
-                    }
-                    instances.push(Instance::Camera(url.to_string()));
+                    let camera = reference(cx, c, "url").and_then(|url| {
+                        if self.cameras.iter().any(|c| c.id == url) {
+                            Ok(url)
+                        } else {
+                            Err(cx.err(c, format!("no <camera> with id {url:?}")))
+                        }
+                    });
+                    instances.push(match camera {
+                        Ok(url) => Instance::Camera(url.to_string()),
+                        Err(e) => Instance::Missing(note(e, warnings)),
+                    });
                 }
                 "instance_light" => {
-                    let url = reference(cx, c, "url")?;
-                    if !self.lights.iter().any(|l| l.id == url) {
-                        // A light of an unknown kind was skipped with a warning.
-                        if self.unknown_lights.iter().any(|id| id == url) {
-                            continue;
+                    let light = reference(cx, c, "url").and_then(|url| {
+                        if self.lights.iter().any(|l| l.id == url)
+                            || self.unknown_lights.iter().any(|id| id == url)
+                        {
+                            Ok(url)
+                        } else {
+                            Err(cx.err(c, format!("no <light> with id {url:?}")))
                         }
-                        return Err(cx.err(c, format!("no <light> with id {url:?}")));
+                    });
+                    match light {
+                        Ok(url) if self.lights.iter().any(|l| l.id == url) => {
+                            instances.push(Instance::Light(url.to_string()));
+                        }
+                        // A light of an unknown kind was skipped with a warning.
+                        Ok(_) => {}
+                        Err(e) => instances.push(Instance::Missing(note(e, warnings))),
                     }
-                    instances.push(Instance::Light(url.to_string()));
                 }
                 "instance_node" => {
                     let url = reference(cx, c, "url")?;
@@ -1055,9 +1235,11 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                 _ => {}
             }
         }
-        let world = parent * local;
+        let mut world = parent * local;
         if !world.is_finite() {
-            return Err(cx.err(n, "the node's world matrix is not finite"));
+            let e = note(cx.err(n, "the node's world matrix is not finite"), warnings);
+            defect.get_or_insert(e);
+            world = DMat4::IDENTITY;
         }
         let id = n.attribute("id").unwrap_or("").to_string();
         out.push(Node {
@@ -1065,13 +1247,81 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
             id,
             line: cx.line(n),
             world,
+            defect: defect.clone(),
             instances,
         });
         for k in kids {
-            self.node(k, world, depth + 1, out, warnings)?;
+            self.node(k, world, defect.as_ref(), depth + 1, out, warnings)?;
         }
         Ok(())
     }
+}
+
+/// One transform element (`matrix`, `translate`, `scale`, `rotate`, `lookat`) as a matrix.
+fn transform(cx: &Cx, c: XmlNode) -> Result<DMat4, SceneError> {
+    Ok(match c.tag_name().name() {
+        "matrix" => {
+            let v = floats_n(cx, c, 16)?;
+            let mut cols = [0.0; 16];
+            cols.copy_from_slice(&v);
+            DMat4::from_cols_array(&cols).transpose()
+        }
+        "translate" => {
+            let v = floats_n(cx, c, 3)?;
+            DMat4::from_translation(DVec3::new(v[0], v[1], v[2]))
+        }
+        "scale" => {
+            let v = floats_n(cx, c, 3)?;
+            DMat4::from_scale(DVec3::new(v[0], v[1], v[2]))
+        }
+        "rotate" => {
+            let v = floats_n(cx, c, 4)?;
+            if v[3] == 0.0 {
+                return Ok(DMat4::IDENTITY);
+            }
+            let axis = DVec3::new(v[0], v[1], v[2])
+                .try_normalize()
+                .ok_or_else(|| cx.err(c, "expected a non-zero rotation axis"))?;
+            DMat4::from_axis_angle(axis, v[3].to_radians())
+        }
+        _ => {
+            let v = floats_n(cx, c, 9)?;
+            let eye = DVec3::new(v[0], v[1], v[2]);
+            let target = DVec3::new(v[3], v[4], v[5]);
+            let up = DVec3::new(v[6], v[7], v[8]);
+            let forward = (target - eye).try_normalize();
+            let right = forward.and_then(|f| f.cross(up).try_normalize());
+            let (Some(f), Some(r)) = (forward, right) else {
+                return Err(cx.err(
+                    c,
+                    "expected distinct eye and target and an up not along the view",
+                ));
+            };
+            let u = r.cross(f);
+            DMat4::from_cols(
+                r.extend(0.0),
+                u.extend(0.0),
+                (-f).extend(0.0),
+                DVec4::new(eye.x, eye.y, eye.z, 1.0),
+            )
+        }
+    })
+}
+
+/// A malformed `<matrix>` as the course's renderer reads it: the finite numbers it holds,
+/// in row-major order, over the identity (a short matrix keeps the identity's last entries;
+/// numbers past 16 are dropped).
+fn lenient_matrix(c: XmlNode) -> DMat4 {
+    let mut rows = DMat4::IDENTITY.transpose().to_cols_array();
+    let numbers = c
+        .text()
+        .unwrap_or("")
+        .split_ascii_whitespace()
+        .map_while(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()));
+    for (slot, v) in rows.iter_mut().zip(numbers) {
+        *slot = v;
+    }
+    DMat4::from_cols_array(&rows).transpose()
 }
 
 #[cfg(test)]

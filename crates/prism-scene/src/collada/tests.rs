@@ -72,7 +72,8 @@ fn polylist_reads_shared_positions_and_per_corner_attributes() {
         c.nodes[0].instances,
         vec![Instance::Geometry {
             geometry: 0,
-            materials: vec![("paint".into(), "red".into())]
+            materials: vec![("paint".into(), "red".into())],
+            defect: None,
         }]
     );
 }
@@ -123,7 +124,7 @@ fn matrix_is_row_major() {
         c.nodes[0].world.transform_point3(DVec3::ONE),
         DVec3::new(9.0, 10.0, 11.0),
     );
-    let m = c.world_mesh(false);
+    let m = c.world_mesh(false).unwrap();
     assert_close(m.positions[2], DVec3::new(9.0, 10.0, 9.0));
 }
 
@@ -145,7 +146,7 @@ fn z_up_converts_to_y_up_like_the_course() {
     let t = "<translate>1 2 3</translate>";
     let c = parse_collada(&doc("Z_UP", SQUARE, &node(t)), "t.dae").unwrap();
     assert_eq!(c.up_axis, UpAxis::Z);
-    let m = c.world_mesh(true);
+    let m = c.world_mesh(true).unwrap();
     assert_close(m.positions[0], DVec3::new(-1.0, 3.0, 2.0));
     // The +Z normal becomes +Y.
     assert_close(m.normals.as_ref().unwrap()[0], DVec3::Y);
@@ -159,7 +160,7 @@ fn cgl_sphere_geometry() {
     let g = r#"<geometry id="sq"><extra><technique profile="CGL"><sphere><radius>.3</radius></sphere></technique></extra></geometry>"#;
     let c = parse_collada(&doc("Z_UP", g, &node("")), "t.dae").unwrap();
     assert!(matches!(c.geometries[0].shape, Shape::Sphere { radius } if radius == 0.3));
-    assert_eq!(c.world_mesh(true).face_count(), 0);
+    assert_eq!(c.world_mesh(true).unwrap().face_count(), 0);
 }
 
 #[test]
@@ -184,8 +185,13 @@ fn unknown_primitives_warn_once() {
     assert!(c.warnings[0].contains("<lines>"));
 }
 
+/// The error a document gives its users: the reader, the world mesh or the scene.
 fn error_of(text: &str) -> String {
-    parse_collada(text, "bad.dae").unwrap_err().to_string()
+    let used = parse_collada(text, "bad.dae").and_then(|c| {
+        c.world_mesh(true)?;
+        crate::Scene::from_collada(&c, &crate::SceneOptions::default(), "bad.dae")
+    });
+    used.unwrap_err().to_string()
 }
 
 #[test]
@@ -280,7 +286,7 @@ fn bad_input_gives_located_errors() {
 fn self_instancing_nodes_are_refused() {
     let text = r##"<COLLADA><library_nodes><node id="a"><instance_node url="#a"/></node></library_nodes>
       <library_visual_scenes><visual_scene id="s"><node><instance_node url="#a"/></node></visual_scene></library_visual_scenes></COLLADA>"##;
-    assert!(error_of(text).contains("nest deeper than 64"));
+    assert!(error_of(text).contains("instances a node that contains it"));
 }
 
 /// Oracle: the writer's output read back is the same mesh (property: lossless round trip).
@@ -300,7 +306,7 @@ fn writer_round_trips() {
     let mut bytes = Vec::new();
     write_collada(&m, &mut bytes).unwrap();
     let c = parse_collada(std::str::from_utf8(&bytes).unwrap(), "rt.dae").unwrap();
-    assert_eq!(c.world_mesh(true), m);
+    assert_eq!(c.world_mesh(true).unwrap(), m);
 }
 
 /// Unsupported features warn once each instead of vanishing silently.
@@ -324,4 +330,166 @@ fn unsupported_features_warn() {
     for want in ["<spotlight>", "diffuse textures", "<velvet>"] {
         assert!(all.contains(want), "{want} not warned: {all}");
     }
+}
+
+/// The 1-based line where `needle` first occurs in `text`.
+fn line_of(text: &str, needle: &str) -> u32 {
+    let at = text.find(needle).expect("needle in text");
+    1 + text[..at].matches('\n').count() as u32
+}
+
+/// Property: 100,000 nested `<node>` elements end in the located depth error, on a test
+/// thread's small stack (the XML parse and the walk check the depth before going deeper).
+#[test]
+fn hundred_thousand_nested_nodes_are_a_located_error() {
+    let levels = 100_000;
+    let nodes = format!("{}{}", "<node>".repeat(levels), "</node>".repeat(levels));
+    let text = doc("Y_UP", SQUARE, &format!("\n{nodes}"));
+    let e = parse_collada(&text, "deep.dae").unwrap_err().to_string();
+    let at = format!("deep.dae:{}: <node>:", line_of(&text, "<node><node>"));
+    assert!(e.starts_with(&at), "{e}");
+    assert!(
+        e.contains(&format!("nest deeper than {MAX_NODE_DEPTH}")),
+        "{e}"
+    );
+}
+
+/// Closed form: `k` library nodes, each instancing the previous one twice, expand to
+/// `2^k − 1` nodes below the top one. Past [`MAX_NODES`] the document is refused before
+/// anything is expanded; below it every copy is there.
+#[test]
+fn instance_node_fan_out_is_counted_before_expanding() {
+    let chain = |k: usize| {
+        let mut lib = String::from("<library_nodes><node id='n0'/>");
+        for i in 1..k {
+            lib += &format!(
+                "<node id='n{i}'><instance_node url='#n{p}'/><instance_node url='#n{p}'/></node>",
+                p = i - 1
+            );
+        }
+        lib += "</library_nodes>";
+        format!(
+            "<COLLADA>{lib}<library_visual_scenes><visual_scene id='s'><node>\
+             <instance_node url='#n{}'/></node></visual_scene></library_visual_scenes></COLLADA>",
+            k - 1
+        )
+    };
+    let c = parse_collada(&chain(10), "fan.dae").unwrap();
+    assert_eq!(c.nodes.len(), 1 + (1 << 10) - 1);
+    let e = parse_collada(&chain(40), "fan.dae")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains(&format!("more than {MAX_NODES} nodes")), "{e}");
+}
+
+/// The course's camera node with a 15-number matrix (the final 1 missing).
+fn short_camera_matrix(text: &str) -> String {
+    text.replace(
+        "<node id=\"Camera\" name=\"Camera\" type=\"NODE\">",
+        "<node id=\"Camera\" name=\"Camera\" type=\"NODE\">\n<matrix>1 0 0 0 0 0 1 3 0 -1 0 0 0 0 0</matrix>",
+    )
+}
+
+fn camera_doc(camera_transform: &str) -> String {
+    doc("Y_UP", SQUARE, &node("")).replace(
+        "</visual_scene>",
+        &format!(
+            "<node id=\"Camera\" name=\"Camera\" type=\"NODE\">{camera_transform}\
+             <instance_camera url=\"#cam\"/></node></visual_scene>"
+        ),
+    )
+}
+
+/// The rule: a malformed value nothing uses is a warning naming file, line and element; a
+/// malformed value that is used is an error. Oracle for the camera: the course reads a
+/// short matrix in order, so the camera it places is the intact file's.
+#[test]
+fn malformed_values_are_errors_only_where_used() {
+    let intact = camera_doc("<matrix>1 0 0 0 0 0 1 3 0 -1 0 0 0 0 0 1</matrix>");
+    let short = short_camera_matrix(&camera_doc(""));
+    let course = crate::SceneOptions::default();
+    let file_camera = crate::SceneOptions {
+        camera: crate::CameraMode::File,
+        ..Default::default()
+    };
+    let c = parse_collada(&short, "cam.dae").unwrap();
+    let at = format!(
+        "cam.dae:{}: <matrix>:",
+        line_of(&short, "<matrix>1 0 0 0 0 0 1 3")
+    );
+    assert!(
+        c.warnings[0].starts_with(&format!("{at} expected 16 numbers, found 15")),
+        "{:?}",
+        c.warnings
+    );
+    // Meshes do not use the camera; the course's placement reads the numbers in order.
+    assert!(c.world_mesh(true).is_ok());
+    let scene = crate::Scene::from_collada(&c, &course, "cam.dae").unwrap();
+    let reference = crate::Scene::from_collada(
+        &parse_collada(&intact, "cam.dae").unwrap(),
+        &course,
+        "cam.dae",
+    )
+    .unwrap();
+    assert_eq!(scene.camera, reference.camera);
+    assert!(scene.warnings.iter().any(|w| w.contains("camera node")));
+    // The file's own camera uses the matrix: an error.
+    let e = crate::Scene::from_collada(&c, &file_camera, "cam.dae").unwrap_err();
+    assert!(e.to_string().starts_with(&at), "{e}");
+
+    // A malformed effect, light or geometry nobody instances is a warning.
+    let unused = doc("Y_UP", SQUARE, &node(""))
+        .replace(
+            "</library_effects>",
+            "<effect id=\"bad-fx\"><extra><technique profile=\"CGL\"><mirror><reflectance>1 x 1\
+             </reflectance></mirror></technique></extra></effect></library_effects>",
+        )
+        .replace(
+            "</library_lights>",
+            "<light id=\"bad\"><technique_common><point><color>1</color></point>\
+             </technique_common></light></library_lights>",
+        )
+        .replace(
+            "</library_geometries>",
+            "<geometry id=\"broken\"><mesh><vertices id=\"v\"/></mesh></geometry></library_geometries>",
+        );
+    let c = parse_collada(&unused, "u.dae").unwrap();
+    assert_eq!(c.warnings.len(), 3, "{:?}", c.warnings);
+    assert!(c.world_mesh(true).is_ok());
+    assert!(crate::Scene::from_collada(&c, &course, "u.dae").is_ok());
+    // Used, each is an error; the mesh commands still read what they use.
+    let lit = unused.replace(
+        "</visual_scene>",
+        "<node><instance_light url=\"#bad\"/></node></visual_scene>",
+    );
+    let c = parse_collada(&lit, "u.dae").unwrap();
+    assert!(c.world_mesh(true).is_ok());
+    let e = crate::Scene::from_collada(&c, &course, "u.dae").unwrap_err();
+    assert!(
+        e.to_string().contains("<color>: expected 3 colour values"),
+        "{e}"
+    );
+    let placed = unused.replace("url=\"#sq\"", "url=\"#broken\"");
+    let e = error_of(&placed.replace("u.dae", "bad.dae"));
+    assert!(e.contains("<vertices>: expected a POSITION input"), "{e}");
+    let bound = unused.replace(
+        "<instance_effect url=\"#red-fx\"/>",
+        "<instance_effect url=\"#bad-fx\"/>",
+    );
+    let e = error_of(&bound);
+    assert!(e.contains("<reflectance>: number 1"), "{e}");
+}
+
+/// A light or camera instance with no target is refused by the renderer, which reads them,
+/// and not by the mesh commands, which do not.
+#[test]
+fn missing_instance_targets_fail_only_their_users() {
+    let text = doc("Y_UP", SQUARE, &node("")).replace(
+        "</visual_scene>",
+        "<node><instance_light url=\"#moon\"/></node></visual_scene>",
+    );
+    let c = parse_collada(&text, "m.dae").unwrap();
+    assert!(c.world_mesh(true).is_ok());
+    let e = crate::Scene::from_collada(&c, &crate::SceneOptions::default(), "m.dae").unwrap_err();
+    assert!(e.to_string().contains("no <light> with id \"moon\""), "{e}");
 }
