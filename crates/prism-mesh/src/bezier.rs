@@ -252,11 +252,7 @@ mod tests {
 
     #[test]
     fn staged_files_parse_and_teapot_welds() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/assets/meshedit");
-        if !dir.exists() {
-            return;
-        }
+        let dir = prism_testkit::shared_asset("meshedit");
         let c = parse_bzc(
             &std::fs::read_to_string(dir.join("bzc/curve2.bzc")).unwrap(),
             "curve2.bzc",

@@ -200,11 +200,7 @@ mod tests {
     /// Every staged OBJ loads and builds a valid halfedge mesh (or a located refusal).
     #[test]
     fn staged_objs_load() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../../shared/assets/delft-raytracer/data");
-        if !dir.exists() {
-            return;
-        }
+        let dir = prism_testkit::shared_asset("delft-raytracer/data");
         for name in ["cube.obj", "monkey.obj", "teapot.obj", "triangle.obj"] {
             let m = read_obj(&dir.join(name)).unwrap();
             assert!(m.face_count() > 0, "{name}");

@@ -1,10 +1,13 @@
-//! Golden-image tests against the course's own reference renders
+//! Golden-image tests, one test per input file: the course's own reference renders
 //! (`shared/assets/rasterizer/tests/outputs/reference/`, made by the CS184 staff renderer at
-//! 1024x1024, sample rate 1, nearest pixel sampling, level 0), and against resvg renders of
-//! the project's own standard-SVG suite (`tests/data/*.svg`, references made by resvg 0.49).
+//! 1024x1024, sample rate 1, nearest pixel sampling, level 0), and resvg renders of the
+//! project's own standard-SVG suite (`tests/data/*.svg`, references made by resvg 0.49).
+//! Images are compared in memory; a failure leaves an `expected | diff | actual` triptych
+//! under `target/test-diffs/`. Two more tests check that the lists below name every file.
 
+use prism_image::Rgb8Image;
 use prism_raster::{read_svg, render, Dialect, RenderOptions};
-use prism_testkit::{compare_golden, shared_assets, workspace_root};
+use prism_testkit::{compare_images, shared_asset, workspace_root};
 
 /// The course's reference file name: every character outside `abdefghijklmnopqrstuvwxyz0-9`
 /// becomes `-` (the letter c included).
@@ -21,9 +24,153 @@ fn reference_name(rel: &str) -> String {
         + ".png"
 }
 
-fn staged_svgs() -> Vec<String> {
-    let root = shared_assets().join("rasterizer");
-    let mut out = Vec::new();
+/// The staged course file `rel` (under `rasterizer/`), rendered with `--compat cs184` at
+/// default settings, matches the course renderer's image in at least 99.9% of its pixels.
+fn course_golden(rel: &str) {
+    let svg = shared_asset(&format!("rasterizer/{rel}"));
+    let reference = shared_asset(&format!(
+        "rasterizer/tests/outputs/reference/{}",
+        reference_name(rel)
+    ));
+    let doc = read_svg(&svg, Dialect::Cs184).unwrap_or_else(|e| panic!("{e}"));
+    let opts = RenderOptions {
+        compat: true,
+        ..RenderOptions::default()
+    };
+    let (img, _) = render(&doc, &opts).expect("render");
+    let expected = prism_image::read_png(&reference)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .to_rgb8();
+    let s = compare_images(&rel.replace('/', "_"), &expected, &img.to_rgb8(), |s| {
+        s.identical_fraction >= 0.999
+    });
+    println!(
+        "{rel}: {:.4}% identical, max error {}",
+        100.0 * s.identical_fraction,
+        s.max_error
+    );
+}
+
+macro_rules! course_goldens {
+    ($($name:ident => $rel:literal,)*) => {
+        $(
+            #[test]
+            fn $name() {
+                course_golden($rel);
+            }
+        )*
+        /// Every staged course SVG, as listed above.
+        const COURSE_FILES: &[&str] = &[$($rel),*];
+    };
+}
+
+course_goldens! {
+    basic_test1 => "svg/basic/test1.svg",
+    basic_test2 => "svg/basic/test2.svg",
+    basic_test3 => "svg/basic/test3.svg",
+    basic_test4 => "svg/basic/test4.svg",
+    basic_test5 => "svg/basic/test5.svg",
+    basic_test6 => "svg/basic/test6.svg",
+    basic_test7 => "svg/basic/test7.svg",
+    basic_test8 => "svg/basic/test8.svg",
+    hardcore_01_degenerate_square1 => "svg/hardcore/01_degenerate_square1.svg",
+    illustration_01_sketchpad => "svg/illustration/01_sketchpad.svg",
+    illustration_02_hexes => "svg/illustration/02_hexes.svg",
+    illustration_03_circle => "svg/illustration/03_circle.svg",
+    illustration_04_sun => "svg/illustration/04_sun.svg",
+    illustration_05_lion => "svg/illustration/05_lion.svg",
+    illustration_07_lines => "svg/illustration/07_lines.svg",
+    illustration_08_monkeytree => "svg/illustration/08_monkeytree.svg",
+    illustration_09_kochcurve => "svg/illustration/09_kochcurve.svg",
+    subdiv_triangle1 => "svg/subdiv/triangle1.svg",
+    subdiv_triangle2 => "svg/subdiv/triangle2.svg",
+    subdiv_triangle3 => "svg/subdiv/triangle3.svg",
+    subdiv_triangle4 => "svg/subdiv/triangle4.svg",
+    subdiv_triangle5 => "svg/subdiv/triangle5.svg",
+    subdiv_triangle6 => "svg/subdiv/triangle6.svg",
+    subdiv_triangle7 => "svg/subdiv/triangle7.svg",
+    texmap_test1 => "svg/texmap/test1.svg",
+    texmap_test2 => "svg/texmap/test2.svg",
+    texmap_test5 => "svg/texmap/test5.svg",
+    texmap_test6 => "svg/texmap/test6.svg",
+    transforms_robot => "svg/transforms/robot.svg",
+}
+
+fn data_dir() -> std::path::PathBuf {
+    workspace_root().join("crates/prism-raster/tests/data")
+}
+
+/// The standard SVG `tests/data/{stem}.svg` at 16 samples agrees with resvg 0.49's render
+/// (the oracle, made by `resvg FILE.svg resvg/FILE.png`): mean absolute channel error at most
+/// 1/255 and at most 0.5% of pixels off by more than 24/255, both composited over white.
+fn resvg_golden(stem: &str) {
+    let doc = read_svg(&data_dir().join(format!("{stem}.svg")), Dialect::Svg)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let reference = data_dir().join("resvg").join(format!("{stem}.png"));
+    let expected = prism_image::read_png(&reference).unwrap_or_else(|e| panic!("{e}"));
+    let opts = RenderOptions {
+        width: expected.width(),
+        height: expected.height(),
+        samples: 16,
+        ..RenderOptions::default()
+    };
+    let (img, _) = render(&doc, &opts).expect("render");
+    let actual: Rgb8Image = img.over_background([255, 255, 255]);
+    let expected: Rgb8Image = expected.over_background([255, 255, 255]);
+    let s = compare_images(&format!("resvg_{stem}"), &expected, &actual, |s| {
+        s.mean_abs_error <= 1.0 && s.over_24_fraction <= 0.005
+    });
+    println!(
+        "{stem}.svg: mean abs {:.3}/255, {:.3}% pixels off by >24, max {}",
+        s.mean_abs_error,
+        100.0 * s.over_24_fraction,
+        s.max_error
+    );
+}
+
+macro_rules! resvg_goldens {
+    ($($name:ident => $stem:literal,)*) => {
+        mod resvg {
+            $(
+                #[test]
+                fn $name() {
+                    super::resvg_golden($stem);
+                }
+            )*
+        }
+        /// Every standard SVG of the suite, as listed above.
+        const RESVG_FILES: &[&str] = &[$($stem),*];
+    };
+}
+
+resvg_goldens! {
+    arcs => "arcs",
+    curves => "curves",
+    dashes => "dashes",
+    evenodd => "evenodd",
+    gradients => "gradients",
+    images => "images",
+    joins => "joins",
+    opacity => "opacity",
+    thin => "thin",
+    transforms => "transforms",
+}
+
+/// The SVG files in `dir`, as sorted names.
+fn svgs_in(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".svg"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// The course list names every staged SVG, so that a new file cannot go untested.
+#[test]
+fn course_list_names_every_staged_file() {
+    let mut staged = Vec::new();
     for dir in [
         "basic",
         "hardcore",
@@ -32,118 +179,22 @@ fn staged_svgs() -> Vec<String> {
         "texmap",
         "transforms",
     ] {
-        let mut files: Vec<String> = std::fs::read_dir(root.join("svg").join(dir))
-            .expect("staged svg folder")
-            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-            .filter(|n| n.ends_with(".svg"))
-            .collect();
-        files.sort();
-        out.extend(files.into_iter().map(|f| format!("svg/{dir}/{f}")));
-    }
-    out
-}
-
-/// Every staged course reference is reproduced with `--compat cs184` at default settings.
-/// Reports the identical-pixel fraction per file and fails below 99.9%.
-#[test]
-fn cs184_references_reproduced() {
-    let root = shared_assets().join("rasterizer");
-    let mut report = Vec::new();
-    let mut failures = Vec::new();
-    for rel in staged_svgs() {
-        let reference = root
-            .join("tests/outputs/reference")
-            .join(reference_name(&rel));
-        assert!(
-            reference.exists(),
-            "missing reference {}",
-            reference.display()
+        let folder = shared_asset(&format!("rasterizer/svg/{dir}"));
+        staged.extend(
+            svgs_in(&folder)
+                .into_iter()
+                .map(|f| format!("svg/{dir}/{f}")),
         );
-        let doc = read_svg(&root.join(&rel), Dialect::Cs184).unwrap_or_else(|e| panic!("{e}"));
-        let opts = RenderOptions {
-            compat: true,
-            ..RenderOptions::default()
-        };
-        let (img, _) = render(&doc, &opts).expect("render");
-        let name = rel.replace('/', "_");
-        let result = std::panic::catch_unwind(|| {
-            compare_golden(&name, &reference, &img.to_rgb8(), false, |s| {
-                s.identical_fraction >= 0.999
-            })
-        });
-        match result {
-            Ok(s) => report.push(format!(
-                "{rel}: {:.4}% identical, max error {}",
-                100.0 * s.identical_fraction,
-                s.max_error
-            )),
-            Err(_) => {
-                let s = prism_image::compare_rgb8(
-                    &prism_image::read_png(&reference).unwrap().to_rgb8(),
-                    &img.to_rgb8(),
-                )
-                .unwrap();
-                report.push(format!(
-                    "{rel}: {:.4}% identical, max error {} (FAIL)",
-                    100.0 * s.identical_fraction,
-                    s.max_error
-                ));
-                failures.push(rel);
-            }
-        }
     }
-    println!("{}", report.join("\n"));
-    assert!(
-        failures.is_empty(),
-        "below 99.9% identical: {failures:?}\n{}",
-        report.join("\n")
-    );
+    assert_eq!(staged, COURSE_FILES);
 }
 
-fn data_dir() -> std::path::PathBuf {
-    workspace_root().join("crates/prism-raster/tests/data")
-}
-
-/// The standard-SVG suite at 16 samples agrees with resvg 0.49's renders (the oracle, made by
-/// `resvg FILE.svg resvg/FILE.png`): mean absolute channel error at most 1/255 and at most
-/// 0.5% of pixels off by more than 24/255, both composited over white.
+/// The resvg list names every SVG of the suite.
 #[test]
-fn standard_svgs_agree_with_resvg() {
-    let mut names: Vec<String> = std::fs::read_dir(data_dir())
-        .expect("tests/data")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".svg"))
+fn resvg_list_names_every_suite_file() {
+    let stems: Vec<String> = svgs_in(&data_dir())
+        .into_iter()
+        .map(|n| n.trim_end_matches(".svg").to_string())
         .collect();
-    names.sort();
-    assert!(names.len() >= 8, "suite is missing files");
-    let mut report = Vec::new();
-    for n in &names {
-        let stem = n.trim_end_matches(".svg");
-        let doc = read_svg(&data_dir().join(n), Dialect::Svg).unwrap_or_else(|e| panic!("{e}"));
-        let reference = data_dir().join("resvg").join(format!("{stem}.png"));
-        let expected = prism_image::read_png(&reference).expect("resvg reference");
-        let opts = RenderOptions {
-            width: expected.width(),
-            height: expected.height(),
-            samples: 16,
-            ..RenderOptions::default()
-        };
-        let (img, _) = render(&doc, &opts).expect("render");
-        let actual = img.over_background([255, 255, 255]);
-        let expected_rgb = expected.over_background([255, 255, 255]);
-        let tmp =
-            std::env::temp_dir().join(format!("prism-resvg-{stem}-{}.png", std::process::id()));
-        prism_image::write_png(&tmp, &expected_rgb).expect("write");
-        let s = compare_golden(&format!("resvg_{stem}"), &tmp, &actual, false, |s| {
-            s.mean_abs_error <= 1.0 && s.over_24_fraction <= 0.005
-        });
-        let _ = std::fs::remove_file(&tmp);
-        report.push(format!(
-            "{n}: mean abs {:.3}/255, {:.3}% pixels off by >24, max {}",
-            s.mean_abs_error,
-            100.0 * s.over_24_fraction,
-            s.max_error
-        ));
-    }
-    println!("{}", report.join("\n"));
+    assert_eq!(stems, RESVG_FILES);
 }

@@ -17,9 +17,35 @@ pub fn workspace_root() -> PathBuf {
 }
 
 /// The shared assets folder beside the checkout (`../shared/assets`).
+///
+/// # Panics
+/// If the folder is missing: every test that reads the course's files fails loudly rather
+/// than passing without its data.
 #[must_use]
 pub fn shared_assets() -> PathBuf {
-    workspace_root().join("../shared/assets")
+    let dir = workspace_root().join("../shared/assets");
+    assert!(
+        dir.is_dir(),
+        "missing {}: prism's tests read the course's files from the shared folder beside \
+         the checkout (../shared/assets); put it there",
+        dir.display()
+    );
+    dir
+}
+
+/// The file or folder `rel` under the shared assets.
+///
+/// # Panics
+/// If it is missing, naming it: a test that passes without its data cannot fail.
+#[must_use]
+pub fn shared_asset(rel: &str) -> PathBuf {
+    let path = shared_assets().join(rel);
+    assert!(
+        path.exists(),
+        "missing shared asset {}: this test needs it (see ../shared/assets/SOURCES.md)",
+        path.display()
+    );
+    path
 }
 
 /// Where failing comparisons leave their triptychs.
@@ -66,14 +92,12 @@ pub fn triptych(expected: &Rgb8Image, actual: &Rgb8Image) -> Rgb8Image {
     })
 }
 
-/// Compares `actual` with the PNG at `expected_path`.
-///
-/// Returns the statistics; when `accept` rejects them, writes a triptych named `name` and
-/// panics with the figures. With `MAKE_REF=1` and `owned` true, writes `actual` as the new
-/// reference and returns perfect statistics.
+/// Compares `actual` with the PNG at `expected_path`, as [`compare_images`] does. With
+/// `MAKE_REF=1` and `owned` true, writes `actual` as the new reference instead and returns
+/// perfect statistics.
 ///
 /// # Panics
-/// If the reference is missing or unreadable, the sizes differ, or `accept` returns false.
+/// If the reference is missing or unreadable, or as [`compare_images`].
 pub fn compare_golden(
     name: &str,
     expected_path: &Path,
@@ -91,16 +115,29 @@ pub fn compare_golden(
     let expected = read_png(expected_path)
         .unwrap_or_else(|e| panic!("{name}: cannot read reference: {e}"))
         .to_rgb8();
-    let stats = compare_rgb8(&expected, actual);
-    let ok = stats.as_ref().is_some_and(&accept);
-    if !ok {
+    compare_images(name, &expected, actual, accept)
+}
+
+/// Compares two images in memory and returns the statistics; when the sizes differ or
+/// `accept` rejects the statistics, writes an `expected | diff | actual` triptych named
+/// `name` under [`diff_dir`] and panics with the figures.
+///
+/// # Panics
+/// If the sizes differ or `accept` returns false.
+pub fn compare_images(
+    name: &str,
+    expected: &Rgb8Image,
+    actual: &Rgb8Image,
+    accept: impl Fn(&DiffStats) -> bool,
+) -> DiffStats {
+    let stats = compare_rgb8(expected, actual);
+    if !stats.as_ref().is_some_and(&accept) {
         let dir = diff_dir();
         std::fs::create_dir_all(&dir).expect("create diff folder");
         let out = dir.join(format!("{name}.png"));
-        write_png(&out, &triptych(&expected, actual)).expect("write triptych");
+        write_png(&out, &triptych(expected, actual)).expect("write triptych");
         panic!(
-            "{name}: image differs from {} ({stats:?}); triptych at {}",
-            expected_path.display(),
+            "{name}: image differs from its reference ({stats:?}); triptych at {}",
             out.display()
         );
     }
