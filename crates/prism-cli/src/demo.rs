@@ -36,7 +36,7 @@ fn trace(
     prism_image::write_png(out, &r.image.linear_to_srgb8())
         .with_context(|| format!("writing {}", out.display()))?;
     if let Some(h) = heat {
-        prism_image::write_png(h, &crate::render::heatmap(&r.samples))
+        prism_image::write_png(h, &prism_image::heatmap(&r.samples))
             .with_context(|| format!("writing {}", h.display()))?;
     }
     Ok(())

@@ -193,7 +193,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", exr.display()))?;
     }
     if let Some(path) = &a.heatmap {
-        prism_image::write_png(path, &heatmap(&out.samples))
+        prism_image::write_png(path, &prism_image::heatmap(&out.samples))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     let write = t3.elapsed();
@@ -221,22 +221,4 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The sample-count heat map: blue for no samples, red for the most any pixel took.
-pub(crate) fn heatmap(samples: &prism_image::Image<u32>) -> prism_image::Rgb8Image {
-    let max = samples.pixels().iter().copied().max().unwrap_or(1).max(1);
-    samples.map(|&n| heat_colour(n as f32 / max as f32))
-}
-
-/// Blue (0) through cyan, green and yellow to red (1).
-fn heat_colour(t: f32) -> [u8; 3] {
-    let t = t.clamp(0.0, 1.0) * 4.0;
-    let (r, g, b) = match t {
-        t if t < 1.0 => (0.0, t, 1.0),
-        t if t < 2.0 => (0.0, 1.0, 2.0 - t),
-        t if t < 3.0 => (t - 2.0, 1.0, 0.0),
-        t => (1.0, 4.0 - t, 0.0),
-    };
-    [(r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8]
 }

@@ -1,10 +1,12 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
-//! the one texture sampler (mipmaps, nearest/bilinear/trilinear) and image-difference metrics.
+//! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics and
+//! heat maps.
 #![warn(missing_docs)]
 
 mod diff;
 mod error;
 mod exr;
+mod heatmap;
 mod image;
 mod io;
 mod srgb;
@@ -13,6 +15,7 @@ mod texture;
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{encode_exr, write_exr};
+pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{
     decode_jpeg, decode_png, encode_png, read_image, read_png, write_atomic, write_atomic_with,
