@@ -5,10 +5,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use prism_math::{DVec2, Rgb};
-use prism_mesh::{bezier_point, de_casteljau_levels, parse_bez, parse_bzc, tessellate};
-use prism_raster::path::{LineCap, LineJoin, Path, StrokeStyle};
-use prism_raster::{render, Document, FillRule, Item, Mat3, Paint, RenderOptions};
+use prism_math::DVec2;
+use prism_mesh::{parse_bez, parse_bzc, tessellate};
+use prism_raster::de_casteljau_construction;
 
 use crate::UserError;
 
@@ -48,7 +47,7 @@ pub fn run(a: &BezierArgs) -> Result<()> {
                 );
             }
             let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
-            draw_curve(&pts, a.t, a.size, &a.output)
+            write_curve(&pts, a.t, a.size, &a.output)
         }
         "bez" => {
             if a.resolution == 0 || a.resolution > 1024 {
@@ -66,67 +65,13 @@ pub fn run(a: &BezierArgs) -> Result<()> {
     }
 }
 
-/// Draws the curve, its control polygon and every de Casteljau level at `t` to a PNG.
-pub(crate) fn draw_curve(pts: &[DVec2], t: f64, size: u32, output: &std::path::Path) -> Result<()> {
-    // Curve files use [0, 1]^2 with y up; the picture has y down.
-    let flip = |p: DVec2| DVec2::new(p.x, 1.0 - p.y);
-    let mut doc = Document {
-        width: 1.0,
-        height: 1.0,
-        ..Document::default()
-    };
-    let stroke = |points: Vec<DVec2>, width: f64, color: Rgb| Item::Stroke {
-        path: Path::polygon(&points, false),
-        transform: Mat3::IDENTITY,
-        style: StrokeStyle {
-            width,
-            join: LineJoin::Round,
-            cap: LineCap::Round,
-            ..StrokeStyle::default()
-        },
-        paint: Paint::Solid(color),
-        opacity: 1.0,
-    };
-    let dot = |p: DVec2, r: f64, color: Rgb| Item::Fill {
-        path: Path::ellipse(p, r, r),
-        transform: Mat3::IDENTITY,
-        rule: FillRule::NonZero,
-        paint: Paint::Solid(color),
-        opacity: 1.0,
-    };
-    doc.items.push(Item::Fill {
-        path: Path::polygon(&[DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y], true),
-        transform: Mat3::IDENTITY,
-        rule: FillRule::NonZero,
-        paint: Paint::Solid(Rgb::WHITE),
-        opacity: 1.0,
-    });
-    let curve: Vec<DVec2> = (0..=400)
-        .map(|k| flip(bezier_point(pts, k as f64 / 400.0)))
-        .collect();
-    doc.items
-        .push(stroke(curve, 0.006, Rgb::new(0.1, 0.1, 0.1)));
-    let levels = de_casteljau_levels(pts, t);
-    let n = levels.len().max(2) as f32;
-    for (k, level) in levels.iter().enumerate() {
-        let hue = k as f32 / (n - 1.0);
-        let color = Rgb::new(0.15 + 0.8 * hue, 0.35, 0.9 - 0.7 * hue);
-        let level: Vec<DVec2> = level.iter().map(|&p| flip(p)).collect();
-        if level.len() > 1 {
-            doc.items.push(stroke(level.clone(), 0.003, color));
-        }
-        for &p in &level {
-            doc.items
-                .push(dot(p, if level.len() == 1 { 0.012 } else { 0.008 }, color));
-        }
-    }
-    let opts = RenderOptions {
-        width: size,
-        height: size,
-        samples: 16,
-        ..RenderOptions::default()
-    };
-    let (img, _) = render(&doc, &opts).map_err(|e| UserError(e.to_string()))?;
-    prism_image::write_png(output, &img.over_background([255, 255, 255]))
-        .with_context(|| format!("writing {}", output.display()))
+/// Draws the curve with its de Casteljau construction at `t` and writes it to a PNG.
+pub(crate) fn write_curve(
+    pts: &[DVec2],
+    t: f64,
+    size: u32,
+    output: &std::path::Path,
+) -> Result<()> {
+    let img = de_casteljau_construction(pts, t, size).map_err(|e| UserError(e.to_string()))?;
+    prism_image::write_png(output, &img).with_context(|| format!("writing {}", output.display()))
 }

@@ -150,72 +150,10 @@ fn group_svg() -> String {
     s
 }
 
-/// A wireframe of a mesh, rotated and projected orthographically, every edge drawn.
-fn wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> Result<()> {
-    use prism_math::glam::DVec3;
-    use prism_raster::path::{LineCap, LineJoin, Path, StrokeStyle};
-    use prism_raster::{Document, Item, Mat3, Paint};
-    let (sy, cy) = 0.6f64.sin_cos();
-    let (sx, cx) = 0.35f64.sin_cos();
-    let turn = |p: DVec3| {
-        let q = DVec3::new(cy * p.x + sy * p.z, p.y, -sy * p.x + cy * p.z);
-        prism_math::DVec2::new(q.x, cx * q.y - sx * q.z)
-    };
-    // Fit the turned mesh into the unit square with a margin.
-    let (mut lo, mut hi) = (
-        prism_math::DVec2::splat(f64::MAX),
-        prism_math::DVec2::splat(f64::MIN),
-    );
-    for &p in &mesh.positions {
-        let q = turn(p);
-        lo = lo.min(q);
-        hi = hi.max(q);
-    }
-    let centre = (lo + hi) * 0.5;
-    let scale = 0.9 / (hi - lo).max_element().max(1e-12);
-    let view = |p: DVec3| {
-        let q = (turn(p) - centre) * scale;
-        prism_math::DVec2::new(0.5 + q.x, 0.5 - q.y)
-    };
-    let mut doc = Document {
-        width: 1.0,
-        height: 1.0,
-        ..Document::default()
-    };
-    let mut path = Path::default();
-    let mut seen = std::collections::HashSet::new();
-    for f in mesh.faces() {
-        for k in 0..f.len() {
-            let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            if seen.insert((a.min(b), a.max(b))) {
-                path.move_to(view(mesh.positions[a as usize]));
-                path.line_to(view(mesh.positions[b as usize]));
-            }
-        }
-    }
-    doc.items.push(Item::Stroke {
-        path,
-        transform: Mat3::IDENTITY,
-        style: StrokeStyle {
-            width: 1.2 / f64::from(size),
-            join: LineJoin::Round,
-            cap: LineCap::Round,
-            ..StrokeStyle::default()
-        },
-        paint: Paint::Solid(prism_math::Rgb::new(0.1, 0.2, 0.45)),
-        opacity: 1.0,
-    });
-    let (img, _) = render(
-        &doc,
-        &RenderOptions {
-            width: size,
-            height: size,
-            samples: 16,
-            ..RenderOptions::default()
-        },
-    )?;
-    prism_image::write_png(out, &img.over_background([255, 255, 255]))
-        .with_context(|| format!("writing {}", out.display()))
+/// Draws a wireframe of a mesh and writes it to a PNG.
+fn write_wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> Result<()> {
+    let img = prism_raster::wireframe(mesh, size)?;
+    prism_image::write_png(out, &img).with_context(|| format!("writing {}", out.display()))
 }
 
 struct Entry {
@@ -303,7 +241,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         prism_math::DVec2::new(0.7, 0.45),
         prism_math::DVec2::new(1.0, 0.9),
     ];
-    crate::bezier::draw_curve(&curve, 0.5, 300, &a.output.join("bezier_decasteljau.png"))?;
+    crate::bezier::write_curve(&curve, 0.5, 300, &a.output.join("bezier_decasteljau.png"))?;
     entries.push(Entry {
         file: "bezier_decasteljau.png".into(),
         caption: "Bezier curve with its de Casteljau levels at t = 0.5".into(),
@@ -316,7 +254,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
             mesh = prism_mesh::loop_subdivide(&he, prism_mesh::LoopWeights::Warren)?;
         }
         let file = format!("loop_level_{level}.png");
-        wireframe(&mesh, 300, &a.output.join(&file))?;
+        write_wireframe(&mesh, 300, &a.output.join(&file))?;
         entries.push(Entry {
             file,
             caption: format!(
@@ -396,7 +334,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     for p in &mut teapot.positions {
         *p = prism_math::glam::DVec3::new(p.x, p.z, -p.y);
     }
-    wireframe(&teapot, 300, &a.output.join("bezier_teapot.png"))?;
+    write_wireframe(&teapot, 300, &a.output.join("bezier_teapot.png"))?;
     entries.push(Entry {
         file: "bezier_teapot.png".into(),
         caption: format!(

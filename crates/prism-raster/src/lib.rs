@@ -1,6 +1,7 @@
 //! Floor-2 2D rasterization for prism: an SVG reader (the CS184 subset and standard SVG
 //! shapes, paths, strokes, gradients and images) producing a plain [`Document`], and a
-//! supersampling rasterizer that renders it to an image.
+//! supersampling rasterizer that renders it to an image; and figures, pictures of geometry
+//! (mesh wireframes, de Casteljau constructions) drawn with that rasterizer.
 //!
 //! ```
 //! use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
@@ -14,11 +15,13 @@
 #![warn(missing_docs)]
 
 mod document;
+mod figures;
 mod parse;
 pub mod path;
 mod raster;
 
 pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
     ear_clip, parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError,
     MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
