@@ -19,14 +19,16 @@ mod figures;
 mod parse;
 pub mod path;
 mod raster;
+mod triangulate;
 
 pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
 pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
-    ear_clip, parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError,
-    MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
+    parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError, MAX_DEPTH,
+    MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RenderError, RenderOptions, RenderStats, View,
     MAX_DIMENSION, MAX_SAMPLES,
 };
+pub use triangulate::ear_clip;

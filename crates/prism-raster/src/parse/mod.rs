@@ -18,7 +18,6 @@ use common::{number_list, number_with_unit, Loc, PlainAttribute, Precision};
 pub use common::{
     SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
-pub use cs184::ear_clip;
 pub use pathdata::{parse_path_data, PathDataError};
 
 use std::collections::HashMap;
