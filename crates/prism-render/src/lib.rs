@@ -12,5 +12,5 @@ pub use sampler::Sampler;
 mod prepare;
 mod render;
 
-pub use prepare::{Interaction, Light, LightSample, RenderScene};
+pub use prepare::{Interaction, LightSample, RenderLight, RenderScene};
 pub use render::{radiance, render, Integrator, RenderOptions, Rendered};

@@ -6,13 +6,13 @@ use prism_math::warp::{
     cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf,
 };
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
-use prism_scene::{Light as SceneLight, Scene, Shading};
+use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
 
-/// A light source ready to sample.
+/// A light source ready to sample: the renderer's form of a [`prism_scene::Light`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Light {
+pub enum RenderLight {
     /// A point light.
     Point {
         /// Position.
@@ -70,18 +70,21 @@ pub struct LightSample {
     pub delta: bool,
 }
 
-impl Light {
+impl RenderLight {
     /// True for lights that need exactly one sample (point, directional).
     #[must_use]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Directional { .. })
+        matches!(
+            self,
+            RenderLight::Point { .. } | RenderLight::Directional { .. }
+        )
     }
 
     /// Samples incident light at `p` from `u`.
     #[must_use]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Point {
+            RenderLight::Point {
                 position,
                 intensity,
             } => {
@@ -96,7 +99,7 @@ impl Light {
                     delta: true,
                 })
             }
-            Light::Directional {
+            RenderLight::Directional {
                 to_light,
                 irradiance,
             } => Some(LightSample {
@@ -106,7 +109,7 @@ impl Light {
                 pdf: 1.0,
                 delta: true,
             }),
-            Light::Area {
+            RenderLight::Area {
                 corner,
                 e1,
                 e2,
@@ -131,14 +134,14 @@ impl Light {
                     delta: false,
                 })
             }
-            Light::Environment { radiance } => Some(LightSample {
+            RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
                 dist: f32::INFINITY,
                 li: radiance,
                 pdf: uniform_sphere_pdf(),
                 delta: false,
             }),
-            Light::Hemisphere { radiance } => {
+            RenderLight::Hemisphere { radiance } => {
                 let frame = Frame::from_normal(Vec3::Y);
                 let local = cosine_hemisphere(u);
                 (local.z > 0.0).then(|| LightSample {
@@ -152,12 +155,12 @@ impl Light {
         }
     }
 
-    /// The density with which [`Light::sample`] picks direction `wi` that reaches the light
+    /// The density with which [`RenderLight::sample`] picks direction `wi` that reaches the light
     /// at distance `dist` (area lights) or escapes (hemisphere and environment lights).
     #[must_use]
     pub fn pdf(&self, wi: Vec3, dist: f32) -> f32 {
         match *self {
-            Light::Area { normal, area, .. } => {
+            RenderLight::Area { normal, area, .. } => {
                 let cos_l = -wi.dot(normal);
                 if cos_l > 0.0 {
                     dist * dist / (area * cos_l)
@@ -165,8 +168,8 @@ impl Light {
                     0.0
                 }
             }
-            Light::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
-            Light::Environment { .. } => uniform_sphere_pdf(),
+            RenderLight::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
+            RenderLight::Environment { .. } => uniform_sphere_pdf(),
             _ => 0.0,
         }
     }
@@ -218,7 +221,7 @@ pub struct RenderScene {
     bsdfs: Vec<Bsdf>,
     emission: Vec<Option<Rgb>>,
     /// Lights.
-    pub lights: Vec<Light>,
+    pub lights: Vec<RenderLight>,
     /// The scene's camera.
     pub camera: prism_scene::Camera,
     /// Index of the light that rays escaping the scene see (hemisphere or environment).
@@ -244,21 +247,21 @@ impl RenderScene {
         let mut infinite = None;
         for l in &scene.lights {
             match *l {
-                SceneLight::Point {
+                Light::Point {
                     position,
                     intensity,
-                } => lights.push(Light::Point {
+                } => lights.push(RenderLight::Point {
                     position,
                     intensity,
                 }),
-                SceneLight::Directional {
+                Light::Directional {
                     direction,
                     irradiance,
-                } => lights.push(Light::Directional {
+                } => lights.push(RenderLight::Directional {
                     to_light: -direction.normalize(),
                     irradiance,
                 }),
-                SceneLight::Area {
+                Light::Area {
                     center,
                     dim_x,
                     dim_y,
@@ -277,7 +280,7 @@ impl RenderScene {
                     tris.push([a, c, d]);
                     prims.push(Prim::LightQuad { light: index });
                     prims.push(Prim::LightQuad { light: index });
-                    lights.push(Light::Area {
+                    lights.push(RenderLight::Area {
                         corner,
                         e1: dim_x,
                         e2: dim_y,
@@ -286,13 +289,13 @@ impl RenderScene {
                         radiance,
                     });
                 }
-                SceneLight::Hemisphere { radiance } => {
+                Light::Hemisphere { radiance } => {
                     infinite = Some(lights.len());
-                    lights.push(Light::Hemisphere { radiance });
+                    lights.push(RenderLight::Hemisphere { radiance });
                 }
-                SceneLight::Environment { radiance } => {
+                Light::Environment { radiance } => {
                     infinite = Some(lights.len());
-                    lights.push(Light::Environment { radiance });
+                    lights.push(RenderLight::Environment { radiance });
                 }
             }
         }
@@ -345,8 +348,8 @@ impl RenderScene {
     #[must_use]
     pub fn escaped(&self, dir: Vec3, camera_ray: bool) -> Rgb {
         match self.infinite.map(|i| self.lights[i]) {
-            Some(Light::Environment { radiance }) => radiance,
-            Some(Light::Hemisphere { radiance }) if !camera_ray && dir.y > 0.0 => radiance,
+            Some(RenderLight::Environment { radiance }) => radiance,
+            Some(RenderLight::Hemisphere { radiance }) if !camera_ray && dir.y > 0.0 => radiance,
             _ => Rgb::BLACK,
         }
     }
@@ -395,7 +398,7 @@ impl RenderScene {
                 }
             }
             Prim::LightQuad { light } => {
-                let Light::Area {
+                let RenderLight::Area {
                     normal, radiance, ..
                 } = self.lights[light as usize]
                 else {
