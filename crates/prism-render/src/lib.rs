@@ -4,13 +4,12 @@
 
 pub mod bsdf;
 mod camera;
+mod render;
+mod render_scene;
 mod sampler;
 
 pub use bsdf::{Bsdf, BsdfSample};
 pub use camera::Pinhole;
-pub use sampler::Sampler;
-mod prepare;
-mod render;
-
-pub use prepare::{Interaction, LightSample, RenderLight, RenderScene};
 pub use render::{radiance, render, Integrator, RenderOptions, Rendered};
+pub use render_scene::{Interaction, LightSample, RenderLight, RenderScene};
+pub use sampler::Sampler;

@@ -5,7 +5,7 @@ use prism_math::{Frame, Ray, Rgb, Vec3};
 use rayon::prelude::*;
 
 use crate::camera::Pinhole;
-use crate::prepare::{spawn, Interaction, RenderScene};
+use crate::render_scene::{spawn, Interaction, RenderScene};
 use crate::sampler::Sampler;
 
 /// Which estimator computes radiance.

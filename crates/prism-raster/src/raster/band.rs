@@ -3,7 +3,7 @@
 
 use prism_math::DVec2;
 
-use super::prepare::{DevPaint, Edge, Placed, Prim, TriShade};
+use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
 use crate::document::FillRule;
 
 #[inline]

@@ -15,7 +15,7 @@
 //! than a pixel are drawn one pixel wide with their opacity scaled by their width.
 
 mod band;
-mod prepare;
+mod primitives;
 
 use std::time::{Duration, Instant};
 
@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use crate::document::{Document, Mat3};
 use band::{Band, Pattern};
-use prepare::prepare;
+use primitives::prepare;
 
 /// Largest output width or height in pixels.
 pub const MAX_DIMENSION: u32 = 16_384;
@@ -253,7 +253,7 @@ pub fn render(
 
 #[cfg(test)]
 mod tests {
-    use super::prepare::{dda, radial_t};
+    use super::primitives::{dda, radial_t};
     use super::*;
     use crate::document::{FillRule, Item, Paint};
     use prism_math::{DVec2, Rgb};

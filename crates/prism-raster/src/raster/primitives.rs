@@ -1,5 +1,5 @@
-//! Preparation: document items become device-space primitives (edges, triangles, pixel
-//! lists, layer markers), each with the pixel box it can touch.
+//! Device-space primitives (edges, triangles, pixel lists, layer markers), each with the
+//! pixel box it can touch, and their preparation from document items.
 
 use std::sync::Arc;
 
