@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+use prism_raster::{parse_svg, render, Dialect, RasterOptions, Source};
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
@@ -12,12 +12,12 @@ fuzz_target!(|data: &[u8]| {
         match parse_svg(text, dialect, &source) {
             Ok(doc) => {
                 if doc.items.len() <= 64 {
-                    let opts = RenderOptions {
+                    let opts = RasterOptions {
                         width: 32,
                         height: 32,
                         samples: 4,
                         compat: dialect == Dialect::Cs184,
-                        ..RenderOptions::default()
+                        ..RasterOptions::default()
                     };
                     let _ = render(&doc, &opts);
                 }

@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use base64::Engine;
 use clap::Args;
 use prism_image::{encode_png, Image, LevelSampling, PixelSampling};
-use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+use prism_raster::{parse_svg, render, Dialect, RasterOptions, Source};
 
 /// Arguments of `prism demo`.
 #[derive(Args, Debug)]
@@ -161,7 +161,7 @@ struct Entry {
     caption: String,
 }
 
-fn draw(svg: &str, dialect: Dialect, opts: &RenderOptions, out: &std::path::Path) -> Result<()> {
+fn draw(svg: &str, dialect: Dialect, opts: &RasterOptions, out: &std::path::Path) -> Result<()> {
     let doc = parse_svg(
         svg,
         dialect,
@@ -181,12 +181,12 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         .with_context(|| format!("creating {}", a.output.display()))?;
     let mut entries = Vec::new();
     let tex = texture_svg()?;
-    let mut jobs: Vec<(String, String, String, Dialect, RenderOptions)> = Vec::new();
-    let base = |w, h, samples| RenderOptions {
+    let mut jobs: Vec<(String, String, String, Dialect, RasterOptions)> = Vec::new();
+    let base = |w, h, samples| RasterOptions {
         width: w,
         height: h,
         samples,
-        ..RenderOptions::default()
+        ..RasterOptions::default()
     };
     for n in [1u32, 4, 16] {
         jobs.push((

@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use prism_image::{LevelSampling, PixelSampling};
-use prism_raster::{read_svg, render, Dialect, Document, RenderOptions, View};
+use prism_raster::{read_svg, render, Dialect, Document, RasterOptions, View};
 
 use crate::UserError;
 
@@ -136,7 +136,7 @@ fn render_one(input: &Path, output: &Path, a: &SvgArgs, view: Option<View>) -> R
     let doc = read_svg(input, dialect).map_err(|e| UserError(e.to_string()))?;
     let parse = t0.elapsed();
     let (width, height) = output_size(&doc, a);
-    let opts = RenderOptions {
+    let opts = RasterOptions {
         width,
         height,
         samples: a.samples,

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use prism_raster::{read_svg, render, Dialect, RenderOptions};
+use prism_raster::{read_svg, render, Dialect, RasterOptions};
 
 fn svgs(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(rd) = std::fs::read_dir(dir) else {
@@ -34,10 +34,10 @@ fn main() {
         let mut total = Duration::ZERO;
         for f in &files {
             let doc = read_svg(f, Dialect::Cs184).expect("staged svg parses");
-            let opts = RenderOptions {
+            let opts = RasterOptions {
                 samples,
                 compat: true,
-                ..RenderOptions::default()
+                ..RasterOptions::default()
             };
             let mut times: Vec<Duration> = (0..5)
                 .map(|_| {

@@ -12,7 +12,7 @@ use prism_mesh::{bezier_point, de_casteljau_levels, PolyMesh};
 
 use crate::document::{Document, FillRule, Item, Mat3, Paint};
 use crate::path::{LineCap, LineJoin, Path, StrokeStyle};
-use crate::raster::{render, RenderError, RenderOptions};
+use crate::raster::{render, RasterOptions, RenderError};
 
 /// Samples per pixel of every figure.
 const FIGURE_SAMPLES: u32 = 16;
@@ -28,11 +28,11 @@ fn unit_document() -> Document {
 
 /// Renders a unit-square document to a `size` x `size` picture over white.
 fn picture(doc: &Document, size: u32) -> Result<Rgb8Image, RenderError> {
-    let opts = RenderOptions {
+    let opts = RasterOptions {
         width: size,
         height: size,
         samples: FIGURE_SAMPLES,
-        ..RenderOptions::default()
+        ..RasterOptions::default()
     };
     let (img, _) = render(doc, &opts)?;
     Ok(img.over_background([255, 255, 255]))

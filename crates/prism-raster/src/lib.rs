@@ -4,11 +4,11 @@
 //! (mesh wireframes, de Casteljau constructions) drawn with that rasterizer.
 //!
 //! ```
-//! use prism_raster::{parse_svg, render, Dialect, RenderOptions, Source};
+//! use prism_raster::{parse_svg, render, Dialect, RasterOptions, Source};
 //! let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10">
 //!   <rect width="10" height="10" fill="red"/></svg>"#;
 //! let doc = parse_svg(svg, Dialect::Svg, &Source::default()).unwrap();
-//! let opts = RenderOptions { width: 10, height: 10, ..Default::default() };
+//! let opts = RasterOptions { width: 10, height: 10, ..Default::default() };
 //! let (image, _) = render(&doc, &opts).unwrap();
 //! assert_eq!(image.get(5, 5), [255, 0, 0, 255]);
 //! ```
@@ -28,7 +28,7 @@ pub use parse::{
     MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
 pub use raster::{
-    render, sample_rate, view_transform, RenderError, RenderOptions, RenderStats, View,
+    render, sample_rate, view_transform, RasterOptions, RenderError, RenderStats, View,
     MAX_DIMENSION, MAX_SAMPLES,
 };
 pub use triangulate::ear_clip;

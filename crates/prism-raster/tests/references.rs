@@ -6,7 +6,7 @@
 //! under `target/test-diffs/`. Two more tests check that the lists below name every file.
 
 use prism_image::Rgb8Image;
-use prism_raster::{read_svg, render, Dialect, RenderOptions};
+use prism_raster::{read_svg, render, Dialect, RasterOptions};
 use prism_testkit::{compare_images, shared_asset, workspace_root};
 
 /// The course's reference file name: every character outside `abdefghijklmnopqrstuvwxyz0-9`
@@ -33,9 +33,9 @@ fn course_golden(rel: &str) {
         reference_name(rel)
     ));
     let doc = read_svg(&svg, Dialect::Cs184).unwrap_or_else(|e| panic!("{e}"));
-    let opts = RenderOptions {
+    let opts = RasterOptions {
         compat: true,
-        ..RenderOptions::default()
+        ..RasterOptions::default()
     };
     let (img, _) = render(&doc, &opts).expect("render");
     let expected = prism_image::read_png(&reference)
@@ -108,11 +108,11 @@ fn resvg_golden(stem: &str) {
         .unwrap_or_else(|e| panic!("{e}"));
     let reference = data_dir().join("resvg").join(format!("{stem}.png"));
     let expected = prism_image::read_png(&reference).unwrap_or_else(|e| panic!("{e}"));
-    let opts = RenderOptions {
+    let opts = RasterOptions {
         width: expected.width(),
         height: expected.height(),
         samples: 16,
-        ..RenderOptions::default()
+        ..RasterOptions::default()
     };
     let (img, _) = render(&doc, &opts).expect("render");
     let actual: Rgb8Image = img.over_background([255, 255, 255]);

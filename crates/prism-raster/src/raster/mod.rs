@@ -54,9 +54,9 @@ pub enum View {
     },
 }
 
-/// Settings for one render.
+/// Settings for one [`render`] of a document: output size, sampling and placement.
 #[derive(Clone, Debug, PartialEq)]
-pub struct RenderOptions {
+pub struct RasterOptions {
     /// Output width in pixels.
     pub width: u32,
     /// Output height in pixels.
@@ -75,9 +75,9 @@ pub struct RenderOptions {
     pub compat: bool,
 }
 
-impl Default for RenderOptions {
+impl Default for RasterOptions {
     fn default() -> Self {
-        RenderOptions {
+        RasterOptions {
             width: 1024,
             height: 1024,
             samples: 1,
@@ -123,7 +123,7 @@ pub fn sample_rate(samples: u32) -> Option<u32> {
 
 /// The transform from document user space to output pixels for these options.
 #[must_use]
-pub fn view_transform(doc: &Document, opts: &RenderOptions) -> Mat3 {
+pub fn view_transform(doc: &Document, opts: &RasterOptions) -> Mat3 {
     let region = match opts.view {
         View::Region { cx, cy, span } => Some((cx, cy, span)),
         View::Fit if opts.compat => {
@@ -172,7 +172,7 @@ pub fn view_transform(doc: &Document, opts: &RenderOptions) -> Mat3 {
 /// [`RenderError`] for an output size, sample count or view outside the documented limits.
 pub fn render(
     doc: &Document,
-    opts: &RenderOptions,
+    opts: &RasterOptions,
 ) -> Result<(Rgba8Image, RenderStats), RenderError> {
     let (w, h) = (opts.width, opts.height);
     if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
@@ -267,16 +267,16 @@ mod tests {
             height: 600.0,
             ..Document::default()
         };
-        let course = RenderOptions {
+        let course = RasterOptions {
             width: 800,
             height: 600,
             compat: true,
-            ..RenderOptions::default()
+            ..RasterOptions::default()
         };
         let m = view_transform(&doc, &course);
         let p = m.apply(DVec2::new(100.0, 40.0));
         assert!((p - DVec2::new(0.625 * 100.0 + 150.0, 0.625 * 40.0 + 112.5)).length() < 1e-9);
-        let zoom = RenderOptions {
+        let zoom = RasterOptions {
             width: 100,
             height: 100,
             view: View::Region {
@@ -284,7 +284,7 @@ mod tests {
                 cy: 50.0,
                 span: 25.0,
             },
-            ..RenderOptions::default()
+            ..RasterOptions::default()
         };
         let doc = Document {
             width: 100.0,
@@ -294,10 +294,10 @@ mod tests {
         let m = view_transform(&doc, &zoom);
         assert!((m.apply(DVec2::new(25.0, 25.0)) - DVec2::ZERO).length() < 1e-9);
         assert!((m.apply(DVec2::new(75.0, 75.0)) - DVec2::splat(100.0)).length() < 1e-9);
-        let fit = RenderOptions {
+        let fit = RasterOptions {
             width: 200,
             height: 50,
-            ..RenderOptions::default()
+            ..RasterOptions::default()
         };
         let m = view_transform(&doc, &fit);
         assert!((m.apply(DVec2::new(100.0, 100.0)) - DVec2::new(200.0, 50.0)).length() < 1e-9);
@@ -416,11 +416,11 @@ mod tests {
                     doc.items.push(Item::EndLayer { opacity: 0.5 });
                 }
                 for samples in [1, 16] {
-                    let opts = RenderOptions {
+                    let opts = RasterOptions {
                         width: 40,
                         height: 40,
                         samples,
-                        ..RenderOptions::default()
+                        ..RasterOptions::default()
                     };
                     let (img, _) = render(&doc, &opts).unwrap();
                     for (k, p) in img.pixels().iter().enumerate() {
@@ -446,12 +446,12 @@ mod tests {
             <path d="M0 0 C1e38 0 0 1e38 5 5 Z" stroke="red" stroke-width="1e38"/></svg>"#;
         for dialect in [Dialect::Svg, Dialect::Cs184] {
             let doc = parse_svg(svg, dialect, &Source::default()).unwrap();
-            let opts = RenderOptions {
+            let opts = RasterOptions {
                 width: 16,
                 height: 16,
                 samples: 4,
                 compat: dialect == Dialect::Cs184,
-                ..RenderOptions::default()
+                ..RasterOptions::default()
             };
             render(&doc, &opts).unwrap();
         }

@@ -7,7 +7,7 @@ use prism_image::{LevelSampling, PixelSampling, Texture};
 use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
-use super::{RenderOptions, TOLERANCE};
+use super::{RasterOptions, TOLERANCE};
 use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread};
 use crate::path::{stroke, Path, StrokeStyle};
 
@@ -313,7 +313,7 @@ pub(super) fn to_f32(p: DVec2) -> (f32, f32) {
 }
 
 /// Turns document items into device primitives.
-pub(super) fn prepare(doc: &Document, opts: &RenderOptions, view: &Mat3) -> Vec<Placed> {
+pub(super) fn prepare(doc: &Document, opts: &RasterOptions, view: &Mat3) -> Vec<Placed> {
     let h = opts.height as i32;
     let w = opts.width as f64;
     let hf = opts.height as f64;
