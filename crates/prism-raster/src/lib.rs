@@ -25,7 +25,7 @@ pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint
 pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
     parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError, MAX_DEPTH,
-    MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
+    MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RasterOptions, RenderError, RenderStats, View,

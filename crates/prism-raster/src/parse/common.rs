@@ -8,7 +8,7 @@ use crate::document::Mat3;
 /// Deepest element nesting a document may have.
 pub const MAX_DEPTH: usize = 256;
 /// Largest SVG file accepted, in bytes.
-pub const MAX_FILE_BYTES: usize = 256 << 20;
+pub const MAX_SVG_BYTES: u64 = 256 << 20;
 /// Most drawables (after expanding points and triangles) a document may produce.
 pub const MAX_ITEMS: usize = 20_000_000;
 /// Most elements that `use` references may create when expanded (each reference copies
@@ -38,13 +38,13 @@ pub enum SvgError {
         #[source]
         source: std::str::Utf8Error,
     },
-    /// The file is larger than [`MAX_FILE_BYTES`].
+    /// The file is larger than [`MAX_SVG_BYTES`].
     #[error("{file}:0: file: file is larger than the limit of {limit} bytes")]
     FileTooLarge {
         /// The file.
         file: String,
         /// The limit, in bytes.
-        limit: usize,
+        limit: u64,
     },
     /// The text is not well-formed XML.
     #[error("{file}:{line}: xml: malformed XML: {source}")]

@@ -15,9 +15,7 @@ use prism_image::{Texture, UvConvention};
 use roxmltree::Node;
 
 use common::{number_list, number_with_unit, Loc, PlainAttribute, Precision};
-pub use common::{
-    SvgError, MAX_DEPTH, MAX_FILE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
-};
+pub use common::{SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
 pub use pathdata::{parse_path_data, PathDataError};
 
 use std::collections::HashMap;
@@ -267,13 +265,13 @@ pub(crate) fn image_item(
 /// # Errors
 /// [`SvgError`] naming the file, line and element: malformed XML, a root that is not
 /// `<svg>`, bad numbers, colours or path data, non-finite coordinates, a missing or corrupt
-/// texture, or a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_FILE_BYTES`],
+/// texture, or a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_SVG_BYTES`],
 /// [`MAX_ITEMS`], [`MAX_USE_ELEMENTS`], [`MAX_HREF_CHAIN`]), each its own variant.
 pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Document, SvgError> {
-    if text.len() > MAX_FILE_BYTES {
+    if text.len() as u64 > MAX_SVG_BYTES {
         return Err(SvgError::FileTooLarge {
             file: source.name.clone(),
-            limit: MAX_FILE_BYTES,
+            limit: MAX_SVG_BYTES,
         });
     }
     let opts = roxmltree::ParsingOptions {
@@ -314,10 +312,10 @@ pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
         source: Arc::new(e),
     };
     let meta = std::fs::metadata(path).map_err(io)?;
-    if meta.len() > MAX_FILE_BYTES as u64 {
+    if meta.len() > MAX_SVG_BYTES {
         return Err(SvgError::FileTooLarge {
             file: name,
-            limit: MAX_FILE_BYTES,
+            limit: MAX_SVG_BYTES,
         });
     }
     let bytes = std::fs::read(path).map_err(io)?;
