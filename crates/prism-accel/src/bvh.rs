@@ -1,3 +1,6 @@
+//! [`Bvh`], the bounding volume hierarchy over triangles and spheres: binned-SAH build,
+//! collapse into 8-wide nodes, statistics, and closest-hit and occlusion traversal.
+
 use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
 

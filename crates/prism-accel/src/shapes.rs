@@ -1,3 +1,6 @@
+//! Primitives and their ray tests: the sphere, per-ray precomputation, the watertight
+//! ray-triangle test and the ray-sphere test.
+
 use prism_math::{Aabb, Ray, Vec3};
 
 /// A sphere.

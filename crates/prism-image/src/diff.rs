@@ -1,3 +1,5 @@
+//! Image-difference metrics: per-channel agreement between two 8-bit images.
+
 use crate::Rgb8Image;
 
 /// Per-channel agreement between two 8-bit images of the same size.

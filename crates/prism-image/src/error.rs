@@ -1,3 +1,5 @@
+//! [`ImageError`], what can go wrong reading or writing an image.
+
 use std::path::PathBuf;
 
 /// Everything that can go wrong reading or writing an image.

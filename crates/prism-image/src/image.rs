@@ -1,3 +1,6 @@
+//! [`Image`], the one image type: a row-major grid of pixels, with its 8-bit and float
+//! aliases and conversions between them.
+
 use prism_math::Rgb;
 
 /// A rectangular grid of pixels stored row-major, top row first.

@@ -1,3 +1,5 @@
+//! Image files: PNG and JPEG reading (with size limits), PNG writing, and atomic file writes.
+
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};

@@ -1,3 +1,5 @@
+//! [`Rgb`], a triple of `f32` colour channels, with its arithmetic.
+
 use std::ops::{Add, AddAssign, Mul, MulAssign, Sub};
 
 /// An RGB triple of `f32` channels; the colour space is whatever the owner states.

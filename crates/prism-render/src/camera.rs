@@ -1,3 +1,5 @@
+//! [`Pinhole`], the pinhole camera: primary rays through image positions.
+
 use prism_math::{Ray, Vec3};
 use prism_scene::Camera;
 

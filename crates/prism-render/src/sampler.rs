@@ -1,3 +1,6 @@
+//! [`Sampler`], the deterministic sampler: uniform samples as a pure function of (seed,
+//! pixel, sample index, dimension).
+
 use prism_math::{hash_words, unit_f32, Vec2};
 
 /// Independent uniform samples whose values are a pure function of (seed, pixel, sample

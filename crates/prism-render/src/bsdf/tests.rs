@@ -1,3 +1,5 @@
+//! Tests of the BSDFs: sampling against the pdf by chi-square, closed forms, and glass.
+
 use super::*;
 use prism_math::Pcg32;
 

@@ -1,3 +1,6 @@
+//! Tests of the COLLADA reader and writer: primitives, transforms, up axes, CGL extras,
+//! located errors and limits, warnings, and the writer's round trip.
+
 use super::*;
 
 fn doc(up: &str, geometry: &str, nodes: &str) -> String {

@@ -1,3 +1,5 @@
+//! The COLLADA writer: a polygon mesh as a COLLADA 1.4.1 document.
+
 use std::io::Write;
 
 use prism_mesh::PolyMesh;
