@@ -564,3 +564,195 @@ fn render_scenes_and_errors() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The hostile inputs of the hardening work, through the command a user runs: 100,000 levels
+/// of nesting (SVG in both dialects, COLLADA for `render` and `mesh info`), `use` and
+/// `instance_node` fan-out to 2^29 copies, and reference cycles. Each ends in exit 2 with a
+/// located message, and leaves no output file.
+#[test]
+fn hostile_inputs_are_located_errors() {
+    let dir = scratch("hostile");
+    let levels = 100_000;
+    let svg_ns = "xmlns='http://www.w3.org/2000/svg' xmlns:xlink='http://www.w3.org/1999/xlink'";
+    let deep_svg = format!(
+        "<svg {svg_ns} width='8' height='8'>\n{}<rect width='4' height='4'/>{}</svg>",
+        "<g>".repeat(levels),
+        "</g>".repeat(levels)
+    );
+    let mut fan_svg = format!(
+        "<svg {svg_ns} width='8' height='8'><defs><g id='g0'><rect width='1' height='1'/></g>\n"
+    );
+    for i in 1..30 {
+        fan_svg += &format!(
+            "<g id='g{i}'><use xlink:href='#g{p}'/><use xlink:href='#g{p}'/></g>\n",
+            p = i - 1
+        );
+    }
+    fan_svg += "</defs><use xlink:href='#g29'/></svg>";
+    let cycle_svg = format!(
+        "<svg {svg_ns} width='8' height='8'>\n<g id='a'><use href='#b'/></g>\n<g id='b'><use href='#a'/></g></svg>"
+    );
+    let dae = |scene: &str, library: &str| {
+        format!(
+            "<?xml version='1.0'?>\n<COLLADA xmlns='http://www.collada.org/2005/11/COLLADASchema' \
+             version='1.4.1'>{library}\n<library_visual_scenes><visual_scene id='s'>\n{scene}\
+             </visual_scene></library_visual_scenes><scene><instance_visual_scene url='#s'/>\
+             </scene></COLLADA>"
+        )
+    };
+    let deep_dae = dae(
+        &format!("{}{}", "<node>".repeat(levels), "</node>".repeat(levels)),
+        "",
+    );
+    let mut library = String::from("<library_nodes><node id='n0'/>");
+    for i in 1..30 {
+        library += &format!(
+            "<node id='n{i}'><instance_node url='#n{p}'/><instance_node url='#n{p}'/></node>",
+            p = i - 1
+        );
+    }
+    library += "<node id='c'><instance_node url='#c'/></node></library_nodes>";
+    let fan_dae = dae("<node><instance_node url='#n29'/></node>", &library);
+    let cycle_dae = dae("<node><instance_node url='#c'/></node>", &library);
+    let svg_cases = [
+        (
+            "deep.svg",
+            &deep_svg,
+            &[][..],
+            "deep.svg:2: g: elements nest deeper than the limit of 256",
+        ),
+        (
+            "deep.svg",
+            &deep_svg,
+            &["--compat", "cs184"][..],
+            "deep.svg:2: g: elements nest deeper",
+        ),
+        (
+            "fan.svg",
+            &fan_svg,
+            &[][..],
+            "fan.svg:19: g: use references would expand to more than 1000000 elements",
+        ),
+        (
+            "cycle.svg",
+            &cycle_svg,
+            &[][..],
+            "cycle.svg:2: use: href #b leads back to itself",
+        ),
+    ];
+    for (name, text, extra, want) in svg_cases {
+        let input = dir.join(name);
+        std::fs::write(&input, text).unwrap();
+        let out = dir.join("out.png");
+        let o = prism()
+            .arg("svg")
+            .arg(&input)
+            .arg("-o")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(want),
+            "{name}: expected {want:?} in {}",
+            stderr(&o)
+        );
+        assert!(!out.exists(), "{name}: output written");
+    }
+    let dae_cases = [
+        (
+            "deep.dae",
+            &deep_dae,
+            "deep.dae:4: <node>: nodes nest deeper than 64",
+        ),
+        (
+            "fan.dae",
+            &fan_dae,
+            ": <node>: the node expands to more than 1000000 nodes",
+        ),
+        (
+            "cycle.dae",
+            &cycle_dae,
+            "the node instances a node that contains it",
+        ),
+    ];
+    for (name, text, want) in dae_cases {
+        let input = dir.join(name);
+        std::fs::write(&input, text).unwrap();
+        let out = dir.join("out.png");
+        for command in [
+            &["render", "-q", "-s", "1", "-r", "8", "6", "-o"][..],
+            &["mesh", "info"][..],
+        ] {
+            let mut c = prism();
+            c.args(command);
+            if command[0] == "render" {
+                c.arg(&out);
+            }
+            let o = c.arg(&input).output().unwrap();
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "{name} {command:?}: {}",
+                stderr(&o)
+            );
+            assert!(
+                stderr(&o).contains(want),
+                "{name}: expected {want:?} in {}",
+                stderr(&o)
+            );
+            assert!(!out.exists(), "{name}: output written");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A course Cornell box whose camera `<matrix>` lacks its final number renders, with a
+/// warning naming file, line and element, to the same bytes as the intact file (the oracle);
+/// under `--camera file`, which uses that matrix, it is an error that writes nothing.
+#[test]
+fn course_file_with_a_short_camera_matrix_renders_as_the_intact_one() {
+    let dir = scratch("short-matrix");
+    let intact = prism_testkit::shared_asset("pathtracer/dae/sky/CBspheres_lambertian.dae");
+    let text = std::fs::read_to_string(&intact).unwrap();
+    let full = "<matrix sid=\"transform\">-1 0 0 0 0 0 1 3 0 1 0 0 0 0 0 1</matrix>";
+    assert!(text.contains(full), "the staged camera matrix changed");
+    let short = dir.join("short.dae");
+    std::fs::write(
+        &short,
+        text.replacen(full, &full.replace(" 0 1</", " 0</"), 1),
+    )
+    .unwrap();
+    let line = 1 + text[..text.find(full).unwrap()].matches('\n').count();
+    let render = |scene: &Path, out: &Path, extra: &[&str]| {
+        prism()
+            .args(["render", "-q", "-s", "2", "-r", "32", "24", "-o"])
+            .arg(out)
+            .arg(scene)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let (a, b) = (dir.join("intact.png"), dir.join("short.png"));
+    assert_eq!(render(&intact, &a, &[]).status.code(), Some(0));
+    let o = render(&short, &b, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let want = format!("short.dae:{line}: <matrix>: expected 16 numbers, found 15");
+    assert!(
+        stderr(&o).contains(&want),
+        "expected {want:?} in {}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let c = dir.join("file-camera.png");
+    let o = render(&short, &c, &["--camera", "file"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&want.replace(", found 15", "")),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!c.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -12,7 +12,7 @@ use prism_mesh::{bezier_point, de_casteljau_levels, PolyMesh};
 
 use crate::document::{Document, FillRule, Item, Mat3, Paint};
 use crate::path::{LineCap, LineJoin, Path, StrokeStyle};
-use crate::raster::{render, RasterOptions, RenderError};
+use crate::raster::{render, RasterError, RasterOptions};
 
 /// Samples per pixel of every figure.
 const FIGURE_SAMPLES: u32 = 16;
@@ -27,7 +27,7 @@ fn unit_document() -> Document {
 }
 
 /// Renders a unit-square document to a `size` x `size` picture over white.
-fn picture(doc: &Document, size: u32) -> Result<Rgb8Image, RenderError> {
+fn picture(doc: &Document, size: u32) -> Result<Rgb8Image, RasterError> {
     let opts = RasterOptions {
         width: size,
         height: size,
@@ -98,8 +98,8 @@ fn wireframe_view(mesh: &PolyMesh) -> impl Fn(DVec3) -> DVec2 {
 /// on its longer side. An edge shared by several faces is drawn once.
 ///
 /// # Errors
-/// [`RenderError::BadSize`] if `size` is outside `1..=MAX_DIMENSION`.
-pub fn wireframe(mesh: &PolyMesh, size: u32) -> Result<Rgb8Image, RenderError> {
+/// [`RasterError::BadSize`] if `size` is outside `1..=MAX_DIMENSION`.
+pub fn wireframe(mesh: &PolyMesh, size: u32) -> Result<Rgb8Image, RasterError> {
     let view = wireframe_view(mesh);
     let mut path = Path::default();
     let mut seen = HashSet::new();
@@ -130,7 +130,7 @@ pub fn wireframe(mesh: &PolyMesh, size: u32) -> Result<Rgb8Image, RenderError> {
 /// picture shows that square, y up.
 ///
 /// # Errors
-/// [`RenderError::BadSize`] if `size` is outside `1..=MAX_DIMENSION`.
+/// [`RasterError::BadSize`] if `size` is outside `1..=MAX_DIMENSION`.
 ///
 /// # Panics
 /// If `points` is empty.
@@ -138,7 +138,7 @@ pub fn de_casteljau_construction(
     points: &[DVec2],
     t: f64,
     size: u32,
-) -> Result<Rgb8Image, RenderError> {
+) -> Result<Rgb8Image, RasterError> {
     // Curve files use [0, 1]^2 with y up; the picture has y down.
     let flip = |p: DVec2| DVec2::new(p.x, 1.0 - p.y);
     let dot = |p: DVec2, r: f64, color: Rgb| fill(Path::ellipse(p, r, r), color);
@@ -234,7 +234,7 @@ mod tests {
     #[test]
     fn wireframe_refuses_a_zero_size() {
         let mesh = PolyMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], &[vec![0, 1, 2]]);
-        assert_eq!(wireframe(&mesh, 0), Err(RenderError::BadSize(0, 0)));
+        assert_eq!(wireframe(&mesh, 0), Err(RasterError::BadSize(0, 0)));
     }
 
     #[test]

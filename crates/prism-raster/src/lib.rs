@@ -28,7 +28,7 @@ pub use parse::{
     MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
 };
 pub use raster::{
-    render, sample_rate, view_transform, RasterOptions, RenderError, RenderStats, View,
+    render, sample_rate, view_transform, RasterError, RasterOptions, RasterStats, View,
     MAX_DIMENSION, MAX_SAMPLES,
 };
 pub use triangulate::ear_clip;

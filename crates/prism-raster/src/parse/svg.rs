@@ -611,9 +611,7 @@ impl<'a> Parser<'_, 'a> {
                     );
                     return Ok(());
                 };
-                if target.ancestors().any(|a| a == node) {
-                    return Err(loc.err(format!("href #{id} refers to its own ancestor")));
-                }
+                // check_use_expansion has refused every reference cycle before the walk.
                 let (x, y) = (num("x", Axis::X)?, num("y", Axis::Y)?);
                 let t = t.mul(&Mat3::translate(x, y));
                 let layer = opacity < 1.0;

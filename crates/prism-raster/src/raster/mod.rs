@@ -91,7 +91,7 @@ impl Default for RasterOptions {
 
 /// Invalid render settings.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum RenderError {
+pub enum RasterError {
     /// Width or height outside `1..=MAX_DIMENSION`.
     #[error("output size {0}x{1} is outside 1..={MAX_DIMENSION} pixels per side")]
     BadSize(u32, u32),
@@ -105,7 +105,7 @@ pub enum RenderError {
 
 /// Wall-clock time spent in each stage of [`render`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RenderStats {
+pub struct RasterStats {
     /// Transforming, flattening and stroking items into device primitives.
     pub prepare: Duration,
     /// Rasterizing samples (band phase, apportioned by thread time).
@@ -169,19 +169,19 @@ pub fn view_transform(doc: &Document, opts: &RasterOptions) -> Mat3 {
 /// Renders a document to straight-alpha RGBA8.
 ///
 /// # Errors
-/// [`RenderError`] for an output size, sample count or view outside the documented limits.
+/// [`RasterError`] for an output size, sample count or view outside the documented limits.
 pub fn render(
     doc: &Document,
     opts: &RasterOptions,
-) -> Result<(Rgba8Image, RenderStats), RenderError> {
+) -> Result<(Rgba8Image, RasterStats), RasterError> {
     let (w, h) = (opts.width, opts.height);
     if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
-        return Err(RenderError::BadSize(w, h));
+        return Err(RasterError::BadSize(w, h));
     }
-    let r = sample_rate(opts.samples).ok_or(RenderError::BadSamples(opts.samples))? as usize;
+    let r = sample_rate(opts.samples).ok_or(RasterError::BadSamples(opts.samples))? as usize;
     if let View::Region { cx, cy, span } = opts.view {
         if !(cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0) {
-            return Err(RenderError::BadView(cx, cy, span));
+            return Err(RasterError::BadView(cx, cy, span));
         }
     }
     let t0 = Instant::now();
@@ -243,7 +243,7 @@ pub fn render(
             (a + *x, b + *y)
         });
     let total = (rt + st).as_secs_f64().max(1e-12);
-    let stats = RenderStats {
+    let stats = RasterStats {
         prepare: prepare_time,
         raster: wall.mul_f64(rt.as_secs_f64() / total),
         resolve: wall.mul_f64(st.as_secs_f64() / total),
