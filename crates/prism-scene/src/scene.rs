@@ -274,6 +274,15 @@ impl Scene {
         let mut effect_material: Vec<Option<usize>> = vec![None; doc.effects.len()];
         let mut default_material = None;
         let mut file_camera = None;
+        // The first entry of each id, as a search in file order finds it.
+        let mut material_by_id = std::collections::HashMap::new();
+        for (id, effect) in &doc.materials {
+            material_by_id.entry(id.as_str()).or_insert(effect);
+        }
+        let mut light_by_id = std::collections::HashMap::new();
+        for l in &doc.lights {
+            light_by_id.entry(l.id.as_str()).or_insert(l);
+        }
         let mut warned_spot = false;
         for node in &doc.nodes {
             let world = up * node.world;
@@ -292,9 +301,9 @@ impl Scene {
                         let effect = match materials.first() {
                             None => None,
                             Some((_, target)) => {
-                                match doc.materials.iter().find(|(id, _)| id == target) {
-                                    Some((_, Ok(e))) => Some(*e),
-                                    Some((_, Err(e))) => return Err(e.clone()),
+                                match material_by_id.get(target.as_str()) {
+                                    Some(Ok(e)) => Some(*e),
+                                    Some(Err(e)) => return Err(e.clone()),
                                     // A missing first target is the binding's defect.
                                     None => match defect {
                                         Some(e) => return Err(e.clone()),
@@ -352,7 +361,7 @@ impl Scene {
                         }
                     }
                     Instance::Light(id) => {
-                        let Some(l) = doc.lights.iter().find(|l| &l.id == id) else {
+                        let Some(l) = light_by_id.get(id.as_str()) else {
                             continue;
                         };
                         if let Some(e) = l.defect.as_ref().or(node.defect.as_ref()) {

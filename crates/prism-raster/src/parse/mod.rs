@@ -46,6 +46,8 @@ pub struct Source {
 pub(crate) struct Ctx<'a> {
     pub source: &'a Source,
     pub xml: &'a roxmltree::Document<'a>,
+    /// Line numbers of the text's byte offsets, for locating elements.
+    pub lines: prism_math::LineIndex<'a>,
     pub warned: std::collections::BTreeSet<String>,
     /// Textures already decoded, by reference and uv convention: each file or data URI is
     /// decoded once however often it is used.
@@ -64,7 +66,7 @@ pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> Loc<'a> {
     let source: &'a Source = ctx.source;
     Loc {
         file: &source.name,
-        line: ctx.xml.text_pos_at(node.range().start).row,
+        line: ctx.lines.line(node.range().start),
         element: node.tag_name().name(),
     }
 }
@@ -288,6 +290,7 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
     let mut ctx = Ctx {
         source,
         xml: &xml,
+        lines: prism_math::LineIndex::new(text),
         warned: Default::default(),
         textures: Default::default(),
     };

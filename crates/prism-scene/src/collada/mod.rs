@@ -22,7 +22,7 @@
 mod library;
 mod writer;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::Path;
 
@@ -321,7 +321,10 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
         source: e,
     })?;
     let root = xml.root_element();
-    let cx = Cx { xml: &xml, file };
+    let cx = Cx {
+        lines: prism_math::LineIndex::new(text),
+        file,
+    };
     if root.tag_name().name() != "COLLADA" {
         return Err(cx.err(root, "expected a <COLLADA> root element"));
     }
@@ -409,15 +412,20 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
             out.effects.push(effect);
         }
     }
+    // The first effect of each id, as a search in file order finds it.
+    let mut effect_index: HashMap<String, usize> = HashMap::new();
+    for (i, e) in out.effects.iter().enumerate() {
+        effect_index.entry(e.id.clone()).or_insert(i);
+    }
     for lib in children(root, "library_materials") {
         for m in children(lib, "material") {
             let effect = child(m, "instance_effect")
                 .ok_or_else(|| cx.err(m, "expected an <instance_effect>"))
                 .and_then(|inst| {
                     let url = reference(&cx, inst, "url")?;
-                    out.effects
-                        .iter()
-                        .position(|e| e.id == url)
+                    effect_index
+                        .get(url)
+                        .copied()
                         .ok_or_else(|| cx.err(inst, format!("no <effect> with id {url:?}")))
                 });
             if let Err(e) = &effect {
@@ -457,10 +465,10 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
             cx: &cx,
             geometry_index: &geometry_index,
             library_nodes: &library_nodes,
-            cameras: &out.cameras,
-            lights: &out.lights,
-            materials: &out.materials,
-            unknown_lights: &all_light_ids,
+            camera_ids: out.cameras.iter().map(|c| c.id.as_str()).collect(),
+            light_ids: out.lights.iter().map(|l| l.id.as_str()).collect(),
+            material_ids: out.materials.iter().map(|(id, _)| id.as_str()).collect(),
+            all_light_ids: all_light_ids.iter().map(String::as_str).collect(),
         };
         count_nodes(&cx, scene, &library_nodes)?;
         let mut nodes = Vec::new();
@@ -575,13 +583,14 @@ fn count_nodes<'b, 'i>(
 }
 
 struct Cx<'a, 'input> {
-    xml: &'a Document<'input>,
+    /// Line numbers of the text's byte offsets, for locating elements.
+    lines: prism_math::LineIndex<'input>,
     file: &'a str,
 }
 
 impl Cx<'_, '_> {
     fn line(&self, n: XmlNode) -> u32 {
-        self.xml.text_pos_at(n.range().start).row
+        self.lines.line(n.range().start)
     }
 
     fn err(&self, n: XmlNode, message: impl Into<String>) -> SceneError {
@@ -1094,11 +1103,11 @@ struct Walker<'a, 'b, 'i> {
     cx: &'a Cx<'a, 'i>,
     geometry_index: &'a HashMap<String, usize>,
     library_nodes: &'a HashMap<String, XmlNode<'b, 'i>>,
-    cameras: &'a [CameraDef],
-    lights: &'a [LightDef],
-    materials: &'a [(String, Result<usize, SceneError>)],
+    camera_ids: HashSet<&'a str>,
+    light_ids: HashSet<&'a str>,
+    material_ids: HashSet<&'a str>,
     /// Every light id, including lights of unknown kinds (skipped with a warning).
-    unknown_lights: &'a [String],
+    all_light_ids: HashSet<&'a str>,
 }
 
 impl<'b, 'i> Walker<'_, 'b, 'i> {
@@ -1167,7 +1176,7 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                             .ok_or_else(|| cx.err(im, "expected a symbol attribute"))
                             .and_then(|symbol| {
                                 let target = reference(cx, im, "target")?;
-                                if !self.materials.iter().any(|(id, _)| id == target) {
+                                if !self.material_ids.contains(target) {
                                     return Err(
                                         cx.err(im, format!("no <material> with id {target:?}"))
                                     );
@@ -1194,7 +1203,7 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                 }
                 "instance_camera" => {
                     let camera = reference(cx, c, "url").and_then(|url| {
-                        if self.cameras.iter().any(|c| c.id == url) {
+                        if self.camera_ids.contains(url) {
                             Ok(url)
                         } else {
                             Err(cx.err(c, format!("no <camera> with id {url:?}")))
@@ -1207,16 +1216,14 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
                 }
                 "instance_light" => {
                     let light = reference(cx, c, "url").and_then(|url| {
-                        if self.lights.iter().any(|l| l.id == url)
-                            || self.unknown_lights.iter().any(|id| id == url)
-                        {
+                        if self.all_light_ids.contains(url) {
                             Ok(url)
                         } else {
                             Err(cx.err(c, format!("no <light> with id {url:?}")))
                         }
                     });
                     match light {
-                        Ok(url) if self.lights.iter().any(|l| l.id == url) => {
+                        Ok(url) if self.light_ids.contains(url) => {
                             instances.push(Instance::Light(url.to_string()));
                         }
                         // A light of an unknown kind was skipped with a warning.
