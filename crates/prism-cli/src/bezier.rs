@@ -3,12 +3,13 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use prism_math::DVec2;
 use prism_mesh::{parse_bez, parse_bzc, tessellate};
 use prism_raster::de_casteljau_construction;
 
+use crate::output::ImageFormat;
 use crate::UserError;
 
 /// Arguments of `prism bezier`.
@@ -16,7 +17,8 @@ use crate::UserError;
 pub struct BezierArgs {
     /// A `.bzc` curve (drawn to PNG) or a `.bez` patch file (tessellated to .obj or .ply).
     pub input: PathBuf,
-    /// Output: a .png for curves, a .obj or .ply for patches.
+    /// Output, by its extension: a .png or .jpg for curves; an .obj, .ply or .dae for
+    /// patches. The folder must exist.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Curve parameter at which the de Casteljau levels are drawn.
@@ -33,23 +35,32 @@ pub struct BezierArgs {
 /// Runs `prism bezier`.
 pub fn run(a: &BezierArgs) -> Result<()> {
     let name = a.input.display().to_string();
+    let kind = crate::output::extension(&a.input);
+    // The output is checked before the input is read.
+    let curve_format = match kind.as_str() {
+        "bzc" => Some(crate::output::image_output(
+            &a.output,
+            "--output",
+            &[ImageFormat::Png, ImageFormat::Jpeg],
+        )?),
+        "bez" => {
+            crate::output::mesh_output(&a.output, "--output")?;
+            None
+        }
+        _ => return Err(UserError(format!("{name}: expected a .bzc or .bez file")).into()),
+    };
     let text = std::fs::read_to_string(&a.input).map_err(|e| UserError(format!("{name}: {e}")))?;
-    let ext = a
-        .input
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "bzc" => {
+    match curve_format {
+        Some(format) => {
             if !(0.0..=1.0).contains(&a.t) {
                 return Err(
                     UserError(format!("--t: expected a value in [0, 1], found {}", a.t)).into(),
                 );
             }
             let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
-            write_curve(&pts, a.t, a.size, &a.output)
+            write_curve(&pts, a.t, a.size, &a.output, format)
         }
-        "bez" => {
+        None => {
             if a.resolution == 0 || a.resolution > 1024 {
                 return Err(UserError(format!(
                     "--resolution: expected 1..=1024, found {}",
@@ -61,17 +72,17 @@ pub fn run(a: &BezierArgs) -> Result<()> {
             let mesh = tessellate(&patches, a.resolution);
             crate::mesh::write(&a.output, &mesh)
         }
-        _ => Err(UserError(format!("{name}: expected a .bzc or .bez file")).into()),
     }
 }
 
-/// Draws the curve with its de Casteljau construction at `t` and writes it to a PNG.
+/// Draws the curve with its de Casteljau construction at `t` and writes it as `format`.
 pub(crate) fn write_curve(
     pts: &[DVec2],
     t: f64,
     size: u32,
     output: &std::path::Path,
+    format: ImageFormat,
 ) -> Result<()> {
     let img = de_casteljau_construction(pts, t, size).map_err(|e| UserError(e.to_string()))?;
-    prism_image::write_png(output, &img).with_context(|| format!("writing {}", output.display()))
+    crate::output::write_rgb8(output, format, &img)
 }

@@ -241,7 +241,13 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         prism_math::DVec2::new(0.7, 0.45),
         prism_math::DVec2::new(1.0, 0.9),
     ];
-    crate::bezier::write_curve(&curve, 0.5, 300, &a.output.join("bezier_decasteljau.png"))?;
+    crate::bezier::write_curve(
+        &curve,
+        0.5,
+        300,
+        &a.output.join("bezier_decasteljau.png"),
+        crate::output::ImageFormat::Png,
+    )?;
     entries.push(Entry {
         file: "bezier_decasteljau.png".into(),
         caption: "Bezier curve with its de Casteljau levels at t = 0.5".into(),
@@ -290,6 +296,10 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         &a.output.join("render_adaptive.png"),
         Some(&a.output.join("render_heatmap.png")),
     )?;
+    entries.push(Entry {
+        file: "render_adaptive.png".into(),
+        caption: "Cornell box with adaptive sampling (tolerance 0.05, at most 256 samples)".into(),
+    });
     entries.push(Entry {
         file: "render_heatmap.png".into(),
         caption: "Adaptive sampling (tolerance 0.05, at most 256 samples): samples per pixel, blue few, red many".into(),

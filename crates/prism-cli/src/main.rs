@@ -3,6 +3,7 @@
 mod bezier;
 mod demo;
 mod mesh;
+mod output;
 mod progress;
 mod render;
 mod svg;

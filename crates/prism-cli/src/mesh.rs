@@ -4,12 +4,13 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
 use prism_mesh::{
     loop_subdivide, read_obj, write_obj, HalfedgeMesh, LoopWeights, PolyMesh, TopologyError,
 };
 
+use crate::output::MeshFormat;
 use crate::UserError;
 
 /// Arguments of `prism mesh`.
@@ -46,10 +47,24 @@ struct EdgeArgs {
 
 #[derive(Subcommand, Debug)]
 enum MeshCommand {
-    /// Print vertex, edge and face counts, boundary loops and the Euler characteristic.
+    /// Print vertex, edge and face counts, boundary edges and the Euler characteristic;
+    /// with --vertices, --edges or --faces, also list them (vertices numbered from 1 as in
+    /// OBJ files, edges and faces from 0, as the edge operations take them).
     Info {
         /// Input mesh (.obj, .ply or .dae).
         input: PathBuf,
+        /// List vertices with their positions.
+        #[arg(long)]
+        vertices: bool,
+        /// List edges with their end vertices and positions (the numbers --edge takes).
+        #[arg(long)]
+        edges: bool,
+        /// List faces with their vertices.
+        #[arg(long)]
+        faces: bool,
+        /// Most items listed per kind (0: all).
+        #[arg(long, default_value_t = 20)]
+        limit: usize,
     },
     /// Area-weighted vertex normals (written as `vn` in OBJ output).
     Normals {
@@ -133,16 +148,10 @@ fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
 }
 
 /// Writes a mesh as .obj, .ply (binary little-endian) or .dae, chosen by extension,
-/// atomically.
+/// atomically. The extension and folder are checked (by [`crate::output::mesh_output`])
+/// before any work.
 pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
-    let ext = extension(path);
-    if !matches!(ext.as_str(), "obj" | "ply" | "dae") {
-        return Err(UserError(format!(
-            "{}: expected an .obj, .ply or .dae output",
-            path.display()
-        ))
-        .into());
-    }
+    let format = crate::output::mesh_output(path, "--output")?;
     let io = |p: &Path, source| prism_mesh::MeshError::Io {
         path: p.display().to_string(),
         source,
@@ -150,27 +159,61 @@ pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
     prism_image::write_atomic_with(
         path,
         |w| {
-            match ext.as_str() {
-                "ply" => prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w),
-                "dae" => prism_scene::write_collada(mesh, w),
-                _ => write_obj(mesh, w),
+            match format {
+                MeshFormat::Ply => {
+                    prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w)
+                }
+                MeshFormat::Dae => prism_scene::write_collada(mesh, w),
+                MeshFormat::Obj => write_obj(mesh, w),
             }
             .map_err(|e| io(path, e))
         },
         io,
-    )
-    .with_context(|| format!("writing {}", path.display()))
+    )?;
+    Ok(())
 }
 
 fn ms(d: std::time::Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
-/// Reads a mesh, applies `op` to the chosen edge and writes the result.
+/// A position as three numbers.
+fn xyz(p: prism_math::glam::DVec3) -> String {
+    format!("{} {} {}", p.x, p.y, p.z)
+}
+
+/// An edge as `vertices A,B` (numbered from 1), with " (boundary)" when it is one.
+fn edge_words(m: &HalfedgeMesh, e: prism_mesh::EdgeId) -> String {
+    let h = m.edge_halfedge(e);
+    let (a, b) = (m.origin(h), m.dest(h));
+    let boundary = if m.is_boundary_edge(e) {
+        " (boundary)"
+    } else {
+        ""
+    };
+    format!("vertices {},{}{boundary}", a.0 + 1, b.0 + 1)
+}
+
+/// Prints up to `limit` lines (all with 0), then how many were left out.
+fn list(kind: &str, count: usize, limit: usize, line: impl Fn(usize) -> String) {
+    let shown = if limit == 0 { count } else { count.min(limit) };
+    for i in 0..shown {
+        println!("{}", line(i));
+    }
+    if shown < count {
+        println!(
+            "... {} more {kind} (--limit {count} lists them all)",
+            count - shown
+        );
+    }
+}
+
+/// Reads a mesh, applies `op` to the chosen edge, prints what changed and writes the result.
+/// `op` says what it did, in words.
 fn edge_op(
     args: &EdgeArgs,
     what: &str,
-    op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<(), TopologyError>,
+    op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<String, TopologyError>,
 ) -> Result<()> {
     let (input, output) = (&args.input, &args.output);
     let (edge, vertices) = (args.edge, args.vertices.as_deref());
@@ -199,14 +242,45 @@ fn edge_op(
         }
         (None, None) => return Err(UserError("give --edge E or --vertices A,B".into()).into()),
     };
-    op(&mut m, e).map_err(|err| UserError(format!("{}: cannot {what}: {err}", input.display())))?;
-    write(output, &m.to_polymesh())
+    let before = if (e.0 as usize) < m.edge_count() {
+        format!("edge {} ({})", e.0, edge_words(&m, e))
+    } else {
+        format!("edge {}", e.0)
+    };
+    let done = op(&mut m, e)
+        .map_err(|err| UserError(format!("{}: cannot {what}: {err}", input.display())))?;
+    write(output, &m.to_polymesh())?;
+    println!("{before}: {done}");
+    println!(
+        "now {} vertices, {} edges, {} faces",
+        m.vertex_count(),
+        m.edge_count(),
+        m.face_count()
+    );
+    Ok(())
 }
 
 /// Runs `prism mesh`.
 pub fn run(a: &MeshArgs) -> Result<()> {
+    // The output's format and folder are checked before any work.
+    let output = match &a.command {
+        MeshCommand::Info { .. } => None,
+        MeshCommand::Normals { output, .. }
+        | MeshCommand::Convert { output, .. }
+        | MeshCommand::Subdivide { output, .. } => Some(output),
+        MeshCommand::Split(e) | MeshCommand::Flip(e) | MeshCommand::Collapse(e) => Some(&e.output),
+    };
+    if let Some(output) = output {
+        crate::output::mesh_output(output, "--output")?;
+    }
     match &a.command {
-        MeshCommand::Info { input } => {
+        MeshCommand::Info {
+            input,
+            vertices,
+            edges,
+            faces,
+            limit,
+        } => {
             let p = read(input)?;
             let m = build(input, &p)?;
             let boundary_edges = (0..m.edge_count())
@@ -218,6 +292,38 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             println!("boundary edges: {boundary_edges}");
             println!("euler characteristic: {}", m.euler_characteristic());
             println!("triangles only: {}", p.is_triangle_mesh());
+            if *vertices {
+                list("vertices", m.vertex_count(), *limit, |i| {
+                    let v = prism_mesh::VertexId(i as u32);
+                    let boundary = if m.is_boundary_vertex(v) {
+                        " (boundary)"
+                    } else {
+                        ""
+                    };
+                    format!("vertex {}: {}{boundary}", i + 1, xyz(m.position(v)))
+                });
+            }
+            if *edges {
+                list("edges", m.edge_count(), *limit, |i| {
+                    let e = prism_mesh::EdgeId(i as u32);
+                    let h = m.edge_halfedge(e);
+                    format!(
+                        "edge {i}: {}, from {} to {}",
+                        edge_words(&m, e),
+                        xyz(m.position(m.origin(h))),
+                        xyz(m.position(m.dest(h)))
+                    )
+                });
+            }
+            if *faces {
+                list("faces", m.face_count(), *limit, |i| {
+                    let ids: Vec<String> = m
+                        .face_halfedges(prism_mesh::FaceId(i as u32))
+                        .map(|h| (m.origin(h).0 + 1).to_string())
+                        .collect();
+                    format!("face {i}: vertices {}", ids.join(","))
+                });
+            }
             Ok(())
         }
         MeshCommand::Normals { input, output } => {
@@ -230,9 +336,26 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             build(input, &p)?;
             write(output, &p)
         }
-        MeshCommand::Flip(e) => edge_op(e, "flip", |m, id| m.flip(id)),
-        MeshCommand::Split(e) => edge_op(e, "split", |m, id| m.split(id).map(|_| ())),
-        MeshCommand::Collapse(e) => edge_op(e, "collapse", |m, id| m.collapse(id).map(|_| ())),
+        MeshCommand::Flip(e) => edge_op(e, "flip", |m, id| {
+            m.flip(id)?;
+            Ok(format!("flipped; it now joins {}", edge_words(m, id)))
+        }),
+        MeshCommand::Split(e) => edge_op(e, "split", |m, id| {
+            let v = m.split(id)?;
+            Ok(format!(
+                "split at new vertex {} ({})",
+                v.0 + 1,
+                xyz(m.position(v))
+            ))
+        }),
+        MeshCommand::Collapse(e) => edge_op(e, "collapse", |m, id| {
+            let v = m.collapse(id)?;
+            Ok(format!(
+                "collapsed to vertex {} ({}); vertices above may be renumbered",
+                v.0 + 1,
+                xyz(m.position(v))
+            ))
+        }),
         MeshCommand::Subdivide {
             input,
             output,

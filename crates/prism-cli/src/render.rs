@@ -47,7 +47,8 @@ pub enum CameraArg {
 pub struct RenderArgs {
     /// A CS184 COLLADA scene (.dae); without one, the built-in Cornell box with two spheres.
     scene: Option<PathBuf>,
-    /// Output PNG (sRGB, clamped).
+    /// Output image; its extension picks the format: .png or .jpg (sRGB, clamped) or .exr
+    /// (linear radiance). The folder must exist.
     #[arg(short, long, default_value = "render.png")]
     output: PathBuf,
     /// Also write linear radiance to this OpenEXR file.
@@ -81,10 +82,10 @@ pub struct RenderArgs {
     /// its mean illuminance (checked every --batch samples).
     #[arg(long, value_name = "TOL")]
     adaptive: Option<f32>,
-    /// Samples between adaptive-sampling checks.
-    #[arg(long, default_value_t = 32)]
-    batch: u32,
-    /// Write the sample-count heat map (blue: few, red: the most) to this PNG.
+    /// Samples between adaptive-sampling checks (default 32; only with --adaptive).
+    #[arg(long)]
+    batch: Option<u32>,
+    /// Write the sample-count heat map (blue: few, red: the most) to this .png or .jpg.
     #[arg(long, value_name = "FILE")]
     heatmap: Option<PathBuf>,
     /// Seed of every random number: the same seed gives the same image.
@@ -99,9 +100,55 @@ pub struct RenderArgs {
     /// Print BVH statistics, per-stage times (`render: 12.3 ms`) and samples/s on stderr.
     #[arg(long)]
     stats: bool,
-    /// No progress bar.
+    /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// Samples between adaptive-sampling checks when --batch is not given.
+const DEFAULT_BATCH: u32 = 32;
+
+/// Refuses impossible flag combinations and warns of ineffective ones, naming the flags.
+fn check_flags(a: &RenderArgs) -> Result<()> {
+    if let Some(m) = a.bounce {
+        let most = match a.integrator {
+            IntegratorArg::Normals => {
+                return Err(UserError(
+                    "--bounce: the normals integrator does not bounce; use --integrator path"
+                        .into(),
+                )
+                .into())
+            }
+            IntegratorArg::Direct => 1,
+            IntegratorArg::Path => a.max_bounces,
+        };
+        if m > most {
+            let why = match a.integrator {
+                IntegratorArg::Direct => "--integrator direct stops after 1".to_string(),
+                _ => format!("--max-bounces is {most}"),
+            };
+            return Err(UserError(format!(
+                "--bounce {m}: no path gets that far ({why}), so the image would be black"
+            ))
+            .into());
+        }
+    }
+    let warn = |flag: &str, why: &str| eprintln!("prism: warning: {flag} has no effect: {why}");
+    if a.hemisphere && !matches!(a.integrator, IntegratorArg::Direct) {
+        warn("--hemisphere", "it applies to --integrator direct only");
+    }
+    if a.adaptive.is_none() {
+        if a.heatmap.is_some() {
+            eprintln!(
+                "prism: warning: --heatmap without --adaptive: every pixel takes the same \
+                 samples, so the map is one colour"
+            );
+        }
+        if a.batch.is_some() {
+            warn("--batch", "it applies to --adaptive only");
+        }
+    }
+    Ok(())
 }
 
 /// Largest image side.
@@ -109,6 +156,21 @@ const MAX_SIDE: u32 = 16384;
 
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
+    use crate::output::{image_output, ImageFormat};
+    let format = image_output(
+        &a.output,
+        "--output",
+        &[ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr],
+    )?;
+    if let Some(exr) = &a.exr {
+        image_output(exr, "--exr", &[ImageFormat::Exr])?;
+    }
+    let heatmap_format = a
+        .heatmap
+        .as_deref()
+        .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
+        .transpose()?;
+    check_flags(a)?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(UserError(format!(
@@ -169,7 +231,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         },
         only_bounce: a.bounce,
         adaptive: a.adaptive,
-        batch: a.batch.max(1),
+        batch: a.batch.unwrap_or(DEFAULT_BATCH).max(1),
         seed: a.seed,
         ..RenderOptions::default()
     };
@@ -186,17 +248,26 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let render_time = t2.elapsed();
     bar.finish_and_clear();
     let t3 = Instant::now();
-    prism_image::write_png(&a.output, &out.image.linear_to_srgb8())
-        .with_context(|| format!("writing {}", a.output.display()))?;
-    if let Some(exr) = &a.exr {
-        prism_image::write_exr(exr, &out.image)
-            .with_context(|| format!("writing {}", exr.display()))?;
+    match format {
+        ImageFormat::Exr => prism_image::write_exr(&a.output, &out.image)?,
+        _ => crate::output::write_rgb8(&a.output, format, &out.image.linear_to_srgb8())?,
     }
-    if let Some(path) = &a.heatmap {
-        prism_image::write_png(path, &prism_image::heatmap(&out.samples))
-            .with_context(|| format!("writing {}", path.display()))?;
+    let mut written = vec![a.output.display().to_string()];
+    if let Some(exr) = &a.exr {
+        prism_image::write_exr(exr, &out.image)?;
+        written.push(exr.display().to_string());
+    }
+    if let (Some(path), Some(f)) = (&a.heatmap, heatmap_format) {
+        crate::output::write_rgb8(path, f, &prism_image::heatmap(&out.samples))?;
+        written.push(path.display().to_string());
     }
     let write = t3.elapsed();
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        eprintln!(
+            "{}",
+            summary(w, h, out.total_samples, t0.elapsed(), render_time, &written)
+        );
+    }
     if a.stats {
         let s = prepared.bvh_stats();
         eprintln!(
@@ -221,4 +292,45 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The line printed when a render ends on a terminal: size, samples, times, outputs.
+fn summary(
+    w: u32,
+    h: u32,
+    samples: u64,
+    total: std::time::Duration,
+    render: std::time::Duration,
+    written: &[String],
+) -> String {
+    let rate = samples as f64 / render.as_secs_f64().max(1e-9);
+    format!(
+        "prism: rendered {w}x{h}, {:.2} M samples ({:.1} per pixel) in {:.1} s ({:.2} M samples/s) -> {}",
+        samples as f64 / 1e6,
+        samples as f64 / (f64::from(w) * f64::from(h)),
+        total.as_secs_f64(),
+        rate / 1e6,
+        written.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn summary_names_size_samples_rate_and_outputs() {
+        let s = summary(
+            4,
+            2,
+            80,
+            std::time::Duration::from_secs(2),
+            std::time::Duration::from_secs(1),
+            &["a.png".into(), "a.exr".into()],
+        );
+        assert_eq!(
+            s,
+            "prism: rendered 4x2, 0.00 M samples (10.0 per pixel) in 2.0 s (0.00 M samples/s) -> a.png, a.exr"
+        );
+    }
 }

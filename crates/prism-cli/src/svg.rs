@@ -8,6 +8,7 @@ use clap::{Args, ValueEnum};
 use prism_image::{LevelSampling, PixelSampling};
 use prism_raster::{read_svg, render, Dialect, Document, RasterOptions, View};
 
+use crate::output::{image_output, write_rgb8, ImageFormat};
 use crate::UserError;
 
 /// Texel lookup within a mip level.
@@ -43,7 +44,8 @@ pub enum Compat {
 pub struct SvgArgs {
     /// An SVG file, or a directory searched recursively for *.svg.
     pub input: PathBuf,
-    /// Output PNG file, or output directory when the input is a directory.
+    /// Output image, .png or .jpg by its extension (the folder must exist); or the output
+    /// directory, for PNGs, when the input is a directory.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Output width in pixels. Standard SVG: the document is fitted into --width x --height
@@ -55,7 +57,7 @@ pub struct SvgArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// Samples per pixel: a perfect square (1, 4, 9, 16, ...; at most 256).
-    #[arg(long, default_value_t = 1)]
+    #[arg(short = 's', long, default_value_t = 1)]
     pub samples: u32,
     /// Texel lookup for textured triangles.
     #[arg(long, value_enum, default_value_t = PixelMode::Nearest)]
@@ -126,7 +128,13 @@ fn ms(d: std::time::Duration) -> String {
 }
 
 /// Renders one file; returns the warnings.
-fn render_one(input: &Path, output: &Path, a: &SvgArgs, view: Option<View>) -> Result<Vec<String>> {
+fn render_one(
+    input: &Path,
+    output: &Path,
+    format: ImageFormat,
+    a: &SvgArgs,
+    view: Option<View>,
+) -> Result<Vec<String>> {
     let dialect = if a.compat.is_some() {
         Dialect::Cs184
     } else {
@@ -155,12 +163,12 @@ fn render_one(input: &Path, output: &Path, a: &SvgArgs, view: Option<View>) -> R
     let (image, stats) =
         render(&doc, &opts).map_err(|e| UserError(format!("{}: {e}", input.display())))?;
     let t1 = Instant::now();
-    if opts.compat {
-        prism_image::write_png(output, &image.to_rgb8())
-    } else {
-        prism_image::write_png_rgba(output, &image)
+    match format {
+        // JPEG has no alpha: the picture goes over white, as a browser shows it.
+        ImageFormat::Jpeg => write_rgb8(output, format, &image.over_background([255, 255, 255]))?,
+        _ if opts.compat => write_rgb8(output, format, &image.to_rgb8())?,
+        _ => prism_image::write_png_rgba(output, &image)?,
     }
-    .with_context(|| format!("writing {}", output.display()))?;
     let encode = t1.elapsed();
     if a.stats {
         eprintln!("parse: {}", ms(parse));
@@ -210,7 +218,12 @@ pub fn run(a: &SvgArgs) -> Result<()> {
         if !a.input.exists() {
             return Err(UserError(format!("{}: no such file", a.input.display())).into());
         }
-        return render_one(&a.input, &a.output, a, view).map(warn);
+        let format = image_output(
+            &a.output,
+            "--output",
+            &[ImageFormat::Png, ImageFormat::Jpeg],
+        )?;
+        return render_one(&a.input, &a.output, format, a, view).map(warn);
     }
     let mut files = Vec::new();
     find_svgs(&a.input, &mut files)?;
@@ -223,7 +236,7 @@ pub fn run(a: &SvgArgs) -> Result<()> {
             std::fs::create_dir_all(parent)
                 .with_context(|| format!("creating {}", parent.display()))?;
         }
-        match render_one(f, &out, a, view) {
+        match render_one(f, &out, ImageFormat::Png, a, view) {
             Ok(ws) => pb.suspend(|| warn(ws)),
             Err(e) => {
                 failed += 1;

@@ -182,25 +182,53 @@ fn demo_writes_gallery() {
     let o = prism()
         .args(["demo", "-q", "-o"])
         .arg(&dir)
+        .arg("--assets")
+        .arg(prism_testkit::shared_assets())
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
-    for f in [
-        "fan_1spp.png",
-        "fan_16spp.png",
-        "colortri.png",
-        "texture_level_linear.png",
-        "transformed_group.png",
-        "bezier_decasteljau.png",
-        "loop_level_2.png",
-        "bezier_teapot.png",
-        "render_cornell.png",
-        "render_heatmap.png",
-        "render_bounce_2.png",
-    ] {
-        assert!(html.contains(f), "{f} not in index");
+    let mut written: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    written.sort();
+    for f in &written {
+        assert!(html.contains(f.as_str()), "{f} not in index");
         assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
+    }
+    // The README's gallery is exactly what the demo writes, and the committed pictures are
+    // the demo's (allowing for the last-bit differences another processor or libm can make
+    // in a Monte Carlo render).
+    let root = prism_testkit::workspace_root();
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let gallery = &readme[readme.find("## Gallery").expect("a gallery section")..];
+    let mut shown: Vec<String> = gallery
+        .split("docs/gallery/")
+        .skip(1)
+        .filter_map(|rest| rest.split(')').next())
+        .filter(|n| n.ends_with(".png"))
+        .map(str::to_string)
+        .collect();
+    shown.sort();
+    shown.dedup();
+    assert_eq!(shown, written, "README gallery and demo output differ");
+    let mut committed: Vec<String> = std::fs::read_dir(root.join("docs/gallery"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    committed.sort();
+    assert_eq!(committed, written, "docs/gallery and demo output differ");
+    for f in &written {
+        let committed = prism_image::read_png(&root.join("docs/gallery").join(f))
+            .unwrap()
+            .to_rgb8();
+        let fresh = prism_image::read_png(&dir.join(f)).unwrap().to_rgb8();
+        let name = format!("gallery_{}", f.trim_end_matches(".png"));
+        prism_testkit::compare_images(&name, &committed, &fresh, |s| {
+            s.identical_fraction >= 0.98 && s.mean_abs_error <= 1.0
+        });
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -616,49 +644,35 @@ fn hostile_inputs_are_located_errors() {
     let cycle_dae = dae("<node><instance_node url='#c'/></node>", &library);
     let svg_cases = [
         (
-            "deep.svg",
             &deep_svg,
             &[][..],
-            "deep.svg:2: g: elements nest deeper than the limit of 256",
+            "in.svg:2: g: elements nest deeper than the limit of 256",
         ),
         (
-            "deep.svg",
             &deep_svg,
             &["--compat", "cs184"][..],
-            "deep.svg:2: g: elements nest deeper",
+            "in.svg:2: g: elements nest deeper",
         ),
         (
-            "fan.svg",
             &fan_svg,
             &[][..],
-            "fan.svg:19: g: use references would expand to more than 1000000 elements",
+            "in.svg:19: g: use references would expand to more than 1000000 elements",
         ),
         (
-            "cycle.svg",
             &cycle_svg,
             &[][..],
-            "cycle.svg:2: use: href #b leads back to itself",
+            "in.svg:2: use: href #b leads back to itself",
         ),
     ];
-    for (name, text, extra, want) in svg_cases {
-        let input = dir.join(name);
-        std::fs::write(&input, text).unwrap();
-        let out = dir.join("out.png");
-        let o = prism()
-            .arg("svg")
-            .arg(&input)
-            .arg("-o")
-            .arg(&out)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+    for (text, extra, want) in svg_cases {
+        let (o, out) = run_svg(&dir, text, extra);
+        assert_eq!(o.status.code(), Some(2), "{want}: {}", stderr(&o));
         assert!(
             stderr(&o).contains(want),
-            "{name}: expected {want:?} in {}",
+            "expected {want:?} in {}",
             stderr(&o)
         );
-        assert!(!out.exists(), "{name}: output written");
+        assert!(!out.exists(), "{want}: output written");
     }
     let dae_cases = [
         (
@@ -754,5 +768,273 @@ fn course_file_with_a_short_camera_matrix_renders_as_the_intact_one() {
         stderr(&o)
     );
     assert!(!c.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Runs `prism ARGS` and returns the output.
+fn run(args: &[&std::ffi::OsStr]) -> Output {
+    prism().args(args).output().unwrap()
+}
+
+/// The output's extension picks the format (PNG, JPEG or EXR bytes, checked by their magic
+/// numbers); an extension a command cannot write, or a missing folder, is refused with exit
+/// 2 before the input is even read (a missing input is not what is reported), naming the
+/// user's path once and never a temporary file.
+#[test]
+fn outputs_are_chosen_by_extension_and_checked_first() {
+    let dir = scratch("outputs");
+    let s = |x: &str| std::ffi::OsString::from(x);
+    let p = |x: &Path| x.as_os_str().to_owned();
+    let magic = |path: &Path| std::fs::read(path).unwrap()[..4].to_vec();
+    let small = ["-q", "-s", "1", "-r", "8", "6"];
+    for (name, want) in [
+        ("r.png", vec![0x89, b'P', b'N', b'G']),
+        ("r.JPG", vec![0xff, 0xd8, 0xff]),
+        ("r.exr", vec![0x76, 0x2f, 0x31, 0x01]),
+    ] {
+        let out = dir.join(name);
+        let mut args = vec![s("render"), s("-o"), p(&out)];
+        args.extend(small.iter().map(|a| s(a)));
+        let o = run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>());
+        assert_eq!(o.status.code(), Some(0), "{name}: {}", stderr(&o));
+        assert_eq!(magic(&out)[..want.len()], want[..], "{name}");
+    }
+    let svg = dir.join("in.svg");
+    std::fs::write(
+        &svg,
+        "<svg xmlns='http://www.w3.org/2000/svg' width='4' height='4'/>",
+    )
+    .unwrap();
+    let o = run(&[&s("svg"), &p(&svg), &s("-o"), &p(&dir.join("s.jpeg"))]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(magic(&dir.join("s.jpeg"))[..2], [0xff, 0xd8]);
+
+    std::fs::create_dir_all(dir.join("folder.png")).unwrap();
+    let curve = prism_testkit::shared_asset("meshedit/bzc/curve1.bzc");
+    let patches = prism_testkit::shared_asset("meshedit/bez/wavy_cube.bez");
+    let cube = prism_testkit::shared_asset("meshedit/dae/cube.dae");
+    let missing = dir.join("no-such-input.dae");
+    let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
+        (
+            vec![s("render"), p(&missing), s("-o"), p(&dir.join("r.tif"))],
+            "--output",
+        ),
+        (
+            vec![s("render"), p(&missing), s("--exr"), p(&dir.join("r.png"))],
+            "--exr",
+        ),
+        (
+            vec![
+                s("render"),
+                p(&missing),
+                s("--heatmap"),
+                p(&dir.join("h.exr")),
+            ],
+            "--heatmap",
+        ),
+        (
+            vec![s("svg"), p(&svg), s("-o"), p(&dir.join("s.exr"))],
+            "expected a .png or .jpg file",
+        ),
+        (
+            vec![s("bezier"), p(&curve), s("-o"), p(&dir.join("c.obj"))],
+            "expected a .png or .jpg file",
+        ),
+        (
+            vec![s("bezier"), p(&patches), s("-o"), p(&dir.join("t.png"))],
+            "expected an .obj, .ply or .dae file",
+        ),
+        (
+            vec![
+                s("mesh"),
+                s("convert"),
+                p(&cube),
+                s("-o"),
+                p(&dir.join("m.png")),
+            ],
+            "expected an .obj, .ply or .dae file",
+        ),
+        (
+            vec![
+                s("mesh"),
+                s("subdivide"),
+                p(&missing),
+                s("-o"),
+                p(&dir.join("nope/m.obj")),
+            ],
+            "does not exist (prism does not create it)",
+        ),
+        (
+            vec![
+                s("render"),
+                p(&missing),
+                s("-o"),
+                p(&dir.join("nope/r.png")),
+            ],
+            "nope does not exist",
+        ),
+        (
+            vec![s("svg"), p(&svg), s("-o"), p(&dir.join("folder.png"))],
+            "expected a file name, found a folder",
+        ),
+    ];
+    for (args, want) in cases {
+        let o = run(&args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>());
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: expected {want:?} in {err}");
+        // The output is checked first: a missing input is never what is reported.
+        assert!(!err.contains("No such file"), "{err}");
+        assert!(!err.contains(".tmp"), "{err}");
+    }
+    for left in ["r.tif", "h.exr", "s.exr", "c.obj", "t.png", "m.png"] {
+        assert!(!dir.join(left).exists(), "{left} written");
+    }
+    assert!(!dir.join("nope").exists(), "a folder was created");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `prism mesh info` lists vertices, edges and faces (limited), and each edge operation says
+/// what it changed and the counts that result.
+#[test]
+fn mesh_listing_and_operation_reports() {
+    let dir = scratch("mesh-report");
+    let tet = dir.join("tet.obj");
+    std::fs::write(
+        &tet,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+    )
+    .unwrap();
+    let o = prism()
+        .args([
+            "mesh",
+            "info",
+            "--vertices",
+            "--edges",
+            "--faces",
+            "--limit",
+            "2",
+        ])
+        .arg(&tet)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "vertex 1: 0 0 0",
+        "vertex 2: 1 0 0",
+        "... 2 more vertices (--limit 4 lists them all)",
+        "edge 0: vertices 1,3, from 0 0 0 to 0 1 0",
+        "... 4 more edges",
+        "face 0: vertices 1,3,2",
+        "... 2 more faces",
+    ] {
+        assert!(text.contains(want), "{want:?} not in {text}");
+    }
+    assert!(!text.contains("vertex 3:"), "{text}");
+    let out = dir.join("out.obj");
+    for (op, want) in [
+        ("split", "edge 0 (vertices 1,3): split at new vertex 5 (0 0.5 0)\nnow 5 vertices, 9 edges, 6 faces"),
+        ("flip", "edge 0 (vertices 1,3): flipped; it now joins vertices"),
+        ("collapse", "edge 0 (vertices 1,3): "),
+    ] {
+        let o = prism()
+            .args(["mesh", op])
+            .arg(&tet)
+            .arg("-o")
+            .arg(&out)
+            .args(["--edge", "0"])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout);
+        if o.status.code() == Some(0) {
+            assert!(text.contains(want), "{op}: {want:?} not in {text}");
+            assert!(text.contains("now "), "{op}: {text}");
+        } else {
+            // A tetrahedron's edges cannot flip or collapse and stay a manifold: a reason.
+            assert_eq!(o.status.code(), Some(2), "{op}: {}", stderr(&o));
+            assert!(stderr(&o).contains(&format!("cannot {op}")), "{}", stderr(&o));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Impossible flag combinations are errors; ineffective ones are warnings naming the flag;
+/// a scene whose only light gives off nothing says so, and what would show it.
+#[test]
+fn render_flags_are_never_silent_no_ops() {
+    let dir = scratch("flags");
+    let out = dir.join("r.png");
+    let render = |extra: &[&str]| {
+        prism()
+            .args(["render", "-q", "-s", "1", "-r", "8", "6", "-o"])
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    for (extra, want) in [
+        (
+            &["--bounce", "3", "-m", "1"][..],
+            "--bounce 3: no path gets that far (--max-bounces is 1)",
+        ),
+        (
+            &["--bounce", "2", "--integrator", "direct"][..],
+            "--integrator direct stops after 1",
+        ),
+        (
+            &["--bounce", "1", "--integrator", "normals"][..],
+            "the normals integrator does not bounce",
+        ),
+    ] {
+        let o = render(extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{extra:?}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+    let heat = dir.join("h.png");
+    let o = render(&[
+        "--hemisphere",
+        "--batch",
+        "8",
+        "--heatmap",
+        heat.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for want in [
+        "warning: --hemisphere has no effect",
+        "warning: --batch has no effect",
+        "warning: --heatmap without --adaptive",
+    ] {
+        assert!(stderr(&o).contains(want), "{want}: {}", stderr(&o));
+    }
+    let o = render(&[
+        "--integrator",
+        "direct",
+        "--hemisphere",
+        "--adaptive",
+        "0.1",
+        "--batch",
+        "8",
+    ]);
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+    let unlit = prism_testkit::shared_asset("pathtracer/dae/sky/bunny_unlit.dae");
+    let o = render(&[unlit.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("renders black (`--integrator normals` shows its shapes)"),
+        "{}",
+        stderr(&o)
+    );
+    let help = prism().arg("--help").output().unwrap();
+    let first = String::from_utf8_lossy(&help.stdout)
+        .lines()
+        .next()
+        .unwrap_or("")
+        .to_string();
+    assert!(
+        first.contains("mesh editing") && first.contains("path tracing"),
+        "{first}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -452,13 +452,23 @@ impl Scene {
             }
         }
         scene.camera = place_camera(&scene, file_camera.as_ref(), opts.camera);
-        let emitters = scene
-            .materials
-            .iter()
-            .any(|m| matches!(m, Material::Emission { .. }));
-        if scene.lights.is_empty() && !emitters {
+        // A light or emitter of zero power (the course's `*_unlit` files) lights nothing.
+        let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
+        let emitters = scene.materials.iter().any(|m| match m {
+            Material::Emission { radiance } => shines(radiance),
+            _ => false,
+        });
+        let lit = scene.lights.iter().any(|l| match l {
+            Light::Point { intensity, .. } => shines(intensity),
+            Light::Directional { irradiance, .. } => shines(irradiance),
+            Light::Area { radiance, .. }
+            | Light::Hemisphere { radiance }
+            | Light::Environment { radiance } => shines(radiance),
+        });
+        if !lit && !emitters {
             scene.warnings.push(format!(
-                "{file}: the scene has no light and no emitting surface; it renders black"
+                "{file}: the scene has no light and no emitting surface that gives off light; \
+                 it renders black (`--integrator normals` shows its shapes)"
             ));
         }
         Ok(scene)

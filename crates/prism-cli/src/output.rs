@@ -1,0 +1,173 @@
+//! Output files: the format is chosen by the output's extension, and the extension and the
+//! folder are checked before any work starts. prism does not create a missing folder (as
+//! resvg does not): a mistyped path is an error, not a new directory.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use crate::UserError;
+
+/// An image file format prism writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// `.png`: 8-bit sRGB (with alpha where the picture has it).
+    Png,
+    /// `.jpg` / `.jpeg`: 8-bit sRGB, quality 95, no alpha.
+    Jpeg,
+    /// `.exr`: linear 32-bit float RGB.
+    Exr,
+}
+
+impl ImageFormat {
+    fn extensions(self) -> &'static str {
+        match self {
+            ImageFormat::Png => ".png",
+            ImageFormat::Jpeg => ".jpg",
+            ImageFormat::Exr => ".exr",
+        }
+    }
+}
+
+/// A mesh file format prism writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront `.obj`.
+    Obj,
+    /// Stanford `.ply`, binary little-endian.
+    Ply,
+    /// COLLADA `.dae`, one node.
+    Dae,
+}
+
+/// The lower-case extension of `path`, without the dot.
+pub fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// The image format `path` names, if it is one of `allowed`; the folder must exist and
+/// take new files. `flag` names the option in the message.
+pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<ImageFormat> {
+    let format = match extension(path).as_str() {
+        "png" => Some(ImageFormat::Png),
+        "jpg" | "jpeg" => Some(ImageFormat::Jpeg),
+        "exr" => Some(ImageFormat::Exr),
+        _ => None,
+    };
+    match format {
+        Some(f) if allowed.contains(&f) => {
+            check_folder(path, flag)?;
+            Ok(f)
+        }
+        _ => {
+            let names: Vec<&str> = allowed.iter().map(|f| f.extensions()).collect();
+            Err(UserError(format!(
+                "{flag} {}: expected a {} file",
+                path.display(),
+                names.join(" or ")
+            ))
+            .into())
+        }
+    }
+}
+
+/// The mesh format `path` names (`.obj`, `.ply` or `.dae`); the folder must exist and take
+/// new files.
+pub fn mesh_output(path: &Path, flag: &str) -> Result<MeshFormat> {
+    let format = match extension(path).as_str() {
+        "obj" => MeshFormat::Obj,
+        "ply" => MeshFormat::Ply,
+        "dae" => MeshFormat::Dae,
+        _ => {
+            return Err(UserError(format!(
+                "{flag} {}: expected an .obj, .ply or .dae file",
+                path.display()
+            ))
+            .into())
+        }
+    };
+    check_folder(path, flag)?;
+    Ok(format)
+}
+
+/// Checks that `path` names a file in an existing folder where a new file can be made.
+pub fn check_folder(path: &Path, flag: &str) -> Result<()> {
+    if path.is_dir() {
+        return Err(UserError(format!(
+            "{flag} {}: expected a file name, found a folder",
+            path.display()
+        ))
+        .into());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(UserError(format!(
+            "{flag} {}: the folder {} does not exist (prism does not create it)",
+            path.display(),
+            dir.display()
+        ))
+        .into());
+    }
+    let probe = dir.join(format!(".prism-probe.{}", std::process::id()));
+    match std::fs::File::create(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => Err(UserError(format!(
+            "{flag} {}: cannot write in {}: {e}",
+            path.display(),
+            dir.display()
+        ))
+        .into()),
+    }
+}
+
+/// Writes an 8-bit sRGB picture as PNG or JPEG, atomically.
+pub fn write_rgb8(path: &Path, format: ImageFormat, image: &prism_image::Rgb8Image) -> Result<()> {
+    match format {
+        ImageFormat::Jpeg => prism_image::write_jpeg(path, image)?,
+        _ => prism_image::write_png(path, image)?,
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extensions_name_formats_case_blind() {
+        let dir = std::env::temp_dir();
+        let all = [ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr];
+        for (name, want) in [
+            ("a.PNG", ImageFormat::Png),
+            ("a.jpeg", ImageFormat::Jpeg),
+            ("a.JPG", ImageFormat::Jpeg),
+            ("a.exr", ImageFormat::Exr),
+        ] {
+            assert_eq!(image_output(&dir.join(name), "-o", &all).unwrap(), want);
+        }
+        let e = image_output(&dir.join("a.exr"), "-o", &[ImageFormat::Png]).unwrap_err();
+        assert!(e.to_string().ends_with("expected a .png file"), "{e}");
+        assert!(image_output(&dir.join("a.obj"), "-o", &all).is_err());
+        assert!(mesh_output(&dir.join("a.png"), "-o").is_err());
+        assert_eq!(
+            mesh_output(&dir.join("m.Ply"), "-o").unwrap(),
+            MeshFormat::Ply
+        );
+    }
+
+    #[test]
+    fn missing_folders_are_named() {
+        let path = std::env::temp_dir().join("prism-no-such-folder-xyz/out.png");
+        let e = image_output(&path, "-o", &[ImageFormat::Png]).unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+        assert!(!path.parent().unwrap().exists());
+    }
+}
