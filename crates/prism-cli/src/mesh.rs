@@ -18,6 +18,11 @@ use crate::UserError;
 pub struct MeshArgs {
     #[command(subcommand)]
     command: MeshCommand,
+    /// Refuse a non-manifold mesh instead of repairing it with a warning, as OpenMesh and
+    /// pmp do on load (a vertex where fans of faces touch becomes one vertex per fan; a
+    /// face on an edge already used in its direction gets vertices of its own).
+    #[arg(long, global = true)]
+    strict: bool,
 }
 
 /// Neighbour weights for Loop subdivision.
@@ -147,6 +152,55 @@ fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
         .map_err(|e| UserError(format!("{}: {e}", path.display())).into())
 }
 
+/// Most split vertices named one by one in warnings.
+const SPLIT_WARNINGS: usize = 10;
+
+/// Reads a mesh and, unless `strict`, repairs it as OpenMesh does on load, with a warning
+/// naming each repair: a face on an edge already used in its direction gets its own
+/// vertices, and a vertex where fans of faces touch becomes one vertex per fan (vertices
+/// numbered from 1, as in OBJ files; faces from 0).
+fn load(path: &Path, strict: bool) -> Result<PolyMesh> {
+    let mut p = read(path)?;
+    if strict {
+        return Ok(p);
+    }
+    let detached = p.detach_faces_on_used_edges();
+    for f in detached.iter().take(SPLIT_WARNINGS) {
+        eprintln!(
+            "warning: {}: face {f} uses an edge an earlier face already uses in that direction \
+             (a non-manifold edge or a face turned over); it gets vertices of its own \
+             (--strict refuses such a mesh)",
+            path.display()
+        );
+    }
+    if detached.len() > SPLIT_WARNINGS {
+        eprintln!(
+            "warning: {}: {} more faces detached the same way",
+            path.display(),
+            detached.len() - SPLIT_WARNINGS
+        );
+    }
+    let split = p.split_nonmanifold_vertices();
+    for s in split.iter().take(SPLIT_WARNINGS) {
+        eprintln!(
+            "warning: {}: vertex {} joins {} fans of faces that touch only there; split into \
+             {} vertices (--strict refuses such a mesh)",
+            path.display(),
+            s.vertex + 1,
+            s.copies.len() + 1,
+            s.copies.len() + 1
+        );
+    }
+    if split.len() > SPLIT_WARNINGS {
+        eprintln!(
+            "warning: {}: {} more vertices split the same way",
+            path.display(),
+            split.len() - SPLIT_WARNINGS
+        );
+    }
+    Ok(p)
+}
+
 /// Writes a mesh as .obj, .ply (binary little-endian) or .dae, chosen by extension,
 /// atomically. The extension and folder are checked (by [`crate::output::mesh_output`])
 /// before any work.
@@ -212,12 +266,13 @@ fn list(kind: &str, count: usize, limit: usize, line: impl Fn(usize) -> String) 
 /// `op` says what it did, in words.
 fn edge_op(
     args: &EdgeArgs,
+    strict: bool,
     what: &str,
     op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<String, TopologyError>,
 ) -> Result<()> {
     let (input, output) = (&args.input, &args.output);
     let (edge, vertices) = (args.edge, args.vertices.as_deref());
-    let p = read(input)?;
+    let p = load(input, strict)?;
     let mut m = build(input, &p)?;
     let e = match (edge, vertices) {
         (Some(e), _) => prism_mesh::EdgeId(e),
@@ -273,6 +328,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
     if let Some(output) = output {
         crate::output::mesh_output(output, "--output")?;
     }
+    let strict = a.strict;
     match &a.command {
         MeshCommand::Info {
             input,
@@ -281,7 +337,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             faces,
             limit,
         } => {
-            let p = read(input)?;
+            let p = load(input, strict)?;
             let m = build(input, &p)?;
             let boundary_edges = (0..m.edge_count())
                 .filter(|&e| m.is_boundary_edge(prism_mesh::EdgeId(e as u32)))
@@ -327,20 +383,20 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             Ok(())
         }
         MeshCommand::Normals { input, output } => {
-            let mut p = read(input)?;
+            let mut p = load(input, strict)?;
             p.normals = Some(prism_mesh::vertex_normals_area_weighted(&p));
             write(output, &p)
         }
         MeshCommand::Convert { input, output } => {
-            let p = read(input)?;
+            let p = load(input, strict)?;
             build(input, &p)?;
             write(output, &p)
         }
-        MeshCommand::Flip(e) => edge_op(e, "flip", |m, id| {
+        MeshCommand::Flip(e) => edge_op(e, a.strict, "flip", |m, id| {
             m.flip(id)?;
             Ok(format!("flipped; it now joins {}", edge_words(m, id)))
         }),
-        MeshCommand::Split(e) => edge_op(e, "split", |m, id| {
+        MeshCommand::Split(e) => edge_op(e, a.strict, "split", |m, id| {
             let v = m.split(id)?;
             Ok(format!(
                 "split at new vertex {} ({})",
@@ -348,7 +404,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
                 xyz(m.position(v))
             ))
         }),
-        MeshCommand::Collapse(e) => edge_op(e, "collapse", |m, id| {
+        MeshCommand::Collapse(e) => edge_op(e, a.strict, "collapse", |m, id| {
             let v = m.collapse(id)?;
             Ok(format!(
                 "collapsed to vertex {} ({}); vertices above may be renumbered",
@@ -369,7 +425,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
                 Weights::Loop => LoopWeights::Loop,
             };
             let t = Instant::now();
-            let mut p = read(input)?;
+            let mut p = load(input, strict)?;
             let read_time = t.elapsed();
             // Refuse before allocating what cannot fit: every level makes 4 faces of one.
             let out_faces = (p.face_count() as u128) << (2 * u128::from((*levels).min(40)));

@@ -1038,3 +1038,56 @@ fn render_flags_are_never_silent_no_ops() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Meshes prism wrote itself load: the welded Bezier teapot (a vertex where the handle
+/// touches the body has two fans) and the Delft `monkey.obj` (a face on an edge already used
+/// in its direction) are repaired on load with a warning naming the vertex or face, subdivide,
+/// and the result builds and validates (prism-mesh's `validate` is the oracle); `--strict`
+/// keeps the refusal.
+#[test]
+fn meshes_prism_wrote_load_repaired() {
+    let dir = scratch("repair");
+    let teapot = dir.join("teapot.obj");
+    let o = prism()
+        .arg("bezier")
+        .arg(prism_testkit::shared_asset("meshedit/bez/teapot.bez"))
+        .arg("-o")
+        .arg(&teapot)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let monkey = prism_testkit::shared_asset("delft-raytracer/data/monkey.obj");
+    for (input, want) in [
+        (
+            &teapot,
+            "joins 2 fans of faces that touch only there; split into 2 vertices",
+        ),
+        (
+            &monkey,
+            "face 143 uses an edge an earlier face already uses in that direction",
+        ),
+    ] {
+        let out = dir.join("smooth.obj");
+        let o = prism()
+            .args(["mesh", "subdivide"])
+            .arg(input)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{want:?} not in {}", stderr(&o));
+        let smooth = prism_mesh::read_obj(&out).unwrap();
+        prism_mesh::HalfedgeMesh::from_polymesh(&smooth)
+            .unwrap()
+            .validate()
+            .unwrap();
+        let o = prism()
+            .args(["mesh", "info", "--strict"])
+            .arg(input)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

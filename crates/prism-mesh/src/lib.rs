@@ -2,8 +2,9 @@
 //! typed index handles ([`HalfedgeMesh`]) built from polygon soups with boundary loops,
 //! edge flips, splits and collapses that check first and refuse with a [`TopologyError`],
 //! Bezier curves and patches (de Casteljau), Wavefront OBJ and Stanford PLY reading and
-//! writing, area-weighted vertex normals, Loop subdivision and procedural shapes
-//! ([`icosahedron`]).
+//! writing, area-weighted vertex normals, Loop subdivision, procedural shapes
+//! ([`icosahedron`]), and the repair made on load of vertices where fans touch
+//! ([`PolyMesh::split_nonmanifold_vertices`]).
 #![warn(missing_docs)]
 
 mod bezier;
@@ -14,6 +15,7 @@ mod normals;
 mod obj;
 mod ply;
 mod polymesh;
+mod repair;
 mod shapes;
 
 pub use bezier::{
@@ -29,4 +31,5 @@ pub use normals::vertex_normals_area_weighted;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};
 pub use polymesh::PolyMesh;
+pub use repair::SplitVertex;
 pub use shapes::icosahedron;

@@ -78,6 +78,15 @@ impl PolyMesh {
         &self.face_indices
     }
 
+    /// A mesh without attributes from compressed face rows (see the type's invariant).
+    pub(crate) fn from_rows(face_starts: Vec<u32>, face_indices: Vec<u32>) -> PolyMesh {
+        PolyMesh {
+            face_starts,
+            face_indices,
+            ..PolyMesh::default()
+        }
+    }
+
     /// True if every face is a triangle.
     #[must_use]
     pub fn is_triangle_mesh(&self) -> bool {
