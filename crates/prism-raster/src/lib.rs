@@ -24,8 +24,8 @@ mod triangulate;
 pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
 pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
-    parse_path_data, parse_svg, read_svg, Dialect, PathDataError, Source, SvgError, MAX_DEPTH,
-    MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
+    parse_path_data, parse_path_data_prefix, parse_svg, read_svg, Dialect, PathDataError, Source,
+    SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RasterError, RasterOptions, RasterStats, View,

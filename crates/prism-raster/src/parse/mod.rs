@@ -16,7 +16,7 @@ use roxmltree::Node;
 
 use common::{number_list, number_with_unit, Loc, PlainAttribute, Precision};
 pub use common::{SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
-pub use pathdata::{parse_path_data, PathDataError};
+pub use pathdata::{parse_path_data, parse_path_data_prefix, PathDataError};
 
 use std::collections::HashMap;
 

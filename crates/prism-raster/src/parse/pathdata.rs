@@ -121,8 +121,32 @@ impl<'a> Cursor<'a> {
 /// [`PathDataError`] with the byte offset of the first malformed token; the SVG spec's "render up to
 /// the error" is not applied, so bad data is reported rather than silently truncated.
 pub fn parse_path_data(d: &str) -> Result<Path, PathDataError> {
-    let mut c = Cursor { s: d, pos: 0 };
+    match parse_path_data_prefix(d) {
+        (path, None) => Ok(path),
+        (_, Some(e)) => Err(e),
+    }
+}
+
+/// Parses path data up to its first error, as the SVG specification has it drawn: the path
+/// of every command before the one in error, and that error (`None` when there is none).
+/// Data that does not begin with a moveto gives an empty path.
+#[must_use]
+pub fn parse_path_data_prefix(d: &str) -> (Path, Option<PathDataError>) {
     let mut path = Path::default();
+    let result = read_commands(d, &mut path);
+    if !matches!(
+        path.segments.first(),
+        Some(crate::path::Segment::MoveTo(_)) | None
+    ) {
+        return (Path::default(), Some(PathDataError::NoInitialMoveTo));
+    }
+    (path, result.err())
+}
+
+/// Reads the commands of `d` into `path`, each command's segments only once all its
+/// numbers have read, until the end or the first error.
+fn read_commands(d: &str, path: &mut Path) -> Result<(), PathDataError> {
+    let mut c = Cursor { s: d, pos: 0 };
     let mut cur = DVec2::ZERO;
     let mut start = DVec2::ZERO;
     // Reflection points for S/s and T/t.
@@ -224,11 +248,7 @@ pub fn parse_path_data(d: &str) -> Result<Path, PathDataError> {
         last_cubic_ctrl = cubic_ctrl;
         last_quad_ctrl = quad_ctrl;
     }
-    if let Some(crate::path::Segment::MoveTo(_)) | None = path.segments.first() {
-        Ok(path)
-    } else {
-        Err(PathDataError::NoInitialMoveTo)
-    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -275,5 +295,17 @@ mod tests {
         assert!(parse_path_data("M0 0 L1e999 0").is_err());
         assert!(parse_path_data("M0 0 K1").is_err());
         assert!(parse_path_data("").unwrap().segments.is_empty());
+    }
+
+    /// The specification's error handling: everything before the command in error is kept.
+    #[test]
+    fn prefix_keeps_the_commands_before_an_error() {
+        let (p, e) = parse_path_data_prefix("M0 0 L10 0 L10 x L0 10");
+        assert_eq!(e, Some(PathDataError::ExpectedNumber { offset: 15 }));
+        assert_eq!(p, parse_path_data("M0 0 L10 0").unwrap());
+        let (p, e) = parse_path_data_prefix("L5 5 M0 0");
+        assert!(p.segments.is_empty());
+        assert_eq!(e, Some(PathDataError::NoInitialMoveTo));
+        assert_eq!(parse_path_data_prefix("M1 2 z").1, None);
     }
 }

@@ -17,7 +17,7 @@ use super::common::{
     number_list, number_with_unit, parse_transform, Loc, PlainAttribute, Precision, SvgError,
     MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
-use super::pathdata::parse_path_data;
+use super::pathdata::parse_path_data_prefix;
 use super::{element_loc, image_item, Ctx};
 use crate::document::{
     Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop,
@@ -173,112 +173,123 @@ struct Parser<'c, 'a> {
     textures: HashMap<String, usize>,
 }
 
-/// Properties this reader resolves; anything else in `style` is ignored.
+/// Properties this reader resolves; anything else in `style` is ignored. An invalid value
+/// is treated as absent, as the SVG specification and browsers do: the property keeps the
+/// value it had, and the error is returned with the property's name, for one warning.
 fn apply_declarations(
     style: &mut Style,
     decls: &[(String, String)],
     loc: &Loc,
     vp: Viewport,
-) -> Result<(f32, bool), SvgError> {
+) -> (f32, bool, Vec<(String, SvgError)>) {
     let mut opacity = 1.0;
     let mut display = true;
+    let mut invalid = Vec::new();
     for (k, v) in decls {
         let v = v.as_str();
         if v.trim() == "inherit" {
             continue;
         }
-        match k.as_str() {
-            "fill" => style.fill = parse_paint(v, loc, k)?,
-            "stroke" => style.stroke_paint = parse_paint(v, loc, k)?,
-            "color" => {
-                if let Some((c, _)) = parse_color(v) {
-                    style.color = c;
+        let mut apply = || -> Result<(), SvgError> {
+            match k.as_str() {
+                "fill" => style.fill = parse_paint(v, loc, k)?,
+                "stroke" => style.stroke_paint = parse_paint(v, loc, k)?,
+                "color" => {
+                    if let Some((c, _)) = parse_color(v) {
+                        style.color = c;
+                    }
                 }
-            }
-            "fill-opacity" => style.fill_opacity = opacity_value(v, loc, k)?,
-            "stroke-opacity" => style.stroke_opacity = opacity_value(v, loc, k)?,
-            "opacity" => opacity = opacity_value(v, loc, k)?,
-            "fill-rule" => {
-                style.fill_rule = match v.trim() {
-                    "evenodd" => FillRule::EvenOdd,
-                    "nonzero" => FillRule::NonZero,
-                    other => {
+                "fill-opacity" => style.fill_opacity = opacity_value(v, loc, k)?,
+                "stroke-opacity" => style.stroke_opacity = opacity_value(v, loc, k)?,
+                "opacity" => opacity = opacity_value(v, loc, k)?,
+                "fill-rule" => {
+                    style.fill_rule = match v.trim() {
+                        "evenodd" => FillRule::EvenOdd,
+                        "nonzero" => FillRule::NonZero,
+                        other => {
+                            return Err(loc.err(format!(
+                                "fill-rule: expected nonzero or evenodd, found {other:?}"
+                            )))
+                        }
+                    }
+                }
+                "stroke-width" => {
+                    let w = length(v, loc, k, vp, Axis::Diag)?;
+                    if w < 0.0 {
                         return Err(loc.err(format!(
-                            "fill-rule: expected nonzero or evenodd, found {other:?}"
-                        )))
+                            "stroke-width: expected a non-negative length, found {v:?}"
+                        )));
+                    }
+                    style.stroke.width = w;
+                }
+                "stroke-linejoin" => {
+                    style.stroke.join = match v.trim() {
+                        "miter" | "miter-clip" | "arcs" => LineJoin::Miter,
+                        "round" => LineJoin::Round,
+                        "bevel" => LineJoin::Bevel,
+                        other => {
+                            return Err(loc.err(format!(
+                                "stroke-linejoin: expected miter, round or bevel, found {other:?}"
+                            )))
+                        }
                     }
                 }
-            }
-            "stroke-width" => {
-                let w = length(v, loc, k, vp, Axis::Diag)?;
-                if w < 0.0 {
-                    return Err(loc.err(format!(
-                        "stroke-width: expected a non-negative length, found {v:?}"
-                    )));
+                "stroke-linecap" => {
+                    style.stroke.cap = match v.trim() {
+                        "butt" => LineCap::Butt,
+                        "round" => LineCap::Round,
+                        "square" => LineCap::Square,
+                        other => {
+                            return Err(loc.err(format!(
+                                "stroke-linecap: expected butt, round or square, found {other:?}"
+                            )))
+                        }
+                    }
                 }
-                style.stroke.width = w;
-            }
-            "stroke-linejoin" => {
-                style.stroke.join = match v.trim() {
-                    "miter" | "miter-clip" | "arcs" => LineJoin::Miter,
-                    "round" => LineJoin::Round,
-                    "bevel" => LineJoin::Bevel,
-                    other => {
+                "stroke-miterlimit" => {
+                    let m = number_with_unit(v, P, loc, k)?.0;
+                    if m < 1.0 {
                         return Err(loc.err(format!(
-                            "stroke-linejoin: expected miter, round or bevel, found {other:?}"
-                        )))
+                            "stroke-miterlimit: expected a number >= 1, found {v:?}"
+                        )));
+                    }
+                    style.stroke.miter_limit = m;
+                }
+                "stroke-dasharray" => {
+                    if v.trim() == "none" {
+                        style.stroke.dashes.clear();
+                    } else {
+                        let mut d = Vec::new();
+                        for part in v
+                            .split(|c: char| c == ',' || c.is_whitespace())
+                            .filter(|p| !p.is_empty())
+                        {
+                            d.push(length(part, loc, k, vp, Axis::Diag)?);
+                        }
+                        if d.iter().any(|x| *x < 0.0) {
+                            return Err(loc.err("stroke-dasharray: expected non-negative lengths"));
+                        }
+                        if d.len() % 2 == 1 {
+                            let copy = d.clone();
+                            d.extend(copy);
+                        }
+                        style.stroke.dashes = d;
                     }
                 }
-            }
-            "stroke-linecap" => {
-                style.stroke.cap = match v.trim() {
-                    "butt" => LineCap::Butt,
-                    "round" => LineCap::Round,
-                    "square" => LineCap::Square,
-                    other => {
-                        return Err(loc.err(format!(
-                            "stroke-linecap: expected butt, round or square, found {other:?}"
-                        )))
-                    }
+                "stroke-dashoffset" => {
+                    style.stroke.dash_offset = length(v, loc, k, vp, Axis::Diag)?
                 }
+                "visibility" => style.visible = v.trim() == "visible",
+                "display" => display = v.trim() != "none",
+                _ => {}
             }
-            "stroke-miterlimit" => {
-                let m = number_with_unit(v, P, loc, k)?.0;
-                if m < 1.0 {
-                    return Err(loc.err(format!(
-                        "stroke-miterlimit: expected a number >= 1, found {v:?}"
-                    )));
-                }
-                style.stroke.miter_limit = m;
-            }
-            "stroke-dasharray" => {
-                if v.trim() == "none" {
-                    style.stroke.dashes.clear();
-                } else {
-                    let mut d = Vec::new();
-                    for part in v
-                        .split(|c: char| c == ',' || c.is_whitespace())
-                        .filter(|p| !p.is_empty())
-                    {
-                        d.push(length(part, loc, k, vp, Axis::Diag)?);
-                    }
-                    if d.iter().any(|x| *x < 0.0) {
-                        return Err(loc.err("stroke-dasharray: expected non-negative lengths"));
-                    }
-                    if d.len() % 2 == 1 {
-                        let copy = d.clone();
-                        d.extend(copy);
-                    }
-                    style.stroke.dashes = d;
-                }
-            }
-            "stroke-dashoffset" => style.stroke.dash_offset = length(v, loc, k, vp, Axis::Diag)?,
-            "visibility" => style.visible = v.trim() == "visible",
-            "display" => display = v.trim() != "none",
-            _ => {}
+            Ok(())
+        };
+        if let Err(e) = apply() {
+            invalid.push((k.clone(), e));
         }
     }
-    Ok((opacity, display))
+    (opacity, display, invalid)
 }
 
 fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<Mat3>, SvgError> {
@@ -379,7 +390,10 @@ pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Documen
     );
     let mut style = Style::default();
     let decls = declarations(&root);
-    let (opacity, _) = apply_declarations(&mut style, &decls, &loc, vp)?;
+    let (opacity, _, invalid) = apply_declarations(&mut style, &decls, &loc, vp);
+    for (property, e) in invalid {
+        p.warn_invalid(&property, &e);
+    }
     let layer = opacity < 1.0;
     if layer {
         p.doc.items.push(Item::BeginLayer);
@@ -515,6 +529,14 @@ impl<'a> Parser<'_, 'a> {
         self.ctx.warn_once(&mut self.doc, key, message);
     }
 
+    /// One warning per property of the file whose value is invalid (and treated as absent).
+    fn warn_invalid(&mut self, property: &str, e: &SvgError) {
+        self.warn(
+            &format!("invalid:{property}"),
+            format!("{e}; treated as absent (warned once per property)"),
+        );
+    }
+
     fn element(
         &mut self,
         node: Node<'a, 'a>,
@@ -555,7 +577,11 @@ impl<'a> Parser<'_, 'a> {
             _ => {}
         }
         let mut style = parent_style.clone();
-        let (opacity, display) = apply_declarations(&mut style, &declarations(&node), &loc, vp)?;
+        let (opacity, display, invalid) =
+            apply_declarations(&mut style, &declarations(&node), &loc, vp);
+        for (property, e) in invalid {
+            self.warn_invalid(&property, &e);
+        }
         if !display {
             return Ok(());
         }
@@ -569,8 +595,16 @@ impl<'a> Parser<'_, 'a> {
                 );
             }
         }
-        let mut t = match node.attr("transform") {
-            Some(s) => ctm.mul(&parse_transform(s, P, &loc, false)?),
+        // An invalid transform is treated as absent, as SVG 2 has it.
+        let mut t = match node
+            .attr("transform")
+            .map(|s| parse_transform(s, P, &loc, false))
+        {
+            Some(Ok(m)) => ctm.mul(&m),
+            Some(Err(e)) => {
+                self.warn_invalid("transform", &e);
+                ctm
+            }
             None => ctm,
         };
         let num = |attr: &str, axis: Axis| -> Result<f64, SvgError> {
@@ -712,7 +746,15 @@ impl<'a> Parser<'_, 'a> {
                 Path::polygon(&pts, name == "polygon")
             }
             "path" => {
-                parse_path_data(node.attr("d").unwrap_or("")).map_err(|e| loc.path_data(e))?
+                // Drawn up to the first error, as the specification has it.
+                let (path, error) = parse_path_data_prefix(node.attr("d").unwrap_or(""));
+                if let Some(e) = error {
+                    self.warn(
+                        "invalid:d",
+                        format!("{}; drawn up to the error", loc.path_data(e)),
+                    );
+                }
+                path
             }
             "image" => {
                 if !style.visible {
