@@ -21,8 +21,13 @@ pub struct BezierArgs {
     /// patches. The folder must exist.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Curve parameter at which the de Casteljau levels are drawn.
-    #[arg(long, default_value_t = 0.5)]
+    /// Curve parameter, in [0, 1], at which the de Casteljau levels are drawn.
+    #[arg(
+        short = 't',
+        long = "parameter",
+        visible_alias = "t",
+        default_value_t = 0.5
+    )]
     pub t: f64,
     /// Grid cells per patch side when tessellating.
     #[arg(long, default_value_t = 16)]
@@ -53,9 +58,11 @@ pub fn run(a: &BezierArgs) -> Result<()> {
     match curve_format {
         Some(format) => {
             if !(0.0..=1.0).contains(&a.t) {
-                return Err(
-                    UserError(format!("--t: expected a value in [0, 1], found {}", a.t)).into(),
-                );
+                return Err(UserError(format!(
+                    "--parameter: expected a value in [0, 1], found {}",
+                    a.t
+                ))
+                .into());
             }
             let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
             write_curve(&pts, a.t, a.size, &a.output, format)

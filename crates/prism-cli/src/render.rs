@@ -49,7 +49,7 @@ pub struct RenderArgs {
     scene: Option<PathBuf>,
     /// Output image; its extension picks the format: .png or .jpg (sRGB, clamped) or .exr
     /// (linear radiance). The folder must exist.
-    #[arg(short, long, default_value = "render.png")]
+    #[arg(short, long, short_alias = 'f', default_value = "render.png")]
     output: PathBuf,
     /// Also write linear radiance to this OpenEXR file.
     #[arg(long, value_name = "FILE")]
@@ -72,8 +72,9 @@ pub struct RenderArgs {
     /// The estimator.
     #[arg(long, value_enum, default_value_t = IntegratorArg::Path)]
     integrator: IntegratorArg,
-    /// With --integrator direct: sample the hemisphere uniformly instead of the lights.
-    #[arg(long)]
+    /// With --integrator direct: sample the hemisphere uniformly instead of the lights (the
+    /// course's -H).
+    #[arg(short = 'H', long)]
     hemisphere: bool,
     /// Keep only light that took exactly this many bounces (0: emitters seen directly).
     #[arg(long, value_name = "M")]
@@ -85,6 +86,16 @@ pub struct RenderArgs {
     /// Samples between adaptive-sampling checks (default 32; only with --adaptive).
     #[arg(long)]
     batch: Option<u32>,
+    /// The course's adaptive-sampling flag: --batch BATCH --adaptive TOL in one.
+    #[arg(short = 'a', num_args = 2, value_names = ["BATCH", "TOL"], conflicts_with_all = ["adaptive", "batch"])]
+    course_adaptive: Option<Vec<String>>,
+    /// Thin-lens camera: the lens radius in world units (the course's -b); 0 is a pinhole.
+    #[arg(short = 'b', long, value_name = "RADIUS")]
+    lens_radius: Option<f32>,
+    /// Thin-lens camera: the distance along the view axis to the plane in focus (the
+    /// course's -d); by default the distance to the point the camera looks at.
+    #[arg(short = 'd', long, value_name = "DISTANCE")]
+    focal_distance: Option<f32>,
     /// Write the sample-count heat map (blue: few, red: the most) to this .png or .jpg.
     #[arg(long, value_name = "FILE")]
     heatmap: Option<PathBuf>,
@@ -108,8 +119,65 @@ pub struct RenderArgs {
 /// Samples between adaptive-sampling checks when --batch is not given.
 const DEFAULT_BATCH: u32 = 32;
 
+/// The adaptive tolerance and batch, from `--adaptive TOL --batch N` or the course's
+/// `-a BATCH TOL`.
+fn adaptive_settings(a: &RenderArgs) -> Result<(Option<f32>, Option<u32>)> {
+    let Some(v) = &a.course_adaptive else {
+        return Ok((a.adaptive, a.batch));
+    };
+    let batch = v[0].parse::<u32>().ok().filter(|&b| b > 0);
+    let tol = v[1].parse::<f32>().ok();
+    match (batch, tol) {
+        (Some(b), Some(t)) => Ok((Some(t), Some(b))),
+        _ => Err(UserError(format!(
+            "-a: expected BATCH (a positive integer) and TOL (a number), found {} {}",
+            v[0], v[1]
+        ))
+        .into()),
+    }
+}
+
+/// The thin lens from --lens-radius and --focal-distance, checked; `None` for a pinhole.
+fn thin_lens(
+    a: &RenderArgs,
+    camera: &prism_scene::Camera,
+) -> Result<Option<prism_scene::ThinLens>> {
+    let radius = match a.lens_radius {
+        None => {
+            if a.focal_distance.is_some() {
+                eprintln!(
+                    "prism: warning: --focal-distance has no effect: it applies to a lens \
+                     (--lens-radius)"
+                );
+            }
+            return Ok(None);
+        }
+        Some(r) if r.is_finite() && r >= 0.0 => r,
+        Some(r) => {
+            return Err(UserError(format!(
+                "--lens-radius: expected a radius of 0 or more, found {r}"
+            ))
+            .into())
+        }
+    };
+    let focal_distance = match a.focal_distance {
+        None => (camera.target - camera.eye).length(),
+        Some(d) if d.is_finite() && d > 0.0 => d,
+        Some(d) => {
+            return Err(UserError(format!(
+                "--focal-distance: expected a positive distance, found {d}"
+            ))
+            .into())
+        }
+    };
+    Ok(Some(prism_scene::ThinLens {
+        radius,
+        focal_distance,
+    }))
+}
+
 /// Refuses impossible flag combinations and warns of ineffective ones, naming the flags.
-fn check_flags(a: &RenderArgs) -> Result<()> {
+fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Result<()> {
     if let Some(m) = a.bounce {
         let most = match a.integrator {
             IntegratorArg::Normals => {
@@ -137,14 +205,14 @@ fn check_flags(a: &RenderArgs) -> Result<()> {
     if a.hemisphere && !matches!(a.integrator, IntegratorArg::Direct) {
         warn("--hemisphere", "it applies to --integrator direct only");
     }
-    if a.adaptive.is_none() {
+    if adaptive.is_none() {
         if a.heatmap.is_some() {
             eprintln!(
                 "prism: warning: --heatmap without --adaptive: every pixel takes the same \
                  samples, so the map is one colour"
             );
         }
-        if a.batch.is_some() {
+        if batch.is_some() {
             warn("--batch", "it applies to --adaptive only");
         }
     }
@@ -170,7 +238,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         .as_deref()
         .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
         .transpose()?;
-    check_flags(a)?;
+    let (adaptive, batch) = adaptive_settings(a)?;
+    check_flags(a, adaptive, batch)?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(UserError(format!(
@@ -181,7 +250,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if a.spp == 0 || a.spp > 1 << 20 {
         return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 20, a.spp)).into());
     }
-    if let Some(t) = a.adaptive {
+    if let Some(t) = adaptive {
         if !(t > 0.0 && t.is_finite()) {
             return Err(UserError(format!(
                 "--adaptive: expected a positive tolerance, found {t}"
@@ -209,6 +278,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 .map_err(|e| UserError(e.to_string()))?
         }
     };
+    let mut scene = scene;
+    scene.camera.lens = thin_lens(a, &scene.camera)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -230,8 +301,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             IntegratorArg::Normals => Integrator::Normals,
         },
         only_bounce: a.bounce,
-        adaptive: a.adaptive,
-        batch: a.batch.unwrap_or(DEFAULT_BATCH).max(1),
+        adaptive,
+        batch: batch.unwrap_or(DEFAULT_BATCH).max(1),
         seed: a.seed,
         ..RenderOptions::default()
     };

@@ -342,7 +342,7 @@ fn bezier_curve_and_patches() {
         .arg(dir.join("c.bzc"))
         .arg("-o")
         .arg(&png)
-        .args(["--t", "0.3", "--size", "200"])
+        .args(["--parameter", "0.3", "--size", "200"])
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -1128,5 +1128,75 @@ fn standard_svg_is_lenient_as_browsers_are() {
             "{bad} differs from {good}"
         );
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The course's own flags work as typed, and mean what the long forms mean (oracle: the
+/// same bytes): `-f` output, `-a BATCH TOL`, `-H`; the thin lens (`-b`, `-d`) changes the
+/// picture, a lens of radius 0 does not; typos get a suggestion.
+#[test]
+fn course_flags_work_as_typed() {
+    let dir = scratch("course-flags");
+    let render = |out: &Path, extra: &[&str]| {
+        let o = prism()
+            .args(["render", "-q", "-s", "8", "-r", "24", "18"])
+            .args(extra)
+            .arg("-o")
+            .arg(out)
+            .output()
+            .unwrap();
+        (
+            o.status.code(),
+            std::fs::read(out).unwrap_or_default(),
+            stderr(&o),
+        )
+    };
+    let bytes = |name: &str, extra: &[&str]| render(&dir.join(name), extra).1;
+    let long = bytes(
+        "long.png",
+        &[
+            "--batch",
+            "4",
+            "--adaptive",
+            "0.2",
+            "--integrator",
+            "direct",
+            "--hemisphere",
+        ],
+    );
+    let short = bytes(
+        "short.png",
+        &["-a", "4", "0.2", "--integrator", "direct", "-H"],
+    );
+    assert!(!long.is_empty());
+    assert_eq!(long, short);
+    let o = prism()
+        .args(["render", "-q", "-s", "1", "-r", "8", "6", "-f"])
+        .arg(dir.join("f.png"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(dir.join("f.png").exists());
+    let pinhole = bytes("pinhole.png", &[]);
+    assert_eq!(bytes("zero-lens.png", &["-b", "0", "-d", "3"]), pinhole);
+    let lens = bytes("lens.png", &["-b", "0.2", "-d", "2"]);
+    assert!(!lens.is_empty() && lens != pinhole);
+    let (code, _, err) = render(&dir.join("bad.png"), &["--lens-radius=-1"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--lens-radius: expected a radius of 0 or more"),
+        "{err}"
+    );
+    let (code, _, err) = render(&dir.join("a.png"), &["-a", "4", "x"]);
+    assert_eq!(code, Some(2), "{err}");
+    let o = prism().args(["render", "--sp", "4"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("similar argument exists: '--spp'"),
+        "{}",
+        stderr(&o)
+    );
+    let o = prism().args(["render", "--help"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&o.stdout).contains("[SCENE]"));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -49,6 +49,15 @@ pub fn concentric_disk(u: Vec2) -> Vec2 {
     r * Vec2::new(theta.cos(), theta.sin())
 }
 
+/// A uniform point on the unit disk by the polar map `r = sqrt(u.x)`, `phi = 2 pi u.y`
+/// (the course's thin-lens sampling); density `1 / pi`.
+#[must_use]
+pub fn polar_disk(u: Vec2) -> Vec2 {
+    let r = u.x.sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u.y;
+    Vec2::new(r * phi.cos(), r * phi.sin())
+}
+
 /// Cosine-weighted direction on the upper hemisphere (Malley's method).
 #[must_use]
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
@@ -108,9 +117,13 @@ mod tests {
             .sum::<f32>()
             / count;
         assert!((z2 - 4.0 * PI / 3.0).abs() < 1e-2, "{z2}");
+        // x^2 over the unit disk is pi/4; the polar map's density is 1/pi.
+        let x2: f32 = grid(n).map(|u| polar_disk(u).x.powi(2) * PI).sum::<f32>() / count;
+        assert!((x2 - PI / 4.0).abs() < 1e-3, "{x2}");
         for u in grid(20) {
             assert!((uniform_sphere(u).length() - 1.0).abs() < 1e-5);
             assert!(concentric_disk(u).length() <= 1.0 + 1e-6);
+            assert!(polar_disk(u).length() <= 1.0 + 1e-6);
             let b = uniform_triangle(u);
             assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
         }

@@ -1,46 +1,165 @@
-//! [`Pinhole`], the pinhole camera: primary rays through image positions.
+//! [`Perspective`], the perspective camera: primary rays through image positions, from a
+//! pinhole or across a thin lens.
 
-use prism_math::{Ray, Vec3};
+use prism_math::{warp, Ray, Vec2, Vec3};
 use prism_scene::Camera;
 
-/// A pinhole camera for an image of `width` x `height` pixels.
+/// A perspective camera for an image of `width` x `height` pixels: a pinhole, or a thin
+/// lens focused on a plane (the course's thin-lens model).
 #[derive(Clone, Copy, Debug)]
-pub struct Pinhole {
+pub struct Perspective {
     eye: Vec3,
     forward: Vec3,
+    /// Unit right and up vectors of the lens plane.
+    right_unit: Vec3,
+    up_unit: Vec3,
+    /// The same, scaled to the half-extent of the image at unit depth.
     right: Vec3,
     up: Vec3,
     width: f32,
     height: f32,
+    /// Lens radius and focal distance; `None` for a pinhole.
+    lens: Option<(f32, f32)>,
 }
 
-impl Pinhole {
+impl Perspective {
     /// The camera with its fields of view widened to the image's aspect ratio. Image x grows
     /// along `normalize(up x (eye - target))`, image rows go down.
     #[must_use]
-    pub fn new(c: &Camera, width: u32, height: u32) -> Pinhole {
+    pub fn new(c: &Camera, width: u32, height: u32) -> Perspective {
         let (hfov, vfov) = c.fov_for(width, height);
         let forward = (c.target - c.eye).normalize();
         let right = c.up.cross(-forward).normalize();
         let up = (-forward).cross(right);
-        Pinhole {
+        Perspective {
             eye: c.eye,
             forward,
+            right_unit: right,
+            up_unit: up,
             right: right * (hfov.to_radians() / 2.0).tan(),
             up: up * (vfov.to_radians() / 2.0).tan(),
             width: width as f32,
             height: height as f32,
+            lens: c
+                .lens
+                .filter(|l| l.radius > 0.0)
+                .map(|l| (l.radius, l.focal_distance)),
         }
     }
 
-    /// The ray through image position `(x, y)` in pixels from the top-left corner.
+    /// True when rays leave a lens, so [`Perspective::ray`] uses its lens sample.
     #[must_use]
-    pub fn ray(&self, x: f32, y: f32) -> Ray {
+    pub fn has_lens(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// The ray through image position `(x, y)` in pixels from the top-left corner. With a
+    /// lens, it leaves the lens point `lens_sample` maps to (uniform on the disk for uniform
+    /// samples) and passes through the point the pinhole ray meets on the plane of focus.
+    #[must_use]
+    pub fn ray(&self, x: f32, y: f32, lens_sample: Vec2) -> Ray {
         let sx = 2.0 * x / self.width - 1.0;
         let sy = 1.0 - 2.0 * y / self.height;
-        Ray::new(
-            self.eye,
-            (self.forward + sx * self.right + sy * self.up).normalize(),
-        )
+        // Direction at unit depth along the view axis.
+        let d = self.forward + sx * self.right + sy * self.up;
+        match self.lens {
+            None => Ray::new(self.eye, d.normalize()),
+            Some((radius, focal_distance)) => {
+                let focus = self.eye + focal_distance * d;
+                let p = radius * warp::polar_disk(lens_sample);
+                let origin = self.eye + p.x * self.right_unit + p.y * self.up_unit;
+                Ray::new(origin, (focus - origin).normalize())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_scene::ThinLens;
+
+    fn camera(lens: Option<ThinLens>) -> Perspective {
+        let c = Camera {
+            eye: Vec3::new(0.0, 0.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            hfov: 60.0,
+            vfov: 45.0,
+            near: 0.001,
+            far: 1000.0,
+            lens,
+        };
+        Perspective::new(&c, 64, 48)
+    }
+
+    /// Where a ray meets the plane `z = 5 - depth` (depth along the view axis, -z here).
+    fn at_depth(r: &Ray, depth: f32) -> Vec3 {
+        let t = (5.0 - depth - r.origin.z) / r.dir.z;
+        r.origin + t * r.dir
+    }
+
+    fn lens_samples() -> impl Iterator<Item = Vec2> {
+        (0..=8).flat_map(|i| (0..8).map(move |j| Vec2::new(i as f32 / 8.0, j as f32 / 8.0)))
+    }
+
+    /// Closed form: every ray through a film point meets the plane of focus at the point
+    /// the pinhole ray meets it, so a point at the focal distance projects sharp.
+    #[test]
+    fn a_point_at_the_focal_distance_is_sharp() {
+        let lens = ThinLens {
+            radius: 0.3,
+            focal_distance: 4.0,
+        };
+        let (pin, thin) = (camera(None), camera(Some(lens)));
+        for (x, y) in [(32.0, 24.0), (3.5, 40.25), (60.0, 1.0)] {
+            let want = at_depth(&pin.ray(x, y, Vec2::ZERO), 4.0);
+            for u in lens_samples() {
+                let got = at_depth(&thin.ray(x, y, u), 4.0);
+                assert!((got - want).length() < 1e-5, "{got} != {want}");
+            }
+        }
+    }
+
+    /// Closed form: on a plane at depth `z`, the rays through one film point spread over a
+    /// disk around the pinhole ray's point whose radius is the circle of confusion
+    /// `R |z - d| / d` (lens radius R, focal distance d); the lens rim reaches it.
+    #[test]
+    fn the_blur_off_focus_is_the_circle_of_confusion() {
+        let (radius, focal_distance) = (0.25f32, 3.0f32);
+        let thin = camera(Some(ThinLens {
+            radius,
+            focal_distance,
+        }));
+        let pin = camera(None);
+        for depth in [1.5f32, 6.0, 9.0] {
+            let coc = radius * (depth - focal_distance).abs() / focal_distance;
+            let centre = at_depth(&pin.ray(32.0, 24.0, Vec2::ZERO), depth);
+            let mut widest = 0.0f32;
+            for u in lens_samples() {
+                let d = (at_depth(&thin.ray(32.0, 24.0, u), depth) - centre).length();
+                assert!(d <= coc * (1.0 + 1e-4) + 1e-6, "{d} > {coc}");
+                widest = widest.max(d);
+            }
+            assert!(
+                (widest - coc).abs() <= coc * 1e-4 + 1e-6,
+                "{widest} vs {coc}"
+            );
+        }
+    }
+
+    /// A lens of radius 0 is a pinhole: the same rays.
+    #[test]
+    fn a_zero_lens_is_a_pinhole() {
+        let thin = camera(Some(ThinLens {
+            radius: 0.0,
+            focal_distance: 2.0,
+        }));
+        assert!(!thin.has_lens());
+        let (a, b) = (
+            thin.ray(7.0, 9.0, Vec2::splat(0.7)),
+            camera(None).ray(7.0, 9.0, Vec2::ZERO),
+        );
+        assert_eq!((a.origin, a.dir), (b.origin, b.dir));
     }
 }

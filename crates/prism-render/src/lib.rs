@@ -9,7 +9,7 @@ mod render_scene;
 mod sampler;
 
 pub use bsdf::{Bsdf, BsdfSample};
-pub use camera::Pinhole;
+pub use camera::Perspective;
 pub use render::{radiance, render, Integrator, RenderOptions, Rendered};
 pub use render_scene::{Interaction, LightSample, RenderLight, RenderScene};
 pub use sampler::Sampler;

@@ -4,7 +4,7 @@ use prism_image::Image;
 use prism_math::{Frame, Ray, Rgb, Vec3};
 use rayon::prelude::*;
 
-use crate::camera::Pinhole;
+use crate::camera::Perspective;
 use crate::render_scene::{spawn, Interaction, RenderScene};
 use crate::sampler::Sampler;
 
@@ -93,7 +93,7 @@ pub fn render(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
     let (w, h) = (opts.width, opts.height);
-    let camera = Pinhole::new(&scene.camera, w, h);
+    let camera = Perspective::new(&scene.camera, w, h);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
@@ -140,7 +140,7 @@ fn illuminance(c: Rgb) -> f32 {
 
 fn pixel(
     scene: &RenderScene,
-    camera: &Pinhole,
+    camera: &Perspective,
     opts: &RenderOptions,
     x: u32,
     y: u32,
@@ -152,7 +152,13 @@ fn pixel(
     while n < opts.spp {
         let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
         let u = sampler.next_2d();
-        let ray = camera.ray(x as f32 + u.x, y as f32 + u.y);
+        // The lens takes dimensions only when there is one: pinhole images keep their bytes.
+        let lens = if camera.has_lens() {
+            sampler.next_2d()
+        } else {
+            prism_math::Vec2::ZERO
+        };
+        let ray = camera.ray(x as f32 + u.x, y as f32 + u.y, lens);
         let mut l = radiance(scene, &ray, &mut sampler, opts);
         if !l.is_finite() {
             l = Rgb::BLACK;

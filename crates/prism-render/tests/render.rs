@@ -24,6 +24,7 @@ fn furnace(material: Material) -> Scene {
             vfov: 30.0,
             near: 0.01,
             far: 100.0,
+            lens: None,
         },
         warnings: vec![],
     }

@@ -120,6 +120,7 @@ pub fn cornell_box() -> Scene {
             vfov,
             near: 0.1,
             far: 100.0,
+            lens: None,
         },
         warnings: Vec::new(),
     }

@@ -24,5 +24,5 @@ pub use collada::{
 pub use error::SceneError;
 pub use scene::{
     Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
-    TriangleMesh,
+    ThinLens, TriangleMesh,
 };

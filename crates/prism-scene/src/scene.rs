@@ -197,6 +197,19 @@ pub struct Camera {
     pub near: f32,
     /// Far clip distance.
     pub far: f32,
+    /// A thin lens, for depth of field; `None` is a pinhole.
+    pub lens: Option<ThinLens>,
+}
+
+/// A thin lens: rays leave a disk of `radius` around the eye, in the plane facing the view,
+/// and meet on the plane of focus `focal_distance` along the view axis from the eye (the
+/// course's thin-lens camera).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// Radius of the lens, in world units.
+    pub radius: f32,
+    /// Distance from the eye to the plane in focus, along the view axis.
+    pub focal_distance: f32,
 }
 
 impl Camera {
@@ -261,6 +274,7 @@ impl Scene {
                 vfov: 35.0,
                 near: 0.001,
                 far: 1000.0,
+                lens: None,
             },
             warnings: doc.warnings.clone(),
         };
@@ -611,5 +625,6 @@ fn place_camera(
         vfov: vfov as f32,
         near: near as f32,
         far: far as f32,
+        lens: None,
     }
 }
