@@ -96,10 +96,13 @@ fn colortri_svg() -> String {
     s
 }
 
-/// A checkerboard plane receding into the distance, so texels are minified.
+/// A checkerboard floor receding to the horizon, so texels are minified more and more: a
+/// grid of small triangles whose uvs follow the floor, so that each is close to a true
+/// perspective mapping. Level 0 shows moire in the distance, the nearest level blocks,
+/// trilinear a smooth grey.
 fn texture_svg() -> Result<String> {
-    let tex = Image::from_fn(256, 256, |x, y| {
-        if (x / 16 + y / 16) % 2 == 0 {
+    let tex = Image::from_fn(512, 512, |x, y| {
+        if (x / 8 + y / 8) % 2 == 0 {
             [240, 240, 240]
         } else {
             [30, 60, 160]
@@ -109,24 +112,32 @@ fn texture_svg() -> Result<String> {
     let mut s = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="200"><texture texid="c" filename="data:image/png;base64,{uri}"/>"#
     );
-    // Rows of the plane: screen position shrinks with distance.
-    let rows = 24;
+    // The floor spans x in [-30, 30] and depth z in [1, 60] (square checks); a point projects
+    // to (150 + 150 x / z, 40 + 160 / z). Depths step geometrically, so rows are even on screen.
+    let (rows, cols, far) = (48, 48, 60.0f64);
+    let z = |j: usize| far.powf(j as f64 / rows as f64);
+    let x = |i: usize| -30.0 + 60.0 * i as f64 / cols as f64;
+    let screen = |i: usize, j: usize| (150.0 + 150.0 * x(i) / z(j), 40.0 + 160.0 / z(j));
+    let uv = |i: usize, j: usize| (i as f64 / cols as f64, (z(j) - 1.0) / (far - 1.0));
     for j in 0..rows {
-        let z0 = 1.0 + j as f64 * 0.5;
-        let z1 = z0 + 0.5;
-        let (y0, y1) = (60.0 + 140.0 / z0, 60.0 + 140.0 / z1);
-        let (w0, w1) = (600.0 / z0, 600.0 / z1);
-        let (v0, v1) = (j as f64 / rows as f64, (j + 1) as f64 / rows as f64);
-        let (xl0, xr0, xl1, xr1) = (
-            150.0 - w0 / 2.0,
-            150.0 + w0 / 2.0,
-            150.0 - w1 / 2.0,
-            150.0 + w1 / 2.0,
-        );
-        let _ = write!(
-            s,
-            r#"<textri texid="c" uvs="0 {v0} 1 {v0} 0 {v1}" points="{xl0} {y0} {xr0} {y0} {xl1} {y1}"/><textri texid="c" uvs="1 {v0} 1 {v1} 0 {v1}" points="{xr0} {y0} {xr1} {y1} {xl1} {y1}"/>"#
-        );
+        for i in 0..cols {
+            let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            for tri in [[0, 1, 2], [0, 2, 3]] {
+                let (mut pts, mut uvs) = (String::new(), String::new());
+                for k in tri {
+                    let (ci, cj) = corners[k];
+                    let ((px, py), (u, v)) = (screen(ci, cj), uv(ci, cj));
+                    let _ = write!(pts, "{px} {py} ");
+                    let _ = write!(uvs, "{u} {v} ");
+                }
+                let _ = write!(
+                    s,
+                    r#"<textri texid="c" uvs="{}" points="{}"/>"#,
+                    uvs.trim_end(),
+                    pts.trim_end()
+                );
+            }
+        }
     }
     s.push_str("</svg>");
     Ok(s)
@@ -285,8 +296,13 @@ pub fn run(a: &DemoArgs) -> Result<()> {
             .into(),
     });
     pb.inc(1);
+    // The course's adaptive-sampling settings (2048 samples at most, checked every 64), at
+    // a small size, so the map shows where the samples went.
     let adaptive = prism_render::RenderOptions {
-        spp: 256,
+        width: 128,
+        height: 96,
+        spp: 2048,
+        batch: 64,
         adaptive: Some(0.05),
         ..base
     };
@@ -298,11 +314,15 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     )?;
     entries.push(Entry {
         file: "render_adaptive.png".into(),
-        caption: "Cornell box with adaptive sampling (tolerance 0.05, at most 256 samples)".into(),
+        caption: "Cornell box with adaptive sampling (tolerance 0.05, at most 2048 samples, \
+                  checked every 64)"
+            .into(),
     });
     entries.push(Entry {
         file: "render_heatmap.png".into(),
-        caption: "Adaptive sampling (tolerance 0.05, at most 256 samples): samples per pixel, blue few, red many".into(),
+        caption: "Adaptive sampling (tolerance 0.05, at most 2048 samples, checked every 64): \
+                  samples per pixel, blue few, red many"
+            .into(),
     });
     pb.inc(1);
     for (m, name) in [
@@ -358,7 +378,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     let mut html = String::from(
         "<!doctype html><meta charset=\"utf-8\"><title>prism gallery</title>\
          <style>body{font-family:sans-serif;background:#eee}figure{display:inline-block;margin:8px;background:#fff;padding:8px}\
-         img{image-rendering:pixelated;width:300px}</style><h1>prism gallery</h1>",
+         img{max-width:100%}</style><h1>prism gallery</h1>",
     );
     for e in &entries {
         let _ = write!(

@@ -196,6 +196,24 @@ fn demo_writes_gallery() {
         assert!(html.contains(f.as_str()), "{f} not in index");
         assert!(prism_image::read_png(&dir.join(f)).is_ok(), "{f}");
     }
+    // Each feature at its best: the page shows pictures at their own size; the mip-level
+    // modes differ visibly (level 0 aliases in the distance, trilinear blurs); the heat map
+    // of the course's adaptive settings has many levels, not two colours.
+    assert!(!html.contains("pixelated"));
+    let png = |f: &str| prism_image::read_png(&dir.join(f)).unwrap().to_rgb8();
+    let (zero, linear) = (
+        png("texture_level_zero.png"),
+        png("texture_level_linear.png"),
+    );
+    let differ = prism_image::compare_rgb8(&zero, &linear).unwrap();
+    assert!(differ.identical_fraction < 0.9, "{differ:?}");
+    let heat = png("render_heatmap.png");
+    let colours: std::collections::BTreeSet<[u8; 3]> = heat.pixels().iter().copied().collect();
+    assert!(
+        colours.len() > 16,
+        "{} colours in the heat map",
+        colours.len()
+    );
     // The README's gallery is exactly what the demo writes, and the committed pictures are
     // the demo's (allowing for the last-bit differences another processor or libm can make
     // in a Monte Carlo render).

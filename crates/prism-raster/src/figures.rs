@@ -139,8 +139,21 @@ pub fn de_casteljau_construction(
     t: f64,
     size: u32,
 ) -> Result<Rgb8Image, RasterError> {
-    // Curve files use [0, 1]^2 with y up; the picture has y down.
-    let flip = |p: DVec2| DVec2::new(p.x, 1.0 - p.y);
+    // Curve files use [0, 1]^2 with y up; the picture has y down. The frame holds that
+    // square and every control point, with a margin, so no point is cut off at the edge.
+    let (mut lo, mut hi) = (DVec2::ZERO, DVec2::ONE);
+    for &p in points.iter().filter(|p| p.is_finite()) {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let side = (hi - lo).max_element();
+    let margin = 0.04 * side;
+    let scale = side + 2.0 * margin;
+    let centre = (lo + hi) / 2.0;
+    let flip = move |p: DVec2| {
+        let q = (p - centre) / scale;
+        DVec2::new(0.5 + q.x, 0.5 - q.y)
+    };
     let dot = |p: DVec2, r: f64, color: Rgb| fill(Path::ellipse(p, r, r), color);
     let mut doc = unit_document();
     doc.items.push(fill(
@@ -246,12 +259,33 @@ mod tests {
         ];
         let img = de_casteljau_construction(&points, 0.5, 200).unwrap();
         assert_eq!((img.width(), img.height()), (200, 200));
-        let flip = |p: DVec2| DVec2::new(p.x, 1.0 - p.y);
+        // The frame is the unit square with a 4% margin each side.
+        let flip = |p: DVec2| DVec2::new(0.5 + (p.x - 0.5) / 1.08, 0.5 - (p.y - 0.5) / 1.08);
         for p in [points[0], points[2], bezier_point(&points, 0.5)] {
             assert!(dark(pixel(&img, flip(p))), "{p}");
         }
         // Far from the curve and every level: background.
         assert_eq!(pixel(&img, flip(DVec2::new(0.5, 0.05))), WHITE);
         assert_eq!(pixel(&img, flip(DVec2::new(0.05, 0.95))), WHITE);
+    }
+
+    /// A control point on the edge of the unit square (the course's curve2.bzc ends at
+    /// (1.0, 0.9)) is drawn whole: its dot has ink on both sides of its centre.
+    #[test]
+    fn control_points_on_the_edge_are_not_cut_off() {
+        let points = [
+            DVec2::new(0.2, 0.35),
+            DVec2::new(0.3, 0.6),
+            DVec2::new(0.5, 0.75),
+            DVec2::new(0.7, 0.45),
+            DVec2::new(1.0, 0.9),
+        ];
+        let img = de_casteljau_construction(&points, 0.5, 300).unwrap();
+        let centre = DVec2::new(0.5 + 0.5 / 1.08, 0.5 - 0.4 / 1.08);
+        for dx in [-0.004, 0.0, 0.004] {
+            let p = centre + DVec2::new(dx, 0.0);
+            assert_ne!(pixel(&img, p), WHITE, "{p}");
+        }
+        assert!(centre.x < 1.0 - 0.01);
     }
 }
