@@ -9,14 +9,14 @@ use crate::{ImageError, Rgb8Image, Rgba8Image};
 /// The largest image, in pixels, that the readers accept (256 megapixels).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
 
-fn decode_err(what: &str, message: impl ToString) -> ImageError {
+pub(crate) fn decode_err(what: &str, message: impl ToString) -> ImageError {
     ImageError::Decode {
         what: what.to_string(),
         message: message.to_string(),
     }
 }
 
-fn check_size(what: &str, width: u64, height: u64) -> Result<(), ImageError> {
+pub(crate) fn check_size(what: &str, width: u64, height: u64) -> Result<(), ImageError> {
     if width == 0 || height == 0 || width * height > MAX_IMAGE_PIXELS {
         return Err(ImageError::BadSize {
             what: what.to_string(),
@@ -124,7 +124,7 @@ pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
 /// The largest image file the readers open, in bytes (1 GiB).
 pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
 
-fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageError> {
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageError> {
     let io = |source| ImageError::Io {
         path: path.to_path_buf(),
         source,

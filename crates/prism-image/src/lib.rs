@@ -14,7 +14,7 @@ mod texture;
 
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
-pub use exr::{encode_exr, write_exr};
+pub use exr::{decode_exr, encode_exr, read_exr, write_exr};
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{
