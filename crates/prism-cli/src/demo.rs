@@ -143,6 +143,27 @@ fn texture_svg() -> Result<String> {
     Ok(s)
 }
 
+/// A small sky for the environment-map demo, in linear radiance: blue overhead fading to a
+/// pale horizon, a warm sun above the camera's right shoulder, and a dim brown ground.
+fn sky_map() -> prism_image::RgbImage {
+    let sun = prism_math::Vec3::new(0.5, 0.7, 0.6).normalize();
+    Image::from_fn(128, 64, |x, y| {
+        let uv = prism_math::Vec2::new((x as f32 + 0.5) / 128.0, (y as f32 + 0.5) / 64.0);
+        let d = prism_render::uv_to_direction(uv);
+        if d.y < 0.0 {
+            return prism_math::Rgb::new(0.25, 0.18, 0.12);
+        }
+        let t = d.y.sqrt();
+        let sky = prism_math::Rgb::new(0.9, 0.95, 1.0) * (1.0 - t)
+            + prism_math::Rgb::new(0.25, 0.45, 1.0) * t;
+        if d.dot(sun) > 0.995 {
+            prism_math::Rgb::new(60.0, 50.0, 35.0)
+        } else {
+            sky
+        }
+    })
+}
+
 /// Nested groups with every transform kind.
 fn group_svg() -> String {
     let mut s = String::from(
@@ -355,6 +376,29 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         entries.push(Entry {
             file: "render_bunny.png".into(),
             caption: "CBbunny.dae from the course, 64 samples per pixel".into(),
+        });
+    }
+    // The course's unlit bunny under a procedural sky map (written beside the pictures).
+    let sky = sky_map();
+    prism_image::write_exr(&a.output.join("sky.exr"), &sky)?;
+    let unlit = a.assets.join("pathtracer/dae/sky/bunny_unlit.dae");
+    if unlit.is_file() {
+        let doc = prism_scene::read_collada(&unlit).map_err(|e| crate::UserError(e.to_string()))?;
+        let mut scene = prism_scene::Scene::from_collada(
+            &doc,
+            &prism_scene::SceneOptions::default(),
+            &unlit.display().to_string(),
+        )
+        .map_err(|e| crate::UserError(e.to_string()))?;
+        scene.lights = vec![prism_scene::Light::EnvironmentMap {
+            radiance: std::sync::Arc::new(sky),
+        }];
+        trace(&scene, &base, &a.output.join("render_envmap.png"), None)?;
+        entries.push(Entry {
+            file: "render_envmap.png".into(),
+            caption: "bunny_unlit.dae lit by a procedural sky map (--envmap sky.exr), 64 \
+                      samples per pixel"
+                .into(),
         });
     }
     pb.inc(1);

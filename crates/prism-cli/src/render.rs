@@ -89,6 +89,11 @@ pub struct RenderArgs {
     /// The course's adaptive-sampling flag: --batch BATCH --adaptive TOL in one.
     #[arg(short = 'a', num_args = 2, value_names = ["BATCH", "TOL"], conflicts_with_all = ["adaptive", "batch"])]
     course_adaptive: Option<Vec<String>>,
+    /// Environment light from a latitude-longitude OpenEXR map of linear radiance (the
+    /// course's -e), seen by every ray and importance-sampled; it replaces the scene's
+    /// hemisphere or environment light. Orientation: docs/path-tracer.md.
+    #[arg(short = 'e', long, value_name = "FILE.exr")]
+    envmap: Option<PathBuf>,
     /// Thin-lens camera: the lens radius in world units (the course's -b); 0 is a pinhole.
     #[arg(short = 'b', long, value_name = "RADIUS")]
     lens_radius: Option<f32>,
@@ -233,6 +238,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if let Some(exr) = &a.exr {
         image_output(exr, "--exr", &[ImageFormat::Exr])?;
     }
+    if let Some(map) = &a.envmap {
+        if crate::output::extension(map) != "exr" {
+            return Err(UserError(format!(
+                "--envmap {}: expected an OpenEXR (.exr) map",
+                map.display()
+            ))
+            .into());
+        }
+    }
     let heatmap_format = a
         .heatmap
         .as_deref()
@@ -280,6 +294,41 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     let mut scene = scene;
     scene.camera.lens = thin_lens(a, &scene.camera)?;
+    if let Some(path) = &a.envmap {
+        let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
+        let infinite = |l: &prism_scene::Light| {
+            matches!(
+                l,
+                prism_scene::Light::Hemisphere { .. }
+                    | prism_scene::Light::Environment { .. }
+                    | prism_scene::Light::EnvironmentMap { .. }
+            )
+        };
+        if scene
+            .lights
+            .iter()
+            .any(|l| infinite(l) && l.gives_off_light())
+        {
+            scene.warnings.push(format!(
+                "--envmap replaces the scene's hemisphere or environment light with {}",
+                path.display()
+            ));
+        }
+        scene.lights.retain(|l| !infinite(l));
+        scene.lights.push(prism_scene::Light::EnvironmentMap {
+            radiance: std::sync::Arc::new(map),
+        });
+    }
+    if !scene.is_lit() {
+        let name = a
+            .scene
+            .as_ref()
+            .map_or("the scene".to_string(), |p| p.display().to_string());
+        scene.warnings.push(format!(
+            "{name}: the scene has no light and no emitting surface that gives off light; it \
+             renders black (`--envmap FILE.exr` lights it, `--integrator normals` shows its shapes)"
+        ));
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

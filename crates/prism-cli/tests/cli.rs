@@ -214,6 +214,21 @@ fn demo_writes_gallery() {
         "{} colours in the heat map",
         colours.len()
     );
+    // The committed sky map is the one the demo generates.
+    let committed =
+        prism_image::read_exr(&prism_testkit::workspace_root().join("docs/envmap/sky.exr"))
+            .unwrap();
+    let fresh = prism_image::read_exr(&dir.join("sky.exr")).unwrap();
+    assert_eq!(
+        (committed.width(), committed.height()),
+        (fresh.width(), fresh.height())
+    );
+    for (a, b) in committed.pixels().iter().zip(fresh.pixels()) {
+        assert!(
+            (a.r - b.r).abs() <= 1e-5 * a.r.abs().max(1.0),
+            "{a:?} vs {b:?}"
+        );
+    }
     // The README's gallery is exactly what the demo writes, and the committed pictures are
     // the demo's (allowing for the last-bit differences another processor or libm can make
     // in a Monte Carlo render).
@@ -1038,7 +1053,7 @@ fn render_flags_are_never_silent_no_ops() {
     let o = render(&[unlit.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("renders black (`--integrator normals` shows its shapes)"),
+        stderr(&o).contains("renders black (`--envmap FILE.exr` lights it, `--integrator normals` shows its shapes)"),
         "{}",
         stderr(&o)
     );
@@ -1216,5 +1231,48 @@ fn course_flags_work_as_typed() {
     );
     let o = prism().args(["render", "--help"]).output().unwrap();
     assert!(String::from_utf8_lossy(&o.stdout).contains("[SCENE]"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--envmap` (`-e`) lights the course's unlit bunny with an OpenEXR map: the picture is no
+/// longer black, the darkness warning is gone, and a map that is not `.exr` or does not read
+/// is a located error with exit 2 and no output.
+#[test]
+fn envmap_lights_the_unlit_bunny() {
+    let dir = scratch("envmap");
+    let unlit = prism_testkit::shared_asset("pathtracer/dae/sky/bunny_unlit.dae");
+    let sky = prism_testkit::workspace_root().join("docs/envmap/sky.exr");
+    let out = dir.join("lit.png");
+    let render = |extra: &[&std::ffi::OsStr]| {
+        prism()
+            .args(["render", "-q", "-s", "4", "-r", "32", "24", "-o"])
+            .arg(&out)
+            .arg(&unlit)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = render(&["-e".as_ref(), sky.as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("renders black"), "{}", stderr(&o));
+    let img = prism_image::read_png(&out).unwrap().to_rgb8();
+    let lit = img
+        .pixels()
+        .iter()
+        .filter(|p| p.iter().any(|&c| c > 20))
+        .count();
+    assert!(lit > img.pixels().len() / 2, "{lit} lit pixels");
+    std::fs::remove_file(&out).unwrap();
+    let bad = dir.join("bad.exr");
+    std::fs::write(&bad, b"v/1\x01 not really").unwrap();
+    for (map, want) in [
+        (sky.with_extension("png"), "expected an OpenEXR (.exr) map"),
+        (bad.clone(), "bad.exr"),
+    ] {
+        let o = render(&["--envmap".as_ref(), map.as_os_str()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{want}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -23,4 +23,4 @@ pub use io::{
     MAX_IMAGE_PIXELS,
 };
 pub use srgb::{linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear};
-pub use texture::{LevelSampling, PixelSampling, Texture, UvConvention};
+pub use texture::{LevelSampling, PixelSampling, Texture, UvConvention, Wrap};

@@ -40,6 +40,17 @@ pub enum LevelSampling {
 pub struct Texture {
     levels: Vec<RgbImage>,
     uv: UvConvention,
+    wrap: [Wrap; 2],
+}
+
+/// What a lookup outside `[0, 1]` reads, along one axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// The edge texel (clamp to edge).
+    #[default]
+    Clamp,
+    /// The texture repeats: texel `i` of `w` is also texel `i + k w`.
+    Repeat,
 }
 
 /// Where uv coordinates fall on the texel grid of a level `w` texels wide.
@@ -112,7 +123,15 @@ impl Texture {
         Texture {
             levels,
             uv: UvConvention::Standard,
+            wrap: [Wrap::Clamp; 2],
         }
+    }
+
+    /// Returns the texture with other wrap modes along u and v.
+    #[must_use]
+    pub fn with_wrap(mut self, u: Wrap, v: Wrap) -> Texture {
+        self.wrap = [u, v];
+        self
     }
 
     /// Returns the texture with a different uv convention.
@@ -155,8 +174,9 @@ impl Texture {
         d.min((self.levels.len() - 1) as f32)
     }
 
-    /// Samples one mip level at `uv`, clamping to the edge. Nearest picks the texel whose
-    /// centre is closest; bilinear blends the four surrounding texel centres.
+    /// Samples one mip level at `uv`, wrapping each axis as [`Texture::with_wrap`] set
+    /// (clamping to the edge by default). Nearest picks the texel whose centre is closest;
+    /// bilinear blends the four surrounding texel centres.
     ///
     /// # Panics
     /// If `level` is not below `levels().len()`.
@@ -175,8 +195,12 @@ impl Texture {
                 f64::from(uv.y) * (h - 1) as f64,
             ),
         };
-        let clamp_x = |x: i64| x.clamp(0, w - 1) as u32;
-        let clamp_y = |y: i64| y.clamp(0, h - 1) as u32;
+        let fold = |i: i64, n: i64, wrap: Wrap| match wrap {
+            Wrap::Clamp => i.clamp(0, n - 1) as u32,
+            Wrap::Repeat => i.rem_euclid(n) as u32,
+        };
+        let clamp_x = |x: i64| fold(x, w, self.wrap[0]);
+        let clamp_y = |y: i64| fold(y, h, self.wrap[1]);
         match mode {
             PixelSampling::Nearest => {
                 let (x, y) = ((gx + 0.5).floor(), (gy + 0.5).floor());
@@ -444,5 +468,19 @@ mod tests {
                 .r,
             3.0
         );
+    }
+
+    /// Repeat wraps: bilinear lookups across the seam blend the last and first columns, and
+    /// u + 1 reads what u reads; v still clamps.
+    #[test]
+    fn repeat_wrap_crosses_the_seam() {
+        let im = Image::from_fn(4, 2, |x, _| Rgb::splat(x as f32));
+        let t = Texture::new(im).with_wrap(Wrap::Repeat, Wrap::Clamp);
+        let at = |u: f32, v: f32| t.sample_level(Vec2::new(u, v), 0, PixelSampling::Bilinear);
+        // u = 0 is the edge between texel 3 (value 3) and texel 0 (value 0).
+        assert_eq!(at(0.0, 0.5), Rgb::splat(1.5));
+        assert_eq!(at(1.25, 0.5), at(0.25, 0.5));
+        assert_eq!(at(-0.75, 0.5), at(0.25, 0.5));
+        assert_eq!(at(0.375, -3.0), at(0.375, 0.0));
     }
 }

@@ -50,6 +50,12 @@ impl Rgb {
         self + (other - self) * t
     }
 
+    /// Luminance of linear sRGB (Rec. 709 weights 0.2126, 0.7152, 0.0722).
+    #[must_use]
+    pub fn luminance(self) -> f32 {
+        0.2126 * self.r + 0.7152 * self.g + 0.0722 * self.b
+    }
+
     /// The largest of the three channels.
     #[must_use]
     pub fn max_channel(self) -> f32 {

@@ -80,6 +80,98 @@ pub fn uniform_triangle(u: Vec2) -> Vec2 {
     Vec2::new(1.0 - s, u.y * s)
 }
 
+/// A piecewise-constant density on `[0, 1)` proportional to non-negative weights, one per
+/// equal cell, sampled by inverting its cumulative distribution (pbrt's
+/// `PiecewiseConstant1D`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piecewise1D {
+    weights: Vec<f32>,
+    /// `cdf[i]`: the probability of the cells before `i`; `cdf[n] = 1`.
+    cdf: Vec<f32>,
+    /// The weights' mean: the density of cell `i` is `weights[i] / mean`.
+    mean: f32,
+}
+
+impl Piecewise1D {
+    /// The density of `weights` (negative and non-finite weights count as 0). With no
+    /// positive weight it is uniform.
+    #[must_use]
+    pub fn new(weights: &[f32]) -> Piecewise1D {
+        let mut weights: Vec<f32> = weights
+            .iter()
+            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
+            .collect();
+        if weights.is_empty() {
+            weights.push(1.0);
+        }
+        let n = weights.len() as f64;
+        let total: f64 = weights.iter().map(|&w| f64::from(w)).sum();
+        if total <= 0.0 {
+            weights.iter_mut().for_each(|w| *w = 1.0);
+        }
+        let total: f64 = weights.iter().map(|&w| f64::from(w)).sum();
+        let mut cdf = Vec::with_capacity(weights.len() + 1);
+        let mut acc = 0.0f64;
+        cdf.push(0.0);
+        for &w in &weights {
+            acc += f64::from(w);
+            cdf.push((acc / total) as f32);
+        }
+        *cdf.last_mut().expect("non-empty") = 1.0;
+        Piecewise1D {
+            weights,
+            cdf,
+            mean: (total / n) as f32,
+        }
+    }
+
+    /// The number of cells.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// False: there is always at least one cell.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// A point `x` in `[0, 1)` for uniform `u`, its density, and its cell.
+    #[must_use]
+    pub fn sample(&self, u: f32) -> (f32, f32, usize) {
+        let n = self.weights.len();
+        // The last cell whose start is at or below u, skipping empty cells.
+        let mut i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .saturating_sub(1)
+            .min(n - 1);
+        while self.weights[i] == 0.0 && i + 1 < n {
+            i += 1;
+        }
+        while self.weights[i] == 0.0 && i > 0 {
+            i -= 1;
+        }
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let t = if width > 0.0 {
+            ((u - self.cdf[i]) / width).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let x = ((i as f32 + t) / n as f32).min(1.0 - f32::EPSILON);
+        (x, self.weights[i] / self.mean, i)
+    }
+
+    /// The density at `x` in `[0, 1)`.
+    #[must_use]
+    pub fn pdf(&self, x: f32) -> f32 {
+        let n = self.weights.len();
+        let i = ((x * n as f32) as usize).min(n - 1);
+        self.weights[i] / self.mean
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -127,5 +219,29 @@ mod tests {
             let b = uniform_triangle(u);
             assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
         }
+    }
+
+    /// Inversion, closed form: uniform u lands in each cell in proportion to its weight,
+    /// and the density is the weight over the mean; empty cells are never picked.
+    #[test]
+    fn piecewise_density_inverts_its_cdf() {
+        let d = Piecewise1D::new(&[1.0, 0.0, 3.0, 4.0]);
+        let mut counts = [0usize; 4];
+        let n = 8000;
+        for k in 0..n {
+            let (x, pdf, i) = d.sample((k as f32 + 0.5) / n as f32);
+            assert_eq!((x * 4.0) as usize, i);
+            assert_eq!(pdf, d.pdf(x));
+            counts[i] += 1;
+        }
+        assert_eq!(counts, [1000, 0, 3000, 4000]);
+        assert_eq!(d.pdf(0.6), 1.5);
+        // The density integrates to 1.
+        let total: f32 = (0..400)
+            .map(|k| d.pdf((k as f32 + 0.5) / 400.0) / 400.0)
+            .sum();
+        assert!((total - 1.0).abs() < 1e-5);
+        let flat = Piecewise1D::new(&[0.0, -1.0]);
+        assert_eq!(flat.pdf(0.1), 1.0);
     }
 }

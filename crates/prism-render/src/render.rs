@@ -135,7 +135,7 @@ pub fn render(
 }
 
 fn illuminance(c: Rgb) -> f32 {
-    0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b
+    c.luminance()
 }
 
 fn pixel(

@@ -9,9 +9,10 @@ use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
+use crate::envmap::EnvMap;
 
 /// A light source ready to sample: the renderer's form of a [`prism_scene::Light`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum RenderLight {
     /// A point light.
     Point {
@@ -52,6 +53,8 @@ pub enum RenderLight {
         /// Radiance.
         radiance: Rgb,
     },
+    /// Radiance from every direction read from a map, seen by every ray.
+    EnvironmentMap(std::sync::Arc<EnvMap>),
 }
 
 /// A sample of incident light at a point.
@@ -84,6 +87,15 @@ impl RenderLight {
     #[must_use]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
+            RenderLight::EnvironmentMap(ref map) => {
+                map.sample(u).map(|(wi, li, pdf)| LightSample {
+                    wi,
+                    dist: f32::INFINITY,
+                    li,
+                    pdf,
+                    delta: false,
+                })
+            }
             RenderLight::Point {
                 position,
                 intensity,
@@ -170,6 +182,7 @@ impl RenderLight {
             }
             RenderLight::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
             RenderLight::Environment { .. } => uniform_sphere_pdf(),
+            RenderLight::EnvironmentMap(ref map) => map.pdf(wi),
             _ => 0.0,
         }
     }
@@ -297,6 +310,12 @@ impl RenderScene {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::Environment { radiance });
                 }
+                Light::EnvironmentMap { ref radiance } => {
+                    infinite = Some(lights.len());
+                    lights.push(RenderLight::EnvironmentMap(std::sync::Arc::new(
+                        EnvMap::new(radiance),
+                    )));
+                }
             }
         }
         let spheres: Vec<Sphere> = scene
@@ -347,9 +366,10 @@ impl RenderScene {
     /// environment lights, not the course's hidden hemisphere light.
     #[must_use]
     pub fn escaped(&self, dir: Vec3, camera_ray: bool) -> Rgb {
-        match self.infinite.map(|i| self.lights[i]) {
-            Some(RenderLight::Environment { radiance }) => radiance,
-            Some(RenderLight::Hemisphere { radiance }) if !camera_ray && dir.y > 0.0 => radiance,
+        match self.infinite.map(|i| &self.lights[i]) {
+            Some(RenderLight::Environment { radiance }) => *radiance,
+            Some(RenderLight::EnvironmentMap(map)) => map.radiance(dir),
+            Some(RenderLight::Hemisphere { radiance }) if !camera_ray && dir.y > 0.0 => *radiance,
             _ => Rgb::BLACK,
         }
     }

@@ -178,9 +178,34 @@ pub enum Light {
         /// Radiance.
         radiance: Rgb,
     },
+    /// Radiance from every direction, seen by every ray, read from a latitude-longitude
+    /// map (the course's environment light): direction `d` reads the map at
+    /// `u = phi / 2 pi`, `v = theta / pi` (v = 0 the top row), where `theta = acos(d.y)`
+    /// and `phi = atan2(-d.z, d.x) + pi`.
+    EnvironmentMap {
+        /// Linear radiance, one texel per direction cell.
+        radiance: std::sync::Arc<prism_image::RgbImage>,
+    },
 }
 
-/// A pinhole camera.
+impl Light {
+    /// True if the light gives off any light (some radiance, intensity or irradiance above
+    /// 0); the course's `*_unlit` files hold a hemisphere light of radiance 0.
+    #[must_use]
+    pub fn gives_off_light(&self) -> bool {
+        let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
+        match self {
+            Light::Point { intensity, .. } => shines(intensity),
+            Light::Directional { irradiance, .. } => shines(irradiance),
+            Light::Area { radiance, .. }
+            | Light::Hemisphere { radiance }
+            | Light::Environment { radiance } => shines(radiance),
+            Light::EnvironmentMap { radiance } => radiance.pixels().iter().any(shines),
+        }
+    }
+}
+
+/// A perspective camera: a pinhole, or a thin lens.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position.
@@ -466,26 +491,18 @@ impl Scene {
             }
         }
         scene.camera = place_camera(&scene, file_camera.as_ref(), opts.camera);
-        // A light or emitter of zero power (the course's `*_unlit` files) lights nothing.
+        Ok(scene)
+    }
+
+    /// True if some light or emitting material gives off light (of non-zero power).
+    #[must_use]
+    pub fn is_lit(&self) -> bool {
         let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
-        let emitters = scene.materials.iter().any(|m| match m {
+        let emitters = self.materials.iter().any(|m| match m {
             Material::Emission { radiance } => shines(radiance),
             _ => false,
         });
-        let lit = scene.lights.iter().any(|l| match l {
-            Light::Point { intensity, .. } => shines(intensity),
-            Light::Directional { irradiance, .. } => shines(irradiance),
-            Light::Area { radiance, .. }
-            | Light::Hemisphere { radiance }
-            | Light::Environment { radiance } => shines(radiance),
-        });
-        if !lit && !emitters {
-            scene.warnings.push(format!(
-                "{file}: the scene has no light and no emitting surface that gives off light; \
-                 it renders black (`--integrator normals` shows its shapes)"
-            ));
-        }
-        Ok(scene)
+        emitters || self.lights.iter().any(Light::gives_off_light)
     }
 
     /// The bounding box of every mesh vertex and sphere: `(min, max)`, or `None` if the
