@@ -319,8 +319,20 @@ fn mesh_subdivide_and_errors() {
     let bad = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
     std::fs::write(dir.join("bad.obj"), bad).unwrap();
     let out2 = dir.join("bad_out.obj");
+    // Repaired on load by default (the third face gets its own vertices), with a warning.
     let o = prism()
         .args(["mesh", "subdivide"])
+        .arg(dir.join("bad.obj"))
+        .arg("-o")
+        .arg(&out2)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("warning: ") && stderr(&o).contains("face 2 uses an edge"));
+    std::fs::remove_file(&out2).unwrap();
+    // Refused with --strict.
+    let o = prism()
+        .args(["mesh", "subdivide", "--strict"])
         .arg(dir.join("bad.obj"))
         .arg("-o")
         .arg(&out2)
