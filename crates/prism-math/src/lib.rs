@@ -1,12 +1,14 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
-//! boxes and frames, warps with their densities, deterministic random numbers, and line
-//! numbers of byte offsets for the readers' error messages.
+//! boxes and frames, 4x4 transforms named destination-from-source, warps with their
+//! densities, deterministic random numbers, and line numbers of byte offsets for the
+//! readers' error messages.
 #![warn(missing_docs)]
 
 mod color;
 mod geometry;
 mod random;
 mod text;
+mod transform;
 pub mod warp;
 
 pub use color::Rgb;
@@ -15,3 +17,4 @@ pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};
 pub use random::{hash_words, mix64, unit_f32, Pcg32};
 pub use text::LineIndex;
+pub use transform::Transform;
