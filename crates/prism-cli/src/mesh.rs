@@ -6,11 +6,8 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
-use prism_mesh::{
-    loop_subdivide, read_obj, write_obj, HalfedgeMesh, LoopWeights, PolyMesh, TopologyError,
-};
+use prism_mesh::{loop_subdivide, HalfedgeMesh, LoopWeights, PolyMesh, TopologyError};
 
-use crate::output::MeshFormat;
 use crate::UserError;
 
 /// Arguments of `prism mesh`.
@@ -118,33 +115,14 @@ enum MeshCommand {
 /// Most faces `prism mesh subdivide` will produce (about 18 GB as a halfedge mesh).
 const MAX_SUBDIVIDED_FACES: u64 = 1 << 28;
 
-fn extension(path: &Path) -> String {
-    path.extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default()
-}
-
+/// Reads a mesh by its extension (prism-scene's table of formats), printing the reader's
+/// warnings.
 fn read(path: &Path) -> Result<PolyMesh> {
-    let mesh = match extension(path).as_str() {
-        "obj" => read_obj(path),
-        "ply" => prism_mesh::read_ply(path),
-        "dae" => {
-            let doc = prism_scene::read_collada(path).map_err(|e| UserError(e.to_string()))?;
-            let mesh = doc.world_mesh(true).map_err(|e| UserError(e.to_string()))?;
-            for w in &doc.warnings {
-                eprintln!("warning: {w}");
-            }
-            return Ok(mesh);
-        }
-        _ => {
-            return Err(UserError(format!(
-                "{}: expected an .obj, .ply or .dae file",
-                path.display()
-            ))
-            .into())
-        }
-    };
-    mesh.map_err(|e| UserError(e.to_string()).into())
+    let (mesh, warnings) = prism_scene::read_mesh(path).map_err(|e| UserError(e.to_string()))?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(mesh)
 }
 
 fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
@@ -212,16 +190,7 @@ pub(crate) fn write(path: &Path, mesh: &PolyMesh) -> Result<()> {
     };
     prism_image::write_atomic_with(
         path,
-        |w| {
-            match format {
-                MeshFormat::Ply => {
-                    prism_mesh::write_ply(mesh, prism_mesh::PlyFormat::BinaryLittleEndian, w)
-                }
-                MeshFormat::Dae => prism_scene::write_collada(mesh, w),
-                MeshFormat::Obj => write_obj(mesh, w),
-            }
-            .map_err(|e| io(path, e))
-        },
+        |w| prism_scene::write_mesh(mesh, format, w).map_err(|e| io(path, e)),
         io,
     )?;
     Ok(())

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use anyhow::Result;
+use prism_scene::MeshFormat;
 
 use crate::UserError;
 
@@ -27,17 +28,6 @@ impl ImageFormat {
             ImageFormat::Exr => ".exr",
         }
     }
-}
-
-/// A mesh file format prism writes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MeshFormat {
-    /// Wavefront `.obj`.
-    Obj,
-    /// Stanford `.ply`, binary little-endian.
-    Ply,
-    /// COLLADA `.dae`, one node.
-    Dae,
 }
 
 /// The lower-case extension of `path`, without the dot.
@@ -76,17 +66,12 @@ pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<
 /// The mesh format `path` names (`.obj`, `.ply` or `.dae`); the folder must exist and take
 /// new files.
 pub fn mesh_output(path: &Path, flag: &str) -> Result<MeshFormat> {
-    let format = match extension(path).as_str() {
-        "obj" => MeshFormat::Obj,
-        "ply" => MeshFormat::Ply,
-        "dae" => MeshFormat::Dae,
-        _ => {
-            return Err(UserError(format!(
-                "{flag} {}: expected an .obj, .ply or .dae file",
-                path.display()
-            ))
-            .into())
-        }
+    let Some(format) = MeshFormat::from_path(path) else {
+        return Err(UserError(format!(
+            "{flag} {}: expected an .obj, .ply or .dae file",
+            path.display()
+        ))
+        .into());
     };
     check_folder(path, flag)?;
     Ok(format)

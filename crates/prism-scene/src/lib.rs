@@ -5,6 +5,8 @@
 //! (`<polylist>`, `<triangles>`, `<polygons>`, the course's CGL spheres), the node hierarchy
 //! with its transforms (`matrix`, `translate`, `rotate`, `scale`, `lookat`) and the up axis.
 //! [`write_collada`] writes a polygon mesh back as a one-node COLLADA document.
+//! [`read_mesh`] and [`write_mesh`] read and write mesh files of every format by extension
+//! ([`MeshFormat`]: OBJ, PLY, COLLADA).
 //!
 //! [`Scene`] is what renderers consume: world-space meshes and spheres with materials,
 //! lights and a camera, built from a document by [`Scene::from_collada`].
@@ -13,6 +15,7 @@
 mod builtin;
 mod collada;
 mod error;
+mod mesh_io;
 mod scene;
 
 pub use builtin::cornell_box;
@@ -22,6 +25,7 @@ pub use collada::{
     MAX_NODE_DEPTH, MAX_PLACED_FACES,
 };
 pub use error::SceneError;
+pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
 pub use scene::{
     Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
     ThinLens, TriangleMesh,
