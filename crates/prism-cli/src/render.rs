@@ -286,11 +286,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     let scene = match &a.scene {
         None => prism_scene::cornell_box(),
-        Some(path) => {
-            let doc = prism_scene::read_collada(path).map_err(|e| UserError(e.to_string()))?;
-            prism_scene::Scene::from_collada(&doc, &opts, &path.display().to_string())
-                .map_err(|e| UserError(e.to_string()))?
-        }
+        Some(path) => prism_scene::load(path, &opts).map_err(|e| UserError(e.to_string()))?,
     };
     let mut scene = scene;
     scene.camera.lens = thin_lens(a, &scene.camera)?;

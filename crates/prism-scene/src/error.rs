@@ -14,6 +14,12 @@ pub enum SceneError {
         #[source]
         source: Arc<std::io::Error>,
     },
+    /// The file's extension names no scene format prism reads.
+    #[error("{path}: expected a scene file (.dae)")]
+    UnknownFormat {
+        /// The file.
+        path: String,
+    },
     /// The path is not a regular file (a directory, say).
     #[error("{path}: expected a regular file")]
     NotAFile {

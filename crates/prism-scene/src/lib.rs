@@ -9,12 +9,14 @@
 //! ([`MeshFormat`]: OBJ, PLY, COLLADA).
 //!
 //! [`Scene`] is what renderers consume: world-space meshes and spheres with materials,
-//! lights and a camera, built from a document by [`Scene::from_collada`].
+//! lights and a camera, built from a document by [`Scene::from_collada`]; the module that
+//! defines it reads no file. [`load`] reads a scene file by its extension.
 #![warn(missing_docs)]
 
 mod builtin;
 mod collada;
 mod error;
+mod load;
 mod mesh_io;
 mod scene;
 
@@ -25,6 +27,7 @@ pub use collada::{
     MAX_NODE_DEPTH, MAX_PLACED_FACES,
 };
 pub use error::SceneError;
+pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
 pub use scene::{
     Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,

@@ -20,6 +20,7 @@
 //! [`MAX_PLACED_FACES`]) are errors at once.
 
 mod library;
+mod to_scene;
 mod writer;
 
 use std::collections::{HashMap, HashSet};

@@ -1,0 +1,42 @@
+//! [`load`]: a scene file read by the reader its extension names.
+
+use std::path::Path;
+
+use crate::collada::read_collada;
+use crate::error::SceneError;
+use crate::scene::{Scene, SceneOptions};
+
+/// Reads the scene in `path` with the reader its extension names (in any letter case):
+/// `.dae`, COLLADA (then [`Scene::from_collada`]).
+///
+/// # Errors
+/// [`SceneError::UnknownFormat`] for another extension, or the reader's located error.
+pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene, SceneError> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "dae" => {
+            let doc = read_collada(path)?;
+            Scene::from_collada(&doc, opts, &path.display().to_string())
+        }
+        _ => Err(SceneError::UnknownFormat {
+            path: path.display().to_string(),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The extension picks the reader; another is a named error.
+    #[test]
+    fn extensions_pick_readers() {
+        let e = load(Path::new("scene.obj.txt"), &SceneOptions::default()).unwrap_err();
+        assert_eq!(e.to_string(), "scene.obj.txt: expected a scene file (.dae)");
+        let e = load(Path::new("no-such-scene.DAE"), &SceneOptions::default()).unwrap_err();
+        assert!(matches!(e, SceneError::Io { .. }), "{e}");
+    }
+}
