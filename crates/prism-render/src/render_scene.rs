@@ -1,192 +1,15 @@
-//! The scene as the integrators see it: one BVH over every triangle, sphere and area-light
-//! rectangle, BSDFs, and lights with their sampling routines.
+//! [`RenderScene`], the scene as the integrators see it: one BVH over every triangle, sphere
+//! and area-light rectangle, the BSDFs and emission of its materials, and its lights; it
+//! answers closest-hit, shadow and escaped-ray queries.
 
 use prism_accel::{BuildOptions, Bvh, BvhStats, Sphere};
-use prism_math::warp::{
-    cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf,
-};
-use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
+use prism_math::{Ray, Rgb, Vec3};
 use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
 use crate::envmap::EnvMap;
-
-/// A light source ready to sample: the renderer's form of a [`prism_scene::Light`].
-#[derive(Clone, Debug)]
-pub enum RenderLight {
-    /// A point light.
-    Point {
-        /// Position.
-        position: Vec3,
-        /// Radiant intensity.
-        intensity: Rgb,
-    },
-    /// A directional light.
-    Directional {
-        /// Direction towards the light (unit).
-        to_light: Vec3,
-        /// Irradiance.
-        irradiance: Rgb,
-    },
-    /// A one-sided rectangle `corner + s e1 + t e2`, `s, t` in `[0, 1]`.
-    Area {
-        /// A corner.
-        corner: Vec3,
-        /// First edge.
-        e1: Vec3,
-        /// Second edge.
-        e2: Vec3,
-        /// Unit normal of the emitting side.
-        normal: Vec3,
-        /// Area.
-        area: f32,
-        /// Radiance.
-        radiance: Rgb,
-    },
-    /// Radiance from the upper hemisphere (world +Y), hidden from camera rays.
-    Hemisphere {
-        /// Radiance.
-        radiance: Rgb,
-    },
-    /// Radiance from every direction, seen by every ray.
-    Environment {
-        /// Radiance.
-        radiance: Rgb,
-    },
-    /// Radiance from every direction read from a map, seen by every ray.
-    EnvironmentMap(std::sync::Arc<EnvMap>),
-}
-
-/// A sample of incident light at a point.
-#[derive(Clone, Copy, Debug)]
-pub struct LightSample {
-    /// Unit direction towards the light.
-    pub wi: Vec3,
-    /// Distance to the light (infinite for directional and hemisphere lights).
-    pub dist: f32,
-    /// Incident radiance (for delta lights, the irradiance-like factor that multiplies the
-    /// BSDF and cosine directly).
-    pub li: Rgb,
-    /// Solid-angle density (1 for delta lights).
-    pub pdf: f32,
-    /// True for point and directional lights.
-    pub delta: bool,
-}
-
-impl RenderLight {
-    /// True for lights that need exactly one sample (point, directional).
-    #[must_use]
-    pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            RenderLight::Point { .. } | RenderLight::Directional { .. }
-        )
-    }
-
-    /// Samples incident light at `p` from `u`.
-    #[must_use]
-    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
-        match *self {
-            RenderLight::EnvironmentMap(ref map) => {
-                map.sample(u).map(|(wi, li, pdf)| LightSample {
-                    wi,
-                    dist: f32::INFINITY,
-                    li,
-                    pdf,
-                    delta: false,
-                })
-            }
-            RenderLight::Point {
-                position,
-                intensity,
-            } => {
-                let d = position - p;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                (dist > 0.0).then(|| LightSample {
-                    wi: d / dist,
-                    dist,
-                    li: intensity * (1.0 / dist2),
-                    pdf: 1.0,
-                    delta: true,
-                })
-            }
-            RenderLight::Directional {
-                to_light,
-                irradiance,
-            } => Some(LightSample {
-                wi: to_light,
-                dist: f32::INFINITY,
-                li: irradiance,
-                pdf: 1.0,
-                delta: true,
-            }),
-            RenderLight::Area {
-                corner,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-            } => {
-                let q = corner + u.x * e1 + u.y * e2;
-                let d = q - p;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                if dist <= 0.0 {
-                    return None;
-                }
-                let wi = d / dist;
-                let cos_l = -wi.dot(normal);
-                (cos_l > 0.0).then(|| LightSample {
-                    wi,
-                    dist,
-                    li: radiance,
-                    pdf: dist2 / (area * cos_l),
-                    delta: false,
-                })
-            }
-            RenderLight::Environment { radiance } => Some(LightSample {
-                wi: uniform_sphere(u),
-                dist: f32::INFINITY,
-                li: radiance,
-                pdf: uniform_sphere_pdf(),
-                delta: false,
-            }),
-            RenderLight::Hemisphere { radiance } => {
-                let frame = Frame::from_normal(Vec3::Y);
-                let local = cosine_hemisphere(u);
-                (local.z > 0.0).then(|| LightSample {
-                    wi: frame.to_world(local),
-                    dist: f32::INFINITY,
-                    li: radiance,
-                    pdf: cosine_hemisphere_pdf(local.z),
-                    delta: false,
-                })
-            }
-        }
-    }
-
-    /// The density with which [`RenderLight::sample`] picks direction `wi` that reaches the light
-    /// at distance `dist` (area lights) or escapes (hemisphere and environment lights).
-    #[must_use]
-    pub fn pdf(&self, wi: Vec3, dist: f32) -> f32 {
-        match *self {
-            RenderLight::Area { normal, area, .. } => {
-                let cos_l = -wi.dot(normal);
-                if cos_l > 0.0 {
-                    dist * dist / (area * cos_l)
-                } else {
-                    0.0
-                }
-            }
-            RenderLight::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
-            RenderLight::Environment { .. } => uniform_sphere_pdf(),
-            RenderLight::EnvironmentMap(ref map) => map.pdf(wi),
-            _ => 0.0,
-        }
-    }
-}
+use crate::interaction::Interaction;
+use crate::lights::RenderLight;
 
 /// What a BVH primitive is.
 #[derive(Clone, Copy, Debug)]
@@ -204,25 +27,6 @@ struct MeshRec {
     triangles: Vec<[u32; 3]>,
     shading: Shading,
     material: usize,
-}
-
-/// A surface point hit by a ray.
-#[derive(Clone, Copy, Debug)]
-pub struct Interaction {
-    /// Position.
-    pub p: Vec3,
-    /// Geometric normal (unit).
-    pub ng: Vec3,
-    /// Shading normal (unit, on the same side as `ng`).
-    pub ns: Vec3,
-    /// The BSDF there.
-    pub bsdf: Bsdf,
-    /// Radiance emitted towards the ray's origin.
-    pub emitted: Rgb,
-    /// The area light hit, if it is one (for MIS).
-    pub light: Option<usize>,
-    /// Distance along the ray.
-    pub t: f32,
 }
 
 /// The prepared scene.
@@ -380,7 +184,7 @@ impl RenderScene {
         self.bvh.stats()
     }
 
-    /// True if something blocks the segment from `p` along `wi` up to `dist`.
+    /// True if something blocks `ray` before distance `dist`.
     #[must_use]
     pub fn occluded(&self, ray: &Ray, dist: f32) -> bool {
         self.bvh.occluded(ray, 0.0, dist)
@@ -451,13 +255,4 @@ impl RenderScene {
             }
         })
     }
-}
-
-/// A ray leaving `p` along `dir`, its origin pushed off the surface (normal `ng`) to the
-/// side `dir` points to, so that it does not hit the surface it starts on.
-#[must_use]
-pub fn spawn(p: Vec3, ng: Vec3, dir: Vec3) -> Ray {
-    let eps = 1e-4 * (1.0 + p.abs().max_element());
-    let side = if dir.dot(ng) >= 0.0 { ng } else { -ng };
-    Ray::new(p + side * eps, dir)
 }

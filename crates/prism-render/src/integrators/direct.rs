@@ -1,0 +1,123 @@
+//! The direct-lighting integrator: emission plus one bounce of direct light, by uniform
+//! hemisphere sampling or by light sampling; light sampling is also the path integrator's
+//! next-event estimate.
+
+use prism_math::{Frame, Ray, Rgb, Vec3};
+
+use super::power;
+use crate::film::RenderOptions;
+use crate::interaction::Interaction;
+use crate::render_scene::RenderScene;
+use crate::sampler::Sampler;
+
+/// Radiance along `ray`, which hit `hit`: its emission and, if `max_bounces` allows, direct
+/// light by the hemisphere estimator (`hemisphere`) or by light sampling.
+pub(super) fn direct(
+    scene: &RenderScene,
+    hit: &Interaction,
+    ray: &Ray,
+    sampler: &mut Sampler,
+    opts: &RenderOptions,
+    hemisphere: bool,
+) -> Rgb {
+    let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
+    let mut l = if keep(0) { hit.emitted } else { Rgb::BLACK };
+    if opts.max_bounces >= 1 && keep(1) {
+        l += if hemisphere {
+            direct_hemisphere(scene, hit, -ray.dir, sampler, opts)
+        } else {
+            let (frame, wo_l) = hit.shading_frame(-ray.dir);
+            direct_lights(scene, hit, (&frame, -ray.dir, wo_l), sampler, opts, false)
+        };
+    }
+    l
+}
+
+/// Light sampling at a hit: every light, `light_samples` samples each (one for delta
+/// lights); with `mis`, weighted against BSDF sampling by the power heuristic.
+pub(super) fn direct_lights(
+    scene: &RenderScene,
+    hit: &Interaction,
+    (frame, wo, wo_l): (&Frame, Vec3, Vec3),
+    sampler: &mut Sampler,
+    opts: &RenderOptions,
+    mis: bool,
+) -> Rgb {
+    if !hit.bsdf.is_smooth() {
+        return Rgb::BLACK;
+    }
+    let mut total = Rgb::BLACK;
+    for light in &scene.lights {
+        let count = if light.is_delta() {
+            1
+        } else {
+            opts.light_samples.max(1)
+        };
+        let mut acc = Rgb::BLACK;
+        for _ in 0..count {
+            let u = sampler.next_2d();
+            let Some(ls) = light.sample(hit.p, u) else {
+                continue;
+            };
+            if !hit.consistent(wo, ls.wi) {
+                continue;
+            }
+            let wi_l = frame.to_local(ls.wi);
+            let f = hit.bsdf.eval(wo_l, wi_l);
+            if f.max_channel() <= 0.0 {
+                continue;
+            }
+            let shadow = hit.spawn(ls.wi);
+            let dist = if ls.dist.is_finite() {
+                ls.dist * (1.0 - 1e-4) - 1e-4
+            } else {
+                f32::INFINITY
+            };
+            if scene.occluded(&shadow, dist) {
+                continue;
+            }
+            let w = if mis && !ls.delta {
+                power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
+            } else {
+                1.0
+            };
+            acc += f * ls.li * (w / ls.pdf);
+        }
+        total += acc * (1.0 / count as f32);
+    }
+    total
+}
+
+/// The course's uniform hemisphere estimator of direct light.
+fn direct_hemisphere(
+    scene: &RenderScene,
+    hit: &Interaction,
+    wo: Vec3,
+    sampler: &mut Sampler,
+    opts: &RenderOptions,
+) -> Rgb {
+    if !hit.bsdf.is_smooth() {
+        return Rgb::BLACK;
+    }
+    let (frame, wo_l) = hit.shading_frame(wo);
+    let count = (scene.lights.len() as u32 * opts.light_samples.max(1)).max(1);
+    let mut acc = Rgb::BLACK;
+    for _ in 0..count {
+        let mut d = prism_math::warp::uniform_hemisphere(sampler.next_2d());
+        if wo_l.z < 0.0 {
+            d.z = -d.z;
+        }
+        let wi = frame.to_world(d);
+        if !hit.consistent(wo, wi) {
+            continue;
+        }
+        let f = hit.bsdf.eval(wo_l, d);
+        let ray = hit.spawn(wi);
+        let le = match scene.intersect(&ray) {
+            Some(h) => h.emitted,
+            None => scene.escaped(wi, false),
+        };
+        acc += f * le * (1.0 / prism_math::warp::uniform_hemisphere_pdf());
+    }
+    acc * (1.0 / count as f32)
+}
