@@ -292,6 +292,21 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     scene.camera.lens = thin_lens(a, &scene.camera)?;
     if let Some(path) = &a.envmap {
         let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
+        // Radiance is finite and non-negative: a NaN or negative texel would make a wrong
+        // picture (the renderer drops non-finite samples), so it is refused by position.
+        if let Some(i) = map
+            .pixels()
+            .iter()
+            .position(|p| !(p.is_finite() && p.r >= 0.0 && p.g >= 0.0 && p.b >= 0.0))
+        {
+            let (x, y) = (i as u32 % map.width(), i as u32 / map.width());
+            return Err(UserError(format!(
+                "--envmap {}: texel ({x}, {y}) is {:?}; expected finite, non-negative radiance",
+                path.display(),
+                map.get(x, y)
+            ))
+            .into());
+        }
         let infinite = |l: &prism_scene::Light| {
             matches!(
                 l,

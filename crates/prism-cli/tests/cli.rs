@@ -1277,9 +1277,16 @@ fn envmap_lights_the_unlit_bunny() {
     std::fs::remove_file(&out).unwrap();
     let bad = dir.join("bad.exr");
     std::fs::write(&bad, b"v/1\x01 not really").unwrap();
+    // A 2x1 map whose second texel is NaN.
+    let nan = dir.join("nan.exr");
+    let map = prism_image::Image::from_fn(2, 1, |x, _| {
+        prism_math::Rgb::splat(if x == 1 { f32::NAN } else { 1.0 })
+    });
+    prism_image::write_exr(&nan, &map).unwrap();
     for (map, want) in [
         (sky.with_extension("png"), "expected an OpenEXR (.exr) map"),
         (bad.clone(), "bad.exr"),
+        (nan.clone(), "nan.exr: texel (1, 0) is"),
     ] {
         let o = render(&["--envmap".as_ref(), map.as_os_str()]);
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
