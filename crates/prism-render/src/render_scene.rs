@@ -46,7 +46,8 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
-    /// Builds the BVH and light list.
+    /// Builds the BVH and light list. Segment and parallelogram lights (the Whitted ray
+    /// tracer's, given as colours, not radiance) are left out.
     #[must_use]
     pub fn new(scene: &Scene) -> RenderScene {
         let mut tris = Vec::new();
@@ -114,6 +115,9 @@ impl RenderScene {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::Environment { radiance });
                 }
+                // Lights of the Whitted ray tracer, with colours rather than radiometric
+                // units: the path tracer has no use for them.
+                Light::Segment { .. } | Light::Parallelogram { .. } => {}
                 Light::EnvironmentMap { ref radiance } => {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::EnvironmentMap(std::sync::Arc::new(

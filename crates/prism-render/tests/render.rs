@@ -13,6 +13,7 @@ fn furnace(material: Material) -> Scene {
             material: 0,
         }],
         materials: vec![material],
+        material_names: vec![],
         lights: vec![Light::Environment {
             radiance: Rgb::WHITE,
         }],

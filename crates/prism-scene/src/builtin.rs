@@ -31,6 +31,7 @@ pub fn cornell_box() -> Scene {
         triangles: vec![[0, 1, 2], [3, 0, 2]],
         shading: Shading::Flat,
         material,
+        uvs: None,
     };
     let meshes = vec![
         quad(
@@ -111,6 +112,7 @@ pub fn cornell_box() -> Scene {
         meshes,
         spheres,
         materials,
+        material_names: Vec::new(),
         lights,
         camera: Camera {
             eye: Vec3::new(0.0, 0.75, r),

@@ -30,6 +30,6 @@ pub use error::SceneError;
 pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
 pub use scene::{
-    Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
+    Camera, CameraMode, Light, Material, MaterialTexture, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
     ThinLens, TriangleMesh,
 };

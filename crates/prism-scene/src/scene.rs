@@ -2,7 +2,10 @@
 //! materials, lights and a camera, all in a Y-up world. This module reads no file: the
 //! readers (`collada`) build these types.
 
-use prism_math::{Rgb, Vec3};
+use std::sync::Arc;
+
+use prism_image::RgbImage;
+use prism_math::{Rgb, Vec2, Vec3};
 
 /// A surface's scattering model, with the parameters the course's files give.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,6 +55,29 @@ pub enum Material {
         /// Imaginary part (absorption).
         k: Rgb,
     },
+    /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
+    /// specular lobe `ks * max(r.v, 0)^shininess` per light.
+    Phong {
+        /// Diffuse colour.
+        kd: Rgb,
+        /// Specular colour, also the weight of the mirror reflection.
+        ks: Rgb,
+        /// Specular exponent.
+        shininess: f32,
+        /// An image whose texel replaces `kd` where texture mapping is on.
+        kd_texture: Option<MaterialTexture>,
+        /// Opacity: 1 is opaque, 0 is fully transparent (the MTL's `d`).
+        transparency: f32,
+    },
+}
+
+/// An image a material reads, with the file it came from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialTexture {
+    /// The file, for messages.
+    pub path: String,
+    /// Linear texel values in `[0, 1]`; row 0 is the file's top row.
+    pub image: Arc<RgbImage>,
 }
 
 /// How shading normals are chosen for meshes.
@@ -110,6 +136,8 @@ pub struct TriangleMesh {
     pub shading: Shading,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// Texture coordinates, one per vertex (`None` for meshes without them).
+    pub uvs: Option<Vec<Vec2>>,
 }
 
 /// A world-space sphere.
@@ -154,6 +182,28 @@ pub enum Light {
         /// Emitted radiance.
         radiance: Rgb,
     },
+    /// A light along the segment `endpoints[0]` to `endpoints[1]` whose colour goes linearly
+    /// from `colors[0]` to `colors[1]`: at `p0 + t (p1 - p0)` it is `(1 - t) c0 + t c1`
+    /// (the Delft ray tracer's segment light; it lights like a point light at each sample).
+    Segment {
+        /// The two ends.
+        endpoints: [Vec3; 2],
+        /// The colours at the two ends.
+        colors: [Rgb; 2],
+    },
+    /// A light over the parallelogram `corner + a edges[0] + b edges[1]`, `a, b` in
+    /// `[0, 1]`, whose colour is bilinear in the corners' colours:
+    /// `(1 - a)((1 - b) c0 + b c2) + a((1 - b) c1 + b c3)`, where `c0` is at `corner`, `c1`
+    /// at `corner + edges[0]`, `c2` at `corner + edges[1]` and `c3` at the far corner (the
+    /// Delft ray tracer's parallelogram light; it lights like a point light at each sample).
+    Parallelogram {
+        /// The corner where `colors[0]` is.
+        corner: Vec3,
+        /// The two edges from that corner.
+        edges: [Vec3; 2],
+        /// The colours at `corner`, `corner + e0`, `corner + e1` and `corner + e0 + e1`.
+        colors: [Rgb; 4],
+    },
     /// Radiance from every direction above the horizon (world y > 0), none from below; not
     /// seen by camera rays.
     Hemisphere {
@@ -188,6 +238,8 @@ impl Light {
             | Light::Hemisphere { radiance }
             | Light::Environment { radiance } => shines(radiance),
             Light::EnvironmentMap { radiance } => radiance.pixels().iter().any(shines),
+            Light::Segment { colors, .. } => colors.iter().any(shines),
+            Light::Parallelogram { colors, .. } => colors.iter().any(shines),
         }
     }
 }
@@ -249,6 +301,8 @@ pub struct Scene {
     pub spheres: Vec<SceneSphere>,
     /// Materials, indexed by meshes and spheres.
     pub materials: Vec<Material>,
+    /// The materials' names, where the file gives them (may be shorter than `materials`).
+    pub material_names: Vec<String>,
     /// Lights.
     pub lights: Vec<Light>,
     /// The camera.
@@ -258,6 +312,15 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The name of material `i`: the file's, else `material i`.
+    #[must_use]
+    pub fn material_name(&self, i: usize) -> String {
+        match self.material_names.get(i) {
+            Some(n) => n.clone(),
+            None => format!("material {i}"),
+        }
+    }
+
     /// True if some light or emitting material gives off light (of non-zero power).
     #[must_use]
     pub fn is_lit(&self) -> bool {

@@ -65,7 +65,9 @@ pub struct BsdfSample {
 }
 
 impl Bsdf {
-    /// The BSDF of a scene material (emitters are black surfaces).
+    /// The BSDF of a scene material (emitters are black surfaces; a Phong material is
+    /// Lambertian with its untextured `kd`, its specular lobe being no energy-conserving
+    /// BSDF).
     #[must_use]
     pub fn from_material(m: &Material) -> Bsdf {
         match *m {
@@ -88,6 +90,7 @@ impl Bsdf {
                 transmittance, ior, ..
             } => Bsdf::Refraction { transmittance, ior },
             Material::Microfacet { alpha, eta, k } => Bsdf::Conductor { alpha, eta, k },
+            Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
         }
     }
 

@@ -41,6 +41,7 @@ impl Scene {
             meshes: Vec::new(),
             spheres: Vec::new(),
             materials: Vec::new(),
+            material_names: Vec::new(),
             lights: Vec::new(),
             camera: Camera {
                 eye: Vec3::ZERO,
@@ -306,6 +307,7 @@ fn mesh(
         triangles,
         shading,
         material,
+        uvs: None,
     }
 }
 
