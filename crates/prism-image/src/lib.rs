@@ -1,8 +1,9 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
-//! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics and
-//! heat maps.
+//! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
+//! heat maps and bloom.
 #![warn(missing_docs)]
 
+mod bloom;
 mod diff;
 mod error;
 mod exr;
@@ -12,6 +13,7 @@ mod io;
 mod srgb;
 mod texture;
 
+pub use bloom::{bloom_weights, Bloom};
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{decode_exr, encode_exr, read_exr, write_exr};
