@@ -45,6 +45,16 @@ pub enum SceneError {
         #[source]
         source: roxmltree::Error,
     },
+    /// A line of a text format (OBJ, MTL, TOML) is missing something or malformed.
+    #[error("{file}:{line}: {message}")]
+    Line {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: u32,
+        /// What was expected and what was found.
+        message: String,
+    },
     /// An element is missing, malformed or refers to something that does not exist.
     #[error("{file}:{line}: <{element}>: {message}")]
     Element {

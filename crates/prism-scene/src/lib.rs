@@ -18,6 +18,7 @@ mod collada;
 mod error;
 mod load;
 mod mesh_io;
+mod obj;
 mod scene;
 
 pub use builtin::cornell_box;
@@ -29,7 +30,8 @@ pub use collada::{
 pub use error::SceneError;
 pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
+pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX_OBJ_BYTES};
 pub use scene::{
-    Camera, CameraMode, Light, Material, MaterialTexture, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
-    ThinLens, TriangleMesh,
+    Camera, CameraMode, Light, Material, MaterialTexture, NormalsMode, OrbitCamera, Scene,
+    SceneOptions, SceneSphere, Shading, ThinLens, TriangleMesh,
 };

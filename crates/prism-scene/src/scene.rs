@@ -292,6 +292,69 @@ impl Camera {
     }
 }
 
+/// The Delft ray tracer's camera: an orbit around `look_at`. With `R = Rz(rz) Ry(ry)
+/// Rx(rx)` from `rotation` in degrees (x applied first), the eye is `look_at + R (0, 0,
+/// -distance)`, the view direction `R (0, 0, 1)`, up `R (0, 1, 0)` and screen-right
+/// `R (-1, 0, 0)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitCamera {
+    /// Vertical field of view in degrees.
+    pub fov_y: f32,
+    /// Distance from the eye to `look_at`.
+    pub distance: f32,
+    /// The point orbited.
+    pub look_at: Vec3,
+    /// Rotation about x, y and z in degrees.
+    pub rotation: Vec3,
+}
+
+impl Default for OrbitCamera {
+    /// The template's: 50 degrees, distance 3, looking at the origin, rotation (20, 20, 0).
+    fn default() -> OrbitCamera {
+        OrbitCamera {
+            fov_y: 50.0,
+            distance: 3.0,
+            look_at: Vec3::ZERO,
+            rotation: Vec3::new(20.0, 20.0, 0.0),
+        }
+    }
+}
+
+impl OrbitCamera {
+    /// The rotation `R = Rz Ry Rx`.
+    #[must_use]
+    pub fn rotation_matrix(&self) -> prism_math::glam::Mat3 {
+        use prism_math::glam::Mat3;
+        Mat3::from_rotation_z(self.rotation.z.to_radians())
+            * Mat3::from_rotation_y(self.rotation.y.to_radians())
+            * Mat3::from_rotation_x(self.rotation.x.to_radians())
+    }
+
+    /// The eye position.
+    #[must_use]
+    pub fn eye(&self) -> Vec3 {
+        self.look_at + self.rotation_matrix() * Vec3::new(0.0, 0.0, -self.distance)
+    }
+
+    /// The same view as a [`Camera`] for an image of aspect ratio `width / height`.
+    #[must_use]
+    pub fn to_camera(&self, aspect: f32) -> Camera {
+        let r = self.rotation_matrix();
+        let eye = self.eye();
+        let hh = (self.fov_y.to_radians() / 2.0).tan();
+        Camera {
+            eye,
+            target: eye + r * Vec3::Z,
+            up: r * Vec3::Y,
+            hfov: (2.0 * (hh * aspect).atan()).to_degrees(),
+            vfov: self.fov_y,
+            near: 1e-3,
+            far: 1e4,
+            lens: None,
+        }
+    }
+}
+
 /// A scene ready to render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {

@@ -1,0 +1,422 @@
+//! Wavefront OBJ scenes as the Delft ray tracer loads them: `v`, `vt`, `vn`, n-gon faces,
+//! `mtllib`, `usemtl`, `o`/`g` shapes; one sub-mesh per run of faces with one material,
+//! vertices de-duplicated on (position, normal, uv), and the optional normalisation to the
+//! unit sphere around the vertices' mean.
+
+mod mtl;
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use prism_math::{Rgb, Vec2, Vec3};
+
+use crate::error::SceneError;
+use crate::scene::{Material, MaterialTexture, OrbitCamera, Scene, Shading, TriangleMesh};
+
+pub(crate) use mtl::parse_mtl;
+
+/// Largest OBJ or MTL file read (1 GiB).
+pub const MAX_OBJ_BYTES: u64 = 1 << 30;
+/// Most corners one face may have.
+pub const MAX_FACE_CORNERS: usize = 1 << 16;
+
+/// A source of an OBJ's companion files (MTL libraries, textures) by their name as
+/// written in the file: the bytes, or a located error.
+pub type Companions<'a> = dyn Fn(&str) -> Result<Vec<u8>, SceneError> + 'a;
+
+/// Reads the OBJ scene in `path`, its MTL libraries and textures relative to its folder;
+/// `normalize` moves the vertices' mean to the origin and scales the farthest vertex to
+/// distance 1 (the Delft presets' `loadMesh(path, true)`).
+///
+/// # Errors
+/// A [`SceneError`] naming the file and line of what is missing or malformed.
+pub fn read_obj_scene(path: &Path, normalize: bool) -> Result<Scene, SceneError> {
+    let text = read_text(path)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let companions = |name: &str| read_bytes(&dir.join(name));
+    parse_obj_scene(&text, &path.display().to_string(), &companions, normalize)
+}
+
+/// Reads a file of at most [`MAX_OBJ_BYTES`].
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
+    let name = path.display().to_string();
+    let io = |e: std::io::Error| SceneError::Io {
+        path: name.clone(),
+        source: Arc::new(e),
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(SceneError::NotAFile { path: name });
+    }
+    if meta.len() > MAX_OBJ_BYTES {
+        return Err(SceneError::TooLarge {
+            path: name,
+            bytes: meta.len(),
+            limit: MAX_OBJ_BYTES,
+        });
+    }
+    std::fs::read(path).map_err(io)
+}
+
+/// Reads a text file of at most [`MAX_OBJ_BYTES`].
+pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
+    let bytes = read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|e| SceneError::Line {
+        file: path.display().to_string(),
+        line: 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count() as u32,
+        message: "expected UTF-8 text".into(),
+    })
+}
+
+/// One corner of a face: indices into the position, uv and normal lists.
+#[derive(Clone, Copy)]
+struct Corner {
+    v: usize,
+    vt: Option<usize>,
+    vn: Option<usize>,
+}
+
+/// A run of triangles with one material, as corners.
+struct Run {
+    material: Option<usize>,
+    triangles: Vec<[Corner; 3]>,
+}
+
+/// Parses OBJ text; `file` names it in errors, `companions` gives the MTL libraries and
+/// textures it names; `normalize` as in [`read_obj_scene`]. The scene's camera is the
+/// Delft default ([`OrbitCamera::default`]); it has no lights.
+///
+/// # Errors
+/// A [`SceneError`] naming the file and line of what is missing or malformed.
+pub fn parse_obj_scene(
+    text: &str,
+    file: &str,
+    companions: &Companions<'_>,
+    normalize: bool,
+) -> Result<Scene, SceneError> {
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut uvs: Vec<Vec2> = Vec::new();
+    let mut normals: Vec<Vec3> = Vec::new();
+    let mut libs: Vec<mtl::MtlMaterial> = Vec::new();
+    let mut lib_files: Vec<String> = Vec::new();
+    let mut runs: Vec<Run> = Vec::new();
+    let mut current: Option<usize> = None;
+    // A shape boundary (`o`, `g`) or a material change starts a new run.
+    let mut new_run = true;
+    let mut corners: Vec<Corner> = Vec::new();
+    for (ln, raw) in text.lines().enumerate() {
+        let line = (ln + 1) as u32;
+        let err = |message: String| SceneError::Line {
+            file: file.to_string(),
+            line,
+            message,
+        };
+        let content = raw.split('#').next().unwrap_or("").trim();
+        let mut words = content.split_whitespace();
+        let Some(key) = words.next() else { continue };
+        let mut numbers = |n: usize, what: &str| -> Result<[f32; 3], SceneError> {
+            let mut out = [0.0; 3];
+            for (k, slot) in out.iter_mut().take(n).enumerate() {
+                let w = words
+                    .next()
+                    .ok_or_else(|| err(format!("{key}: expected {n} {what}, found {k}")))?;
+                *slot = w
+                    .parse::<f32>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| err(format!("{key}: expected a finite number, found {w:?}")))?;
+            }
+            Ok(out)
+        };
+        match key {
+            "v" => positions.push(Vec3::from_array(numbers(3, "coordinates")?)),
+            "vn" => normals.push(Vec3::from_array(numbers(3, "coordinates")?)),
+            "vt" => {
+                let [u, v, _] = numbers(2, "coordinates")?;
+                uvs.push(Vec2::new(u, v));
+            }
+            "mtllib" => {
+                for name in content[key.len()..].split_whitespace() {
+                    let bytes = companions(name).map_err(|e| {
+                        err(format!("mtllib: cannot read the material library: {e}"))
+                    })?;
+                    let what = Path::new(file)
+                        .parent()
+                        .unwrap_or(Path::new(""))
+                        .join(name)
+                        .display()
+                        .to_string();
+                    let text = String::from_utf8(bytes)
+                        .map_err(|_| err(format!("mtllib {name}: expected UTF-8 text")))?;
+                    libs.extend(parse_mtl(&text, &what)?);
+                    lib_files.push(name.to_string());
+                }
+            }
+            "usemtl" => {
+                let name = content[key.len()..].trim();
+                let found = libs.iter().rposition(|m| m.name == name);
+                let Some(found) = found else {
+                    return Err(err(if lib_files.is_empty() {
+                        format!("usemtl {name}: no material library was named before it")
+                    } else {
+                        format!(
+                            "usemtl {name}: no such material in {}",
+                            lib_files.join(", ")
+                        )
+                    }));
+                };
+                if current != Some(found) {
+                    new_run = true;
+                }
+                current = Some(found);
+            }
+            "o" | "g" => new_run = true,
+            "f" => {
+                corners.clear();
+                for w in words {
+                    corners.push(corner(w, &positions, &uvs, &normals).map_err(&err)?);
+                    if corners.len() > MAX_FACE_CORNERS {
+                        return Err(err(format!(
+                            "f: more than {MAX_FACE_CORNERS} corners in one face"
+                        )));
+                    }
+                }
+                if corners.len() < 3 {
+                    return Err(err(format!(
+                        "f: expected at least 3 corners, found {}",
+                        corners.len()
+                    )));
+                }
+                if new_run || runs.is_empty() {
+                    runs.push(Run {
+                        material: current,
+                        triangles: Vec::new(),
+                    });
+                    new_run = false;
+                }
+                let run = runs.last_mut().expect("a run was just ensured");
+                // A fan from the first corner: a quad becomes (0 1 2) and (0 2 3).
+                for i in 1..corners.len() - 1 {
+                    run.triangles.push([corners[0], corners[i], corners[i + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    let mut scene = Scene {
+        meshes: Vec::new(),
+        spheres: Vec::new(),
+        materials: Vec::new(),
+        material_names: Vec::new(),
+        lights: Vec::new(),
+        camera: OrbitCamera::default().to_camera(1.0),
+        warnings: Vec::new(),
+    };
+    // Materials in the order they are first used; faces without one share the default.
+    let mut material_slot: HashMap<Option<usize>, usize> = HashMap::new();
+    for run in &runs {
+        if run.triangles.is_empty() {
+            continue;
+        }
+        let slot = match material_slot.get(&run.material) {
+            Some(&s) => s,
+            None => {
+                let (m, name) = match run.material {
+                    None => (
+                        Material::Phong {
+                            kd: Rgb::WHITE,
+                            ks: Rgb::BLACK,
+                            shininess: 1.0,
+                            kd_texture: None,
+                            transparency: 1.0,
+                        },
+                        "(none)".to_string(),
+                    ),
+                    Some(i) => (to_material(&libs[i], companions)?, libs[i].name.clone()),
+                };
+                scene.materials.push(m);
+                scene.material_names.push(name);
+                material_slot.insert(run.material, scene.materials.len() - 1);
+                scene.materials.len() - 1
+            }
+        };
+        scene
+            .meshes
+            .push(build_mesh(run, slot, &positions, &uvs, &normals, &scene));
+    }
+    if normalize {
+        normalize_meshes(&mut scene.meshes);
+    }
+    Ok(scene)
+}
+
+/// Parses one face corner: `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative.
+fn corner(w: &str, positions: &[Vec3], uvs: &[Vec2], normals: &[Vec3]) -> Result<Corner, String> {
+    let mut parts = w.split('/');
+    let index = |s: &str, n: usize, what: &str| -> Result<usize, String> {
+        let i: i64 = s
+            .parse()
+            .map_err(|_| format!("f: expected a {what} index, found {w:?}"))?;
+        let idx = if i > 0 { i - 1 } else { n as i64 + i };
+        if i == 0 || idx < 0 || idx >= n as i64 {
+            return Err(format!(
+                "f: {what} index {i} is out of range ({n} defined so far)"
+            ));
+        }
+        Ok(idx as usize)
+    };
+    let v = index(parts.next().unwrap_or(""), positions.len(), "vertex")?;
+    // A file with no `vt` (no `vn`) at all gets (0, 0) (the geometric normal) wherever a
+    // corner names one, as the template does.
+    let vt = match parts.next() {
+        None | Some("") => None,
+        Some(_) if uvs.is_empty() => None,
+        Some(s) => Some(index(s, uvs.len(), "texture coordinate")?),
+    };
+    let vn = match parts.next() {
+        None | Some("") => None,
+        Some(_) if normals.is_empty() => None,
+        Some(s) => Some(index(s, normals.len(), "normal")?),
+    };
+    if parts.next().is_some() {
+        return Err(format!(
+            "f: expected v, v/vt, v//vn or v/vt/vn, found {w:?}"
+        ));
+    }
+    Ok(Corner { v, vt, vn })
+}
+
+/// A Phong material from an MTL entry, its texture loaded.
+fn to_material(m: &mtl::MtlMaterial, companions: &Companions<'_>) -> Result<Material, SceneError> {
+    let kd_texture = match &m.kd_map {
+        None => None,
+        Some((name, line)) => {
+            let located = |message: String| SceneError::Line {
+                file: m.file.clone(),
+                line: *line,
+                message,
+            };
+            let bytes = companions(name).map_err(|e| {
+                located(format!(
+                    "material {}: map_Kd {name}: cannot read the texture: {e}",
+                    m.name
+                ))
+            })?;
+            let image = decode_texture(&bytes, name)
+                .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
+            Some(MaterialTexture {
+                path: name.clone(),
+                image: Arc::new(image),
+            })
+        }
+    };
+    Ok(Material::Phong {
+        kd: m.kd,
+        ks: m.ks,
+        shininess: m.shininess,
+        kd_texture,
+        transparency: m.dissolve,
+    })
+}
+
+/// Decodes a PNG or JPEG texture as linear values `byte / 255` (no sRGB decoding), row 0
+/// the file's top row.
+fn decode_texture(bytes: &[u8], name: &str) -> Result<prism_image::RgbImage, String> {
+    let img = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        prism_image::decode_png(bytes, name)
+    } else if bytes.starts_with(&[0xff, 0xd8]) {
+        prism_image::decode_jpeg(bytes, name)
+    } else {
+        return Err("expected a PNG or JPEG image".into());
+    };
+    Ok(img.map_err(|e| e.to_string())?.to_rgb8().to_rgb_f32())
+}
+
+/// Key of a vertex for de-duplication: the bits of its values, with -0 read as 0.
+fn vertex_key(p: Vec3, n: Vec3, uv: Vec2) -> [u32; 8] {
+    let b = |x: f32| if x == 0.0 { 0 } else { x.to_bits() };
+    [
+        b(p.x),
+        b(p.y),
+        b(p.z),
+        b(n.x),
+        b(n.y),
+        b(n.z),
+        b(uv.x),
+        b(uv.y),
+    ]
+}
+
+/// One sub-mesh: vertices de-duplicated on (position, normal, uv); a corner without `vn`
+/// takes its triangle's geometric normal, one without `vt` (0, 0).
+fn build_mesh(
+    run: &Run,
+    material: usize,
+    positions: &[Vec3],
+    uvs: &[Vec2],
+    normals: &[Vec3],
+    scene: &Scene,
+) -> TriangleMesh {
+    let mut cache: HashMap<[u32; 8], u32> = HashMap::new();
+    let mut mesh_positions = Vec::new();
+    let mut mesh_normals = Vec::new();
+    let mut mesh_uvs = Vec::new();
+    let mut triangles = Vec::with_capacity(run.triangles.len());
+    for tri in &run.triangles {
+        let [p0, p1, p2] = tri.map(|c| positions[c.v]);
+        let geometric = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let mut t = [0u32; 3];
+        for (j, c) in tri.iter().enumerate() {
+            let p = positions[c.v];
+            let n = c.vn.map_or(geometric, |i| normals[i]);
+            let uv = c.vt.map_or(Vec2::ZERO, |i| uvs[i]);
+            t[j] = *cache.entry(vertex_key(p, n, uv)).or_insert_with(|| {
+                mesh_positions.push(p);
+                mesh_normals.push(n);
+                mesh_uvs.push(uv);
+                (mesh_positions.len() - 1) as u32
+            });
+        }
+        triangles.push(t);
+    }
+    TriangleMesh {
+        name: scene.material_name(material),
+        positions: mesh_positions,
+        triangles,
+        shading: Shading::Smooth(mesh_normals),
+        material,
+        uvs: Some(mesh_uvs),
+    }
+}
+
+/// Moves the mean of every mesh vertex to the origin and scales the farthest to distance
+/// 1 (a scene whose vertices all coincide is only moved).
+fn normalize_meshes(meshes: &mut [TriangleMesh]) {
+    let count: usize = meshes.iter().map(|m| m.positions.len()).sum();
+    if count == 0 {
+        return;
+    }
+    let sum = meshes
+        .iter()
+        .flat_map(|m| m.positions.iter())
+        .fold(Vec3::ZERO, |a, &p| a + p);
+    let center = sum / count as f32;
+    let max_d = meshes
+        .iter()
+        .flat_map(|m| m.positions.iter())
+        .fold(0.0f32, |a, &p| a.max((p - center).length()));
+    let scale = if max_d > 0.0 { max_d } else { 1.0 };
+    for m in meshes {
+        for p in &mut m.positions {
+            *p = (*p - center) / scale;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
