@@ -15,7 +15,7 @@ pub enum SceneError {
         source: Arc<std::io::Error>,
     },
     /// The file's extension names no scene format prism reads.
-    #[error("{path}: expected a scene file (.dae)")]
+    #[error("{path}: expected a scene file (.dae, .obj, .toml)")]
     UnknownFormat {
         /// The file.
         path: String,
@@ -54,6 +54,16 @@ pub enum SceneError {
         line: u32,
         /// What was expected and what was found.
         message: String,
+    },
+    /// No data folder holds a preset's file and prism has no copy built in.
+    #[error("preset {preset}: {file} is in none of the data folders ({searched}); give one with --data DIR or data_path", searched = if searched.is_empty() { "none given".to_string() } else { searched.join(", ") })]
+    PresetFileMissing {
+        /// The preset.
+        preset: &'static str,
+        /// The file it loads.
+        file: &'static str,
+        /// The folders searched.
+        searched: Vec<String>,
     },
     /// An element is missing, malformed or refers to something that does not exist.
     #[error("{file}:{line}: <{element}>: {message}")]

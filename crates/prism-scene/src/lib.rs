@@ -8,6 +8,10 @@
 //! [`read_mesh`] and [`write_mesh`] read and write mesh files of every format by extension
 //! ([`MeshFormat`]: OBJ, PLY, COLLADA).
 //!
+//! The Delft ray tracer's inputs: OBJ scenes with MTL materials and textures
+//! ([`read_obj_scene`]), its built-in scenes ([`Preset`]) and its TOML render
+//! configuration ([`read_render_config`]).
+//!
 //! [`Scene`] is what renderers consume: world-space meshes and spheres with materials,
 //! lights and a camera, built from a document by [`Scene::from_collada`]; the module that
 //! defines it reads no file. [`load`] reads a scene file by its extension.
@@ -19,6 +23,8 @@ mod error;
 mod load;
 mod mesh_io;
 mod obj;
+mod presets;
+mod render_config;
 mod scene;
 
 pub use builtin::cornell_box;
@@ -31,6 +37,11 @@ pub use error::SceneError;
 pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
 pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX_OBJ_BYTES};
+pub use presets::Preset;
+pub use render_config::{
+    parse_render_config, read_render_config, Features, RenderConfig, SceneSource,
+    MAX_WINDOW_PIXELS, MAX_WINDOW_SIDE,
+};
 pub use scene::{
     Camera, CameraMode, Light, Material, MaterialTexture, NormalsMode, OrbitCamera, Scene,
     SceneOptions, SceneSphere, Shading, ThinLens, TriangleMesh,

@@ -4,10 +4,15 @@ use std::path::Path;
 
 use crate::collada::read_collada;
 use crate::error::SceneError;
+use crate::obj::read_obj_scene;
+use crate::render_config::read_render_config;
 use crate::scene::{Scene, SceneOptions};
 
 /// Reads the scene in `path` with the reader its extension names (in any letter case):
-/// `.dae`, COLLADA (then [`Scene::from_collada`]).
+/// `.dae`, COLLADA (then [`Scene::from_collada`]); `.obj`, a Wavefront OBJ scene with its
+/// MTL materials, unlit and not normalised ([`read_obj_scene`]); `.toml`, a Delft render
+/// configuration, whose scene is loaded with its lights ([`crate::RenderConfig::load_scene`],
+/// presets from the folder its `data_path` names or the copies built into prism).
 ///
 /// # Errors
 /// [`SceneError::UnknownFormat`] for another extension, or the reader's located error.
@@ -21,6 +26,8 @@ pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene, SceneError> {
             let doc = read_collada(path)?;
             Scene::from_collada(&doc, opts, &path.display().to_string())
         }
+        "obj" => read_obj_scene(path, false),
+        "toml" => read_render_config(path)?.load_scene(&[]),
         _ => Err(SceneError::UnknownFormat {
             path: path.display().to_string(),
         }),
@@ -35,7 +42,7 @@ mod tests {
     #[test]
     fn extensions_pick_readers() {
         let e = load(Path::new("scene.obj.txt"), &SceneOptions::default()).unwrap_err();
-        assert_eq!(e.to_string(), "scene.obj.txt: expected a scene file (.dae)");
+        assert_eq!(e.to_string(), "scene.obj.txt: expected a scene file (.dae, .obj, .toml)");
         let e = load(Path::new("no-such-scene.DAE"), &SceneOptions::default()).unwrap_err();
         assert!(matches!(e, SceneError::Io { .. }), "{e}");
     }

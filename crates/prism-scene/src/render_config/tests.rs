@@ -1,0 +1,174 @@
+//! Tests of the render-config reader: values as written, defaults as documented, and a
+//! located error for every kind of bad input.
+
+use super::*;
+
+fn parse(text: &str) -> Result<RenderConfig, SceneError> {
+    parse_render_config(text, "c.toml", Path::new("/cfg"))
+}
+
+/// Closed form: every key reads back as written; ints stand for floats; paths are
+/// relative to the config's folder.
+#[test]
+fn every_key_reads_back() {
+    let c = parse(
+        r#"
+command_line_rendering = true
+window_size = [320, 240]
+data_path = "../data"
+scene = "cornell_box_parallelogram_light"
+output_dir = "out"
+[features]
+enable_shading = true
+enable_hard_shadow = true
+[features.extra]
+enable_bloom_effect = true
+enable_bilinear_texture_filtering = true
+[[cameras]]
+field_of_view = 60
+distance_from_look_at = 2.5
+look_at = [0, 0.5, 0]
+rotation = [10, -30.0, 0]
+[[cameras]]
+[[lights]]
+type = "point"
+position = [1, 2, 3]
+color = [1, 1, 1]
+[[lights]]
+type = "segment"
+endpoints = [[0, 0, 0], [1, 0, 0]]
+colors = [[1, 0, 0], [0, 1, 0]]
+[[lights]]
+type = "parallelogram"
+corner = [0, 1, 0]
+edges = [[1, 0, 0], [0, 0, 1]]
+colors = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]
+"#,
+    )
+    .unwrap();
+    assert_eq!(c.window_size, Some([320, 240]));
+    assert_eq!(c.data_path, Some(PathBuf::from("/cfg/../data")));
+    assert_eq!(c.output_dir, Some(PathBuf::from("/cfg/out")));
+    assert_eq!(
+        c.scene,
+        SceneSource::Preset(Preset::CornellBoxParallelogramLight)
+    );
+    assert!(
+        c.features.shading && c.features.hard_shadow && c.features.bloom && c.features.bilinear
+    );
+    assert!(!c.features.recursive && !c.features.accel_structure);
+    assert_eq!(c.cameras.len(), 2);
+    assert_eq!(c.cameras[0].fov_y, 60.0);
+    assert_eq!(c.cameras[0].rotation, Vec3::new(10.0, -30.0, 0.0));
+    assert_eq!(c.cameras[1], OrbitCamera::default());
+    assert_eq!(c.lights.len(), 3);
+    assert!(matches!(c.lights[2], Light::Parallelogram { .. }));
+}
+
+/// Defaults: the single triangle, every feature off, no cameras (the default camera is
+/// the renderer's), `"default"` data path means none.
+#[test]
+fn defaults() {
+    let c = parse("data_path = \"default\"\nscene = 3\n").unwrap();
+    assert_eq!(c.data_path, None);
+    assert_eq!(c.scene, SceneSource::Preset(Preset::CornellBox));
+    assert_eq!(c.features, Features::default());
+    let c = parse("").unwrap();
+    assert_eq!(c.scene, SceneSource::Preset(Preset::SingleTriangle));
+    let c = parse("scene = \"my/model.OBJ\"").unwrap();
+    assert_eq!(c.scene, SceneSource::File(PathBuf::from("my/model.OBJ")));
+}
+
+/// Every kind of bad input names the line and what was expected.
+#[test]
+fn bad_configs_are_located() {
+    let cases = [
+        ("scene = \"kitchen\"", "c.toml:1: scene: expected a preset"),
+        (
+            "scene = 12",
+            "c.toml:1: scene: expected a preset number from 0 to 9, found 12",
+        ),
+        (
+            "\n[[cameras]]\nfield_of_view = 0",
+            "c.toml:3: field_of_view: expected degrees strictly between 0 and 180, found 0",
+        ),
+        (
+            "[[cameras]]\nfield_of_view = \"wide\"",
+            "c.toml:2: field_of_view: expected a number, found string",
+        ),
+        (
+            "window_size = [0, 10]",
+            "c.toml:1: window_size: expected sides from 1 to 16384, found 0",
+        ),
+        (
+            "window_size = [16000, 16000]",
+            "c.toml:1: window_size: 16000 x 16000 is over the limit",
+        ),
+        (
+            "window_size = [10]",
+            "c.toml:1: window_size: expected 2 elements, found 1",
+        ),
+        (
+            "[[lights]]\ntype = \"parallelogram\"\ncorner = [0,0,0]\nedges = [[1,0,0],[2,0,0]]\n\
+             colors = [[1,1,1],[1,1,1],[1,1,1],[1,1,1]]",
+            "c.toml:4: edges: a parallelogram light needs an area above 0",
+        ),
+        (
+            "[[lights]]\ntype = \"segment\"\nendpoints = [[1,0,0],[1,0,0]]\ncolors = [[1,1,1],[1,1,1]]",
+            "c.toml:3: endpoints: a segment light needs two different ends",
+        ),
+        (
+            "[[lights]]\ntype = \"spot\"",
+            "c.toml:2: type: expected \"point\", \"segment\" or \"parallelogram\", found \"spot\"",
+        ),
+        (
+            "[[lights]]\ntype = \"point\"\nposition = [0,0,0]",
+            "c.toml:1: point light: missing required key \"color\"",
+        ),
+        (
+            "[[lights]]\ntype = \"point\"\nposition = [0,0,0]\ncolor = [1,-1,1]",
+            "c.toml:4: color: expected colour values of at least 0",
+        ),
+        (
+            "[features]\nenable_shadin = true",
+            "c.toml:2: unknown key \"enable_shadin\" in [features]",
+        ),
+        (
+            "[features]\nenable_shading = 1",
+            "c.toml:2: enable_shading: expected true or false, found integer",
+        ),
+        ("scene = \"cube", "c.toml:1: expected TOML"),
+        (
+            "[[cameras]]\nlook_at = [0, nan, 0]",
+            "c.toml:2: look_at: expected a finite number",
+        ),
+        (
+            "colour = 1",
+            "c.toml:1: unknown key \"colour\" in the top level",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = parse(text).unwrap_err().to_string();
+        assert!(e.starts_with(want), "{text:?}\n got: {e}\nwant: {want}");
+    }
+}
+
+/// Extras prism does not have are warnings naming the key, not silent.
+#[test]
+fn unsupported_extras_warn() {
+    let c = parse("[features.extra]\nenable_motion_blur = true\nenable_bvh_sah_binning = true\n")
+        .unwrap();
+    assert_eq!(c.warnings.len(), 1);
+    assert!(
+        c.warnings[0].contains("enable_motion_blur"),
+        "{:?}",
+        c.warnings
+    );
+}
+
+/// Deep nesting is refused by the parser's recursion limit, never a stack overflow.
+#[test]
+fn deep_nesting_is_an_error() {
+    let text = format!("x = {}{}", "[".repeat(100_000), "]".repeat(100_000));
+    assert!(parse(&text).is_err());
+}
