@@ -430,6 +430,49 @@ impl Bvh {
         }
     }
 
+    /// The packs and spheres of leaf reference `r`.
+    #[inline(always)]
+    fn leaf_rec(&self, r: u32) -> LeafRec {
+        let in_ref = (r >> PACKS_SHIFT) & 7;
+        if in_ref != 0 {
+            LeafRec {
+                pack_start: r & LOW_BITS,
+                packs: in_ref as u16,
+                ..LeafRec::default()
+            }
+        } else {
+            self.leaves[(r & LOW_BITS) as usize]
+        }
+    }
+
+    /// The 8-wide nodes, root first (none for an empty hierarchy).
+    pub(crate) fn node_array(&self) -> &[Node8] {
+        &self.nodes
+    }
+
+    /// True if child reference `r` names a leaf rather than a node.
+    pub(crate) fn is_leaf_ref(r: u32) -> bool {
+        r & LEAF != 0
+    }
+
+    /// The primitive numbers of leaf reference `r`: its triangles in pack order, then its
+    /// spheres.
+    pub(crate) fn leaf_prims(&self, r: u32) -> Vec<u32> {
+        let rec = self.leaf_rec(r);
+        let p0 = rec.pack_start as usize;
+        let s0 = rec.sphere_start as usize;
+        self.packs[p0..p0 + rec.packs as usize]
+            .iter()
+            .flat_map(|pack| pack.prim)
+            .filter(|&p| p != u32::MAX)
+            .chain(
+                self.leaf_spheres[s0..s0 + rec.spheres as usize]
+                    .iter()
+                    .copied(),
+            )
+            .collect()
+    }
+
     /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
     /// the first hit.
     #[inline(always)]
@@ -442,16 +485,7 @@ impl Bvh {
         tmax: &mut f32,
         any: bool,
     ) -> Option<Hit> {
-        let in_ref = (r >> PACKS_SHIFT) & 7;
-        let rec = if in_ref != 0 {
-            LeafRec {
-                pack_start: r & LOW_BITS,
-                packs: in_ref as u16,
-                ..LeafRec::default()
-            }
-        } else {
-            self.leaves[(r & LOW_BITS) as usize]
-        };
+        let rec = self.leaf_rec(r);
         let mut best = None;
         let p0 = rec.pack_start as usize;
         for pack in &self.packs[p0..p0 + rec.packs as usize] {

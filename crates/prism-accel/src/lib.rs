@@ -11,12 +11,16 @@
 //!   a pure function of the input, whatever the thread count.
 //! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
 //!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays.
+//! - [`Bvh::levels`], [`Bvh::level_boxes`] and [`Bvh::leaf_views`] show the 8-wide tree
+//!   level by level and leaf by leaf, for drawing and checking it.
 #![warn(missing_docs)]
 
 mod bvh;
+mod inspect;
 mod node8;
 mod shapes;
 mod tri4;
 
 pub use bvh::{BuildOptions, Bvh, BvhStats, Hit};
+pub use inspect::LeafView;
 pub use shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};

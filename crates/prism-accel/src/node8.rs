@@ -4,7 +4,7 @@
 //! distances and traversal is identical either way.
 
 use prism_math::glam::Vec4;
-use prism_math::Aabb;
+use prism_math::{Aabb, Vec3};
 
 use crate::shapes::RayPre;
 
@@ -44,6 +44,21 @@ impl Node8 {
         }
         self.child[slot] = child;
         self.used |= 1 << slot;
+    }
+
+    /// True if `slot` holds a child.
+    pub(crate) fn slot_used(&self, slot: usize) -> bool {
+        self.used & (1 << slot) != 0
+    }
+
+    /// The box of the child in `slot` (the empty box for an unused slot).
+    pub(crate) fn child_box(&self, slot: usize) -> Aabb {
+        let (half, lane) = (slot / 4, slot % 4);
+        let plane = |p: usize| self.bounds[p][half][lane];
+        Aabb {
+            min: Vec3::new(plane(0), plane(1), plane(2)),
+            max: Vec3::new(plane(3), plane(4), plane(5)),
+        }
     }
 }
 
