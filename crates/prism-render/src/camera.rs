@@ -163,3 +163,64 @@ mod tests {
         assert_eq!((a.origin, a.dir), (b.origin, b.dir));
     }
 }
+
+/// The Delft ray tracer's camera over an image of `width` x `height` pixels: pixel
+/// `(x, y)`, `y = 0` the **bottom** row, maps to `ndc = (2x/W - 1, 2y/H - 1)` with no
+/// half-pixel offset, and the ray leaves the eye along
+/// `normalize(R normalize(-ndc.x hw, ndc.y hh, 1))` with `hh = tan(fov / 2)`,
+/// `hw = (W / H) hh` (screen-right is camera -x).
+#[derive(Clone, Copy, Debug)]
+pub struct OrbitView {
+    eye: Vec3,
+    rotation: prism_math::glam::Mat3,
+    hw: f32,
+    hh: f32,
+    width: f32,
+    height: f32,
+}
+
+impl OrbitView {
+    /// The view of `c` on a `width` x `height` image.
+    #[must_use]
+    pub fn new(c: &prism_scene::OrbitCamera, width: u32, height: u32) -> OrbitView {
+        let hh = (c.fov_y.to_radians() / 2.0).tan();
+        OrbitView {
+            eye: c.eye(),
+            rotation: c.rotation_matrix(),
+            hw: width as f32 / height as f32 * hh,
+            hh,
+            width: width as f32,
+            height: height as f32,
+        }
+    }
+
+    /// The eye.
+    #[must_use]
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The ray through image position `(x, y)`, measured in pixels from the bottom-left
+    /// corner (a pixel's integer corner is its lower-left).
+    #[must_use]
+    pub fn ray(&self, x: f32, y: f32) -> Ray {
+        let ndc = Vec2::new(2.0 * x / self.width - 1.0, 2.0 * y / self.height - 1.0);
+        let local = Vec3::new(-ndc.x * self.hw, ndc.y * self.hh, 1.0).normalize();
+        Ray::new(self.eye, (self.rotation * local).normalize())
+    }
+
+    /// Where a world point lands: `(x, y from the top, depth along the view axis)` in
+    /// pixels of the written image (row 0 at the top), or `None` behind the eye.
+    #[must_use]
+    pub fn project(&self, p: Vec3) -> Option<(f32, f32, f32)> {
+        let local = self.rotation.transpose() * (p - self.eye);
+        if local.z <= 1e-6 {
+            return None;
+        }
+        let ndc_x = -local.x / local.z / self.hw;
+        let ndc_y = local.y / local.z / self.hh;
+        let x = (ndc_x + 1.0) * 0.5 * self.width;
+        let y_up = (ndc_y + 1.0) * 0.5 * self.height;
+        Some((x, self.height - y_up, local.z))
+    }
+}

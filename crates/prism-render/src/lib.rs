@@ -3,25 +3,38 @@
 //! environment map's data in `envmap`), the render scene with its BVH (`render_scene`) and the
 //! hit records it returns (`interaction`), the integrators (`integrators`: `normals`,
 //! `direct`, `path`) and the film that loops over pixels with adaptive sampling (`film`),
-//! over a scene from prism-scene.
+//! over a scene from prism-scene. The Whitted ray tracer of the Delft project has its scene
+//! (`whitted_scene`), integrator (`integrators::whitted`), orbit camera (`camera`) and film
+//! with per-pixel ray recording (`raytrace`).
 #![warn(missing_docs)]
 
 pub mod bsdf;
 mod camera;
+mod debug_output;
 mod envmap;
 mod film;
 mod integrators;
 mod interaction;
 mod lights;
+mod overlay;
+mod raytrace;
 mod render_scene;
 mod sampler;
+mod whitted_scene;
 
 pub use bsdf::{Bsdf, BsdfSample};
-pub use camera::Perspective;
+pub use camera::{OrbitView, Perspective};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use film::{render, RenderOptions, Rendered};
+pub use integrators::whitted::{
+    parallelogram_color, parallelogram_grid, phong, DebugRay, RayCounts, RayKind, WhittedSettings,
+    WhittedTracer, MISS_LENGTH, RAY_EPSILON,
+};
 pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;
 pub use lights::{LightSample, RenderLight};
+pub use overlay::{palette, Overlay};
+pub use raytrace::{raytrace, trace_pixel, PixelTrace, RaytraceOptions, Raytraced};
 pub use render_scene::RenderScene;
 pub use sampler::Sampler;
+pub use whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};

@@ -1,9 +1,11 @@
 //! The integrators: [`Integrator`] names the estimator, [`radiance`] dispatches a camera ray
-//! to it (`normals`, `direct`, `path`), and the multiple-importance-sampling weight they share.
+//! to it (`normals`, `direct`, `path`), and the multiple-importance-sampling weight they share;
+//! `whitted` is the Delft ray tracer's recursive integrator.
 
 mod direct;
 mod normals;
 mod path;
+pub mod whitted;
 
 use prism_math::{Ray, Rgb};
 

@@ -1,0 +1,418 @@
+//! The Whitted integrator of the Delft ray tracer: Phong per light sample, hard shadows
+//! from point lights, stratified samples of segment and parallelogram lights, recursive
+//! mirror reflection, textures, transparency; every ray it casts can be recorded.
+
+use prism_image::PixelSampling;
+use prism_math::{Ray, Rgb, Vec2, Vec3};
+use prism_scene::{Features, Light};
+
+use crate::sampler::Sampler;
+use crate::whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
+
+/// Offset of secondary-ray origins along their direction.
+pub const RAY_EPSILON: f32 = 1e-4;
+/// Length of a missed ray in the debug record: origin + this times the direction.
+pub const MISS_LENGTH: f32 = 10.0;
+
+/// Settings of one Whitted render.
+#[derive(Clone, Copy, Debug)]
+pub struct WhittedSettings {
+    /// The template's feature switches.
+    pub features: Features,
+    /// Samples per segment light, and the target count for a parallelogram light (which
+    /// takes a `k x k` grid, `k = ceil(sqrt(n))`).
+    pub light_samples: u32,
+    /// Most reflection (and transparency) bounces after the camera ray.
+    pub max_depth: u32,
+}
+
+/// What kind of ray a debug record is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    /// From the camera.
+    Camera,
+    /// A mirror reflection.
+    Reflection,
+    /// Through a transparent surface.
+    Transmission,
+    /// Towards a point light.
+    Shadow,
+    /// Towards a sample of a segment or parallelogram light.
+    AreaSample,
+    /// The geometric normal at a hit.
+    Normal,
+    /// The interpolated normal at a hit.
+    InterpolatedNormal,
+}
+
+impl RayKind {
+    /// The name used in the debug JSON.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Camera => "camera",
+            RayKind::Reflection => "reflection",
+            RayKind::Transmission => "transmission",
+            RayKind::Shadow => "shadow",
+            RayKind::AreaSample => "area-sample",
+            RayKind::Normal => "normal",
+            RayKind::InterpolatedNormal => "interpolated-normal",
+        }
+    }
+}
+
+/// One recorded ray (or normal) segment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DebugRay {
+    /// Its kind.
+    pub kind: RayKind,
+    /// Bounces before it (0 for the camera ray and what starts at its hit).
+    pub depth: u32,
+    /// Start.
+    pub origin: Vec3,
+    /// The hit point, the light sample, or origin + [`MISS_LENGTH`] times the direction.
+    pub end: Vec3,
+    /// Camera and reflection rays: the colour they return; shadow rays and area samples:
+    /// the light's colour when it is reached, red when blocked; normals: white.
+    pub color: Rgb,
+    /// Shadow rays and area samples: whether something blocks them.
+    pub blocked: Option<bool>,
+    /// Where a blocked shadow ray or area sample is blocked.
+    pub blocked_at: Option<Vec3>,
+    /// The surface it hit: material name and primitive.
+    pub hit: Option<(String, Surface)>,
+}
+
+/// Rays cast, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Camera rays.
+    pub camera: u64,
+    /// Reflection rays.
+    pub reflection: u64,
+    /// Transmission rays.
+    pub transmission: u64,
+    /// Shadow rays towards point lights.
+    pub shadow: u64,
+    /// Shadow rays towards area-light samples.
+    pub area_sample: u64,
+}
+
+impl RayCounts {
+    /// All rays.
+    #[must_use]
+    pub fn total(&self) -> u64 {
+        self.camera + self.reflection + self.transmission + self.shadow + self.area_sample
+    }
+
+    /// Adds another count.
+    pub fn add(&mut self, o: &RayCounts) {
+        self.camera += o.camera;
+        self.reflection += o.reflection;
+        self.transmission += o.transmission;
+        self.shadow += o.shadow;
+        self.area_sample += o.area_sample;
+    }
+}
+
+/// One ray tree's state: the scene, settings, sampler, counters and optional record.
+pub struct WhittedTracer<'a> {
+    /// The scene.
+    pub scene: &'a WhittedScene,
+    /// The settings.
+    pub settings: &'a WhittedSettings,
+    /// Random numbers for light-sample jitter.
+    pub sampler: Sampler,
+    /// Rays cast so far.
+    pub counts: RayCounts,
+    /// When set, every ray is recorded here.
+    pub record: Option<Vec<DebugRay>>,
+}
+
+const RED: Rgb = Rgb::new(1.0, 0.0, 0.0);
+
+/// The Phong response `c (kd (n.l) + ks max(r.v, 0)^Ns)` to light of colour `c` from unit
+/// direction `l`, seen along unit `v`; zero when `n.l <= 0`.
+#[must_use]
+pub fn phong(n: Vec3, l: Vec3, v: Vec3, kd: Rgb, ks: Rgb, shininess: f32, c: Rgb) -> Rgb {
+    let nl = n.dot(l);
+    if nl <= 0.0 {
+        return Rgb::BLACK;
+    }
+    let r = 2.0 * nl * n - l;
+    let spec = r.dot(v).max(0.0).powf(shininess);
+    c * (kd * nl + ks * spec)
+}
+
+impl WhittedTracer<'_> {
+    fn push(&mut self, ray: DebugRay) -> Option<usize> {
+        let rec = self.record.as_mut()?;
+        rec.push(ray);
+        Some(rec.len() - 1)
+    }
+
+    /// The colour seen along `ray` (unit direction), `depth` bounces after the camera.
+    pub fn trace(&mut self, ray: &Ray, depth: u32, kind: RayKind) -> Rgb {
+        match kind {
+            RayKind::Camera => self.counts.camera += 1,
+            RayKind::Reflection => self.counts.reflection += 1,
+            _ => self.counts.transmission += 1,
+        }
+        let f = self.settings.features;
+        let hit = self.scene.intersect(ray, f32::INFINITY, f.normal_interp);
+        let slot = self.push(DebugRay {
+            kind,
+            depth,
+            origin: ray.origin,
+            end: hit.map_or(ray.origin + MISS_LENGTH * ray.dir, |h| h.p),
+            color: Rgb::BLACK,
+            blocked: None,
+            blocked_at: None,
+            hit: hit.map(|h| {
+                (
+                    self.scene.materials[h.material as usize].name.clone(),
+                    h.surface,
+                )
+            }),
+        });
+        let Some(hit) = hit else { return Rgb::BLACK };
+        let color = self.shade(ray, &hit, depth);
+        if let (Some(i), Some(rec)) = (slot, self.record.as_mut()) {
+            rec[i].color = color;
+        }
+        color
+    }
+
+    fn shade(&mut self, ray: &Ray, hit: &WhittedHit, depth: u32) -> Rgb {
+        let f = self.settings.features;
+        let m: &PhongMaterial = &self.scene.materials[hit.material as usize];
+        if self.record.is_some() {
+            let len = 0.05 * self.scene.size();
+            self.push(DebugRay {
+                kind: RayKind::Normal,
+                depth,
+                origin: hit.p,
+                end: hit.p + len * hit.n_g,
+                color: Rgb::WHITE,
+                blocked: None,
+                blocked_at: None,
+                hit: None,
+            });
+            if f.normal_interp {
+                self.push(DebugRay {
+                    kind: RayKind::InterpolatedNormal,
+                    depth,
+                    origin: hit.p,
+                    end: hit.p + len * hit.n_s,
+                    color: Rgb::new(0.0, 1.0, 1.0),
+                    blocked: None,
+                    blocked_at: None,
+                    hit: None,
+                });
+            }
+        }
+        let kd = match (&m.texture, f.texture_mapping) {
+            (Some(tex), true) => {
+                let mode = if f.bilinear {
+                    PixelSampling::Bilinear
+                } else {
+                    PixelSampling::Nearest
+                };
+                tex.sample_level(Vec2::new(hit.uv.x, 1.0 - hit.uv.y), 0, mode)
+            }
+            _ => m.kd,
+        };
+        if !f.shading {
+            return kd;
+        }
+        let (ks, shininess, transparency) = (m.ks, m.shininess, m.transparency);
+        let v = -ray.dir;
+        let mut local = Rgb::BLACK;
+        for li in 0..self.scene.lights.len() {
+            local += self.light(li, hit, v, kd, ks, shininess, depth);
+        }
+        let mut color = local;
+        if f.recursive && ks != Rgb::BLACK && depth < self.settings.max_depth {
+            let n = hit.n_s;
+            let r = (ray.dir - 2.0 * ray.dir.dot(n) * n).normalize_or_zero();
+            if r != Vec3::ZERO {
+                let reflected = self.trace(
+                    &Ray::new(hit.p + RAY_EPSILON * r, r),
+                    depth + 1,
+                    RayKind::Reflection,
+                );
+                color += ks * reflected;
+            }
+        }
+        if f.transparency && transparency < 1.0 && depth < self.settings.max_depth {
+            let behind = self.trace(
+                &Ray::new(hit.p + RAY_EPSILON * ray.dir, ray.dir),
+                depth + 1,
+                RayKind::Transmission,
+            );
+            color = color * transparency + behind * (1.0 - transparency);
+        }
+        color
+    }
+
+    /// One light's contribution at a hit.
+    #[allow(clippy::too_many_arguments)]
+    fn light(
+        &mut self,
+        li: usize,
+        hit: &WhittedHit,
+        v: Vec3,
+        kd: Rgb,
+        ks: Rgb,
+        shininess: f32,
+        depth: u32,
+    ) -> Rgb {
+        let f = self.settings.features;
+        match self.scene.lights[li] {
+            Light::Point {
+                position,
+                intensity,
+            } => self.sample(
+                hit,
+                v,
+                kd,
+                ks,
+                shininess,
+                position,
+                intensity,
+                f.hard_shadow,
+                RayKind::Shadow,
+                depth,
+            ),
+            Light::Segment { endpoints, colors } => {
+                if !f.soft_shadow {
+                    return Rgb::BLACK;
+                }
+                let n = self.settings.light_samples.max(1);
+                let mut sum = Rgb::BLACK;
+                for i in 0..n {
+                    let t = (i as f32 + self.sampler.next_1d()) / n as f32;
+                    let q = endpoints[0] + t * (endpoints[1] - endpoints[0]);
+                    let c = colors[0] * (1.0 - t) + colors[1] * t;
+                    sum += self.sample(
+                        hit,
+                        v,
+                        kd,
+                        ks,
+                        shininess,
+                        q,
+                        c,
+                        true,
+                        RayKind::AreaSample,
+                        depth,
+                    );
+                }
+                sum * (1.0 / n as f32)
+            }
+            Light::Parallelogram {
+                corner,
+                edges,
+                colors,
+            } => {
+                if !f.soft_shadow {
+                    return Rgb::BLACK;
+                }
+                let k = parallelogram_grid(self.settings.light_samples);
+                let mut sum = Rgb::BLACK;
+                for j in 0..k {
+                    for i in 0..k {
+                        let a = (i as f32 + self.sampler.next_1d()) / k as f32;
+                        let b = (j as f32 + self.sampler.next_1d()) / k as f32;
+                        let q = corner + a * edges[0] + b * edges[1];
+                        let c = parallelogram_color(&colors, a, b);
+                        sum += self.sample(
+                            hit,
+                            v,
+                            kd,
+                            ks,
+                            shininess,
+                            q,
+                            c,
+                            true,
+                            RayKind::AreaSample,
+                            depth,
+                        );
+                    }
+                }
+                sum * (1.0 / (k * k) as f32)
+            }
+            // Lights of the path tracer without a place in the template's model.
+            _ => Rgb::BLACK,
+        }
+    }
+
+    /// Phong for one light sample at `q` of colour `c`, shadow-tested if `shadowed`.
+    #[allow(clippy::too_many_arguments)]
+    fn sample(
+        &mut self,
+        hit: &WhittedHit,
+        v: Vec3,
+        kd: Rgb,
+        ks: Rgb,
+        shininess: f32,
+        q: Vec3,
+        c: Rgb,
+        shadowed: bool,
+        kind: RayKind,
+        depth: u32,
+    ) -> Rgb {
+        let to = q - hit.p;
+        let dist = to.length();
+        let l = to / dist;
+        if !(hit.n_s.dot(l) > 0.0) {
+            return Rgb::BLACK;
+        }
+        let mut blocked_at = None;
+        if shadowed {
+            match kind {
+                RayKind::Shadow => self.counts.shadow += 1,
+                _ => self.counts.area_sample += 1,
+            }
+            let ray = Ray::new(hit.p + RAY_EPSILON * l, l);
+            let tmax = dist - RAY_EPSILON;
+            if self.record.is_some() {
+                // The blocking point is drawn: find the closest blocker.
+                blocked_at = self.scene.intersect(&ray, tmax, false).map(|b| b.p);
+            } else if self.scene.occluded(&ray, tmax) {
+                return Rgb::BLACK;
+            }
+        }
+        let blocked = blocked_at.is_some();
+        self.push(DebugRay {
+            kind,
+            depth,
+            origin: hit.p,
+            end: q,
+            color: if blocked { RED } else { c },
+            blocked: Some(blocked),
+            blocked_at,
+            hit: None,
+        });
+        if blocked {
+            return Rgb::BLACK;
+        }
+        phong(hit.n_s, l, v, kd, ks, shininess, c)
+    }
+}
+
+/// The side `k` of the `k x k` grid of samples a parallelogram light takes for a target
+/// of `n` samples: `ceil(sqrt(n))`, at least 1.
+#[must_use]
+pub fn parallelogram_grid(n: u32) -> u32 {
+    let mut k = 1;
+    while k * k < n.max(1) {
+        k += 1;
+    }
+    k
+}
+
+/// The colour of a parallelogram light at `(a, b)`: bilinear in its corners' colours.
+#[must_use]
+pub fn parallelogram_color(c: &[Rgb; 4], a: f32, b: f32) -> Rgb {
+    (c[0] * (1.0 - b) + c[2] * b) * (1.0 - a) + (c[1] * (1.0 - b) + c[3] * b) * a
+}

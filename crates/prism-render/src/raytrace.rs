@@ -1,0 +1,188 @@
+//! The Whitted film: [`RaytraceOptions`], the pixel loop over rows on rayon (one ray through
+//! each pixel's lower-left corner, or jittered rays), bloom, and the ray tree of one pixel
+//! for visual debugging.
+
+use std::sync::Mutex;
+
+use prism_image::{Bloom, Image, RgbImage};
+use prism_math::Rgb;
+use rayon::prelude::*;
+
+use crate::camera::OrbitView;
+use crate::integrators::whitted::{DebugRay, RayCounts, RayKind, WhittedSettings, WhittedTracer};
+use crate::sampler::Sampler;
+use crate::whitted_scene::WhittedScene;
+
+/// Whitted render settings.
+#[derive(Clone, Copy, Debug)]
+pub struct RaytraceOptions {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Features, light samples and depth.
+    pub settings: WhittedSettings,
+    /// Rays per pixel when `settings.features.multiple_rays_per_pixel` is on.
+    pub spp: u32,
+    /// Bloom threshold and passes (applied when `settings.features.bloom` is on).
+    pub bloom: Bloom,
+    /// Seed of the jitter.
+    pub seed: u64,
+}
+
+/// A Whitted render.
+pub struct Raytraced {
+    /// Linear colour, row 0 at the top, bloom added if on.
+    pub image: RgbImage,
+    /// The bloom layer alone (black when bloom is off).
+    pub bloom_layer: Option<RgbImage>,
+    /// Rays cast, by kind.
+    pub counts: RayCounts,
+}
+
+/// The sampler of ray `s` of the pixel at written position `(x, row)`.
+fn pixel_sampler(opts: &RaytraceOptions, x: u32, row: u32, s: u32) -> Sampler {
+    Sampler::new(
+        opts.seed,
+        u64::from(row) * u64::from(opts.width) + u64::from(x),
+        u64::from(s),
+    )
+}
+
+/// Rays per pixel actually cast.
+fn rays_per_pixel(opts: &RaytraceOptions) -> u32 {
+    if opts.settings.features.multiple_rays_per_pixel {
+        opts.spp.max(1)
+    } else {
+        1
+    }
+}
+
+/// The colour of the pixel at written position `(x, row)` (row 0 at the top), with every
+/// ray recorded into `record` if given.
+fn pixel(
+    scene: &WhittedScene,
+    view: &OrbitView,
+    opts: &RaytraceOptions,
+    x: u32,
+    row: u32,
+    counts: &mut RayCounts,
+    record: Option<&mut Vec<DebugRay>>,
+) -> Rgb {
+    let y = opts.height - 1 - row;
+    let n = rays_per_pixel(opts);
+    let mut sum = Rgb::BLACK;
+    let mut rec: Option<Vec<DebugRay>> = record.as_ref().map(|_| Vec::new());
+    for s in 0..n {
+        let mut sampler = pixel_sampler(opts, x, row, s);
+        let (jx, jy) = if n > 1 {
+            (sampler.next_1d(), sampler.next_1d())
+        } else {
+            (0.0, 0.0)
+        };
+        let ray = view.ray(x as f32 + jx, y as f32 + jy);
+        let mut tracer = WhittedTracer {
+            scene,
+            settings: &opts.settings,
+            sampler,
+            counts: RayCounts::default(),
+            record: rec.take(),
+        };
+        sum += tracer.trace(&ray, 0, RayKind::Camera);
+        counts.add(&tracer.counts);
+        rec = tracer.record;
+    }
+    if let (Some(out), Some(r)) = (record, rec) {
+        *out = r;
+    }
+    sum * (1.0 / n as f32)
+}
+
+/// Renders `scene` through `camera`. `progress` is called with the number of rows done
+/// after each row (from worker threads). The image is the same whatever the thread count.
+#[must_use]
+pub fn raytrace(
+    scene: &WhittedScene,
+    camera: &prism_scene::OrbitCamera,
+    opts: &RaytraceOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Raytraced {
+    let view = OrbitView::new(camera, opts.width, opts.height);
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let totals = Mutex::new(RayCounts::default());
+    let rows: Vec<Vec<Rgb>> = (0..opts.height)
+        .into_par_iter()
+        .map(|row| {
+            let mut counts = RayCounts::default();
+            let line = (0..opts.width)
+                .map(|x| pixel(scene, &view, opts, x, row, &mut counts, None))
+                .collect();
+            totals
+                .lock()
+                .expect("no panics under the lock")
+                .add(&counts);
+            let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(d);
+            line
+        })
+        .collect();
+    let image = Image::from_vec(opts.width, opts.height, rows.concat());
+    let counts = totals.into_inner().expect("no panics under the lock");
+    if opts.settings.features.bloom {
+        let layer = opts.bloom.layer(&image);
+        let mut sum = image;
+        for (p, l) in sum.pixels_mut().iter_mut().zip(layer.pixels()) {
+            *p += *l;
+        }
+        Raytraced {
+            image: sum,
+            bloom_layer: Some(layer),
+            counts,
+        }
+    } else {
+        Raytraced {
+            image,
+            bloom_layer: None,
+            counts,
+        }
+    }
+}
+
+/// One pixel's ray tree, for visual debugging.
+#[derive(Clone, Debug)]
+pub struct PixelTrace {
+    /// The pixel, `(x, row)` with row 0 at the top of the written image.
+    pub pixel: (u32, u32),
+    /// Its colour (before bloom).
+    pub color: Rgb,
+    /// Every ray cast for it, in the order cast.
+    pub rays: Vec<DebugRay>,
+}
+
+/// Traces the pixel at `(x, row)` (row 0 at the top) exactly as [`raytrace`] does,
+/// recording every ray.
+///
+/// # Panics
+/// If the pixel is outside the image.
+#[must_use]
+pub fn trace_pixel(
+    scene: &WhittedScene,
+    camera: &prism_scene::OrbitCamera,
+    opts: &RaytraceOptions,
+    x: u32,
+    row: u32,
+) -> PixelTrace {
+    assert!(
+        x < opts.width && row < opts.height,
+        "pixel outside the image"
+    );
+    let view = OrbitView::new(camera, opts.width, opts.height);
+    let mut rays = Vec::new();
+    let mut counts = RayCounts::default();
+    let color = pixel(scene, &view, opts, x, row, &mut counts, Some(&mut rays));
+    PixelTrace {
+        pixel: (x, row),
+        color,
+        rays,
+    }
+}
