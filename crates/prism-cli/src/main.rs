@@ -5,6 +5,7 @@ mod demo;
 mod mesh;
 mod output;
 mod progress;
+mod raytrace;
 mod render;
 mod svg;
 
@@ -30,6 +31,8 @@ enum Command {
     Mesh(mesh::MeshArgs),
     /// Path-trace a CS184 COLLADA scene, or the built-in Cornell box.
     Render(render::RenderArgs),
+    /// Whitted-ray-trace a Delft scene (preset, OBJ or TOML config), with visual debugging.
+    Raytrace(raytrace::RaytraceArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Bezier(a) => bezier::run(&a),
         Command::Mesh(a) => mesh::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::Raytrace(a) => raytrace::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

@@ -364,7 +364,8 @@ impl WhittedTracer<'_> {
         let to = q - hit.p;
         let dist = to.length();
         let l = to / dist;
-        if !(hit.n_s.dot(l) > 0.0) {
+        // Also refuses a light at the hit point itself (NaN direction).
+        if hit.n_s.dot(l).is_nan() || hit.n_s.dot(l) <= 0.0 {
             return Rgb::BLACK;
         }
         let mut blocked_at = None;

@@ -1,0 +1,571 @@
+//! `prism raytrace`: the Delft Whitted ray tracer on a preset, an OBJ scene or a TOML render
+//! config, with its feature switches, bloom, BVH views and the ray tree of one pixel.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use prism_image::{Bloom, RgbImage};
+use prism_math::Rgb;
+use prism_render::{
+    palette, raytrace, trace_pixel, OrbitView, Overlay, RayKind, RaytraceOptions, WhittedScene,
+    WhittedSettings,
+};
+use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
+
+use crate::output::{image_output, ImageFormat};
+use crate::UserError;
+
+/// Arguments of `prism raytrace`.
+#[derive(Args, Debug)]
+pub struct RaytraceArgs {
+    /// A preset (single-triangle, cube, cube-textured, cornell-box,
+    /// cornell-box-parallelogram-light, monkey, teapot, dragon, spheres, custom), an OBJ
+    /// scene (lit by a point light at (-1, 1, -1)) or a TOML render config.
+    #[arg(default_value = "cornell-box")]
+    scene: String,
+    /// Output image: .png or .jpg (clamped, byte = trunc(255 v), no gamma) or .exr
+    /// (linear). With several config cameras, NAME-0.png, NAME-1.png, ...
+    #[arg(short, long, default_value = "raytrace.png")]
+    output: PathBuf,
+    /// Also write the linear image to this OpenEXR file.
+    #[arg(long, value_name = "FILE")]
+    exr: Option<PathBuf>,
+    /// Image size: WIDTH HEIGHT (default: the config's window_size, else 800 800).
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
+    resolution: Option<Vec<u32>>,
+    /// Folder of the preset OBJ files (default: the config's data_path, else the staged
+    /// delft-raytracer/data folder, else the copies built into prism).
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+    /// Turn features on, comma-separated: shading, recursive, hard-shadow, soft-shadow,
+    /// normal-interp, texture, bilinear, bvh, bloom, transparency, multi-rays. Without a
+    /// config all but bloom, transparency and multi-rays start on; a config's [features]
+    /// start as it says (off when absent).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    enable: Vec<String>,
+    /// Turn features off (names as --enable).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    disable: Vec<String>,
+    /// Brute force: test every ray against every primitive (same as --disable bvh).
+    #[arg(long)]
+    no_bvh: bool,
+    /// Rays per pixel, jittered over the pixel (more than 1 turns multi-rays on).
+    #[arg(long = "spp", default_value_t = 1)]
+    spp: u32,
+    /// Samples per segment light; a parallelogram takes a k x k grid, k = ceil(sqrt(N)).
+    #[arg(long = "light-samples", default_value_t = 16)]
+    light_samples: u32,
+    /// Most reflection bounces after the camera ray.
+    #[arg(long = "max-depth", default_value_t = 3)]
+    max_depth: u32,
+    /// Bloom: only pixels whose luminance is above this count as bright.
+    #[arg(long, default_value_t = 0.0)]
+    bloom_threshold: f32,
+    /// Bloom: blur passes (each horizontal then vertical).
+    #[arg(long, default_value_t = 1)]
+    bloom_passes: u32,
+    /// Write only the bloom layer (turns bloom on).
+    #[arg(long)]
+    bloom_debug: bool,
+    /// Record the ray tree of pixel X,Y (X from the left, Y from the top of the written
+    /// image): writes OUT.rays.json and OUT.debug.png, the rays drawn over the render.
+    #[arg(long, value_name = "X,Y", value_delimiter = ',', num_args = 2)]
+    debug_pixel: Option<Vec<u32>>,
+    /// Draw the debug overlay from this orbit around the render camera's look-at point:
+    /// rotation in degrees and distance, like a config camera.
+    #[arg(
+        long,
+        value_name = "RX,RY,RZ,DIST",
+        value_delimiter = ',',
+        num_args = 4,
+        allow_hyphen_values = true
+    )]
+    debug_camera: Option<Vec<f32>>,
+    /// Also write the ray tree as a PLY of coloured line segments (for Blender).
+    #[arg(long, value_name = "FILE.ply")]
+    debug_ply: Option<PathBuf>,
+    /// Draw the boxes of this level of the BVH over the render (0: the root box).
+    #[arg(long, value_name = "N")]
+    bvh_level: Option<usize>,
+    /// Draw leaf K of the BVH (its box and its triangles) over the render.
+    #[arg(long, value_name = "K")]
+    bvh_leaf: Option<usize>,
+    /// Seed of the jitter: the same seed gives the same image.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    threads: Option<usize>,
+    /// Print BVH statistics, rays by kind, times and rays/s on stderr.
+    #[arg(long)]
+    stats: bool,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Largest image side.
+const MAX_SIDE: u32 = 16384;
+/// Default image side.
+const DEFAULT_SIDE: u32 = 800;
+
+/// Sets feature `name` in `f`.
+fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()> {
+    let slot = match name.trim() {
+        "shading" => &mut f.shading,
+        "recursive" => &mut f.recursive,
+        "hard-shadow" => &mut f.hard_shadow,
+        "soft-shadow" => &mut f.soft_shadow,
+        "normal-interp" => &mut f.normal_interp,
+        "texture" => &mut f.texture_mapping,
+        "bilinear" => &mut f.bilinear,
+        "bvh" => &mut f.accel_structure,
+        "bloom" => &mut f.bloom,
+        "transparency" => &mut f.transparency,
+        "multi-rays" => &mut f.multiple_rays_per_pixel,
+        other => {
+            return Err(UserError(format!(
+                "{flag} {other}: expected one of shading, recursive, hard-shadow, soft-shadow, \
+                 normal-interp, texture, bilinear, bvh, bloom, transparency, multi-rays"
+            ))
+            .into())
+        }
+    };
+    *slot = on;
+    Ok(())
+}
+
+/// The features prism starts with when no config sets them.
+#[must_use]
+pub fn default_features() -> Features {
+    Features {
+        shading: true,
+        recursive: true,
+        hard_shadow: true,
+        soft_shadow: true,
+        normal_interp: true,
+        texture_mapping: true,
+        accel_structure: true,
+        bilinear: true,
+        ..Features::default()
+    }
+}
+
+/// The staged data folder, when prism runs from its source tree.
+fn staged_data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data")
+}
+
+/// The output path for camera `i` of `n`: the path itself for one camera, else
+/// `STEM-i.EXT`.
+fn numbered(path: &Path, i: usize, n: usize) -> PathBuf {
+    if n <= 1 {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let name = match path.extension() {
+        Some(e) => format!("{stem}-{i}.{}", e.to_string_lossy()),
+        None => format!("{stem}-{i}"),
+    };
+    path.with_file_name(name)
+}
+
+/// `OUT` with its extension replaced by `suffix` (`OUT.rays.json`).
+fn sibling(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// Clamped bytes with `byte = trunc(255 v)`, no gamma (the template's bitmap).
+#[must_use]
+pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
+    let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
+    img.map(|p| [b(p.r), b(p.g), b(p.b)])
+}
+
+/// Writes text to `path` through a temporary file and a rename.
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    use std::io::Write;
+    prism_image::write_atomic(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|source| prism_image::ImageError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+    })?;
+    Ok(())
+}
+
+/// What the command loads: the scene, its cameras, the config if any.
+struct Loaded {
+    scene: prism_scene::Scene,
+    cameras: Vec<OrbitCamera>,
+    features: Features,
+    window: Option<[u32; 2]>,
+}
+
+fn load(a: &RaytraceArgs) -> Result<Loaded> {
+    let user = |e: prism_scene::SceneError| anyhow::Error::from(UserError(e.to_string()));
+    let mut dirs = Vec::new();
+    if let Some(d) = &a.data {
+        if !d.is_dir() {
+            return Err(UserError(format!("--data {}: expected a folder", d.display())).into());
+        }
+        dirs.push(d.clone());
+    }
+    dirs.push(staged_data());
+    let lower = a.scene.to_ascii_lowercase();
+    if lower.ends_with(".toml") {
+        let cfg: RenderConfig =
+            prism_scene::read_render_config(Path::new(&a.scene)).map_err(user)?;
+        for w in &cfg.warnings {
+            eprintln!("prism: warning: {w}");
+        }
+        if a.data.is_some() && cfg.data_path.is_some() {
+            eprintln!("prism: warning: --data has no effect: the config's data_path is used");
+        }
+        let scene = cfg.load_scene(&dirs).map_err(user)?;
+        if matches!(cfg.scene, SceneSource::File(_)) && cfg.lights.is_empty() {
+            eprintln!("prism: warning: {}: the scene is an OBJ and the config has no [[lights]]; it renders black under shading", cfg.file);
+        }
+        let cameras = if cfg.cameras.is_empty() {
+            vec![OrbitCamera::default()]
+        } else {
+            cfg.cameras.clone()
+        };
+        return Ok(Loaded {
+            scene,
+            cameras,
+            features: cfg.features,
+            window: cfg.window_size,
+        });
+    }
+    let scene = if lower.ends_with(".obj") {
+        let mut s = prism_scene::read_obj_scene(Path::new(&a.scene), false).map_err(user)?;
+        s.lights = vec![prism_scene::Light::Point {
+            position: prism_math::Vec3::new(-1.0, 1.0, -1.0),
+            intensity: Rgb::WHITE,
+        }];
+        s
+    } else {
+        let preset = Preset::from_name(&a.scene).ok_or_else(|| {
+            let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+            UserError(format!(
+                "{}: expected a preset ({}), an .obj scene or a .toml config",
+                a.scene,
+                names.join(", ")
+            ))
+        })?;
+        preset.load(&dirs).map_err(user)?
+    };
+    Ok(Loaded {
+        scene,
+        cameras: vec![OrbitCamera::default()],
+        features: default_features(),
+        window: None,
+    })
+}
+
+/// Runs `prism raytrace`.
+pub fn run(a: &RaytraceArgs) -> Result<()> {
+    let allowed = [ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr];
+    let format = image_output(&a.output, "--output", &allowed)?;
+    if let Some(exr) = &a.exr {
+        image_output(exr, "--exr", &[ImageFormat::Exr])?;
+    }
+    if let Some(ply) = &a.debug_ply {
+        if crate::output::extension(ply) != "ply" {
+            return Err(UserError(format!(
+                "--debug-ply {}: expected a .ply file",
+                ply.display()
+            ))
+            .into());
+        }
+        crate::output::check_folder(ply, "--debug-ply")?;
+        if a.debug_pixel.is_none() {
+            return Err(UserError("--debug-ply: it needs --debug-pixel X,Y".into()).into());
+        }
+    }
+    if a.debug_camera.is_some() && a.debug_pixel.is_none() {
+        eprintln!("prism: warning: --debug-camera has no effect: it applies to --debug-pixel");
+    }
+    if a.spp == 0 || a.spp > 1 << 16 {
+        return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 16, a.spp)).into());
+    }
+    if a.light_samples == 0 || a.light_samples > 1 << 16 {
+        return Err(UserError(format!(
+            "--light-samples: expected 1 to {}, found {}",
+            1 << 16,
+            a.light_samples
+        ))
+        .into());
+    }
+    if a.max_depth > 64 {
+        return Err(UserError(format!(
+            "--max-depth: expected 0 to 64, found {}",
+            a.max_depth
+        ))
+        .into());
+    }
+    if !(a.bloom_threshold.is_finite() && a.bloom_threshold >= 0.0) {
+        return Err(UserError(format!(
+            "--bloom-threshold: expected a number of at least 0, found {}",
+            a.bloom_threshold
+        ))
+        .into());
+    }
+    if a.bloom_passes > 64 {
+        return Err(UserError(format!(
+            "--bloom-passes: expected 0 to 64, found {}",
+            a.bloom_passes
+        ))
+        .into());
+    }
+    let t0 = Instant::now();
+    let loaded = load(a)?;
+    let mut features = loaded.features;
+    for n in &a.enable {
+        set_feature(&mut features, n, true, "--enable")?;
+    }
+    for n in &a.disable {
+        set_feature(&mut features, n, false, "--disable")?;
+    }
+    if a.no_bvh {
+        features.accel_structure = false;
+    }
+    if a.spp > 1 {
+        features.multiple_rays_per_pixel = true;
+    }
+    if a.bloom_debug {
+        features.bloom = true;
+    }
+    let (w, h) = match (&a.resolution, loaded.window) {
+        (Some(r), _) => (r[0], r[1]),
+        (None, Some([w, h])) => (w, h),
+        (None, None) => (DEFAULT_SIDE, DEFAULT_SIDE),
+    };
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(UserError(format!(
+            "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
+        ))
+        .into());
+    }
+    let debug_pixel = match &a.debug_pixel {
+        Some(p) if p[0] >= w || p[1] >= h => {
+            return Err(UserError(format!(
+                "--debug-pixel {},{}: outside the {w} x {h} image",
+                p[0], p[1]
+            ))
+            .into())
+        }
+        Some(p) => Some((p[0], p[1])),
+        None => None,
+    };
+    if let Some(c) = &a.debug_camera {
+        if c.iter().any(|v| !v.is_finite()) || c[3] < 0.0 {
+            return Err(UserError(
+                "--debug-camera: expected finite RX,RY,RZ degrees and a distance of at least 0"
+                    .into(),
+            )
+            .into());
+        }
+    }
+    let read = t0.elapsed();
+    let t1 = Instant::now();
+    let scene = WhittedScene::new(&loaded.scene, features.accel_structure);
+    let build = t1.elapsed();
+    if (a.bvh_level.is_some() || a.bvh_leaf.is_some()) && scene.bvh().is_none() {
+        return Err(UserError(
+            "--bvh-level and --bvh-leaf draw the BVH; it is off (--no-bvh or --disable bvh)".into(),
+        )
+        .into());
+    }
+    if let (Some(bvh), Some(level)) = (scene.bvh(), a.bvh_level) {
+        if level >= bvh.levels() {
+            return Err(UserError(format!(
+                "--bvh-level {level}: the BVH has levels 0 to {}",
+                bvh.levels().saturating_sub(1)
+            ))
+            .into());
+        }
+    }
+    if let (Some(bvh), Some(leaf)) = (scene.bvh(), a.bvh_leaf) {
+        let n = bvh.leaf_views().len();
+        if leaf >= n {
+            return Err(UserError(format!(
+                "--bvh-leaf {leaf}: the BVH has leaves 0 to {}",
+                n.saturating_sub(1)
+            ))
+            .into());
+        }
+    }
+    let opts = RaytraceOptions {
+        width: w,
+        height: h,
+        settings: WhittedSettings {
+            features,
+            light_samples: a.light_samples,
+            max_depth: a.max_depth,
+        },
+        spp: a.spp,
+        bloom: Bloom {
+            threshold: a.bloom_threshold,
+            passes: a.bloom_passes,
+        },
+        seed: a.seed,
+    };
+    let pool = {
+        let mut b = rayon::ThreadPoolBuilder::new();
+        if let Some(t) = a.threads {
+            b = b.num_threads(t.max(1));
+        }
+        b.build().context("starting worker threads")?
+    };
+    let n = loaded.cameras.len();
+    let mut written = Vec::new();
+    let mut counts = prism_render::RayCounts::default();
+    let mut render_time = std::time::Duration::ZERO;
+    let mut write_time = std::time::Duration::ZERO;
+    for (ci, camera) in loaded.cameras.iter().enumerate() {
+        let bar = crate::progress::bar(u64::from(h), "raytrace", a.quiet);
+        let t2 = Instant::now();
+        let out = pool.install(|| raytrace(&scene, camera, &opts, &|done| bar.set_position(done)));
+        render_time += t2.elapsed();
+        bar.finish_and_clear();
+        counts.add(&out.counts);
+        let t3 = Instant::now();
+        let path = numbered(&a.output, ci, n);
+        let picture = if a.bloom_debug {
+            out.bloom_layer.clone().unwrap_or_else(|| out.image.clone())
+        } else {
+            out.image.clone()
+        };
+        // BVH views are drawn on the picture (never on the EXR's linear values).
+        let mut shown = picture.clone();
+        if a.bvh_level.is_some() || a.bvh_leaf.is_some() {
+            let view = OrbitView::new(camera, w, h);
+            let mut ov = Overlay::new(shown, view, &scene);
+            let bvh = scene.bvh().expect("checked above");
+            if let Some(level) = a.bvh_level {
+                for (i, b) in bvh.level_boxes(level).iter().enumerate() {
+                    ov.aabb(b, palette(i));
+                }
+            }
+            if let Some(k) = a.bvh_leaf {
+                let leaf = &bvh.leaf_views()[k];
+                ov.aabb(&leaf.bounds, Rgb::new(1.0, 1.0, 0.0));
+                for &p in &leaf.prims {
+                    if (p as usize) < scene.triangle_count() {
+                        let t = scene.triangle(p as usize);
+                        for e in 0..3 {
+                            ov.segment(t[e], t[(e + 1) % 3], Rgb::new(1.0, 0.0, 1.0), false);
+                        }
+                    }
+                }
+            }
+            shown = ov.image;
+        }
+        match format {
+            ImageFormat::Exr => prism_image::write_exr(&path, &picture)?,
+            _ => crate::output::write_rgb8(&path, format, &to_bytes(&shown))?,
+        }
+        written.push(path.display().to_string());
+        if let Some(exr) = &a.exr {
+            let p = numbered(exr, ci, n);
+            prism_image::write_exr(&p, &picture)?;
+            written.push(p.display().to_string());
+        }
+        if let Some((x, row)) = debug_pixel {
+            let tr = trace_pixel(&scene, camera, &opts, x, row);
+            let json = sibling(&path, ".rays.json");
+            write_text(&json, &tr.to_json())?;
+            written.push(json.display().to_string());
+            if let Some(ply) = &a.debug_ply {
+                let p = numbered(ply, ci, n);
+                write_text(&p, &tr.to_ply())?;
+                written.push(p.display().to_string());
+            }
+            let (debug_cam, base) = match &a.debug_camera {
+                None => (*camera, out.image.clone()),
+                Some(c) => {
+                    let cam = OrbitCamera {
+                        rotation: prism_math::Vec3::new(c[0], c[1], c[2]),
+                        distance: c[3],
+                        ..*camera
+                    };
+                    let img = pool
+                        .install(|| raytrace(&scene, &cam, &opts, &|_| {}))
+                        .image;
+                    (cam, img)
+                }
+            };
+            let view = OrbitView::new(&debug_cam, w, h);
+            // The picture is dimmed so that the rays stand out.
+            let dim = base.map(|p| *p * 0.5);
+            let mut ov = Overlay::new(dim, view, &scene);
+            for r in &tr.rays {
+                let on_top = matches!(r.kind, RayKind::Normal | RayKind::InterpolatedNormal);
+                ov.segment(r.origin, r.end, r.color, !on_top);
+            }
+            for r in &tr.rays {
+                if let Some(p) = r.blocked_at {
+                    ov.marker(p, Rgb::new(1.0, 0.0, 0.0));
+                }
+            }
+            let png = sibling(&path, ".debug.png");
+            crate::output::write_rgb8(&png, ImageFormat::Png, &to_bytes(&ov.image))?;
+            written.push(png.display().to_string());
+        }
+        write_time += t3.elapsed();
+    }
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        eprintln!(
+            "prism: ray traced {w}x{h} x {n} camera(s), {:.2} M rays in {:.1} s ({:.2} M rays/s) -> {}",
+            counts.total() as f64 / 1e6,
+            t0.elapsed().as_secs_f64(),
+            counts.total() as f64 / render_time.as_secs_f64().max(1e-9) / 1e6,
+            written.join(", ")
+        );
+    }
+    if a.stats {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("triangles: {}", scene.triangle_count());
+        match scene.bvh() {
+            Some(bvh) => {
+                let s = bvh.stats();
+                eprintln!(
+                    "bvh: {} levels (8-wide), binary depth {}, {} leaves, largest leaf {}",
+                    bvh.levels(),
+                    s.depth,
+                    s.leaves,
+                    s.max_leaf_size
+                );
+            }
+            None => eprintln!("bvh: off (brute force)"),
+        }
+        eprintln!(
+            "rays: camera {}, reflection {}, transmission {}, shadow {}, area-sample {}, total {}",
+            counts.camera,
+            counts.reflection,
+            counts.transmission,
+            counts.shadow,
+            counts.area_sample,
+            counts.total()
+        );
+        eprintln!("read: {:.1} ms", ms(read));
+        eprintln!("build: {:.1} ms", ms(build));
+        eprintln!("render: {:.1} ms", ms(render_time));
+        eprintln!("write: {:.1} ms", ms(write_time));
+        eprintln!(
+            "rays/s: {:.0}",
+            counts.total() as f64 / render_time.as_secs_f64().max(1e-9)
+        );
+    }
+    Ok(())
+}
