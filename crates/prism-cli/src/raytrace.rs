@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use prism_image::{Bloom, RgbImage};
+use prism_image::Bloom;
 use prism_math::Rgb;
 use prism_render::{
     palette, raytrace, trace_pixel, OrbitView, Overlay, RayKind, RaytraceOptions, WhittedScene,
@@ -180,13 +180,6 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
     path.with_file_name(format!("{stem}{suffix}"))
-}
-
-/// Clamped bytes with `byte = trunc(255 v)`, no gamma (the template's bitmap).
-#[must_use]
-pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
-    let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
-    img.map(|p| [b(p.r), b(p.g), b(p.b)])
 }
 
 /// Writes text to `path` through a temporary file and a rename.
@@ -473,7 +466,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         }
         match format {
             ImageFormat::Exr => prism_image::write_exr(&path, &picture)?,
-            _ => crate::output::write_rgb8(&path, format, &to_bytes(&shown))?,
+            _ => crate::output::write_rgb8(&path, format, &shown.to_rgb8_truncated())?,
         }
         written.push(path.display().to_string());
         if let Some(exr) = &a.exr {
@@ -519,7 +512,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
                 }
             }
             let png = sibling(&path, ".debug.png");
-            crate::output::write_rgb8(&png, ImageFormat::Png, &to_bytes(&ov.image))?;
+            crate::output::write_rgb8(&png, ImageFormat::Png, &ov.image.to_rgb8_truncated())?;
             written.push(png.display().to_string());
         }
         write_time += t3.elapsed();

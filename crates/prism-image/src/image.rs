@@ -178,6 +178,14 @@ impl Image<[u8; 3]> {
 }
 
 impl Image<Rgb> {
+    /// Bytes with no colour-space change: each channel clamped to `[0, 1]` and
+    /// `byte = trunc(255 v)` (the Delft ray tracer's bitmap output).
+    #[must_use]
+    pub fn to_rgb8_truncated(&self) -> Rgb8Image {
+        let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
+        self.map(|p| [b(p.r), b(p.g), b(p.b)])
+    }
+
     /// Encodes linear values as 8-bit sRGB (clamped to [0, 1], rounded; NaN becomes 0).
     #[must_use]
     pub fn linear_to_srgb8(&self) -> Rgb8Image {
