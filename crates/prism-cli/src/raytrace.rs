@@ -71,17 +71,11 @@ pub struct RaytraceArgs {
     bloom_debug: bool,
     /// Record the ray tree of pixel X,Y (X from the left, Y from the top of the written
     /// image): writes OUT.rays.json and OUT.debug.png, the rays drawn over the render.
-    #[arg(long, value_name = "X,Y", value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_name = "X,Y", value_delimiter = ',')]
     debug_pixel: Option<Vec<u32>>,
     /// Draw the debug overlay from this orbit around the render camera's look-at point:
     /// rotation in degrees and distance, like a config camera.
-    #[arg(
-        long,
-        value_name = "RX,RY,RZ,DIST",
-        value_delimiter = ',',
-        num_args = 4,
-        allow_hyphen_values = true
-    )]
+    #[arg(long, value_name = "RX,RY,RZ,DIST", value_delimiter = ',', allow_hyphen_values = true)]
     debug_camera: Option<Vec<f32>>,
     /// Also write the ray tree as a PLY of coloured line segments (for Blender).
     #[arg(long, value_name = "FILE.ply")]
@@ -347,6 +341,15 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         return Err(UserError(format!(
             "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
         ))
+        .into());
+    }
+    if a.debug_pixel.as_ref().is_some_and(|p| p.len() != 2) {
+        return Err(UserError("--debug-pixel: expected X,Y (two whole numbers)".into()).into());
+    }
+    if a.debug_camera.as_ref().is_some_and(|c| c.len() != 4) {
+        return Err(UserError(
+            "--debug-camera: expected RX,RY,RZ,DIST (four numbers)".into(),
+        )
         .into());
     }
     let debug_pixel = match &a.debug_pixel {

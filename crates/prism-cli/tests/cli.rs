@@ -1295,3 +1295,140 @@ fn envmap_lights_the_unlit_bunny() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `prism raytrace`: presets, configs with several cameras, the debug outputs, and every
+/// kind of bad OBJ, MTL or config input as a located error with exit 2 and no output.
+#[test]
+fn raytrace_scenes_debugging_and_errors() {
+    let dir = scratch("raytrace");
+    let out = dir.join("cb.png");
+    let ply = dir.join("rays.ply");
+    let o = prism()
+        .args(["raytrace", "cornell-box", "-q", "-r", "40", "30", "--stats"])
+        .arg("-o")
+        .arg(&out)
+        .args(["--debug-pixel", "20,15", "--debug-camera", "30,-40,0,3.5"])
+        .arg("--debug-ply")
+        .arg(&ply)
+        .args(["--bvh-level", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = prism_image::read_png(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    assert!(prism_image::read_png(&dir.join("cb.debug.png")).is_ok());
+    let json = std::fs::read_to_string(dir.join("cb.rays.json")).unwrap();
+    assert!(json.starts_with("{\"pixel\":[20,15],\"color\":["), "{json}");
+    assert!(json.contains("\"kind\":\"camera\""), "{json}");
+    assert!(json.contains("\"kind\":\"shadow\""), "{json}");
+    assert!(std::fs::read_to_string(&ply).unwrap().starts_with("ply\n"));
+    let err = stderr(&o);
+    for stage in [
+        "bvh: ", "rays: ", "read: ", "render: ", "write: ", "rays/s: ",
+    ] {
+        assert!(
+            err.lines().any(|l| l.starts_with(stage)),
+            "{stage} missing: {err}"
+        );
+    }
+
+    // A config: two cameras make two images; the OBJ path is relative to data_path.
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        "window_size = [16, 12]\ndata_path = \".\"\nscene = \"tri.obj\"\n\
+         [features]\nenable_shading = true\n[[cameras]]\nrotation = [0, 0, 0]\n[[cameras]]\n\
+         [[lights]]\ntype = \"point\"\nposition = [0, 0, -3]\ncolor = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let o = prism()
+        .args(["raytrace", "-q"])
+        .arg(dir.join("scene.toml"))
+        .arg("-o")
+        .arg(dir.join("cfg.png"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for i in 0..2 {
+        let img = prism_image::read_png(&dir.join(format!("cfg-{i}.png"))).unwrap();
+        assert_eq!((img.width(), img.height()), (16, 12));
+    }
+
+    // Bad inputs: each a located error, exit 2, no output file, within seconds.
+    let cases: Vec<(&str, &str, &str)> = vec![
+        ("bad-index.obj", "v 0 0 0\nf 1 2 3\n", "bad-index.obj:2: f: vertex index 2 is out of range"),
+        ("nan.obj", "v 0 nan 0\n", "nan.obj:1: v: expected a finite number"),
+        ("no-mtl.obj", "mtllib gone.mtl\n", "no-mtl.obj:1: mtllib: cannot read the material library"),
+        ("bad-number.obj", "v 0 0 x\n", "bad-number.obj:1: v: expected a finite number, found \"x\""),
+        ("bad.toml", "scene = \"kitchen\"\n", "bad.toml:1: scene: expected a preset"),
+        ("types.toml", "[[cameras]]\nfield_of_view = \"wide\"\n", "types.toml:2: field_of_view: expected a number"),
+        ("fov.toml", "[[cameras]]\nfield_of_view = 0\n", "fov.toml:2: field_of_view: expected degrees strictly between 0 and 180"),
+        ("light.toml", "[[lights]]\ntype = \"parallelogram\"\ncorner = [0,0,0]\nedges = [[1,0,0],[1,0,0]]\ncolors = [[1,1,1],[1,1,1],[1,1,1],[1,1,1]]\n", "light.toml:4: edges: a parallelogram light needs an area above 0"),
+        ("window.toml", "window_size = [100000, 2]\n", "window.toml:1: window_size: expected sides from 1 to 16384"),
+        ("truncated.toml", "[features\n", "truncated.toml:1: expected TOML"),
+        ("missing.toml", "data_path = \".\"\nscene = \"nowhere.obj\"\n", "nowhere.obj"),
+    ];
+    for (name, text, want) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        let target = dir.join(format!("{name}.png"));
+        let t = std::time::Instant::now();
+        let o = prism()
+            .args(["raytrace", "-q"])
+            .arg(dir.join(name))
+            .arg("-o")
+            .arg(&target)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{name}: {}", stderr(&o));
+        assert!(!target.exists(), "{name}: wrote an output");
+        assert!(t.elapsed().as_secs() < 20, "{name}: too slow");
+    }
+    // A texture that is missing, a huge face, an unknown preset, a bad flag value.
+    std::fs::write(dir.join("t.mtl"), "newmtl a\nmap_Kd gone.png\n").unwrap();
+    std::fs::write(
+        dir.join("tex.obj"),
+        "mtllib t.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let huge = format!("v 0 0 0\nf {}\n", "1 ".repeat(100_000));
+    std::fs::write(dir.join("huge.obj"), huge).unwrap();
+    for (args, want) in [
+        (
+            vec![dir.join("tex.obj").display().to_string()],
+            "t.mtl:2: material a: map_Kd gone.png: cannot read the texture".to_string(),
+        ),
+        (
+            vec![dir.join("huge.obj").display().to_string()],
+            "f: more than 65536 corners".to_string(),
+        ),
+        (
+            vec!["kitchen".into()],
+            "kitchen: expected a preset".to_string(),
+        ),
+        (
+            vec!["cube".into(), "--enable".into(), "glossy".into()],
+            "--enable glossy: expected one of".to_string(),
+        ),
+        (
+            vec!["cube".into(), "--debug-pixel".into(), "900,1".into()],
+            "--debug-pixel 900,1: outside".to_string(),
+        ),
+    ] {
+        let target = dir.join("x.png");
+        let o = prism()
+            .args(["raytrace", "-q", "-r", "8", "8"])
+            .args(&args)
+            .arg("-o")
+            .arg(&target)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(&want), "{args:?}: {}", stderr(&o));
+        assert!(!target.exists());
+    }
+}
