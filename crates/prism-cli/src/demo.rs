@@ -418,6 +418,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         ),
     });
     pb.inc(1);
+    raytrace_gallery(a, &mut entries)?;
     pb.finish_and_clear();
     let mut html = String::from(
         "<!doctype html><meta charset=\"utf-8\"><title>prism gallery</title>\
@@ -445,6 +446,149 @@ pub fn run(a: &DemoArgs) -> Result<()> {
             entries.len(),
             a.output.display()
         );
+    }
+    Ok(())
+}
+
+/// Panels side by side (all the same size) in one picture, `cols` to a row.
+fn montage(panels: &[prism_image::RgbImage], cols: usize) -> prism_image::RgbImage {
+    let (w, h) = (panels[0].width(), panels[0].height());
+    let rows = panels.len().div_ceil(cols);
+    Image::from_fn(w * cols as u32, h * rows as u32, |x, y| {
+        let i = (y / h) as usize * cols + (x / w) as usize;
+        panels
+            .get(i)
+            .map_or(prism_math::Rgb::BLACK, |p| p.get(x % w, y % h))
+    })
+}
+
+/// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
+/// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
+fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
+    use prism_render::{raytrace, trace_pixel, OrbitView, Overlay, RaytraceOptions, WhittedScene};
+    use prism_scene::{OrbitCamera, Preset};
+    let dirs = vec![a.assets.join("delft-raytracer/data")];
+    let on = crate::raytrace::default_features();
+    let opts = |size: u32, features: prism_scene::Features| RaytraceOptions {
+        width: size,
+        height: size,
+        settings: prism_render::WhittedSettings {
+            features,
+            light_samples: 16,
+            max_depth: 3,
+        },
+        spp: 4,
+        bloom: prism_image::Bloom::default(),
+        seed: 0,
+    };
+    let cam = OrbitCamera::default();
+    let user = |e: prism_scene::SceneError| crate::UserError(e.to_string());
+    let write = |name: &str, img: &prism_image::RgbImage| {
+        prism_image::write_png(&a.output.join(name), &img.to_rgb8_truncated())
+            .with_context(|| format!("writing {name}"))
+    };
+    // Every preset whose file is here (the dragon is never shipped).
+    let mut panels = Vec::new();
+    let mut names = Vec::new();
+    for p in Preset::ALL {
+        let Ok(scene) = p.load(&dirs) else { continue };
+        let ws = WhittedScene::new(&scene, true);
+        panels.push(raytrace(&ws, &cam, &opts(200, on), &|_| {}).image);
+        names.push(p.name());
+    }
+    write("raytrace_presets.png", &montage(&panels, 3))?;
+    entries.push(Entry {
+        file: "raytrace_presets.png".into(),
+        caption: format!("prism raytrace presets: {}", names.join(", ")),
+    });
+    // Feature switches on the Cornell box with the four-colour parallelogram light.
+    let scene = Preset::CornellBoxParallelogramLight.load(&dirs).map_err(user)?;
+    let ws = WhittedScene::new(&scene, true);
+    let switches: [(&str, prism_scene::Features); 4] = [
+        ("everything on", on),
+        ("--disable shading", prism_scene::Features { shading: false, ..on }),
+        ("--disable soft-shadow", prism_scene::Features { soft_shadow: false, ..on }),
+        ("--disable recursive", prism_scene::Features { recursive: false, ..on }),
+    ];
+    let panels: Vec<_> = switches
+        .iter()
+        .map(|(_, f)| raytrace(&ws, &cam, &opts(200, *f), &|_| {}).image)
+        .collect();
+    write("raytrace_toggles.png", &montage(&panels, 4))?;
+    entries.push(Entry {
+        file: "raytrace_toggles.png".into(),
+        caption: format!(
+            "cornell-box-parallelogram-light, left to right: {}",
+            switches.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
+        ),
+    });
+    // Bloom on the spheres, and the layer it adds.
+    let spheres = WhittedScene::new(&Preset::Spheres.load(&dirs).map_err(user)?, true);
+    let mut b = opts(300, prism_scene::Features { bloom: true, ..on });
+    b.bloom.passes = 2;
+    let out = raytrace(&spheres, &cam, &b, &|_| {});
+    write("raytrace_bloom.png", &out.image)?;
+    write(
+        "raytrace_bloom_layer.png",
+        out.bloom_layer.as_ref().expect("bloom is on"),
+    )?;
+    entries.push(Entry {
+        file: "raytrace_bloom.png".into(),
+        caption: "spheres with bloom (--enable bloom --bloom-passes 2)".into(),
+    });
+    entries.push(Entry {
+        file: "raytrace_bloom_layer.png".into(),
+        caption: "its bloom layer alone (--bloom-debug)".into(),
+    });
+    // The mirror Cornell box: a BVH level, and the ray tree of a pixel on the mirror.
+    let scene = Preset::CornellBox.load(&dirs).map_err(user)?;
+    let ws = WhittedScene::new(&scene, true);
+    let o = opts(300, on);
+    let img = raytrace(&ws, &cam, &o, &|_| {}).image;
+    let mut ov = Overlay::new(img.clone(), OrbitView::new(&cam, 300, 300), &ws);
+    let bvh = ws.bvh().expect("built");
+    for (i, bx) in bvh.level_boxes(1).iter().enumerate() {
+        ov.aabb(bx, prism_render::palette(i));
+    }
+    write("raytrace_bvh_level.png", &ov.image)?;
+    entries.push(Entry {
+        file: "raytrace_bvh_level.png".into(),
+        caption: "the BVH's level 1 over the mirror Cornell box (--bvh-level 1)".into(),
+    });
+    // The first pixel of the middle row whose camera ray meets the mirror box.
+    let mirror = (0..300).find_map(|x| {
+        let t = trace_pixel(&ws, &cam, &o, x, 170);
+        let on_mirror = t.rays.first().and_then(|r| r.hit.as_ref()).is_some_and(|h| h.0 == "tallBox");
+        on_mirror.then_some(t)
+    });
+    if let Some(t) = mirror {
+        let debug_cam = OrbitCamera {
+            rotation: prism_math::Vec3::new(35.0, -30.0, 0.0),
+            distance: 3.2,
+            ..cam
+        };
+        let base = raytrace(&ws, &debug_cam, &o, &|_| {}).image.map(|p| *p * 0.5);
+        let mut ov = Overlay::new(base, OrbitView::new(&debug_cam, 300, 300), &ws);
+        for r in &t.rays {
+            let on_top = matches!(
+                r.kind,
+                prism_render::RayKind::Normal | prism_render::RayKind::InterpolatedNormal
+            );
+            ov.segment(r.origin, r.end, r.color, !on_top);
+        }
+        for r in &t.rays {
+            if let Some(p) = r.blocked_at {
+                ov.marker(p, prism_math::Rgb::new(1.0, 0.0, 0.0));
+            }
+        }
+        write("raytrace_debug_pixel.png", &ov.image)?;
+        entries.push(Entry {
+            file: "raytrace_debug_pixel.png".into(),
+            caption: format!(
+                "the ray tree of pixel {},{} on the mirror box, seen from another orbit                  (--debug-pixel {},{} --debug-camera 35,-30,0,3.2)",
+                t.pixel.0, t.pixel.1, t.pixel.0, t.pixel.1
+            ),
+        });
     }
     Ok(())
 }
