@@ -502,13 +502,33 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         caption: format!("prism raytrace presets: {}", names.join(", ")),
     });
     // Feature switches on the Cornell box with the four-colour parallelogram light.
-    let scene = Preset::CornellBoxParallelogramLight.load(&dirs).map_err(user)?;
+    let scene = Preset::CornellBoxParallelogramLight
+        .load(&dirs)
+        .map_err(user)?;
     let ws = WhittedScene::new(&scene, true);
     let switches: [(&str, prism_scene::Features); 4] = [
         ("everything on", on),
-        ("--disable shading", prism_scene::Features { shading: false, ..on }),
-        ("--disable soft-shadow", prism_scene::Features { soft_shadow: false, ..on }),
-        ("--disable recursive", prism_scene::Features { recursive: false, ..on }),
+        (
+            "--disable shading",
+            prism_scene::Features {
+                shading: false,
+                ..on
+            },
+        ),
+        (
+            "--disable soft-shadow",
+            prism_scene::Features {
+                soft_shadow: false,
+                ..on
+            },
+        ),
+        (
+            "--disable recursive",
+            prism_scene::Features {
+                recursive: false,
+                ..on
+            },
+        ),
     ];
     let panels: Vec<_> = switches
         .iter()
@@ -558,7 +578,11 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
     // The first pixel of the middle row whose camera ray meets the mirror box.
     let mirror = (0..300).find_map(|x| {
         let t = trace_pixel(&ws, &cam, &o, x, 170);
-        let on_mirror = t.rays.first().and_then(|r| r.hit.as_ref()).is_some_and(|h| h.0 == "tallBox");
+        let on_mirror = t
+            .rays
+            .first()
+            .and_then(|r| r.hit.as_ref())
+            .is_some_and(|h| h.0 == "tallBox");
         on_mirror.then_some(t)
     });
     if let Some(t) = mirror {
@@ -567,7 +591,9 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
             distance: 3.2,
             ..cam
         };
-        let base = raytrace(&ws, &debug_cam, &o, &|_| {}).image.map(|p| *p * 0.5);
+        let base = raytrace(&ws, &debug_cam, &o, &|_| {})
+            .image
+            .map(|p| *p * 0.5);
         let mut ov = Overlay::new(base, OrbitView::new(&debug_cam, 300, 300), &ws);
         for r in &t.rays {
             let on_top = matches!(

@@ -75,7 +75,12 @@ pub struct RaytraceArgs {
     debug_pixel: Option<Vec<u32>>,
     /// Draw the debug overlay from this orbit around the render camera's look-at point:
     /// rotation in degrees and distance, like a config camera.
-    #[arg(long, value_name = "RX,RY,RZ,DIST", value_delimiter = ',', allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "RX,RY,RZ,DIST",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     debug_camera: Option<Vec<f32>>,
     /// Also write the ray tree as a PLY of coloured line segments (for Blender).
     #[arg(long, value_name = "FILE.ply")]
@@ -347,10 +352,9 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         return Err(UserError("--debug-pixel: expected X,Y (two whole numbers)".into()).into());
     }
     if a.debug_camera.as_ref().is_some_and(|c| c.len() != 4) {
-        return Err(UserError(
-            "--debug-camera: expected RX,RY,RZ,DIST (four numbers)".into(),
-        )
-        .into());
+        return Err(
+            UserError("--debug-camera: expected RX,RY,RZ,DIST (four numbers)".into()).into(),
+        );
     }
     let debug_pixel = match &a.debug_pixel {
         Some(p) if p[0] >= w || p[1] >= h => {

@@ -172,7 +172,7 @@ mod tests {
 #[derive(Clone, Copy, Debug)]
 pub struct OrbitView {
     eye: Vec3,
-    rotation: prism_math::glam::Mat3,
+    world_from_camera: prism_math::Transform,
     hw: f32,
     hh: f32,
     width: f32,
@@ -186,7 +186,7 @@ impl OrbitView {
         let hh = (c.fov_y.to_radians() / 2.0).tan();
         OrbitView {
             eye: c.eye(),
-            rotation: c.rotation_matrix(),
+            world_from_camera: c.world_from_camera(),
             hw: width as f32 / height as f32 * hh,
             hh,
             width: width as f32,
@@ -206,14 +206,14 @@ impl OrbitView {
     pub fn ray(&self, x: f32, y: f32) -> Ray {
         let ndc = Vec2::new(2.0 * x / self.width - 1.0, 2.0 * y / self.height - 1.0);
         let local = Vec3::new(-ndc.x * self.hw, ndc.y * self.hh, 1.0).normalize();
-        Ray::new(self.eye, (self.rotation * local).normalize())
+        Ray::new(self.eye, self.world_from_camera.vector(local).normalize())
     }
 
     /// Where a world point lands: `(x, y from the top, depth along the view axis)` in
     /// pixels of the written image (row 0 at the top), or `None` behind the eye.
     #[must_use]
     pub fn project(&self, p: Vec3) -> Option<(f32, f32, f32)> {
-        let local = self.rotation.transpose() * (p - self.eye);
+        let local = self.world_from_camera.inverse().point(p);
         if local.z <= 1e-6 {
             return None;
         }

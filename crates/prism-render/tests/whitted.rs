@@ -438,3 +438,29 @@ fn dragon_without_its_file_is_a_named_error() {
         .unwrap_err();
     assert!(e.to_string().contains("dragon.obj"), "{e}");
 }
+
+/// Closed form of the template's camera: the default orbit (20, 20, 0) at distance 3 puts
+/// the eye at `R (0, 0, -3) = (-3 cos20 sin20, 3 sin20, -3 cos^2 20)`; the ray through the
+/// image centre points at `look_at`; pixel (0, 0), the bottom-left corner, looks along
+/// `R normalize(hw, -hh, 1)` (screen-right is camera -x); projecting a point of a pixel's
+/// ray gives that pixel back (row 0 at the top).
+#[test]
+fn orbit_camera_closed_form() {
+    let cam = OrbitCamera::default();
+    let (s, c) = 20f32.to_radians().sin_cos();
+    let want = Vec3::new(-3.0 * c * s, 3.0 * s, -3.0 * c * c);
+    assert!((cam.eye() - want).length() < 1e-5, "{}", cam.eye());
+    let view = prism_render::OrbitView::new(&cam, 200, 100);
+    let centre = view.ray(100.0, 50.0);
+    assert!((centre.dir - (-cam.eye()).normalize()).length() < 1e-5);
+    let head = prism_render::OrbitView::new(&head_on(), 200, 100);
+    let hh = 25f32.to_radians().tan();
+    let corner = head.ray(0.0, 0.0).dir;
+    let want = Vec3::new(2.0 * hh, -hh, 1.0).normalize();
+    assert!((corner - want).length() < 1e-6, "{corner} vs {want}");
+    for (x, y) in [(10.5f32, 20.5f32), (150.25, 90.75)] {
+        let r = view.ray(x, y);
+        let (px, py, _) = view.project(r.origin + 4.0 * r.dir).unwrap();
+        assert!((px - x).abs() < 1e-3 && (py - (100.0 - y)).abs() < 1e-3, "{px} {py}");
+    }
+}

@@ -42,7 +42,10 @@ mod tests {
     #[test]
     fn extensions_pick_readers() {
         let e = load(Path::new("scene.obj.txt"), &SceneOptions::default()).unwrap_err();
-        assert_eq!(e.to_string(), "scene.obj.txt: expected a scene file (.dae, .obj, .toml)");
+        assert_eq!(
+            e.to_string(),
+            "scene.obj.txt: expected a scene file (.dae, .obj, .toml)"
+        );
         let e = load(Path::new("no-such-scene.DAE"), &SceneOptions::default()).unwrap_err();
         assert!(matches!(e, SceneError::Io { .. }), "{e}");
     }

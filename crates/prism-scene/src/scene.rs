@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use prism_image::RgbImage;
-use prism_math::{Rgb, Vec2, Vec3};
+use prism_math::{Rgb, Transform, Vec2, Vec3};
 
 /// A surface's scattering model, with the parameters the course's files give.
 #[derive(Clone, Debug, PartialEq)]
@@ -321,31 +321,37 @@ impl Default for OrbitCamera {
 }
 
 impl OrbitCamera {
-    /// The rotation `R = Rz Ry Rx`.
+    /// The rotation `R = Rz Ry Rx` (x applied first), from camera to world directions.
     #[must_use]
-    pub fn rotation_matrix(&self) -> prism_math::glam::Mat3 {
-        use prism_math::glam::Mat3;
-        Mat3::from_rotation_z(self.rotation.z.to_radians())
-            * Mat3::from_rotation_y(self.rotation.y.to_radians())
-            * Mat3::from_rotation_x(self.rotation.x.to_radians())
+    pub fn rotation(&self) -> Transform {
+        let axis = |a: Vec3, deg: f32| Transform::rotate(a, deg).expect("a unit axis");
+        axis(Vec3::Z, self.rotation.z)
+            * axis(Vec3::Y, self.rotation.y)
+            * axis(Vec3::X, self.rotation.x)
+    }
+
+    /// World from camera: the rotation, then a move to the eye.
+    #[must_use]
+    pub fn world_from_camera(&self) -> Transform {
+        Transform::translate(self.eye()) * self.rotation()
     }
 
     /// The eye position.
     #[must_use]
     pub fn eye(&self) -> Vec3 {
-        self.look_at + self.rotation_matrix() * Vec3::new(0.0, 0.0, -self.distance)
+        self.look_at + self.rotation().vector(Vec3::new(0.0, 0.0, -self.distance))
     }
 
     /// The same view as a [`Camera`] for an image of aspect ratio `width / height`.
     #[must_use]
     pub fn to_camera(&self, aspect: f32) -> Camera {
-        let r = self.rotation_matrix();
+        let r = self.rotation();
         let eye = self.eye();
         let hh = (self.fov_y.to_radians() / 2.0).tan();
         Camera {
             eye,
-            target: eye + r * Vec3::Z,
-            up: r * Vec3::Y,
+            target: eye + r.vector(Vec3::Z),
+            up: r.vector(Vec3::Y),
             hfov: (2.0 * (hh * aspect).atan()).to_degrees(),
             vfov: self.fov_y,
             near: 1e-3,
