@@ -461,6 +461,9 @@ fn orbit_camera_closed_form() {
     for (x, y) in [(10.5f32, 20.5f32), (150.25, 90.75)] {
         let r = view.ray(x, y);
         let (px, py, _) = view.project(r.origin + 4.0 * r.dir).unwrap();
-        assert!((px - x).abs() < 1e-3 && (py - (100.0 - y)).abs() < 1e-3, "{px} {py}");
+        assert!(
+            (px - x).abs() < 1e-3 && (py - (100.0 - y)).abs() < 1e-3,
+            "{px} {py}"
+        );
     }
 }

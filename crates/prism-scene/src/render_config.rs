@@ -19,6 +19,9 @@ pub const MAX_WINDOW_SIDE: u32 = 16384;
 /// Most pixels a config may ask for (64 M).
 pub const MAX_WINDOW_PIXELS: u64 = 1 << 26;
 
+/// Largest colour value a light may have.
+pub const MAX_COLOR: f32 = 1e6;
+
 /// The template's feature switches; all default to off.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Features {
@@ -384,10 +387,10 @@ impl Cx<'_> {
 
     fn color(&self, v: &Val<'_>, key: &str) -> Result<Rgb, SceneError> {
         let c = self.vec3(v, key)?;
-        if c.min_element() < 0.0 {
+        if c.min_element() < 0.0 || c.max_element() > MAX_COLOR {
             return Err(self.err(
                 v,
-                format!("{key}: expected colour values of at least 0, found {c}"),
+                format!("{key}: expected colour values from 0 to {MAX_COLOR}, found {c}"),
             ));
         }
         Ok(Rgb::new(c.x, c.y, c.z))

@@ -5,6 +5,9 @@ use prism_math::Rgb;
 
 use crate::error::SceneError;
 
+/// Largest colour value or exponent a material may give.
+pub(crate) const MAX_MTL_VALUE: f32 = 1e6;
+
 /// One `newmtl` block, before its texture is loaded.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct MtlMaterial {
@@ -80,13 +83,27 @@ pub(crate) fn parse_mtl(text: &str, file: &str) -> Result<Vec<MtlMaterial>, Scen
                         Rgb::new(r, g, b)
                     }
                 };
+                if !(c.r.min(c.g).min(c.b) >= 0.0 && c.r.max(c.g).max(c.b) <= MAX_MTL_VALUE) {
+                    return Err(err(format!(
+                        "{key}: expected values from 0 to {MAX_MTL_VALUE}, found {} {} {}",
+                        c.r, c.g, c.b
+                    )));
+                }
                 if key == "Kd" {
                     m.kd = c;
                 } else {
                     m.ks = c;
                 }
             }
-            "Ns" => m.shininess = number(words.next(), "a number")?,
+            "Ns" => {
+                let v = number(words.next(), "a number")?;
+                if !(0.0..=MAX_MTL_VALUE).contains(&v) {
+                    return Err(err(format!(
+                        "Ns: expected an exponent from 0 to {MAX_MTL_VALUE}, found {v}"
+                    )));
+                }
+                m.shininess = v;
+            }
             "d" => {
                 // `d -halo 0.5`: the factor is the last word.
                 let w = content.split_whitespace().last().filter(|w| *w != "d");
@@ -143,6 +160,13 @@ mod tests {
         );
         let e = parse_mtl("Kd 1 1 1\n", "t.mtl").unwrap_err();
         assert_eq!(e.to_string(), "t.mtl:1: Kd: expected `newmtl` before it");
+        let e = parse_mtl("newmtl a\nKd 0.8 0.5 -0.5\n", "t.mtl").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.mtl:2: Kd: expected values from 0 to 1000000, found 0.8 0.5 -0.5"
+        );
+        let e = parse_mtl("newmtl a\nNs -1\n", "t.mtl").unwrap_err();
+        assert!(e.to_string().contains("Ns: expected an exponent"), "{e}");
         let e = parse_mtl("newmtl a\nd 2\n", "t.mtl").unwrap_err();
         assert!(e.to_string().contains("[0, 1]"), "{e}");
     }

@@ -127,7 +127,7 @@ fn bad_configs_are_located() {
         ),
         (
             "[[lights]]\ntype = \"point\"\nposition = [0,0,0]\ncolor = [1,-1,1]",
-            "c.toml:4: color: expected colour values of at least 0",
+            "c.toml:4: color: expected colour values from 0 to 1000000",
         ),
         (
             "[features]\nenable_shadin = true",
