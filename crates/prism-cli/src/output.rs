@@ -18,6 +18,8 @@ pub enum ImageFormat {
     Jpeg,
     /// `.exr`: linear 32-bit float RGB.
     Exr,
+    /// `.bmp`: 24-bit uncompressed bitmap.
+    Bmp,
 }
 
 impl ImageFormat {
@@ -26,6 +28,7 @@ impl ImageFormat {
             ImageFormat::Png => ".png",
             ImageFormat::Jpeg => ".jpg",
             ImageFormat::Exr => ".exr",
+            ImageFormat::Bmp => ".bmp",
         }
     }
 }
@@ -44,6 +47,7 @@ pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<
         "png" => Some(ImageFormat::Png),
         "jpg" | "jpeg" => Some(ImageFormat::Jpeg),
         "exr" => Some(ImageFormat::Exr),
+        "bmp" => Some(ImageFormat::Bmp),
         _ => None,
     };
     match format {
@@ -113,10 +117,11 @@ pub fn check_folder(path: &Path, flag: &str) -> Result<()> {
     }
 }
 
-/// Writes an 8-bit sRGB picture as PNG or JPEG, atomically.
+/// Writes an 8-bit picture as PNG, JPEG or BMP, atomically.
 pub fn write_rgb8(path: &Path, format: ImageFormat, image: &prism_image::Rgb8Image) -> Result<()> {
     match format {
         ImageFormat::Jpeg => prism_image::write_jpeg(path, image)?,
+        ImageFormat::Bmp => prism_image::write_bmp(path, image)?,
         _ => prism_image::write_png(path, image)?,
     }
     Ok(())

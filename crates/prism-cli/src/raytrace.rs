@@ -25,7 +25,7 @@ pub struct RaytraceArgs {
     /// scene (lit by a point light at (-1, 1, -1)) or a TOML render config.
     #[arg(default_value = "cornell-box")]
     scene: String,
-    /// Output image: .png or .jpg (clamped, byte = trunc(255 v), no gamma) or .exr
+    /// Output image: .png, .bmp or .jpg (clamped, byte = trunc(255 v), no gamma) or .exr
     /// (linear). With several config cameras, NAME-0.png, NAME-1.png, ...
     #[arg(short, long, default_value = "raytrace.png")]
     output: PathBuf,
@@ -51,9 +51,10 @@ pub struct RaytraceArgs {
     /// Brute force: test every ray against every primitive (same as --disable bvh).
     #[arg(long)]
     no_bvh: bool,
-    /// Rays per pixel, jittered over the pixel (more than 1 turns multi-rays on).
-    #[arg(long = "spp", default_value_t = 1)]
-    spp: u32,
+    /// Rays per pixel, jittered over the pixel (more than 1 turns multi-rays on; with
+    /// multi-rays on and no --spp, 16).
+    #[arg(long = "spp")]
+    spp: Option<u32>,
     /// Samples per segment light; a parallelogram takes a k x k grid, k = ceil(sqrt(N)).
     #[arg(long = "light-samples", default_value_t = 16)]
     light_samples: u32,
@@ -107,6 +108,8 @@ pub struct RaytraceArgs {
 
 /// Largest image side.
 const MAX_SIDE: u32 = 16384;
+/// Rays per pixel with multi-rays on and no --spp.
+const DEFAULT_SPP: u32 = 16;
 /// Default image side.
 const DEFAULT_SIDE: u32 = 800;
 
@@ -266,7 +269,12 @@ fn load(a: &RaytraceArgs) -> Result<Loaded> {
 
 /// Runs `prism raytrace`.
 pub fn run(a: &RaytraceArgs) -> Result<()> {
-    let allowed = [ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr];
+    let allowed = [
+        ImageFormat::Png,
+        ImageFormat::Bmp,
+        ImageFormat::Jpeg,
+        ImageFormat::Exr,
+    ];
     let format = image_output(&a.output, "--output", &allowed)?;
     if let Some(exr) = &a.exr {
         image_output(exr, "--exr", &[ImageFormat::Exr])?;
@@ -287,8 +295,8 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     if a.debug_camera.is_some() && a.debug_pixel.is_none() {
         eprintln!("prism: warning: --debug-camera has no effect: it applies to --debug-pixel");
     }
-    if a.spp == 0 || a.spp > 1 << 16 {
-        return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 16, a.spp)).into());
+    if let Some(spp) = a.spp.filter(|&s| s == 0 || s > 1 << 16) {
+        return Err(UserError(format!("--spp: expected 1 to {}, found {spp}", 1 << 16)).into());
     }
     if a.light_samples == 0 || a.light_samples > 1 << 16 {
         return Err(UserError(format!(
@@ -331,7 +339,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     if a.no_bvh {
         features.accel_structure = false;
     }
-    if a.spp > 1 {
+    if a.spp.is_some_and(|s| s > 1) {
         features.multiple_rays_per_pixel = true;
     }
     if a.bloom_debug {
@@ -413,7 +421,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             light_samples: a.light_samples,
             max_depth: a.max_depth,
         },
-        spp: a.spp,
+        spp: a.spp.unwrap_or(DEFAULT_SPP),
         bloom: Bloom {
             threshold: a.bloom_threshold,
             passes: a.bloom_passes,

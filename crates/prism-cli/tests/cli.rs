@@ -1358,6 +1358,16 @@ fn raytrace_scenes_debugging_and_errors() {
         assert_eq!((img.width(), img.height()), (16, 12));
     }
 
+    // The template's own output format: a 24-bit bitmap of the same bytes as the PNG.
+    let o = prism()
+        .args(["raytrace", "cube", "-q", "-r", "8", "6", "-o"])
+        .arg(dir.join("cube.bmp"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let bmp = std::fs::read(dir.join("cube.bmp")).unwrap();
+    assert_eq!((&bmp[..2], bmp.len()), (&b"BM"[..], 54 + 6 * 24));
+
     // Bad inputs: each a located error, exit 2, no output file, within seconds.
     let cases: Vec<(&str, &str, &str)> = vec![
         ("bad-index.obj", "v 0 0 0\nf 1 2 3\n", "bad-index.obj:2: f: vertex index 2 is out of range"),

@@ -255,6 +255,58 @@ pub fn write_jpeg(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
     })
 }
 
+/// Encodes an RGB8 image as a 24-bit uncompressed Windows bitmap (BITMAPINFOHEADER, rows
+/// stored bottom-up in BGR order, each padded to a multiple of 4 bytes).
+///
+/// # Errors
+/// [`ImageError::Encode`] if the file would exceed 4 GiB.
+pub fn encode_bmp(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
+    let (w, h) = (image.width() as usize, image.height() as usize);
+    let row = (3 * w).div_ceil(4) * 4;
+    let data = row * h;
+    let size = u32::try_from(54 + data).map_err(|_| ImageError::Encode {
+        format: "BMP",
+        message: format!("{w} x {h} is over the format's 4 GiB"),
+    })?;
+    let mut out = Vec::with_capacity(54 + data);
+    out.extend_from_slice(b"BM");
+    out.extend_from_slice(&size.to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&54u32.to_le_bytes());
+    out.extend_from_slice(&40u32.to_le_bytes());
+    out.extend_from_slice(&(w as i32).to_le_bytes());
+    out.extend_from_slice(&(h as i32).to_le_bytes());
+    out.extend_from_slice(&1u16.to_le_bytes());
+    out.extend_from_slice(&24u16.to_le_bytes());
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&(data as u32).to_le_bytes());
+    out.extend_from_slice(&2835u32.to_le_bytes());
+    out.extend_from_slice(&2835u32.to_le_bytes());
+    out.extend_from_slice(&[0; 8]);
+    for y in (0..image.height()).rev() {
+        let start = out.len();
+        for p in image.row(y) {
+            out.extend_from_slice(&[p[2], p[1], p[0]]);
+        }
+        out.resize(start + row, 0);
+    }
+    Ok(out)
+}
+
+/// Writes an RGB8 image as a 24-bit BMP file (see [`encode_bmp`]), atomically.
+///
+/// # Errors
+/// [`ImageError::Io`] or [`ImageError::Encode`]; on error the destination is untouched.
+pub fn write_bmp(path: &Path, image: &Rgb8Image) -> Result<(), ImageError> {
+    let bytes = encode_bmp(image)?;
+    write_atomic(path, |w| {
+        w.write_all(&bytes).map_err(|source| ImageError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    })
+}
+
 /// Writes an RGB8 image as a PNG file, atomically (see [`write_atomic`]).
 ///
 /// # Errors
@@ -329,6 +381,24 @@ pub fn write_atomic(
 
 #[cfg(test)]
 mod tests {
+
+    /// Layout by hand: a 2 x 2 image is a 54-byte header and two rows of 6 bytes padded to
+    /// 8, bottom row first, blue first.
+    #[test]
+    fn bmp_layout_by_hand() {
+        let img = crate::Image::from_vec(2, 2, vec![[1, 2, 3], [4, 5, 6], [7, 8, 9], [10, 11, 12]]);
+        let b = encode_bmp(&img).unwrap();
+        assert_eq!(b.len(), 54 + 16);
+        assert_eq!(&b[0..2], b"BM");
+        assert_eq!(u32::from_le_bytes(b[2..6].try_into().unwrap()), 70);
+        assert_eq!(u32::from_le_bytes(b[10..14].try_into().unwrap()), 54);
+        assert_eq!(i32::from_le_bytes(b[18..22].try_into().unwrap()), 2);
+        assert_eq!(i32::from_le_bytes(b[22..26].try_into().unwrap()), 2);
+        assert_eq!(u16::from_le_bytes(b[28..30].try_into().unwrap()), 24);
+        assert_eq!(&b[54..62], &[9, 8, 7, 12, 11, 10, 0, 0]);
+        assert_eq!(&b[62..70], &[3, 2, 1, 6, 5, 4, 0, 0]);
+    }
+
     use super::*;
     use crate::Image;
 

@@ -234,15 +234,15 @@ impl WhittedTracer<'_> {
         let mut color = local;
         if f.recursive && ks != Rgb::BLACK && depth < self.settings.max_depth {
             let n = hit.n_s;
-            let r = (ray.dir - 2.0 * ray.dir.dot(n) * n).normalize_or_zero();
-            if r != Vec3::ZERO {
-                let reflected = self.trace(
-                    &Ray::new(hit.p + RAY_EPSILON * r, r),
-                    depth + 1,
-                    RayKind::Reflection,
-                );
-                color += ks * reflected;
-            }
+            // The mirror direction of a unit ray about a unit normal is a unit vector; it
+            // is used as computed, as the template does.
+            let r = ray.dir - 2.0 * ray.dir.dot(n) * n;
+            let reflected = self.trace(
+                &Ray::new(hit.p + RAY_EPSILON * r, r),
+                depth + 1,
+                RayKind::Reflection,
+            );
+            color += ks * reflected;
         }
         if f.transparency && transparency < 1.0 && depth < self.settings.max_depth {
             let behind = self.trace(
