@@ -46,8 +46,8 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
-    /// Builds the BVH and light list. Segment and parallelogram lights (the Whitted ray
-    /// tracer's, given as colours, not radiance) are left out.
+    /// Builds the BVH and light list. Segment lights and parallelogram lights without a
+    /// facing side (the Whitted ray tracer's, given as colours, not radiance) are left out.
     #[must_use]
     pub fn new(scene: &Scene) -> RenderScene {
         let mut tris = Vec::new();
@@ -79,14 +79,19 @@ impl RenderScene {
                     to_light: -direction.normalize(),
                     irradiance,
                 }),
-                Light::Area {
-                    center,
-                    dim_x,
-                    dim_y,
-                    normal,
-                    radiance,
+                Light::Parallelogram {
+                    corner,
+                    edges: [dim_x, dim_y],
+                    colors,
+                    facing: Some(normal),
                 } => {
-                    let corner = center - 0.5 * dim_x - 0.5 * dim_y;
+                    // Radiance is uniform over the rectangle: the corners' mean if they
+                    // differ.
+                    let radiance = if colors.iter().all(|&c| c == colors[0]) {
+                        colors[0]
+                    } else {
+                        (colors[0] + colors[1] + colors[2] + colors[3]) * 0.25
+                    };
                     let index = lights.len() as u32;
                     let (a, b, c, d) = (
                         corner,
@@ -115,9 +120,10 @@ impl RenderScene {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::Environment { radiance });
                 }
-                // Lights of the Whitted ray tracer, with colours rather than radiometric
-                // units: the path tracer has no use for them.
-                Light::Segment { .. } | Light::Parallelogram { .. } => {}
+                // Lights of the Whitted ray tracer that shine both ways like point lights,
+                // with colours rather than radiometric units: the path tracer has no use
+                // for them.
+                Light::Segment { .. } | Light::Parallelogram { facing: None, .. } => {}
                 Light::EnvironmentMap { ref radiance } => {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::EnvironmentMap(std::sync::Arc::new(

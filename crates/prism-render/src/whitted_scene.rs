@@ -107,7 +107,7 @@ pub struct WhittedScene {
     spheres: Vec<(Sphere, u32)>,
     /// Materials, indexed by hits.
     pub materials: Vec<PhongMaterial>,
-    /// Lights (scene area rectangles as parallelograms of one colour).
+    /// Lights.
     pub lights: Vec<Light>,
     bvh: Option<Bvh>,
     bounds_diagonal: f32,
@@ -153,24 +153,7 @@ impl WhittedScene {
                 )
             })
             .collect();
-        let lights = scene
-            .lights
-            .iter()
-            .map(|l| match *l {
-                Light::Area {
-                    center,
-                    dim_x,
-                    dim_y,
-                    radiance,
-                    ..
-                } => Light::Parallelogram {
-                    corner: center - 0.5 * dim_x - 0.5 * dim_y,
-                    edges: [dim_x, dim_y],
-                    colors: [radiance; 4],
-                },
-                ref other => other.clone(),
-            })
-            .collect();
+        let lights = scene.lights.clone();
         let bvh = use_bvh.then(|| {
             let s: Vec<Sphere> = spheres.iter().map(|s| s.0).collect();
             Bvh::build(&triangles, &s, &BuildOptions::default())

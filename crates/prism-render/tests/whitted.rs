@@ -224,6 +224,7 @@ fn area_light_strata_each_get_one_sample() {
             corner: Vec3::new(-0.5, 2.0, -0.5),
             edges: [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)],
             colors: [Rgb::WHITE; 4],
+            facing: None,
         },
         16,
     );
@@ -466,4 +467,35 @@ fn orbit_camera_closed_form() {
             "{px} {py}"
         );
     }
+}
+
+/// Property of the one light description: a parallelogram that faces away from a surface
+/// (the course's one-sided area light) gives it nothing; facing it, or with no facing side
+/// (the Delft light), it lights it, and the same amount either way.
+#[test]
+fn one_sided_parallelograms_light_only_their_side() {
+    let light = |facing| Light::Parallelogram {
+        corner: Vec3::new(-0.5, 2.0, -0.5),
+        edges: [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)],
+        colors: [Rgb::WHITE; 4],
+        facing,
+    };
+    let mean = |facing| {
+        let scene = triangles(
+            &floor(),
+            phong_material(Rgb::splat(0.7), Rgb::BLACK),
+            vec![light(facing)],
+        );
+        let ws = WhittedScene::new(&scene, true);
+        let cam = OrbitCamera {
+            rotation: Vec3::new(90.0, 0.0, 0.0),
+            ..OrbitCamera::default()
+        };
+        let out = raytrace(&ws, &cam, &options(16, 16, all_on()), &|_| {});
+        out.image.pixels().iter().map(|p| p.r).sum::<f32>()
+    };
+    assert_eq!(mean(Some(Vec3::Y)), 0.0);
+    let down = mean(Some(Vec3::NEG_Y));
+    assert!(down > 0.0);
+    assert_eq!(down, mean(None));
 }

@@ -97,12 +97,17 @@ pub fn cornell_box() -> Scene {
             material: 0,
         },
     ];
-    let lights = vec![Light::Area {
-        center: Vec3::new(0.0, 1.49, 0.0),
-        dim_x: Vec3::new(0.6, 0.0, 0.0),
-        dim_y: Vec3::new(0.0, 0.0, 0.8),
-        normal: Vec3::NEG_Y,
-        radiance: Rgb::splat(10.0),
+    // The ceiling light: 0.6 x 0.8 around (0, 1.49, 0), facing down.
+    let (center, dim_x, dim_y) = (
+        Vec3::new(0.0, 1.49, 0.0),
+        Vec3::new(0.6, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.8),
+    );
+    let lights = vec![Light::Parallelogram {
+        corner: center - 0.5 * dim_x - 0.5 * dim_y,
+        edges: [dim_x, dim_y],
+        colors: [Rgb::splat(10.0); 4],
+        facing: Some(Vec3::NEG_Y),
     }];
     let hfov: f32 = 49.134_34;
     let vfov = (2.0 * ((hfov.to_radians() / 2.0).tan() / 1.333_333).atan()).to_degrees();

@@ -168,6 +168,7 @@ impl Preset {
                     Rgb::new(0.0, 0.0, 1.0),
                     Rgb::new(0.0, 1.0, 1.0),
                 ],
+                facing: None,
             }],
             Preset::Monkey => vec![point(-1.0, 1.0, -1.0, 1.0), point(1.0, -1.0, -1.0, 1.0)],
             Preset::Spheres => vec![point(3.0, 0.0, 3.0, 15.0)],

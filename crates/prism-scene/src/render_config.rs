@@ -623,6 +623,7 @@ impl Cx<'_> {
                     corner,
                     edges,
                     colors,
+                    facing: None,
                 })
             }
             other => Err(self.err(

@@ -168,20 +168,6 @@ pub enum Light {
         /// Irradiance on a surface facing the light.
         irradiance: Rgb,
     },
-    /// A one-sided emitting rectangle `center ± dim_x/2 ± dim_y/2`, emitting towards
-    /// `normal`.
-    Area {
-        /// Centre.
-        center: Vec3,
-        /// First edge (full length).
-        dim_x: Vec3,
-        /// Second edge (full length).
-        dim_y: Vec3,
-        /// Unit normal of the emitting side.
-        normal: Vec3,
-        /// Emitted radiance.
-        radiance: Rgb,
-    },
     /// A light along the segment `endpoints[0]` to `endpoints[1]` whose colour goes linearly
     /// from `colors[0]` to `colors[1]`: at `p0 + t (p1 - p0)` it is `(1 - t) c0 + t c1`
     /// (the Delft ray tracer's segment light; it lights like a point light at each sample).
@@ -194,8 +180,12 @@ pub enum Light {
     /// A light over the parallelogram `corner + a edges[0] + b edges[1]`, `a, b` in
     /// `[0, 1]`, whose colour is bilinear in the corners' colours:
     /// `(1 - a)((1 - b) c0 + b c2) + a((1 - b) c1 + b c3)`, where `c0` is at `corner`, `c1`
-    /// at `corner + edges[0]`, `c2` at `corner + edges[1]` and `c3` at the far corner (the
-    /// Delft ray tracer's parallelogram light; it lights like a point light at each sample).
+    /// at `corner + edges[0]`, `c2` at `corner + edges[1]` and `c3` at the far corner.
+    ///
+    /// This is both the course's area light (a rectangle of uniform radiance emitting
+    /// towards `facing`; the path tracer reads the colours as radiance, and the mean of the
+    /// four if they differ) and the Delft ray tracer's parallelogram light (`facing` `None`:
+    /// it lights both sides, like a point light at each sample of colour `c`).
     Parallelogram {
         /// The corner where `colors[0]` is.
         corner: Vec3,
@@ -203,6 +193,8 @@ pub enum Light {
         edges: [Vec3; 2],
         /// The colours at `corner`, `corner + e0`, `corner + e1` and `corner + e0 + e1`.
         colors: [Rgb; 4],
+        /// The unit normal of the one emitting side, or `None` for light on both sides.
+        facing: Option<Vec3>,
     },
     /// Radiance from every direction above the horizon (world y > 0), none from below; not
     /// seen by camera rays.
@@ -234,9 +226,7 @@ impl Light {
         match self {
             Light::Point { intensity, .. } => shines(intensity),
             Light::Directional { irradiance, .. } => shines(irradiance),
-            Light::Area { radiance, .. }
-            | Light::Hemisphere { radiance }
-            | Light::Environment { radiance } => shines(radiance),
+            Light::Hemisphere { radiance } | Light::Environment { radiance } => shines(radiance),
             Light::EnvironmentMap { radiance } => radiance.pixels().iter().any(shines),
             Light::Segment { colors, .. } => colors.iter().any(shines),
             Light::Parallelogram { colors, .. } => colors.iter().any(shines),

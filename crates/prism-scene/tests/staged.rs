@@ -264,19 +264,19 @@ fn cornell_scenes_match_the_recorded_layout() {
     ));
     assert!(s.spheres.iter().all(|x| (x.radius - 0.3).abs() < 1e-5));
     assert_eq!(s.lights.len(), 1);
-    let Light::Area {
-        center,
-        dim_x,
-        dim_y,
-        normal,
-        radiance,
+    let Light::Parallelogram {
+        corner,
+        edges: [dim_x, dim_y],
+        colors,
+        facing: Some(normal),
     } = &s.lights[0]
     else {
         panic!("expected an area light: {:?}", s.lights)
     };
-    assert!(close(*center, [0.0, 1.49, 0.0]) && close(*normal, [0.0, -1.0, 0.0]));
+    let center = *corner + 0.5 * *dim_x + 0.5 * *dim_y;
+    assert!(close(center, [0.0, 1.49, 0.0]) && close(*normal, [0.0, -1.0, 0.0]));
     assert!((dim_x.cross(*dim_y).length() - 0.48).abs() < 1e-4);
-    assert_eq!(radiance.to_array(), [10.0, 10.0, 10.0]);
+    assert!(colors.iter().all(|c| c.to_array() == [10.0, 10.0, 10.0]));
     let (h, v) = s.camera.fov_for(512, 384);
     assert!(
         (h - 49.134).abs() < 1e-2 && (v - 37.849).abs() < 1e-2,

@@ -313,6 +313,7 @@ impl WhittedTracer<'_> {
                 corner,
                 edges,
                 colors,
+                facing,
             } => {
                 if !f.soft_shadow {
                     return Rgb::BLACK;
@@ -324,6 +325,10 @@ impl WhittedTracer<'_> {
                         let a = (i as f32 + self.sampler.next_1d()) / k as f32;
                         let b = (j as f32 + self.sampler.next_1d()) / k as f32;
                         let q = corner + a * edges[0] + b * edges[1];
+                        // A one-sided light gives nothing behind its plane.
+                        if facing.is_some_and(|n| n.dot(hit.p - q) <= 0.0) {
+                            continue;
+                        }
                         let c = parallelogram_color(&colors, a, b);
                         sum += self.sample(
                             hit,

@@ -187,13 +187,15 @@ impl Scene {
                                 let area = dim_x.cross(dim_y).length();
                                 let normal = dir.try_normalize();
                                 match normal {
-                                    Some(n) if area > 0.0 && area.is_finite() => scene.lights.push(Light::Area {
-                                        center: v3(center),
-                                        dim_x: v3(dim_x),
-                                        dim_y: v3(dim_y),
-                                        normal: v3(n),
-                                        radiance: l.color,
-                                    }),
+                                    Some(n) if area > 0.0 && area.is_finite() => {
+                                        let (c, dx, dy) = (v3(center), v3(dim_x), v3(dim_y));
+                                        scene.lights.push(Light::Parallelogram {
+                                            corner: c - 0.5 * dx - 0.5 * dy,
+                                            edges: [dx, dy],
+                                            colors: [l.color; 4],
+                                            facing: Some(v3(n)),
+                                        });
+                                    }
                                     _ => {
                                         return Err(err(
                                             node.line,
