@@ -20,17 +20,10 @@ fn render(scene: &Scene, camera: &OrbitCamera) {
         return;
     }
     let features = Features {
-        shading: true,
-        recursive: true,
-        hard_shadow: true,
-        soft_shadow: true,
-        normal_interp: true,
-        texture_mapping: true,
-        accel_structure: true,
         bloom: true,
         multiple_rays_per_pixel: true,
         transparency: true,
-        bilinear: true,
+        ..Features::prism_defaults()
     };
     let opts = RaytraceOptions {
         width: 4,

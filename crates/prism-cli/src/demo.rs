@@ -468,7 +468,7 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
     use prism_render::{raytrace, trace_pixel, OrbitView, Overlay, RaytraceOptions, WhittedScene};
     use prism_scene::{OrbitCamera, Preset};
     let dirs = vec![a.assets.join("delft-raytracer/data")];
-    let on = crate::raytrace::default_features();
+    let on = prism_scene::Features::prism_defaults();
     let opts = |size: u32, features: prism_scene::Features| RaytraceOptions {
         width: size,
         height: size,

@@ -139,22 +139,6 @@ fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()>
     Ok(())
 }
 
-/// The features prism starts with when no config sets them.
-#[must_use]
-pub fn default_features() -> Features {
-    Features {
-        shading: true,
-        recursive: true,
-        hard_shadow: true,
-        soft_shadow: true,
-        normal_interp: true,
-        texture_mapping: true,
-        accel_structure: true,
-        bilinear: true,
-        ..Features::default()
-    }
-}
-
 /// The staged data folder, when prism runs from its source tree.
 fn staged_data() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data")
@@ -262,7 +246,7 @@ fn load(a: &RaytraceArgs) -> Result<Loaded> {
     Ok(Loaded {
         scene,
         cameras: vec![OrbitCamera::default()],
-        features: default_features(),
+        features: Features::prism_defaults(),
         window: None,
     })
 }

@@ -13,17 +13,7 @@ use prism_render::{
 use prism_scene::{Features, Light, Material, OrbitCamera, Preset, Scene, Shading, TriangleMesh};
 
 fn all_on() -> Features {
-    Features {
-        shading: true,
-        recursive: true,
-        hard_shadow: true,
-        soft_shadow: true,
-        normal_interp: true,
-        texture_mapping: true,
-        accel_structure: true,
-        bilinear: true,
-        ..Features::default()
-    }
+    Features::prism_defaults()
 }
 
 fn options(w: u32, h: u32, features: Features) -> RaytraceOptions {

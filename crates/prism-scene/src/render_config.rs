@@ -49,6 +49,25 @@ pub struct Features {
     pub bilinear: bool,
 }
 
+impl Features {
+    /// prism's switches when no config sets them: everything on but bloom, transparency
+    /// and multiple rays per pixel.
+    #[must_use]
+    pub fn prism_defaults() -> Features {
+        Features {
+            shading: true,
+            recursive: true,
+            hard_shadow: true,
+            soft_shadow: true,
+            normal_interp: true,
+            texture_mapping: true,
+            accel_structure: true,
+            bilinear: true,
+            ..Features::default()
+        }
+    }
+}
+
 /// What a config renders.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SceneSource {

@@ -371,6 +371,20 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// A scene with nothing in it but the camera.
+    #[must_use]
+    pub fn new(camera: Camera) -> Scene {
+        Scene {
+            meshes: Vec::new(),
+            spheres: Vec::new(),
+            materials: Vec::new(),
+            material_names: Vec::new(),
+            lights: Vec::new(),
+            camera,
+            warnings: Vec::new(),
+        }
+    }
+
     /// The name of material `i`: the file's, else `material i`.
     #[must_use]
     pub fn material_name(&self, i: usize) -> String {

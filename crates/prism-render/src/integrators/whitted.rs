@@ -131,6 +131,17 @@ pub struct WhittedTracer<'a> {
 
 const RED: Rgb = Rgb::new(1.0, 0.0, 0.0);
 
+/// What every light sample at one hit needs: the hit, the direction to the viewer, the
+/// material's (possibly textured) colours and exponent, and the bounce.
+struct ShadePoint<'h> {
+    hit: &'h WhittedHit,
+    v: Vec3,
+    kd: Rgb,
+    ks: Rgb,
+    shininess: f32,
+    depth: u32,
+}
+
 /// The Phong response `c (kd (n.l) + ks max(r.v, 0)^Ns)` to light of colour `c` from unit
 /// direction `l`, seen along unit `v`; zero when `n.l <= 0`.
 #[must_use]
@@ -226,10 +237,17 @@ impl WhittedTracer<'_> {
             return kd;
         }
         let (ks, shininess, transparency) = (m.ks, m.shininess, m.transparency);
-        let v = -ray.dir;
+        let at = ShadePoint {
+            hit,
+            v: -ray.dir,
+            kd,
+            ks,
+            shininess,
+            depth,
+        };
         let mut local = Rgb::BLACK;
         for li in 0..self.scene.lights.len() {
-            local += self.light(li, hit, v, kd, ks, shininess, depth);
+            local += self.light(li, &at);
         }
         let mut color = local;
         if f.recursive && ks != Rgb::BLACK && depth < self.settings.max_depth {
@@ -255,35 +273,14 @@ impl WhittedTracer<'_> {
         color
     }
 
-    /// One light's contribution at a hit.
-    #[allow(clippy::too_many_arguments)]
-    fn light(
-        &mut self,
-        li: usize,
-        hit: &WhittedHit,
-        v: Vec3,
-        kd: Rgb,
-        ks: Rgb,
-        shininess: f32,
-        depth: u32,
-    ) -> Rgb {
+    /// One light's contribution at a shading point.
+    fn light(&mut self, li: usize, at: &ShadePoint<'_>) -> Rgb {
         let f = self.settings.features;
         match self.scene.lights[li] {
             Light::Point {
                 position,
                 intensity,
-            } => self.sample(
-                hit,
-                v,
-                kd,
-                ks,
-                shininess,
-                position,
-                intensity,
-                f.hard_shadow,
-                RayKind::Shadow,
-                depth,
-            ),
+            } => self.sample(at, position, intensity, f.hard_shadow, RayKind::Shadow),
             Light::Segment { endpoints, colors } => {
                 if !f.soft_shadow {
                     return Rgb::BLACK;
@@ -294,18 +291,7 @@ impl WhittedTracer<'_> {
                     let t = (i as f32 + self.sampler.next_1d()) / n as f32;
                     let q = endpoints[0] + t * (endpoints[1] - endpoints[0]);
                     let c = colors[0] * (1.0 - t) + colors[1] * t;
-                    sum += self.sample(
-                        hit,
-                        v,
-                        kd,
-                        ks,
-                        shininess,
-                        q,
-                        c,
-                        true,
-                        RayKind::AreaSample,
-                        depth,
-                    );
+                    sum += self.sample(at, q, c, true, RayKind::AreaSample);
                 }
                 sum * (1.0 / n as f32)
             }
@@ -326,22 +312,11 @@ impl WhittedTracer<'_> {
                         let b = (j as f32 + self.sampler.next_1d()) / k as f32;
                         let q = corner + a * edges[0] + b * edges[1];
                         // A one-sided light gives nothing behind its plane.
-                        if facing.is_some_and(|n| n.dot(hit.p - q) <= 0.0) {
+                        if facing.is_some_and(|n| n.dot(at.hit.p - q) <= 0.0) {
                             continue;
                         }
                         let c = parallelogram_color(&colors, a, b);
-                        sum += self.sample(
-                            hit,
-                            v,
-                            kd,
-                            ks,
-                            shininess,
-                            q,
-                            c,
-                            true,
-                            RayKind::AreaSample,
-                            depth,
-                        );
+                        sum += self.sample(at, q, c, true, RayKind::AreaSample);
                     }
                 }
                 sum * (1.0 / (k * k) as f32)
@@ -352,20 +327,15 @@ impl WhittedTracer<'_> {
     }
 
     /// Phong for one light sample at `q` of colour `c`, shadow-tested if `shadowed`.
-    #[allow(clippy::too_many_arguments)]
     fn sample(
         &mut self,
-        hit: &WhittedHit,
-        v: Vec3,
-        kd: Rgb,
-        ks: Rgb,
-        shininess: f32,
+        at: &ShadePoint<'_>,
         q: Vec3,
         c: Rgb,
         shadowed: bool,
         kind: RayKind,
-        depth: u32,
     ) -> Rgb {
+        let hit = at.hit;
         let to = q - hit.p;
         let dist = to.length();
         let l = to / dist;
@@ -391,7 +361,7 @@ impl WhittedTracer<'_> {
         let blocked = blocked_at.is_some();
         self.push(DebugRay {
             kind,
-            depth,
+            depth: at.depth,
             origin: hit.p,
             end: q,
             color: if blocked { RED } else { c },
@@ -402,7 +372,7 @@ impl WhittedTracer<'_> {
         if blocked {
             return Rgb::BLACK;
         }
-        phong(hit.n_s, l, v, kd, ks, shininess, c)
+        phong(hit.n_s, l, at.v, at.kd, at.ks, at.shininess, c)
     }
 }
 

@@ -37,24 +37,17 @@ impl Scene {
         file: &str,
     ) -> Result<Scene, SceneError> {
         let up = doc.up_axis.to_y_up();
-        let mut scene = Scene {
-            meshes: Vec::new(),
-            spheres: Vec::new(),
-            materials: Vec::new(),
-            material_names: Vec::new(),
-            lights: Vec::new(),
-            camera: Camera {
-                eye: Vec3::ZERO,
-                target: Vec3::NEG_Z,
-                up: Vec3::Y,
-                hfov: 50.0,
-                vfov: 35.0,
-                near: 0.001,
-                far: 1000.0,
-                lens: None,
-            },
-            warnings: doc.warnings.clone(),
-        };
+        let mut scene = Scene::new(Camera {
+            eye: Vec3::ZERO,
+            target: Vec3::NEG_Z,
+            up: Vec3::Y,
+            hfov: 50.0,
+            vfov: 35.0,
+            near: 0.001,
+            far: 1000.0,
+            lens: None,
+        });
+        scene.warnings.clone_from(&doc.warnings);
         let err = |line: u32, element: &str, message: String| SceneError::Element {
             file: file.to_string(),
             line,

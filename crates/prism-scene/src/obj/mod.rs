@@ -72,6 +72,40 @@ pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
     })
 }
 
+/// One non-empty line of an OBJ or MTL file, comments removed.
+pub(crate) struct Statement<'t> {
+    /// 1-based line.
+    pub line: u32,
+    /// The first word.
+    pub key: &'t str,
+    /// The whole line, trimmed, the key included.
+    pub content: &'t str,
+}
+
+impl Statement<'_> {
+    /// An error at this line of `file`.
+    pub fn error(&self, file: &str, message: String) -> SceneError {
+        SceneError::Line {
+            file: file.to_string(),
+            line: self.line,
+            message,
+        }
+    }
+}
+
+/// The statements of OBJ or MTL text, in order.
+pub(crate) fn statements(text: &str) -> impl Iterator<Item = Statement<'_>> {
+    text.lines().enumerate().filter_map(|(ln, raw)| {
+        let content = raw.split('#').next().unwrap_or("").trim();
+        let key = content.split_whitespace().next()?;
+        Some(Statement {
+            line: (ln + 1) as u32,
+            key,
+            content,
+        })
+    })
+}
+
 /// One corner of a face: indices into the position, uv and normal lists.
 #[derive(Clone, Copy)]
 struct Corner {
@@ -108,16 +142,10 @@ pub fn parse_obj_scene(
     // A shape boundary (`o`, `g`) or a material change starts a new run.
     let mut new_run = true;
     let mut corners: Vec<Corner> = Vec::new();
-    for (ln, raw) in text.lines().enumerate() {
-        let line = (ln + 1) as u32;
-        let err = |message: String| SceneError::Line {
-            file: file.to_string(),
-            line,
-            message,
-        };
-        let content = raw.split('#').next().unwrap_or("").trim();
-        let mut words = content.split_whitespace();
-        let Some(key) = words.next() else { continue };
+    for st in statements(text) {
+        let (key, content) = (st.key, st.content);
+        let err = |message: String| st.error(file, message);
+        let mut words = content.split_whitespace().skip(1);
         let mut numbers = |n: usize, what: &str| -> Result<[f32; 3], SceneError> {
             let mut out = [0.0; 3];
             for (k, slot) in out.iter_mut().take(n).enumerate() {
@@ -208,15 +236,7 @@ pub fn parse_obj_scene(
         }
     }
 
-    let mut scene = Scene {
-        meshes: Vec::new(),
-        spheres: Vec::new(),
-        materials: Vec::new(),
-        material_names: Vec::new(),
-        lights: Vec::new(),
-        camera: OrbitCamera::default().to_camera(1.0),
-        warnings: Vec::new(),
-    };
+    let mut scene = Scene::new(OrbitCamera::default().to_camera(1.0));
     // Materials in the order they are first used; faces without one share the default.
     let mut material_slot: HashMap<Option<usize>, usize> = HashMap::new();
     for run in &runs {

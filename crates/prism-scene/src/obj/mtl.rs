@@ -30,16 +30,10 @@ pub(crate) struct MtlMaterial {
 /// Parses MTL text; `file` names it in errors.
 pub(crate) fn parse_mtl(text: &str, file: &str) -> Result<Vec<MtlMaterial>, SceneError> {
     let mut out: Vec<MtlMaterial> = Vec::new();
-    for (ln, raw) in text.lines().enumerate() {
-        let line = (ln + 1) as u32;
-        let err = |message: String| SceneError::Line {
-            file: file.to_string(),
-            line,
-            message,
-        };
-        let content = raw.split('#').next().unwrap_or("").trim();
-        let mut words = content.split_whitespace();
-        let Some(key) = words.next() else { continue };
+    for st in super::statements(text) {
+        let (line, key, content) = (st.line, st.key, st.content);
+        let err = |message: String| st.error(file, message);
+        let mut words = content.split_whitespace().skip(1);
         if key == "newmtl" {
             let name = content[key.len()..].trim();
             if name.is_empty() {
