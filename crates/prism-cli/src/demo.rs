@@ -575,19 +575,19 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         file: "raytrace_bvh_level.png".into(),
         caption: "the BVH's level 1 over the mirror Cornell box (--bvh-level 1)".into(),
     });
-    // The first pixel of the middle row whose camera ray meets the mirror box.
-    let mirror = (0..300).find_map(|x| {
-        let t = trace_pixel(&ws, &cam, &o, x, 170);
-        let on_mirror = t
-            .rays
-            .first()
-            .and_then(|r| r.hit.as_ref())
-            .is_some_and(|h| h.0 == "tallBox");
-        on_mirror.then_some(t)
-    });
-    if let Some(t) = mirror {
+    // The middle one of the pixels of row 120 whose camera rays meet the mirror box.
+    let on_mirror: Vec<_> = (0..300)
+        .map(|x| trace_pixel(&ws, &cam, &o, x, 120))
+        .filter(|t| {
+            t.rays
+                .first()
+                .and_then(|r| r.hit.as_ref())
+                .is_some_and(|h| h.0 == "tallBox")
+        })
+        .collect();
+    if let Some(t) = on_mirror.get(on_mirror.len() / 2) {
         let debug_cam = OrbitCamera {
-            rotation: prism_math::Vec3::new(35.0, -30.0, 0.0),
+            rotation: prism_math::Vec3::new(10.0, -15.0, 0.0),
             distance: 3.2,
             ..cam
         };
@@ -611,7 +611,7 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         entries.push(Entry {
             file: "raytrace_debug_pixel.png".into(),
             caption: format!(
-                "the ray tree of pixel {},{} on the mirror box, seen from another orbit                  (--debug-pixel {},{} --debug-camera 35,-30,0,3.2)",
+                "the ray tree of pixel {},{} on the mirror box, seen from another orbit                  (--debug-pixel {},{} --debug-camera 10,-15,0,3.2)",
                 t.pixel.0, t.pixel.1, t.pixel.0, t.pixel.1
             ),
         });

@@ -35,8 +35,9 @@ impl Overlay {
         Overlay { image, view, depth }
     }
 
-    /// Draws the segment `a`-`b` in `color` (clamped to [0, 1]); with `depth_test`, only
-    /// where it is not behind the scene's surface (within 0.5% of the depth).
+    /// Draws the segment `a`-`b`, two pixels wide, in `color` (clamped to [0, 1]); with
+    /// `depth_test`, only where it is not behind the scene's surface (within 0.5% of the
+    /// depth).
     pub fn segment(&mut self, a: Vec3, b: Vec3, color: Rgb, depth_test: bool) {
         // Clip to the part in front of the eye by sampling in world space.
         let (w, h) = (self.image.width(), self.image.height());
@@ -66,7 +67,12 @@ impl Overlay {
             if depth_test && z > d * 1.005 {
                 continue;
             }
-            self.image.set(px, py, c);
+            // Two pixels wide, so that lines read at any size.
+            for (qx, qy) in [(px, py), (px + 1, py), (px, py + 1), (px + 1, py + 1)] {
+                if qx < w && qy < h {
+                    self.image.set(qx, qy, c);
+                }
+            }
         }
     }
 
