@@ -209,6 +209,33 @@ impl OrbitView {
         Ray::new(self.eye, self.world_from_camera.vector(local).normalize())
     }
 
+    /// The directions of the rays through the lower-left corners of the pixels `x = 0, 1,
+    /// ...` of row `y` (counted from the bottom), the same bits as [`OrbitView::ray`] gives,
+    /// computed a row at a time so that the square roots and divisions run on SIMD lanes.
+    pub fn corner_directions(&self, y: u32, out: &mut Vec<Vec3>) {
+        let n = self.width as usize;
+        let ly = (2.0 * y as f32 / self.height - 1.0) * self.hh;
+        let lx: Vec<f32> = (0..n)
+            .map(|x| -(2.0 * x as f32 / self.width - 1.0) * self.hw)
+            .collect();
+        // As `Vec3::normalize`: times the reciprocal of the length, x, y, z summed in order.
+        let r1: Vec<f32> = lx
+            .iter()
+            .map(|&x| 1.0 / (x * x + ly * ly + 1.0).sqrt())
+            .collect();
+        let w: Vec<Vec3> = lx
+            .iter()
+            .zip(&r1)
+            .map(|(&x, &r)| self.world_from_camera.vector(Vec3::new(x * r, ly * r, r)))
+            .collect();
+        let r2: Vec<f32> = w
+            .iter()
+            .map(|v| 1.0 / (v.x * v.x + v.y * v.y + v.z * v.z).sqrt())
+            .collect();
+        out.clear();
+        out.extend(w.iter().zip(&r2).map(|(&v, &r)| v * r));
+    }
+
     /// Where a world point lands: `(x, y from the top, depth along the view axis)` in
     /// pixels of the written image (row 0 at the top), or `None` behind the eye.
     #[must_use]

@@ -5,7 +5,7 @@
 use std::sync::Mutex;
 
 use prism_image::{Bloom, Image, RgbImage};
-use prism_math::Rgb;
+use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
 use crate::camera::OrbitView;
@@ -58,17 +58,24 @@ fn rays_per_pixel(opts: &RaytraceOptions) -> u32 {
     }
 }
 
-/// The colour of the pixel at written position `(x, row)` (row 0 at the top), with every
-/// ray recorded into `record` if given.
+/// What every pixel of one render shares.
+struct Frame<'a> {
+    scene: &'a WhittedScene,
+    view: OrbitView,
+    opts: &'a RaytraceOptions,
+}
+
+/// The colour of the pixel at written position `(x, row)` (row 0 at the top), its single
+/// ray along `corner_dir` if given, with every ray recorded into `record` if given.
 fn pixel(
-    scene: &WhittedScene,
-    view: &OrbitView,
-    opts: &RaytraceOptions,
+    f: &Frame<'_>,
     x: u32,
     row: u32,
+    corner_dir: Option<prism_math::Vec3>,
     counts: &mut RayCounts,
     record: Option<&mut Vec<DebugRay>>,
 ) -> Rgb {
+    let (scene, view, opts) = (f.scene, &f.view, f.opts);
     let y = opts.height - 1 - row;
     let n = rays_per_pixel(opts);
     let mut sum = Rgb::BLACK;
@@ -80,7 +87,10 @@ fn pixel(
         } else {
             (0.0, 0.0)
         };
-        let ray = view.ray(x as f32 + jx, y as f32 + jy);
+        let ray = match corner_dir {
+            Some(d) if n == 1 => Ray::new(view.eye(), d),
+            _ => view.ray(x as f32 + jx, y as f32 + jy),
+        };
         let mut tracer = WhittedTracer {
             scene,
             settings: &opts.settings,
@@ -108,25 +118,31 @@ pub fn raytrace(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Raytraced {
     let view = OrbitView::new(camera, opts.width, opts.height);
+    let frame = Frame { scene, view, opts };
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
-    let rows: Vec<Vec<Rgb>> = (0..opts.height)
-        .into_par_iter()
-        .map(|row| {
+    let mut image = Image::new(opts.width, opts.height, Rgb::BLACK);
+    image
+        .pixels_mut()
+        .par_chunks_mut(opts.width as usize)
+        .enumerate()
+        .for_each(|(row, line)| {
             let mut counts = RayCounts::default();
-            let line = (0..opts.width)
-                .map(|x| pixel(scene, &view, opts, x, row, &mut counts, None))
-                .collect();
+            let mut dirs = Vec::new();
+            if rays_per_pixel(opts) == 1 {
+                view.corner_directions(opts.height - 1 - row as u32, &mut dirs);
+            }
+            for (x, p) in line.iter_mut().enumerate() {
+                let d = dirs.get(x).copied();
+                *p = pixel(&frame, x as u32, row as u32, d, &mut counts, None);
+            }
             totals
                 .lock()
                 .expect("no panics under the lock")
                 .add(&counts);
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(d);
-            line
-        })
-        .collect();
-    let image = Image::from_vec(opts.width, opts.height, rows.concat());
+        });
     let counts = totals.into_inner().expect("no panics under the lock");
     if opts.settings.features.bloom {
         let layer = opts.bloom.layer(&image);
@@ -179,7 +195,8 @@ pub fn trace_pixel(
     let view = OrbitView::new(camera, opts.width, opts.height);
     let mut rays = Vec::new();
     let mut counts = RayCounts::default();
-    let color = pixel(scene, &view, opts, x, row, &mut counts, Some(&mut rays));
+    let frame = Frame { scene, view, opts };
+    let color = pixel(&frame, x, row, None, &mut counts, Some(&mut rays));
     PixelTrace {
         pixel: (x, row),
         color,

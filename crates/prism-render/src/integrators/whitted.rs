@@ -150,13 +150,20 @@ pub fn phong(n: Vec3, l: Vec3, v: Vec3, kd: Rgb, ks: Rgb, shininess: f32, c: Rgb
     if nl <= 0.0 {
         return Rgb::BLACK;
     }
+    if ks == Rgb::BLACK {
+        // The same value without the costly power: ks x (a finite number) is 0.
+        return c * (kd * nl + ks);
+    }
     let r = 2.0 * nl * n - l;
     let spec = r.dot(v).max(0.0).powf(shininess);
     c * (kd * nl + ks * spec)
 }
 
 impl WhittedTracer<'_> {
-    fn push(&mut self, ray: DebugRay) -> Option<usize> {
+    /// Records a ray built by `make`, only when recording (building one costs a string).
+    fn push(&mut self, make: impl FnOnce(&Self) -> DebugRay) -> Option<usize> {
+        self.record.as_ref()?;
+        let ray = make(self);
         let rec = self.record.as_mut()?;
         rec.push(ray);
         Some(rec.len() - 1)
@@ -171,7 +178,7 @@ impl WhittedTracer<'_> {
         }
         let f = self.settings.features;
         let hit = self.scene.intersect(ray, f32::INFINITY, f.normal_interp);
-        let slot = self.push(DebugRay {
+        let slot = self.push(|_| DebugRay {
             kind,
             depth,
             origin: ray.origin,
@@ -199,7 +206,7 @@ impl WhittedTracer<'_> {
         let m: &PhongMaterial = &self.scene.materials[hit.material as usize];
         if self.record.is_some() {
             let len = 0.05 * self.scene.size();
-            self.push(DebugRay {
+            self.push(|_| DebugRay {
                 kind: RayKind::Normal,
                 depth,
                 origin: hit.p,
@@ -210,7 +217,7 @@ impl WhittedTracer<'_> {
                 hit: None,
             });
             if f.normal_interp {
-                self.push(DebugRay {
+                self.push(|_| DebugRay {
                     kind: RayKind::InterpolatedNormal,
                     depth,
                     origin: hit.p,
@@ -338,7 +345,8 @@ impl WhittedTracer<'_> {
         let hit = at.hit;
         let to = q - hit.p;
         let dist = to.length();
-        let l = to / dist;
+        // normalize(q - p), as `Vec3::normalize` computes it.
+        let l = to * dist.recip();
         // Also refuses a light at the hit point itself (NaN direction).
         if hit.n_s.dot(l).is_nan() || hit.n_s.dot(l) <= 0.0 {
             return Rgb::BLACK;
@@ -359,7 +367,7 @@ impl WhittedTracer<'_> {
             }
         }
         let blocked = blocked_at.is_some();
-        self.push(DebugRay {
+        self.push(|_| DebugRay {
             kind,
             depth: at.depth,
             origin: hit.p,
