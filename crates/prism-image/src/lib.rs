@@ -1,6 +1,6 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
 //! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
-//! heat maps and bloom.
+//! heat maps, bloom, and BMP output.
 #![warn(missing_docs)]
 
 mod bloom;
