@@ -27,8 +27,8 @@ pub use camera::{OrbitView, Perspective};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use film::{render, RenderOptions, Rendered};
 pub use integrators::whitted::{
-    parallelogram_color, parallelogram_grid, phong, DebugRay, RayCounts, RayKind, WhittedSettings,
-    WhittedTracer, MISS_LENGTH, RAY_EPSILON,
+    parallelogram_color, parallelogram_grid, phong, DebugRay, PixelSampler, RayCounts, RayKind,
+    WhittedSettings, WhittedTracer, MISS_LENGTH, RAY_EPSILON,
 };
 pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;

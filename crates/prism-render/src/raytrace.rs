@@ -9,8 +9,9 @@ use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
 use crate::camera::OrbitView;
-use crate::integrators::whitted::{DebugRay, RayCounts, RayKind, WhittedSettings, WhittedTracer};
-use crate::sampler::Sampler;
+use crate::integrators::whitted::{
+    DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
+};
 use crate::whitted_scene::WhittedScene;
 
 /// Whitted render settings.
@@ -41,8 +42,8 @@ pub struct Raytraced {
 }
 
 /// The sampler of ray `s` of the pixel at written position `(x, row)`.
-fn pixel_sampler(opts: &RaytraceOptions, x: u32, row: u32, s: u32) -> Sampler {
-    Sampler::new(
+fn pixel_sampler(opts: &RaytraceOptions, x: u32, row: u32, s: u32) -> PixelSampler {
+    PixelSampler::new(
         opts.seed,
         u64::from(row) * u64::from(opts.width) + u64::from(x),
         u64::from(s),

@@ -115,6 +115,34 @@ impl RayCounts {
     }
 }
 
+/// A pixel's sampler, keyed on its first number: most pixels of a scene without area
+/// lights or jitter never draw one, and keying costs a hash. Draws the same numbers as
+/// [`Sampler::new`] with the same words.
+#[derive(Clone, Debug)]
+pub struct PixelSampler {
+    words: [u64; 3],
+    inner: Option<Sampler>,
+}
+
+impl PixelSampler {
+    /// The sampler of sample `index` of pixel `pixel` (as [`Sampler::new`]).
+    #[must_use]
+    pub fn new(seed: u64, pixel: u64, index: u64) -> PixelSampler {
+        PixelSampler {
+            words: [seed, pixel, index],
+            inner: None,
+        }
+    }
+
+    /// The next dimension's value in `[0, 1)`.
+    pub fn next_1d(&mut self) -> f32 {
+        let [a, b, c] = self.words;
+        self.inner
+            .get_or_insert_with(|| Sampler::new(a, b, c))
+            .next_1d()
+    }
+}
+
 /// One ray tree's state: the scene, settings, sampler, counters and optional record.
 pub struct WhittedTracer<'a> {
     /// The scene.
@@ -122,7 +150,7 @@ pub struct WhittedTracer<'a> {
     /// The settings.
     pub settings: &'a WhittedSettings,
     /// Random numbers for light-sample jitter.
-    pub sampler: Sampler,
+    pub sampler: PixelSampler,
     /// Rays cast so far.
     pub counts: RayCounts,
     /// When set, every ray is recorded here.
