@@ -1,9 +1,10 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
 //! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
-//! heat maps, bloom, and BMP output.
+//! cube maps looked up as OpenGL does, heat maps, bloom, and BMP output.
 #![warn(missing_docs)]
 
 mod bloom;
+mod cubemap;
 mod diff;
 mod error;
 mod exr;
@@ -14,6 +15,7 @@ mod srgb;
 mod texture;
 
 pub use bloom::{bloom_weights, Bloom};
+pub use cubemap::{cube_face, CubeMap, CUBE_FACES};
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{decode_exr, encode_exr, read_exr, write_exr};
