@@ -7,6 +7,7 @@ mod output;
 mod progress;
 mod raytrace;
 mod render;
+mod shade;
 mod svg;
 
 use std::process::ExitCode;
@@ -33,6 +34,8 @@ enum Command {
     Render(render::RenderArgs),
     /// Whitted-ray-trace a Delft scene (preset, OBJ or TOML config), with visual debugging.
     Raytrace(raytrace::RaytraceArgs),
+    /// Draw a mesh with one of the course's shaders, as its OpenGL app would, on the CPU.
+    Shade(shade::ShadeArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -82,6 +85,7 @@ fn main() -> ExitCode {
         Command::Mesh(a) => mesh::run(&a),
         Command::Render(a) => render::run(&a),
         Command::Raytrace(a) => raytrace::run(&a),
+        Command::Shade(a) => shade::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

@@ -1,0 +1,329 @@
+//! `prism shade`: a mesh drawn by the software pipeline with one of the course's shaders,
+//! as the course app's OpenGL would draw it.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use prism_math::{Rgb, Vec3};
+use prism_shade::{
+    course_texture, shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View,
+};
+
+use crate::output::{image_output, ImageFormat};
+use crate::UserError;
+
+/// The shader.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ShaderArg {
+    /// The normal as a colour, (n + 1) / 2.
+    Normal,
+    /// The flat colour (white).
+    Wireframe,
+    /// I / r^2 max(n.l, 0).
+    Diffuse,
+    /// Blinn-Phong: ambient 0.1, diffuse 0.8, specular 0.5 with exponent 32.
+    Phong,
+    /// The texture's colour (--texture).
+    Texture,
+    /// Blinn-Phong with the normal bent by a height map (--height-map).
+    Bump,
+    /// Vertices moved along their normals by the height map, then bump shading.
+    Displacement,
+    /// The cube map (--cubemap) along the mirror direction.
+    Mirror,
+}
+
+/// Arguments of `prism shade`.
+#[derive(Args, Debug)]
+pub struct ShadeArgs {
+    /// The mesh: .obj (with its uvs and normals), .ply or .dae.
+    mesh: PathBuf,
+    /// Output image: .png, .bmp or .jpg (round(255 clamp(c)), no gamma, as OpenGL writes).
+    #[arg(short, long, default_value = "shade.png")]
+    output: PathBuf,
+    /// The shader.
+    #[arg(long, value_enum, default_value_t = ShaderArg::Phong)]
+    shader: ShaderArg,
+    /// Eye position X,Y,Z (default: in front of the mesh along +z, framing its bounds).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    eye: Option<Vec<f32>>,
+    /// The point looked at (default: the centre of the mesh's bounds).
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    target: Option<Vec<f32>>,
+    /// Up direction.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        default_value = "0,1,0"
+    )]
+    up: Vec<f32>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 45.0)]
+    fov_y: f32,
+    /// Image size: WIDTH HEIGHT.
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [800, 600])]
+    resolution: Vec<u32>,
+    /// Samples per pixel: a square number (1, 4, 9, 16, ...).
+    #[arg(long, default_value_t = 1)]
+    samples: u32,
+    /// Texture for --shader texture (default: the course's texture_1.png when staged).
+    #[arg(long, value_name = "PNG")]
+    texture: Option<PathBuf>,
+    /// Height map for --shader bump and displacement (its red channel).
+    #[arg(long, value_name = "PNG")]
+    height_map: Option<PathBuf>,
+    /// Folder with the cube map's faces posx, negx, posy, negy, posz, negz (.png or .jpg)
+    /// for --shader mirror (default: the course's textures/cube when staged).
+    #[arg(long, value_name = "DIR")]
+    cubemap: Option<PathBuf>,
+    /// Light position.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        default_value = "0.5,2,2"
+    )]
+    light: Vec<f32>,
+    /// Light intensity.
+    #[arg(
+        long,
+        value_name = "R,G,B",
+        value_delimiter = ',',
+        default_value = "3,3,3"
+    )]
+    light_intensity: Vec<f32>,
+    /// Background colour.
+    #[arg(
+        long,
+        value_name = "R,G,B",
+        value_delimiter = ',',
+        default_value = "0,0,0"
+    )]
+    background: Vec<f32>,
+    /// Draw every triangle's edges on top (depth-tested), in this colour.
+    #[arg(long, value_name = "R,G,B", value_delimiter = ',')]
+    wireframe: Option<Vec<f32>>,
+    /// Print per-stage times on stderr: read, render (vertex stage to final image), write.
+    #[arg(long)]
+    stats: bool,
+    /// No summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn three(v: &[f32], flag: &str) -> Result<Vec3> {
+    if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
+        return Err(UserError(format!(
+            "{flag}: expected three finite numbers separated by commas, found {v:?}"
+        ))
+        .into());
+    }
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
+    let c = three(v, flag)?;
+    if c.min_element() < 0.0 {
+        return Err(UserError(format!(
+            "{flag}: expected values of at least 0, found {v:?}"
+        ))
+        .into());
+    }
+    Ok(Rgb::new(c.x, c.y, c.z))
+}
+
+/// The staged course assets, when prism runs from its source tree.
+fn staged(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/assets/clothsim/textures")
+        .join(rel)
+}
+
+fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
+    let img = prism_image::read_image(path)
+        .map_err(|e| UserError(format!("{flag} {}: {e}", path.display())))?;
+    Ok(img.to_rgb8().to_rgb_f32())
+}
+
+/// Reads the mesh by its extension.
+pub fn read_shade_mesh(path: &Path) -> Result<ShadeMesh> {
+    let user = |m: String| anyhow::Error::from(UserError(m));
+    if crate::output::extension(path) == "obj" {
+        let meta = std::fs::metadata(path).map_err(|e| user(format!("{}: {e}", path.display())))?;
+        if meta.len() > 1 << 30 {
+            return Err(user(format!("{}: over the 1 GiB limit", path.display())));
+        }
+        let text =
+            std::fs::read_to_string(path).map_err(|e| user(format!("{}: {e}", path.display())))?;
+        ShadeMesh::from_obj(&text, &path.display().to_string()).map_err(|e| user(e.to_string()))
+    } else {
+        let (mesh, warnings) = prism_scene::read_mesh(path).map_err(|e| user(e.to_string()))?;
+        for w in warnings {
+            eprintln!("prism: warning: {w}");
+        }
+        Ok(ShadeMesh::from_polymesh(&mesh))
+    }
+}
+
+/// Runs `prism shade`.
+pub fn run(a: &ShadeArgs) -> Result<()> {
+    let format = image_output(
+        &a.output,
+        "--output",
+        &[ImageFormat::Png, ImageFormat::Bmp, ImageFormat::Jpeg],
+    )?;
+    let (w, h) = (a.resolution[0], a.resolution[1]);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(UserError(format!(
+            "--resolution: expected 1 to 16384 pixels a side, found {w} x {h}"
+        ))
+        .into());
+    }
+    if a.samples == 0 || a.samples > 256 {
+        return Err(UserError(format!("--samples: expected 1 to 256, found {}", a.samples)).into());
+    }
+    let up = three(&a.up, "--up")?;
+    let light = three(&a.light, "--light")?;
+    let intensity = colour(&a.light_intensity, "--light-intensity")?;
+    let background = colour(&a.background, "--background")?;
+    let wire = a
+        .wireframe
+        .as_deref()
+        .map(|c| colour(c, "--wireframe"))
+        .transpose()?;
+    let t0 = Instant::now();
+    let mesh = read_shade_mesh(&a.mesh)?;
+    let shader = match a.shader {
+        ShaderArg::Normal => Shader::Normal,
+        ShaderArg::Wireframe => Shader::Wireframe,
+        ShaderArg::Diffuse => Shader::Diffuse,
+        ShaderArg::Phong => Shader::Phong,
+        ShaderArg::Texture => {
+            let path = a.texture.clone().unwrap_or_else(|| staged("texture_1.png"));
+            Shader::Texture(course_texture(load_rgb(&path, "--texture")?))
+        }
+        ShaderArg::Bump | ShaderArg::Displacement => {
+            let Some(path) = &a.height_map else {
+                return Err(UserError(format!(
+                    "--shader {:?}: it needs --height-map PNG",
+                    a.shader
+                ))
+                .into());
+            };
+            let map = course_texture(load_rgb(path, "--height-map")?);
+            if a.shader == ShaderArg::Bump {
+                Shader::Bump(map)
+            } else {
+                Shader::Displacement(map)
+            }
+        }
+        ShaderArg::Mirror => {
+            let dir = a.cubemap.clone().unwrap_or_else(|| staged("cube"));
+            let mut faces = Vec::new();
+            for name in prism_image::CUBE_FACES {
+                let path = ["png", "jpg", "jpeg"]
+                    .iter()
+                    .map(|e| dir.join(format!("{name}.{e}")))
+                    .find(|p| p.is_file())
+                    .ok_or_else(|| {
+                        UserError(format!(
+                            "--cubemap {}: no {name}.png or {name}.jpg",
+                            dir.display()
+                        ))
+                    })?;
+                faces.push(load_rgb(&path, "--cubemap")?);
+            }
+            let faces: [prism_image::RgbImage; 6] = faces.try_into().expect("six faces were read");
+            Shader::Mirror(
+                prism_image::CubeMap::new(faces)
+                    .map_err(|e| UserError(format!("--cubemap: {e}")))?,
+            )
+        }
+    };
+    if a.texture.is_some() && a.shader != ShaderArg::Texture {
+        eprintln!("prism: warning: --texture has no effect: it applies to --shader texture");
+    }
+    if a.height_map.is_some() && !matches!(a.shader, ShaderArg::Bump | ShaderArg::Displacement) {
+        eprintln!("prism: warning: --height-map has no effect: it applies to --shader bump and displacement");
+    }
+    if a.cubemap.is_some() && a.shader != ShaderArg::Mirror {
+        eprintln!("prism: warning: --cubemap has no effect: it applies to --shader mirror");
+    }
+    let (lo, hi) = mesh
+        .bounds()
+        .ok_or_else(|| UserError(format!("{}: the mesh has no vertices", a.mesh.display())))?;
+    let centre = (lo + hi) * 0.5;
+    let target = match &a.target {
+        Some(t) => three(t, "--target")?,
+        None => centre,
+    };
+    let eye = match &a.eye {
+        Some(e) => three(e, "--eye")?,
+        None => {
+            // Far enough that the bounding sphere fits the narrower field of view.
+            let r = ((hi - lo).length() * 0.5).max(1e-3);
+            let half = a.fov_y.to_radians() * 0.5;
+            let aspect = (w as f32 / h as f32).min(1.0);
+            let fit = (half.tan() * aspect).atan();
+            target + Vec3::new(0.0, 0.0, 1.1 * r / fit.sin())
+        }
+    };
+    let view = View {
+        eye,
+        target,
+        up,
+        fov_y: a.fov_y,
+        width: w,
+        height: h,
+    };
+    let uniforms = Uniforms {
+        light_pos: light,
+        light_intensity: intensity,
+        ..Uniforms::default()
+    };
+    let opts = ShadeOptions {
+        samples: a.samples,
+        background,
+        wireframe: wire,
+    };
+    let read = t0.elapsed();
+    let t1 = Instant::now();
+    let img =
+        shade(&mesh, &view, &shader, &uniforms, &opts).map_err(|e| UserError(e.to_string()))?;
+    let bytes = to_bytes(&img);
+    let render = t1.elapsed();
+    let t2 = Instant::now();
+    crate::output::write_rgb8(&a.output, format, &bytes).context("writing the picture")?;
+    let write = t2.elapsed();
+    if a.stats {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read: {:.1} ms", ms(read));
+        eprintln!("render: {:.1} ms", ms(render));
+        eprintln!("write: {:.1} ms", ms(write));
+    }
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        eprintln!(
+            "prism: shaded {} triangles at {w}x{h} with {} in {:.1} ms -> {}",
+            mesh.triangles.len(),
+            shader.name(),
+            render.as_secs_f64() * 1e3,
+            a.output.display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,24 @@
+//! [`ShadeError`], what can go wrong preparing a shaded picture.
+
+/// Everything that can go wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ShadeError {
+    /// A line of a mesh file is malformed.
+    #[error("{file}:{line}: {message}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// The camera cannot form a picture.
+    #[error("camera: {0}")]
+    Camera(String),
+    /// The sample count is not a square.
+    #[error(
+        "samples: expected a square number of samples per pixel (1, 4, 9, 16, ...), found {0}"
+    )]
+    Samples(u32),
+}

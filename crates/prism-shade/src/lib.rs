@@ -1,0 +1,21 @@
+//! Floor-3 shading for prism: a software 3D pipeline that draws what the CS184 course app's
+//! OpenGL set-up draws, on the CPU.
+//!
+//! - `mesh`: [`ShadeMesh`], one vertex per distinct corner with normals, uvs and tangents, as
+//!   the course app builds its buffers (from OBJ text, or any polygon mesh).
+//! - `shaders`: [`Shader`], the course's shaders with their [`Uniforms`] and formulas.
+//! - `pipeline`: [`shade`], vertex stage, clipping, depth-tested rasterization with
+//!   perspective-correct varyings, supersampling and an optional wireframe on top.
+#![warn(missing_docs)]
+
+mod error;
+mod mesh;
+mod pipeline;
+mod shaders;
+
+pub use error::ShadeError;
+pub use mesh::{ShadeMesh, MAX_FACE_CORNERS};
+pub use pipeline::{shade, to_bytes, ShadeOptions, View, FAR, NEAR};
+pub use shaders::{
+    blinn_phong, bumped_normal, course_texture, fragment, height, Shader, Uniforms, Varyings,
+};

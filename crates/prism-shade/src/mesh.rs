@@ -1,0 +1,329 @@
+//! [`ShadeMesh`], a mesh as OpenGL draws it: one vertex per distinct corner (position, uv,
+//! normal and tangent), triangles over them; built from OBJ text (the course app's rules) or
+//! from any polygon mesh prism reads.
+
+use std::collections::HashMap;
+
+use prism_math::glam::DVec3;
+use prism_math::{Vec2, Vec3};
+
+use crate::error::ShadeError;
+
+/// Most corners one OBJ face may have.
+pub const MAX_FACE_CORNERS: usize = 1 << 16;
+
+/// Vertex attributes and triangles, ready for the vertex stage.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShadeMesh {
+    /// Positions.
+    pub positions: Vec<Vec3>,
+    /// Unit normals.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates ((0, 0) where the file gives none).
+    pub uvs: Vec<Vec2>,
+    /// Unit tangents (see [`ShadeMesh::compute_tangents`]).
+    pub tangents: Vec<Vec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A unit vector, or `fallback` for one too short to normalise.
+fn unit_or(v: DVec3, fallback: DVec3) -> DVec3 {
+    let l = v.length();
+    if l > 1e-30 {
+        v / l
+    } else {
+        fallback
+    }
+}
+
+impl ShadeMesh {
+    /// The mesh of OBJ text: each distinct `v/vt/vn` index triple is one vertex; polygons are
+    /// fan-triangulated `(0, i, i + 1)`; a missing `vt` is (0, 0); file normals are
+    /// normalised; corners without `vn` take the normalised sum of the cross products of
+    /// the faces around their position (area-weighted); tangents as
+    /// [`ShadeMesh::compute_tangents`]. `file` names the text in errors.
+    ///
+    /// # Errors
+    /// [`ShadeError::Parse`] with the line of a malformed number or index.
+    pub fn from_obj(text: &str, file: &str) -> Result<ShadeMesh, ShadeError> {
+        let mut v: Vec<DVec3> = Vec::new();
+        let mut vt: Vec<[f64; 2]> = Vec::new();
+        let mut vn: Vec<DVec3> = Vec::new();
+        let mut corner_of: HashMap<(usize, Option<usize>, Option<usize>), u32> = HashMap::new();
+        let mut corners: Vec<(usize, Option<usize>, Option<usize>)> = Vec::new();
+        let mut triangles = Vec::new();
+        let mut face = Vec::new();
+        for (ln, raw) in text.lines().enumerate() {
+            let err = |message: String| ShadeError::Parse {
+                file: file.to_string(),
+                line: ln + 1,
+                message,
+            };
+            let line = raw.split('#').next().unwrap_or("");
+            let mut words = line.split_whitespace();
+            let Some(key) = words.next() else { continue };
+            let mut numbers = |n: usize| -> Result<[f64; 3], ShadeError> {
+                let mut out = [0.0; 3];
+                for (k, slot) in out.iter_mut().take(n).enumerate() {
+                    let w = words
+                        .next()
+                        .ok_or_else(|| err(format!("{key}: expected {n} numbers, found {k}")))?;
+                    *slot = w
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| {
+                            err(format!("{key}: expected a finite number, found {w:?}"))
+                        })?;
+                }
+                Ok(out)
+            };
+            match key {
+                "v" => v.push(DVec3::from_array(numbers(3)?)),
+                "vn" => vn.push(DVec3::from_array(numbers(3)?)),
+                "vt" => {
+                    let [a, _, _] = numbers(1)?;
+                    // A missing second coordinate is 0.
+                    let b =
+                        match words.next() {
+                            None => 0.0,
+                            Some(w) => w.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(
+                                || err(format!("vt: expected a finite number, found {w:?}")),
+                            )?,
+                        };
+                    vt.push([a, b]);
+                }
+                "f" => {
+                    face.clear();
+                    for w in words {
+                        let mut parts = w.split('/');
+                        // A file without any `vt` (`vn`) reads none wherever a corner names one,
+                        // as the course app does.
+                        let index = |s: Option<&str>,
+                                     n: usize,
+                                     what: &str|
+                         -> Result<Option<usize>, ShadeError> {
+                            let Some(s) = s.filter(|s| !s.is_empty()) else {
+                                return Ok(None);
+                            };
+                            if n == 0 && what != "vertex" {
+                                return Ok(None);
+                            }
+                            let i: i64 = s.parse().map_err(|_| {
+                                err(format!("f: expected a {what} index, found {w:?}"))
+                            })?;
+                            let idx = if i > 0 { i - 1 } else { n as i64 + i };
+                            if i == 0 || idx < 0 || idx >= n as i64 {
+                                return Err(err(format!(
+                                    "f: {what} index {i} is out of range ({n} defined so far)"
+                                )));
+                            }
+                            Ok(Some(idx as usize))
+                        };
+                        let vi = index(parts.next(), v.len(), "vertex")?.ok_or_else(|| {
+                            err(format!("f: expected a vertex index, found {w:?}"))
+                        })?;
+                        let ti = index(parts.next(), vt.len(), "texture coordinate")?;
+                        let ni = index(parts.next(), vn.len(), "normal")?;
+                        let key = (vi, ti, ni);
+                        let c = *corner_of.entry(key).or_insert_with(|| {
+                            corners.push(key);
+                            (corners.len() - 1) as u32
+                        });
+                        face.push(c);
+                        if face.len() > MAX_FACE_CORNERS {
+                            return Err(err(format!(
+                                "f: more than {MAX_FACE_CORNERS} corners in one face"
+                            )));
+                        }
+                    }
+                    if face.len() < 3 {
+                        return Err(err(format!(
+                            "f: expected at least 3 corners, found {}",
+                            face.len()
+                        )));
+                    }
+                    for i in 1..face.len() - 1 {
+                        triangles.push([face[0], face[i], face[i + 1]]);
+                    }
+                }
+                _ => {}
+            }
+        }
+        let position_of: Vec<usize> = corners.iter().map(|c| c.0).collect();
+        let needs_generated = corners.iter().any(|c| c.2.is_none());
+        let generated = if needs_generated {
+            generated_normals(&v, &position_of, &triangles)
+        } else {
+            Vec::new()
+        };
+        let z = DVec3::Z;
+        let mut mesh = ShadeMesh {
+            positions: corners.iter().map(|c| v[c.0].as_vec3()).collect(),
+            normals: corners
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    let n = match c.2 {
+                        Some(ni) => vn[ni],
+                        None => generated[i],
+                    };
+                    unit_or(n, z).as_vec3()
+                })
+                .collect(),
+            uvs: corners
+                .iter()
+                .map(|c| {
+                    c.1.map_or(Vec2::ZERO, |t| Vec2::new(vt[t][0] as f32, vt[t][1] as f32))
+                })
+                .collect(),
+            tangents: Vec::new(),
+            triangles,
+        };
+        mesh.compute_tangents();
+        Ok(mesh)
+    }
+
+    /// The mesh of a polygon mesh (PLY, COLLADA): one vertex per position, fans of its
+    /// faces, area-weighted vertex normals, uvs (0, 0).
+    #[must_use]
+    pub fn from_polymesh(p: &prism_mesh::PolyMesh) -> ShadeMesh {
+        let mut triangles = Vec::new();
+        for f in p.faces() {
+            for i in 1..f.len() - 1 {
+                triangles.push([f[0], f[i], f[i + 1]]);
+            }
+        }
+        let ids: Vec<usize> = (0..p.positions.len()).collect();
+        let normals = generated_normals(&p.positions, &ids, &triangles);
+        let mut mesh = ShadeMesh {
+            positions: p.positions.iter().map(|q| q.as_vec3()).collect(),
+            normals: normals
+                .iter()
+                .map(|&n| unit_or(n, DVec3::Z).as_vec3())
+                .collect(),
+            uvs: vec![Vec2::ZERO; p.positions.len()],
+            tangents: Vec::new(),
+            triangles,
+        };
+        mesh.compute_tangents();
+        mesh
+    }
+
+    /// Tangents as the course app computes them: per triangle `T = (dv2 e1 - dv1 e2) / det`
+    /// (`e1`, `e2` its edges, `du`, `dv` their uv steps, `det = du1 dv2 - du2 dv1`, triangles
+    /// with `|det| <= 1e-20` giving none), summed per vertex, made orthogonal to the normal
+    /// (Gram-Schmidt) and normalised; where that leaves nothing, `normalize(n x (0, 1, 0))`,
+    /// else (1, 0, 0).
+    pub fn compute_tangents(&mut self) {
+        let mut acc = vec![DVec3::ZERO; self.positions.len()];
+        for t in &self.triangles {
+            let [a, b, c] = t.map(|i| i as usize);
+            let p0 = self.positions[a].as_dvec3();
+            let e1 = self.positions[b].as_dvec3() - p0;
+            let e2 = self.positions[c].as_dvec3() - p0;
+            let (t0, t1, t2) = (
+                self.uvs[a].as_dvec2(),
+                self.uvs[b].as_dvec2(),
+                self.uvs[c].as_dvec2(),
+            );
+            let (du1, dv1) = (t1.x - t0.x, t1.y - t0.y);
+            let (du2, dv2) = (t2.x - t0.x, t2.y - t0.y);
+            let det = du1 * dv2 - du2 * dv1;
+            if det.abs() > 1e-20 {
+                let tan = (dv2 * e1 - dv1 * e2) / det;
+                for i in [a, b, c] {
+                    acc[i] += tan;
+                }
+            }
+        }
+        self.tangents = acc
+            .iter()
+            .zip(&self.normals)
+            .map(|(&t, n)| {
+                let n = n.as_dvec3();
+                let t = t - n * n.dot(t);
+                let l = t.length();
+                if l >= 1e-12 {
+                    (t / l).as_vec3()
+                } else {
+                    let alt = n.cross(DVec3::Y);
+                    let la = alt.length();
+                    if la > 1e-6 {
+                        (alt / la).as_vec3()
+                    } else {
+                        Vec3::X
+                    }
+                }
+            })
+            .collect();
+    }
+
+    /// The bounds of the positions: `(min, max)`, or `None` for an empty mesh.
+    #[must_use]
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for &p in &self.positions {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+}
+
+/// Per corner, the sum of the (area-weighted) cross products of the triangles around its
+/// position index.
+fn generated_normals(v: &[DVec3], position_of: &[usize], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut acc = vec![DVec3::ZERO; v.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| v[position_of[i as usize]]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            acc[position_of[i as usize]] += n;
+        }
+    }
+    position_of.iter().map(|&p| acc[p]).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed form: a quad fans into two triangles; distinct v/vt/vn triples are distinct
+    /// vertices; a missing vn gives the normalised sum of the face normals around the
+    /// position; the tangent of a quad with u along x is +x.
+    #[test]
+    fn corners_normals_tangents() {
+        let m = ShadeMesh::from_obj(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+             f 1/1 2/2 3/3 4/4\n",
+            "q.obj",
+        )
+        .unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert!(m.normals.iter().all(|&n| n == Vec3::Z));
+        for t in &m.tangents {
+            assert!((*t - Vec3::X).length() < 1e-6, "{t}");
+        }
+        // Two faces around a shared edge at 90 degrees: the shared corners' normal is the
+        // normalised sum.
+        let m = ShadeMesh::from_obj(
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\n",
+            "e.obj",
+        )
+        .unwrap();
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        assert!(
+            (m.normals[0] - Vec3::new(0.0, s, s)).length() < 1e-6,
+            "{}",
+            m.normals[0]
+        );
+        let e = ShadeMesh::from_obj("v 0 0 0\nf 1 2 3\n", "bad.obj").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "bad.obj:2: f: vertex index 2 is out of range (1 defined so far)"
+        );
+    }
+}
