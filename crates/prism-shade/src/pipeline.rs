@@ -376,9 +376,10 @@ fn raster_triangle(
     }
 }
 
-/// Colours to bytes as OpenGL writes them: `round(clamp(c, 0, 1) 255)`, no sRGB encoding.
+/// Colours to bytes as OpenGL writes them: `round(clamp(c, 0, 1) 255)` with halves to even
+/// (as the processor's conversion rounds; 0.3 is 76, not 77), no sRGB encoding.
 #[must_use]
 pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
-    let b = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let b = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round_ties_even() as u8;
     img.map(|p| [b(p.r), b(p.g), b(p.b)])
 }
