@@ -250,39 +250,43 @@ pub fn shade(
         .pixels_mut()
         .par_chunks_mut(rows_per_band)
         .enumerate()
-        .for_each(|(band, out)| {
-            let y_start = band as u32 * BAND;
-            let rows = (out.len() / w as usize) as u32;
-            let n = (k * k) as usize;
-            let mut color = vec![opts.background; out.len() * n];
-            // Depth is cleared to 1 (the far plane); LESS passes below it.
-            let mut depth = vec![1.0f32; out.len() * n];
-            let mut fill = |t: &[ScreenVertex; 3], wire: Option<Rgb>| {
-                raster_triangle(
-                    t, shader, &u, k, w, y_start, rows, &mut color, &mut depth, wire,
-                );
-            };
-            for &i in &by_band[band] {
-                fill(&tris[i as usize], None);
-            }
-            if let Some(c) = opts.wireframe {
-                for &i in &by_band[band] {
-                    fill(&tris[i as usize], Some(c));
-                }
-            }
-            for (p, samples) in out.iter_mut().zip(color.chunks(n)) {
-                // Each sample is stored clamped, as in an 8-bit colour buffer.
-                let clamp = |c: Rgb| {
-                    Rgb::new(
-                        c.r.clamp(0.0, 1.0),
-                        c.g.clamp(0.0, 1.0),
-                        c.b.clamp(0.0, 1.0),
-                    )
+        .for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(color, depth): &mut (Vec<Rgb>, Vec<f32>), (band, out)| {
+                let y_start = band as u32 * BAND;
+                let rows = (out.len() / w as usize) as u32;
+                let n = (k * k) as usize;
+                // Every sample is cleared: the buffers are the worker's, reused band to band.
+                color.clear();
+                color.resize(out.len() * n, opts.background);
+                // Depth is cleared to 1 (the far plane); LESS passes below it.
+                depth.clear();
+                depth.resize(out.len() * n, 1.0);
+                let mut fill = |t: &[ScreenVertex; 3], wire: Option<Rgb>| {
+                    raster_triangle(t, shader, &u, k, w, y_start, rows, color, depth, wire);
                 };
-                let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
-                *p = sum * (1.0 / n as f32);
-            }
-        });
+                for &i in &by_band[band] {
+                    fill(&tris[i as usize], None);
+                }
+                if let Some(c) = opts.wireframe {
+                    for &i in &by_band[band] {
+                        fill(&tris[i as usize], Some(c));
+                    }
+                }
+                for (p, samples) in out.iter_mut().zip(color.chunks(n)) {
+                    // Each sample is stored clamped, as in an 8-bit colour buffer.
+                    let clamp = |c: Rgb| {
+                        Rgb::new(
+                            c.r.clamp(0.0, 1.0),
+                            c.g.clamp(0.0, 1.0),
+                            c.b.clamp(0.0, 1.0),
+                        )
+                    };
+                    let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
+                    *p = sum * (1.0 / n as f32);
+                }
+            },
+        );
     Ok(image)
 }
 
@@ -308,6 +312,7 @@ fn raster_triangle(
         return;
     }
     let sign = area.signum();
+    let inv_area = 1.0 / (area * sign);
     let min_x = a.x.min(b.x).min(c.x).floor().max(0.0);
     let max_x = a.x.max(b.x).max(c.x).ceil().min(w as f32);
     let min_y = a.y.min(b.y).min(c.y).floor().max(y_start as f32);
@@ -340,11 +345,7 @@ fn raster_triangle(
                     if e.iter().zip(own).any(|(&v, o)| v < 0.0 || (v == 0.0 && !o)) {
                         continue;
                     }
-                    let l = [
-                        e[0] / (area * sign),
-                        e[1] / (area * sign),
-                        e[2] / (area * sign),
-                    ];
+                    let l = [e[0] * inv_area, e[1] * inv_area, e[2] * inv_area];
                     let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
                     let s = ((py - y_start) * w + px) as usize * n + (sy * k + sx) as usize;
                     let c_out = match wire {
@@ -380,6 +381,9 @@ fn raster_triangle(
 /// (as the processor's conversion rounds; 0.3 is 76, not 77), no sRGB encoding.
 #[must_use]
 pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
-    let b = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round_ties_even() as u8;
+    // Adding and taking away 2^23 rounds halves to even in the default rounding mode, for
+    // the values 0..=255 here (`round_ties_even` would be a library call on plain x86-64).
+    const SHIFT: f32 = 8_388_608.0;
+    let b = |v: f32| ((v.clamp(0.0, 1.0) * 255.0 + SHIFT) - SHIFT) as u8;
     img.map(|p| [b(p.r), b(p.g), b(p.b)])
 }

@@ -128,7 +128,9 @@ pub fn blinn_phong(u: &Uniforms, p: Vec3, n: Vec3) -> Rgb {
     let v = (u.cam_pos - p).normalize();
     let h = (l + v).normalize();
     let e = u.light_intensity * (1.0 / r2);
-    Rgb::splat(0.1) + e * (0.8 * n.dot(l).max(0.0)) + e * (0.5 * n.dot(h).max(0.0).powf(32.0))
+    // p = 32 by five squarings.
+    let spec = n.dot(h).max(0.0).powi(32);
+    Rgb::splat(0.1) + e * (0.8 * n.dot(l).max(0.0)) + e * (0.5 * spec)
 }
 
 /// The normal bent by the height map: `normalize(TBN (-dU, -dV, 1))`, `TBN = [t, n x t,
