@@ -18,7 +18,7 @@ pub enum ShadeError {
     Camera(String),
     /// The sample count is not a square.
     #[error(
-        "samples: expected a square number of samples per pixel (1, 4, 9, 16, ...), found {0}"
+        "samples: expected a square number of samples per pixel (1, 4, 9, ..., 256), found {0}"
     )]
     Samples(u32),
 }

@@ -219,7 +219,7 @@ pub fn shade(
     opts: &ShadeOptions,
 ) -> Result<RgbImage, ShadeError> {
     let k = (opts.samples as f64).sqrt().round() as u32;
-    if k == 0 || k * k != opts.samples {
+    if k == 0 || k > 16 || k * k != opts.samples {
         return Err(ShadeError::Samples(opts.samples));
     }
     let mut u = *uniforms;
@@ -250,62 +250,105 @@ pub fn shade(
         .pixels_mut()
         .par_chunks_mut(rows_per_band)
         .enumerate()
-        .for_each_init(
-            || (Vec::new(), Vec::new()),
-            |(color, depth): &mut (Vec<Rgb>, Vec<f32>), (band, out)| {
-                let y_start = band as u32 * BAND;
-                let rows = (out.len() / w as usize) as u32;
-                let n = (k * k) as usize;
-                // Every sample is cleared: the buffers are the worker's, reused band to band.
-                color.clear();
-                color.resize(out.len() * n, opts.background);
-                // Depth is cleared to 1 (the far plane); LESS passes below it.
-                depth.clear();
-                depth.resize(out.len() * n, 1.0);
-                let mut fill = |t: &[ScreenVertex; 3], wire: Option<Rgb>| {
-                    raster_triangle(t, shader, &u, k, w, y_start, rows, color, depth, wire);
-                };
+        .for_each_init(Band::default, |buf, (band, out)| {
+            let y_start = band as u32 * BAND;
+            let rows = (out.len() / w as usize) as u32;
+            let n = (k * k) as usize;
+            // Every sample is cleared: the buffers are the worker's, reused band to band.
+            buf.clear(out.len() * n, opts.background);
+            let target = Target {
+                k,
+                w,
+                y_start,
+                rows,
+            };
+            // Visibility first (depth LESS, the first of equals kept), then one fragment per
+            // visible sample: the same colours as shading each fragment as it passes.
+            for &i in &by_band[band] {
+                raster_triangle(&tris[i as usize], i, &target, buf, None);
+            }
+            for s in 0..buf.prim.len() {
+                let p = buf.prim[s];
+                if p != NONE {
+                    let [a, b, c] = &tris[p as usize];
+                    let l = buf.bary[s];
+                    let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
+                    let inv = 1.0 / (pw[0] + pw[1] + pw[2]);
+                    let v =
+                        Varyings::blend(&a.v, &b.v, &c.v, [pw[0] * inv, pw[1] * inv, pw[2] * inv]);
+                    buf.color[s] = fragment(shader, &u, &v);
+                }
+            }
+            if let Some(c) = opts.wireframe {
                 for &i in &by_band[band] {
-                    fill(&tris[i as usize], None);
+                    raster_triangle(&tris[i as usize], i, &target, buf, Some(c));
                 }
-                if let Some(c) = opts.wireframe {
-                    for &i in &by_band[band] {
-                        fill(&tris[i as usize], Some(c));
-                    }
-                }
-                for (p, samples) in out.iter_mut().zip(color.chunks(n)) {
-                    // Each sample is stored clamped, as in an 8-bit colour buffer.
-                    let clamp = |c: Rgb| {
-                        Rgb::new(
-                            c.r.clamp(0.0, 1.0),
-                            c.g.clamp(0.0, 1.0),
-                            c.b.clamp(0.0, 1.0),
-                        )
-                    };
+            }
+            for (p, samples) in out.iter_mut().zip(buf.color.chunks(n)) {
+                // Each sample is stored clamped, as in an 8-bit colour buffer.
+                let clamp = |c: Rgb| {
+                    Rgb::new(
+                        c.r.clamp(0.0, 1.0),
+                        c.g.clamp(0.0, 1.0),
+                        c.b.clamp(0.0, 1.0),
+                    )
+                };
+                if n == 1 {
+                    *p = clamp(samples[0]);
+                } else {
                     let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
                     *p = sum * (1.0 / n as f32);
                 }
-            },
-        );
+            }
+        });
     Ok(image)
 }
 
-/// Rasterizes one triangle into a band's sample buffers. With `wire`, only samples within
-/// one pixel of an edge are drawn, in that colour, and the depth test passes up to a small
-/// bias so that edges show on their own faces.
-#[allow(clippy::too_many_arguments)]
-fn raster_triangle(
-    t: &[ScreenVertex; 3],
-    shader: &Shader,
-    u: &Uniforms,
+/// No triangle covers the sample.
+const NONE: u32 = u32::MAX;
+
+/// A worker's sample buffers for one band: depth, the triangle seen with its screen-space
+/// barycentric weights, and the colour.
+#[derive(Default)]
+struct Band {
+    depth: Vec<f32>,
+    prim: Vec<u32>,
+    bary: Vec<[f32; 3]>,
+    color: Vec<Rgb>,
+}
+
+impl Band {
+    fn clear(&mut self, len: usize, background: Rgb) {
+        // Depth is cleared to 1 (the far plane); LESS passes below it.
+        self.depth.clear();
+        self.depth.resize(len, 1.0);
+        self.prim.clear();
+        self.prim.resize(len, NONE);
+        self.bary.clear();
+        self.bary.resize(len, [0.0; 3]);
+        self.color.clear();
+        self.color.resize(len, background);
+    }
+}
+
+/// Where a band's samples lie: `k x k` per pixel, `w` pixels a row, rows `y_start` on.
+struct Target {
     k: u32,
     w: u32,
     y_start: u32,
     rows: u32,
-    color: &mut [Rgb],
-    depth: &mut [f32],
-    wire: Option<Rgb>,
-) {
+}
+
+/// Rasterizes triangle `id` into a band: the depth test and the visible triangle with its
+/// weights; with `wire`, only samples within 0.75 pixel of an edge, in that colour, the
+/// depth test passing up to a small bias so that edges show on their own faces.
+fn raster_triangle(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band, wire: Option<Rgb>) {
+    let Target {
+        k,
+        w,
+        y_start,
+        rows,
+    } = *to;
     let [a, b, c] = t;
     let area = edge(a.x, a.y, b.x, b.y, c.x, c.y);
     if area == 0.0 || !area.is_finite() {
@@ -331,12 +374,17 @@ fn raster_triangle(
         ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt(),
     ];
     let n = (k * k) as usize;
+    // Sample offsets inside a pixel (at most 16 x 16 samples).
+    let mut offsets = [0.0f32; 16];
+    for (i, o) in offsets.iter_mut().enumerate().take(k as usize) {
+        *o = (i as f32 + 0.5) / k as f32;
+    }
     for py in min_y as u32..max_y as u32 {
         for px in min_x as u32..max_x as u32 {
             for sy in 0..k {
                 for sx in 0..k {
-                    let x = px as f32 + (sx as f32 + 0.5) / k as f32;
-                    let y = py as f32 + (sy as f32 + 0.5) / k as f32;
+                    let x = px as f32 + offsets[sx as usize];
+                    let y = py as f32 + offsets[sy as usize];
                     let e = [
                         edge(b.x, b.y, c.x, c.y, x, y) * sign,
                         edge(c.x, c.y, a.x, a.y, x, y) * sign,
@@ -348,29 +396,26 @@ fn raster_triangle(
                     let l = [e[0] * inv_area, e[1] * inv_area, e[2] * inv_area];
                     let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
                     let s = ((py - y_start) * w + px) as usize * n + (sy * k + sx) as usize;
-                    let c_out = match wire {
+                    match wire {
                         None => {
                             // LESS: a NaN depth never passes.
-                            if z.is_nan() || z >= depth[s] {
+                            if z.is_nan() || z >= buf.depth[s] {
                                 continue;
                             }
-                            let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
-                            let sum = pw[0] + pw[1] + pw[2];
-                            let pc = [pw[0] / sum, pw[1] / sum, pw[2] / sum];
-                            let v = Varyings::blend(&a.v, &b.v, &c.v, pc);
-                            fragment(shader, u, &v)
+                            buf.depth[s] = z;
+                            buf.prim[s] = id;
+                            buf.bary[s] = l;
                         }
                         Some(col) => {
                             // Distance in pixels to the nearest edge.
                             let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= 0.75);
-                            if !near_edge || z > depth[s] + 1e-4 {
+                            if !near_edge || z > buf.depth[s] + 1e-4 {
                                 continue;
                             }
-                            col
+                            buf.depth[s] = z;
+                            buf.color[s] = col;
                         }
-                    };
-                    depth[s] = z;
-                    color[s] = c_out;
+                    }
                 }
             }
         }
@@ -385,5 +430,10 @@ pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
     // the values 0..=255 here (`round_ties_even` would be a library call on plain x86-64).
     const SHIFT: f32 = 8_388_608.0;
     let b = |v: f32| ((v.clamp(0.0, 1.0) * 255.0 + SHIFT) - SHIFT) as u8;
-    img.map(|p| [b(p.r), b(p.g), b(p.b)])
+    let bytes = img
+        .pixels()
+        .par_iter()
+        .map(|p| [b(p.r), b(p.g), b(p.b)])
+        .collect();
+    Image::from_vec(img.width(), img.height(), bytes)
 }
