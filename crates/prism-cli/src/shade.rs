@@ -219,11 +219,8 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         }
         ShaderArg::Bump | ShaderArg::Displacement => {
             let Some(path) = &a.height_map else {
-                return Err(UserError(format!(
-                    "--shader {:?}: it needs --height-map PNG",
-                    a.shader
-                ))
-                .into());
+                let name = if a.shader == ShaderArg::Bump { "bump" } else { "displacement" };
+                return Err(UserError(format!("--shader {name}: it needs --height-map PNG")).into());
             };
             let map = course_texture(load_rgb(path, "--height-map")?);
             if a.shader == ShaderArg::Bump {

@@ -1442,3 +1442,131 @@ fn raytrace_scenes_debugging_and_errors() {
         assert!(!target.exists());
     }
 }
+
+/// `prism shade`: a mesh of each format drawn with every shader, `--flag=VALUE` for values
+/// that start with `-`, per-stage times; bad input is a located error with exit 2 and no
+/// output.
+#[test]
+fn shade_meshes_and_errors() {
+    let dir = scratch("shade");
+    let monkey = prism_testkit::shared_asset("delft-raytracer/data/monkey.obj");
+    let textures = prism_testkit::shared_asset("clothsim/textures");
+    for (shader, extra) in [
+        ("normal", vec![]),
+        ("wireframe", vec![]),
+        ("diffuse", vec![]),
+        (
+            "phong",
+            vec!["--wireframe".to_string(), "0,0,0".to_string()],
+        ),
+        (
+            "texture",
+            vec![
+                "--texture".into(),
+                textures.join("texture_1.png").display().to_string(),
+            ],
+        ),
+        (
+            "bump",
+            vec![
+                "--height-map".into(),
+                textures.join("texture_1.png").display().to_string(),
+            ],
+        ),
+        (
+            "displacement",
+            vec![
+                "--height-map".into(),
+                textures.join("texture_1.png").display().to_string(),
+            ],
+        ),
+        (
+            "mirror",
+            vec![
+                "--cubemap".into(),
+                textures.join("cube").display().to_string(),
+            ],
+        ),
+    ] {
+        let out = dir.join(format!("{shader}.png"));
+        let o = prism()
+            .arg("shade")
+            .arg(&monkey)
+            .args([
+                "--shader",
+                shader,
+                "-r",
+                "64",
+                "48",
+                "--eye=-1,0.5,-3",
+                "--stats",
+                "-o",
+            ])
+            .arg(&out)
+            .args(&extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{shader}: {}", stderr(&o));
+        let img = prism_image::read_png(&out).unwrap();
+        assert_eq!((img.width(), img.height()), (64, 48));
+        let err = stderr(&o);
+        for stage in ["read: ", "render: ", "write: "] {
+            assert!(err.lines().any(|l| l.starts_with(stage)), "{stage}: {err}");
+        }
+    }
+    // PLY and COLLADA too, framed automatically.
+    for mesh in ["meshedit/dae/cow.dae"] {
+        let out = dir.join("auto.png");
+        let o = prism()
+            .arg("shade")
+            .arg(prism_testkit::shared_asset(mesh))
+            .args(["-r", "32", "32", "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{mesh}: {}", stderr(&o));
+    }
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 3\n").unwrap();
+    for (args, want) in [
+        (
+            vec![dir.join("bad.obj").display().to_string()],
+            "bad.obj:3: f: vertex index 3 is out of range",
+        ),
+        (
+            vec![
+                monkey.display().to_string(),
+                "--shader".into(),
+                "bump".into(),
+            ],
+            "--shader bump: it needs --height-map PNG",
+        ),
+        (
+            vec![monkey.display().to_string(), "--eye".into(), "1,2".into()],
+            "--eye: expected three finite numbers",
+        ),
+        (
+            vec![monkey.display().to_string(), "--samples".into(), "3".into()],
+            "expected a square number of samples",
+        ),
+        (
+            vec![
+                monkey.display().to_string(),
+                "--eye=0,0,0".into(),
+                "--target=0,0,0".into(),
+            ],
+            "camera: the eye is the target",
+        ),
+    ] {
+        let out = dir.join("x.png");
+        let o = prism()
+            .arg("shade")
+            .args(&args)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{args:?}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+}
