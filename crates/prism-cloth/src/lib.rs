@@ -1,0 +1,23 @@
+//! Floor-3 simulation for prism: the CS184 ClothSim homework's cloth.
+//!
+//! - `scene`: [`ClothScene`], the course's scene JSON read as the course reads it, every key
+//!   checked, with `--set` overrides; `json` is its small reader with line numbers.
+//! - `sim`: [`Cloth`], the mass-spring simulation stepped exactly as the course's algorithm
+//!   (`FORMATS.md` §4), in f64.
+//! - `random`: [`GlibcRand`], the C library's `rand()` that jitters the vertical cloth.
+#![warn(missing_docs)]
+
+mod error;
+mod json;
+mod random;
+mod scene;
+mod sim;
+
+pub use error::ClothError;
+pub use json::{parse_json, Json, JsonValue, MAX_JSON_DEPTH};
+pub use random::{GlibcRand, RAND_MAX};
+pub use scene::{
+    parse_scene, read_scene, ClothParams, ClothScene, Orientation, PlaneParams, SphereParams,
+    MAX_GRID_SIDE, MAX_MASSES, MAX_SCENE_BYTES,
+};
+pub use sim::{Cloth, Spring, SpringKind, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};

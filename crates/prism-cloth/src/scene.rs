@@ -1,0 +1,487 @@
+//! [`ClothScene`], the course's scene JSON: a cloth, and optionally a sphere and a plane,
+//! every key required (`pinned` aside), unknown keys refused, values checked; and `--set`
+//! overrides applied to the text's values before they are checked.
+
+use std::path::Path;
+
+use prism_math::glam::DVec3;
+
+use crate::error::ClothError;
+use crate::json::{parse_json, Json, JsonValue};
+
+/// Most masses along one side of the grid.
+pub const MAX_GRID_SIDE: usize = 4096;
+/// Most masses in a cloth.
+pub const MAX_MASSES: usize = 1 << 22;
+/// Largest scene file read (16 MiB).
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// How the cloth lies at the start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Orientation {
+    /// All masses at y = 1, over x and z.
+    Horizontal,
+    /// Over x and y, z a small random offset.
+    Vertical,
+}
+
+/// The cloth's parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClothParams {
+    /// Width in metres.
+    pub width: f64,
+    /// Height in metres.
+    pub height: f64,
+    /// Masses along the width.
+    pub num_width_points: usize,
+    /// Masses along the height.
+    pub num_height_points: usize,
+    /// Collision thickness, as the course app's 32-bit float holds it.
+    pub thickness: f64,
+    /// Starting orientation.
+    pub orientation: Orientation,
+    /// Pinned masses as `[x, y]` grid indices.
+    pub pinned: Vec<[usize; 2]>,
+    /// Structural springs exert force.
+    pub enable_structural: bool,
+    /// Shearing springs exert force.
+    pub enable_shearing: bool,
+    /// Bending springs exert force.
+    pub enable_bending: bool,
+    /// Verlet damping, in percent.
+    pub damping: f64,
+    /// Density (kg/m² as the course uses it).
+    pub density: f64,
+    /// Spring constant in N/m (bending springs use 0.2 of it).
+    pub ks: f64,
+}
+
+/// A sphere to collide with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereParams {
+    /// Centre.
+    pub origin: DVec3,
+    /// Radius.
+    pub radius: f64,
+    /// Friction in [0, 1].
+    pub friction: f64,
+}
+
+/// A plane to collide with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneParams {
+    /// A point on it.
+    pub point: DVec3,
+    /// Its unit normal.
+    pub normal: DVec3,
+    /// Friction in [0, 1].
+    pub friction: f64,
+}
+
+/// A scene: the cloth and what it collides with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClothScene {
+    /// The cloth.
+    pub cloth: ClothParams,
+    /// A sphere, if any.
+    pub sphere: Option<SphereParams>,
+    /// A plane, if any.
+    pub plane: Option<PlaneParams>,
+}
+
+/// Reads a scene file with `--set` overrides (`KEY=VALUE`, `KEY` one of an object's keys as
+/// `cloth.ks`, or a cloth key alone as `ks`; `VALUE` JSON).
+///
+/// # Errors
+/// A located [`ClothError`].
+pub fn read_scene(path: &Path, overrides: &[String]) -> Result<ClothScene, ClothError> {
+    let name = path.display().to_string();
+    let io = |e: std::io::Error| ClothError::Io {
+        path: name.clone(),
+        message: e.to_string(),
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(ClothError::Io {
+            path: name,
+            message: "expected a regular file".into(),
+        });
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        return Err(ClothError::Io {
+            path: name,
+            message: format!(
+                "{} bytes is over the {MAX_SCENE_BYTES}-byte limit",
+                meta.len()
+            ),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(io)?;
+    parse_scene(&text, &name, overrides)
+}
+
+/// Parses scene text; `file` names it in errors.
+///
+/// # Errors
+/// A located [`ClothError`].
+pub fn parse_scene(text: &str, file: &str, overrides: &[String]) -> Result<ClothScene, ClothError> {
+    let mut root = parse_json(text, file)?;
+    for o in overrides {
+        apply_override(&mut root, o)?;
+    }
+    let cx = Cx { file };
+    let top = cx.object(&root, "the top level", &["cloth", "sphere", "plane"])?;
+    let get = |k: &str| top.iter().find(|(n, _, _)| n == k).map(|(_, _, v)| v);
+    let cloth = get("cloth").ok_or_else(|| {
+        cx.err(
+            root.line,
+            "the top level: missing required key \"cloth\"".into(),
+        )
+    })?;
+    let cloth = cx.cloth(cloth)?;
+    let sphere = get("sphere").map(|s| cx.sphere(s)).transpose()?;
+    let plane = get("plane").map(|p| cx.plane(p)).transpose()?;
+    Ok(ClothScene {
+        cloth,
+        sphere,
+        plane,
+    })
+}
+
+/// Replaces (or adds) the value a `KEY=VALUE` override names.
+fn apply_override(root: &mut Json, setting: &str) -> Result<(), ClothError> {
+    let bad = |message: &str| ClothError::Override {
+        setting: setting.to_string(),
+        message: message.to_string(),
+    };
+    let (key, value) = setting
+        .split_once('=')
+        .ok_or_else(|| bad("expected KEY=VALUE"))?;
+    let (object, key) = match key.trim().split_once('.') {
+        Some((o, k)) => (o.to_string(), k.to_string()),
+        None => ("cloth".to_string(), key.trim().to_string()),
+    };
+    let value =
+        parse_json(value, "the value").map_err(|e| bad(&format!("expected a JSON value: {e}")))?;
+    let JsonValue::Object(top) = &mut root.value else {
+        return Err(bad("the scene is not a JSON object"));
+    };
+    let Some((_, _, obj)) = top.iter_mut().find(|(n, _, _)| *n == object) else {
+        return Err(bad(&format!("the scene has no \"{object}\"")));
+    };
+    let JsonValue::Object(fields) = &mut obj.value else {
+        return Err(bad(&format!("\"{object}\" is not an object")));
+    };
+    let line = obj.line;
+    match fields.iter_mut().find(|(n, _, _)| *n == key) {
+        Some((_, _, v)) => v.value = value.value,
+        None => fields.push((
+            key,
+            line,
+            Json {
+                value: value.value,
+                line,
+            },
+        )),
+    }
+    Ok(())
+}
+
+struct Cx<'a> {
+    file: &'a str,
+}
+
+type Fields = [(String, u32, Json)];
+
+impl Cx<'_> {
+    fn err(&self, line: u32, message: String) -> ClothError {
+        ClothError::Parse {
+            file: self.file.to_string(),
+            line,
+            message,
+        }
+    }
+
+    fn object<'j>(
+        &self,
+        v: &'j Json,
+        place: &str,
+        known: &[&str],
+    ) -> Result<&'j Fields, ClothError> {
+        let JsonValue::Object(fields) = &v.value else {
+            return Err(self.err(
+                v.line,
+                format!("{place}: expected an object, found {}", v.value.kind()),
+            ));
+        };
+        for (k, line, _) in fields {
+            if !known.contains(&k.as_str()) {
+                return Err(self.err(
+                    *line,
+                    format!(
+                        "{place}: unknown key {k:?} (expected one of: {})",
+                        known.join(", ")
+                    ),
+                ));
+            }
+        }
+        for (i, (k, line, _)) in fields.iter().enumerate() {
+            if fields[..i].iter().any(|(o, _, _)| o == k) {
+                return Err(self.err(*line, format!("{place}: key {k:?} appears twice")));
+            }
+        }
+        Ok(fields)
+    }
+
+    fn field<'j>(
+        &self,
+        f: &'j Fields,
+        at: u32,
+        place: &str,
+        key: &str,
+    ) -> Result<&'j Json, ClothError> {
+        f.iter()
+            .find(|(k, _, _)| k == key)
+            .map(|(_, _, v)| v)
+            .ok_or_else(|| self.err(at, format!("{place}: missing required key {key:?}")))
+    }
+
+    fn number(&self, v: &Json, key: &str) -> Result<f64, ClothError> {
+        match v.value {
+            JsonValue::Number(x, _) => Ok(x),
+            ref o => Err(self.err(
+                v.line,
+                format!("{key}: expected a number, found {}", o.kind()),
+            )),
+        }
+    }
+
+    fn ranged(&self, v: &Json, key: &str, lo: f64, hi: f64, what: &str) -> Result<f64, ClothError> {
+        let x = self.number(v, key)?;
+        if !(x >= lo && x <= hi) {
+            return Err(self.err(v.line, format!("{key}: expected {what}, found {x}")));
+        }
+        Ok(x)
+    }
+
+    fn positive(&self, v: &Json, key: &str) -> Result<f64, ClothError> {
+        let x = self.number(v, key)?;
+        if !(x > 0.0) {
+            return Err(self.err(
+                v.line,
+                format!("{key}: expected a number above 0, found {x}"),
+            ));
+        }
+        Ok(x)
+    }
+
+    fn integer(&self, v: &Json, key: &str) -> Result<i64, ClothError> {
+        match v.value {
+            JsonValue::Number(x, _) if x.fract() == 0.0 && x.abs() < 9e15 => Ok(x as i64),
+            ref o => Err(self.err(
+                v.line,
+                format!(
+                    "{key}: expected an integer, found {}",
+                    match o {
+                        JsonValue::Number(x, _) => x.to_string(),
+                        o => o.kind().to_string(),
+                    }
+                ),
+            )),
+        }
+    }
+
+    fn boolean(&self, v: &Json, key: &str) -> Result<bool, ClothError> {
+        match v.value {
+            JsonValue::Bool(b) => Ok(b),
+            ref o => Err(self.err(
+                v.line,
+                format!("{key}: expected true or false, found {}", o.kind()),
+            )),
+        }
+    }
+
+    fn vec3(&self, v: &Json, key: &str) -> Result<DVec3, ClothError> {
+        match &v.value {
+            JsonValue::Array(a) if a.len() == 3 => Ok(DVec3::new(
+                self.number(&a[0], key)?,
+                self.number(&a[1], key)?,
+                self.number(&a[2], key)?,
+            )),
+            o => Err(self.err(
+                v.line,
+                format!(
+                    "{key}: expected [x, y, z], found {}",
+                    match o {
+                        JsonValue::Array(a) => format!("{} elements", a.len()),
+                        o => o.kind().to_string(),
+                    }
+                ),
+            )),
+        }
+    }
+
+    fn cloth(&self, v: &Json) -> Result<ClothParams, ClothError> {
+        let keys = [
+            "width",
+            "height",
+            "num_width_points",
+            "num_height_points",
+            "thickness",
+            "orientation",
+            "pinned",
+            "enable_structural",
+            "enable_shearing",
+            "enable_bending",
+            "damping",
+            "density",
+            "ks",
+        ];
+        let f = self.object(v, "cloth", &keys)?;
+        let req = |k: &str| self.field(f, v.line, "cloth", k);
+        let width = self.positive(req("width")?, "width")?;
+        let height = self.positive(req("height")?, "height")?;
+        let side = |k: &str| -> Result<usize, ClothError> {
+            let j = req(k)?;
+            let n = self.integer(j, k)?;
+            if !(2..=MAX_GRID_SIDE as i64).contains(&n) {
+                return Err(self.err(
+                    j.line,
+                    format!("{k}: expected 2 to {MAX_GRID_SIDE} masses, found {n}"),
+                ));
+            }
+            Ok(n as usize)
+        };
+        let nw = side("num_width_points")?;
+        let nh = side("num_height_points")?;
+        if nw * nh > MAX_MASSES {
+            return Err(self.err(
+                v.line,
+                format!("cloth: {nw} x {nh} masses is over the limit of {MAX_MASSES}"),
+            ));
+        }
+        let thickness = self.ranged(
+            req("thickness")?,
+            "thickness",
+            0.0,
+            f64::MAX,
+            "a thickness of at least 0",
+        )?;
+        let o = req("orientation")?;
+        let orientation = match self.integer(o, "orientation")? {
+            0 => Orientation::Horizontal,
+            1 => Orientation::Vertical,
+            n => {
+                return Err(self.err(
+                    o.line,
+                    format!("orientation: expected 0 (horizontal) or 1 (vertical), found {n}"),
+                ))
+            }
+        };
+        let mut pinned = Vec::new();
+        if let Some((_, _, p)) = f.iter().find(|(k, _, _)| k == "pinned") {
+            let JsonValue::Array(items) = &p.value else {
+                return Err(self.err(
+                    p.line,
+                    format!(
+                        "pinned: expected an array of [x, y], found {}",
+                        p.value.kind()
+                    ),
+                ));
+            };
+            for item in items {
+                let pair = match &item.value {
+                    JsonValue::Array(a) if a.len() == 2 => [
+                        self.integer(&a[0], "pinned")?,
+                        self.integer(&a[1], "pinned")?,
+                    ],
+                    o => {
+                        return Err(self.err(
+                            item.line,
+                            format!("pinned: expected [x, y], found {}", o.kind()),
+                        ))
+                    }
+                };
+                if !(0..nw as i64).contains(&pair[0]) || !(0..nh as i64).contains(&pair[1]) {
+                    return Err(self.err(
+                        item.line,
+                        format!(
+                            "pinned: [{}, {}] is outside the {nw} x {nh} grid",
+                            pair[0], pair[1]
+                        ),
+                    ));
+                }
+                pinned.push([pair[0] as usize, pair[1] as usize]);
+            }
+        }
+        Ok(ClothParams {
+            width,
+            height,
+            num_width_points: nw,
+            num_height_points: nh,
+            // The course app holds it in a 32-bit float.
+            thickness: f64::from(thickness as f32),
+            orientation,
+            pinned,
+            enable_structural: self.boolean(req("enable_structural")?, "enable_structural")?,
+            enable_shearing: self.boolean(req("enable_shearing")?, "enable_shearing")?,
+            enable_bending: self.boolean(req("enable_bending")?, "enable_bending")?,
+            damping: self.ranged(
+                req("damping")?,
+                "damping",
+                0.0,
+                100.0,
+                "a percentage from 0 to 100",
+            )?,
+            density: self.positive(req("density")?, "density")?,
+            ks: self.ranged(
+                req("ks")?,
+                "ks",
+                0.0,
+                f64::MAX,
+                "a spring constant of at least 0",
+            )?,
+        })
+    }
+
+    fn sphere(&self, v: &Json) -> Result<SphereParams, ClothError> {
+        let f = self.object(v, "sphere", &["origin", "radius", "friction"])?;
+        let req = |k: &str| self.field(f, v.line, "sphere", k);
+        Ok(SphereParams {
+            origin: self.vec3(req("origin")?, "origin")?,
+            radius: self.positive(req("radius")?, "radius")?,
+            friction: self.ranged(
+                req("friction")?,
+                "friction",
+                0.0,
+                1.0,
+                "a friction from 0 to 1",
+            )?,
+        })
+    }
+
+    fn plane(&self, v: &Json) -> Result<PlaneParams, ClothError> {
+        let f = self.object(v, "plane", &["point", "normal", "friction"])?;
+        let req = |k: &str| self.field(f, v.line, "plane", k);
+        let n = req("normal")?;
+        let normal = self.vec3(n, "normal")?;
+        let len = normal.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return Err(self.err(n.line, "normal: expected a non-zero vector".into()));
+        }
+        Ok(PlaneParams {
+            point: self.vec3(req("point")?, "point")?,
+            normal: normal / len,
+            friction: self.ranged(
+                req("friction")?,
+                "friction",
+                0.0,
+                1.0,
+                "a friction from 0 to 1",
+            )?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
