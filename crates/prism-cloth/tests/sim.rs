@@ -1,0 +1,189 @@
+//! The cloth simulation against closed forms and the properties it must have.
+
+use prism_cloth::{parse_scene, Cloth, ClothScene, SpringKind, GRAVITY};
+use prism_math::glam::DVec3;
+
+fn scene(nw: usize, nh: usize, orientation: u8, extra: &str, pinned: &str) -> ClothScene {
+    let text = format!(
+        r#"{{ {extra} "cloth": {{
+            "damping": 0.2, "density": 150.0, "ks": 5000.0,
+            "enable_structural": true, "enable_shearing": true, "enable_bending": true,
+            "orientation": {orientation}, "width": 1, "height": 1,
+            "num_width_points": {nw}, "num_height_points": {nh},
+            "thickness": 0.0095, "pinned": {pinned} }} }}"#
+    );
+    parse_scene(&text, "test.json", &[]).unwrap()
+}
+
+/// Closed form: structural 2 nw nh - nw - nh, shearing 2 (nw - 1)(nh - 1), bending
+/// structural - nw - nh, created in the documented order.
+#[test]
+fn spring_counts_per_family() {
+    for (nw, nh) in [(2, 2), (7, 5), (50, 50)] {
+        let c = Cloth::new(&scene(nw, nh, 0, "", "[]"));
+        let count = |k| c.springs.iter().filter(|s| s.kind == k).count();
+        let structural = 2 * nw * nh - nw - nh;
+        assert_eq!(count(SpringKind::Structural), structural);
+        assert_eq!(count(SpringKind::Shearing), 2 * (nw - 1) * (nh - 1));
+        assert_eq!(count(SpringKind::Bending), structural - nw - nh);
+    }
+    // Mass (1, 1) of a 3 x 3 grid: structural left and up, shearing up-left and up-right,
+    // then nothing two away.
+    let c = Cloth::new(&scene(3, 3, 0, "", "[]"));
+    let of4: Vec<(u32, SpringKind)> = c
+        .springs
+        .iter()
+        .filter(|s| s.a == 4)
+        .map(|s| (s.b, s.kind))
+        .collect();
+    assert_eq!(
+        of4,
+        [
+            (3, SpringKind::Structural),
+            (1, SpringKind::Structural),
+            (0, SpringKind::Shearing),
+            (2, SpringKind::Shearing)
+        ]
+    );
+}
+
+/// Closed form (Hooke): a vertical two-column chain hanging from its pinned top row, each
+/// vertical spring stretched by the weight below it over ks, is at rest: one step moves no
+/// mass by more than rounding. A 2 x 2 grid is a single spring per column.
+#[test]
+fn hanging_chains_at_rest_obey_hooke() {
+    for nh in [2, 5] {
+        let mut s = scene(2, nh, 1, "", &format!("[[0, {}], [1, {}]]", nh - 1, nh - 1));
+        s.cloth.enable_shearing = false;
+        s.cloth.enable_bending = false;
+        s.cloth.thickness = 0.0;
+        s.cloth.damping = 0.0;
+        // Stiff enough that no spring stretches 10% (the length limit stays out of it).
+        s.cloth.ks = 50_000.0;
+        let mut c = Cloth::new(&s);
+        let spacing = 1.0 / (nh - 1) as f64;
+        // Flat in z, every structural spring at its length there.
+        for p in &mut c.positions {
+            p.z = 0.0;
+        }
+        for sp in &mut c.springs {
+            sp.rest = (c.positions[sp.a as usize] - c.positions[sp.b as usize]).length();
+        }
+        // Row j hangs below row j + 1 by spacing + (j + 1) m g / ks.
+        let mg = c.mass * -GRAVITY.y;
+        let mut y = 1.0;
+        for j in (0..nh - 1).rev() {
+            y -= spacing + (j + 1) as f64 * mg / s.cloth.ks;
+            for x in 0..2 {
+                c.positions[j * 2 + x].y = y;
+            }
+        }
+        c.last.clone_from(&c.positions);
+        let before = c.positions.clone();
+        c.step();
+        for (a, b) in before.iter().zip(&c.positions) {
+            assert!((*a - *b).length() < 1e-12, "{a} -> {b}");
+        }
+    }
+}
+
+/// Closed form (Verlet): without springs or collisions, starting at rest, after n steps a
+/// mass has fallen g dt² n (n + 1) / 2.
+#[test]
+fn free_fall_matches_verlet_closed_form() {
+    let mut s = scene(4, 4, 0, "", "[]");
+    s.cloth.ks = 0.0;
+    s.cloth.damping = 0.0;
+    s.cloth.thickness = 0.0;
+    let mut c = Cloth::new(&s);
+    let start = c.positions.clone();
+    let n = 90;
+    for _ in 0..n {
+        c.step();
+    }
+    let dt = Cloth::dt();
+    let drop = GRAVITY * dt * dt * (n * (n + 1) / 2) as f64;
+    for (p0, p) in start.iter().zip(&c.positions) {
+        assert!(
+            (*p - (*p0 + drop)).length() < 1e-12,
+            "{p} vs {}",
+            *p0 + drop
+        );
+    }
+}
+
+/// Property: with no damping and no collisions, a swinging cloth's energy stays within a
+/// few percent of where it started (Verlet is symplectic; the length limit only removes
+/// energy).
+#[test]
+fn energy_is_bounded_without_damping() {
+    let mut s = scene(10, 10, 0, "", "[[0, 0], [9, 0]]");
+    s.cloth.damping = 0.0;
+    s.cloth.thickness = 0.0;
+    s.cloth.ks = 50_000.0;
+    let mut c = Cloth::new(&s);
+    let e0 = c.kinetic_energy() + c.potential_energy();
+    let mut worst: f64 = 0.0;
+    for _ in 0..60 {
+        c.frame();
+        let e = c.kinetic_energy() + c.potential_energy();
+        worst = worst.max(e - e0);
+    }
+    // Energy may fall (the length limit) but never grow by more than 1% of the drop scale.
+    let scale = c.mass * 9.8 * 100.0;
+    assert!(
+        worst <= 0.01 * scale,
+        "energy grew by {worst} J (scale {scale})"
+    );
+}
+
+/// Property: a cloth dropped on a sphere above a plane never sinks into either, and pinned
+/// masses never move.
+#[test]
+fn no_penetration_and_pinned_masses_stay() {
+    let extra = r#""sphere": {"origin": [0.5, 0.2, 0.5], "radius": 0.2, "friction": 0.3},
+                   "plane": {"point": [0, -0.1, 0], "normal": [0, 1, 0], "friction": 0.5},"#;
+    let s = scene(20, 20, 0, extra, "[[0, 0]]");
+    let mut c = Cloth::new(&s);
+    let pin0 = c.positions[0];
+    let mut min_sphere = f64::INFINITY;
+    let mut min_plane = f64::INFINITY;
+    for _ in 0..150 {
+        c.frame();
+        for (i, p) in c.positions.iter().enumerate() {
+            if i != 0 {
+                min_sphere = min_sphere.min((*p - DVec3::new(0.5, 0.2, 0.5)).length());
+                min_plane = min_plane.min(p.y + 0.1);
+            }
+        }
+        assert_eq!(c.positions[0], pin0);
+    }
+    assert!(
+        min_sphere > 0.2 * 0.98,
+        "a mass went {min_sphere} from the centre"
+    );
+    assert!(
+        min_plane >= -1e-9,
+        "a mass went {min_plane} below the plane"
+    );
+}
+
+/// Determinism: one and two threads give the same trajectory, bit for bit.
+#[test]
+fn identical_on_one_and_two_threads() {
+    let s = scene(30, 30, 1, "", "[[0, 29], [29, 29]]");
+    let run = |t: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| {
+                let mut c = Cloth::new(&s);
+                for _ in 0..20 {
+                    c.frame();
+                }
+                c.positions
+            })
+    };
+    assert_eq!(run(1), run(2));
+}
