@@ -50,7 +50,7 @@ impl GlibcRand {
     }
 
     /// The next `rand()`.
-    pub fn next(&mut self) -> u32 {
+    pub fn rand(&mut self) -> u32 {
         self.advance() >> 1
     }
 }
@@ -63,13 +63,13 @@ mod tests {
     #[test]
     fn first_outputs_of_seed_one() {
         let mut g = GlibcRand::new(1);
-        let first: Vec<u32> = (0..5).map(|_| g.next()).collect();
+        let first: Vec<u32> = (0..5).map(|_| g.rand()).collect();
         assert_eq!(
             first,
             [1804289383, 846930886, 1681692777, 1714636915, 1957747793]
         );
         for _ in 0..10_000 {
-            assert!(g.next() <= RAND_MAX);
+            assert!(g.rand() <= RAND_MAX);
         }
     }
 }

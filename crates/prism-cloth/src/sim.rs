@@ -73,7 +73,7 @@ impl Cloth {
                 positions.push(match c.orientation {
                     Orientation::Horizontal => DVec3::new(px, 1.0, py),
                     Orientation::Vertical => {
-                        let z = f64::from(rand.next()) / f64::from(RAND_MAX) * 2.0 / 1000.0
+                        let z = f64::from(rand.rand()) / f64::from(RAND_MAX) * 2.0 / 1000.0
                             - 1.0 / 1000.0;
                         DVec3::new(px, py, z)
                     }
