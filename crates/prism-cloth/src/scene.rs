@@ -266,7 +266,7 @@ impl Cx<'_> {
 
     fn positive(&self, v: &Json, key: &str) -> Result<f64, ClothError> {
         let x = self.number(v, key)?;
-        if !(x > 0.0) {
+        if x <= 0.0 {
             return Err(self.err(
                 v.line,
                 format!("{key}: expected a number above 0, found {x}"),
