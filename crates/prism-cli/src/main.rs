@@ -1,6 +1,7 @@
 //! `prism`: one command for the prism graphics toolkit.
 
 mod bezier;
+mod cloth;
 mod demo;
 mod mesh;
 mod output;
@@ -36,6 +37,8 @@ enum Command {
     Raytrace(raytrace::RaytraceArgs),
     /// Draw a mesh with one of the course's shaders, as its OpenGL app would, on the CPU.
     Shade(shade::ShadeArgs),
+    /// Simulate the course's ClothSim scenes exactly; write OBJ and draw the run.
+    Cloth(cloth::ClothArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -86,6 +89,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::run(&a),
         Command::Raytrace(a) => raytrace::run(&a),
         Command::Shade(a) => shade::run(&a),
+        Command::Cloth(a) => cloth::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

@@ -219,8 +219,14 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         }
         ShaderArg::Bump | ShaderArg::Displacement => {
             let Some(path) = &a.height_map else {
-                let name = if a.shader == ShaderArg::Bump { "bump" } else { "displacement" };
-                return Err(UserError(format!("--shader {name}: it needs --height-map PNG")).into());
+                let name = if a.shader == ShaderArg::Bump {
+                    "bump"
+                } else {
+                    "displacement"
+                };
+                return Err(
+                    UserError(format!("--shader {name}: it needs --height-map PNG")).into(),
+                );
             };
             let map = course_texture(load_rgb(path, "--height-map")?);
             if a.shader == ShaderArg::Bump {

@@ -260,6 +260,85 @@ impl ShadeMesh {
             .collect();
     }
 
+    /// A grid of `nw x nh` vertices in row-major order (index `y nw + x`), two triangles a
+    /// cell, uvs `(x / (nw - 1), y / (nh - 1))`, area-weighted vertex normals and the
+    /// constant tangent (1, 0, 0), as the course app uploads its cloth.
+    ///
+    /// # Panics
+    /// If `positions` does not hold `nw nh` points or a side is below 2.
+    #[must_use]
+    pub fn grid(positions: &[Vec3], nw: usize, nh: usize) -> ShadeMesh {
+        assert!(
+            nw >= 2 && nh >= 2 && positions.len() == nw * nh,
+            "a grid of nw x nh"
+        );
+        let mut triangles = Vec::with_capacity(2 * (nw - 1) * (nh - 1));
+        for y in 0..nh - 1 {
+            for x in 0..nw - 1 {
+                let i = (y * nw + x) as u32;
+                let (r, d, rd) = (i + 1, i + nw as u32, i + nw as u32 + 1);
+                triangles.push([i, d, r]);
+                triangles.push([r, d, rd]);
+            }
+        }
+        let p64: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
+        let ids: Vec<usize> = (0..positions.len()).collect();
+        let normals = generated_normals(&p64, &ids, &triangles);
+        ShadeMesh {
+            positions: positions.to_vec(),
+            normals: normals
+                .iter()
+                .map(|&n| unit_or(n, DVec3::Y).as_vec3())
+                .collect(),
+            uvs: (0..nh)
+                .flat_map(|y| {
+                    (0..nw).map(move |x| {
+                        Vec2::new(x as f32 / (nw - 1) as f32, y as f32 / (nh - 1) as f32)
+                    })
+                })
+                .collect(),
+            tangents: vec![Vec3::X; positions.len()],
+            triangles,
+        }
+    }
+
+    /// A sphere of `n x n` latitude-longitude cells around `center`, outward normals.
+    #[must_use]
+    pub fn sphere(center: Vec3, radius: f32, n: usize) -> ShadeMesh {
+        let n = n.max(3);
+        let mut positions = Vec::new();
+        for i in 0..=n {
+            let theta = std::f32::consts::PI * i as f32 / n as f32;
+            for j in 0..=n {
+                let phi = 2.0 * std::f32::consts::PI * j as f32 / n as f32;
+                let d = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
+                positions.push(d);
+            }
+        }
+        let mut mesh = ShadeMesh::grid(&positions, n + 1, n + 1);
+        mesh.normals.clone_from(&mesh.positions);
+        for p in &mut mesh.positions {
+            *p = center + radius * *p;
+        }
+        mesh.compute_tangents();
+        mesh
+    }
+
+    /// Appends another mesh's vertices and triangles.
+    pub fn append(&mut self, other: &ShadeMesh) {
+        let off = self.positions.len() as u32;
+        self.positions.extend(&other.positions);
+        self.normals.extend(&other.normals);
+        self.uvs.extend(&other.uvs);
+        self.tangents.extend(&other.tangents);
+        self.triangles
+            .extend(other.triangles.iter().map(|t| t.map(|i| i + off)));
+    }
+
     /// The bounds of the positions: `(min, max)`, or `None` for an empty mesh.
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {

@@ -1,0 +1,283 @@
+//! `prism cloth`: the course's ClothSim scenes simulated exactly, written as OBJ and drawn
+//! through prism-shade with the course app's camera.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use prism_cloth::{read_scene, Cloth, STEPS_PER_FRAME};
+use prism_math::Vec3;
+use prism_shade::{shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
+
+use crate::shade::ShaderArg;
+use crate::UserError;
+
+/// Arguments of `prism cloth`.
+#[derive(Args, Debug)]
+pub struct ClothArgs {
+    /// The course's scene JSON (cloth, and optionally sphere and plane).
+    scene: PathBuf,
+    /// Draw the run: a folder (one PNG per frame, `frame_0001.png`, ...), or a .png of
+    /// the last frame.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Frames to simulate (30 steps each, 90 frames a simulated second).
+    #[arg(long, default_value_t = 90)]
+    frames: u32,
+    /// The cloth's shader when drawing (the sphere and plane take the same).
+    #[arg(long, value_enum, default_value_t = ShaderArg::Phong)]
+    shader: ShaderArg,
+    /// Picture size: WIDTH HEIGHT (the course app's window by default).
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [1024, 800])]
+    resolution: Vec<u32>,
+    /// Write the state after the last frame as OBJ: the first nw*nh `v` lines are the
+    /// masses in row-major order (index y*nw + x), then uvs, normals and faces.
+    #[arg(long, value_name = "OUT.obj")]
+    obj: Option<PathBuf>,
+    /// Write one such OBJ per frame into this folder (`frame_0001.obj`, ...).
+    #[arg(long, value_name = "DIR")]
+    obj_sequence: Option<PathBuf>,
+    /// Override a scene value: `--set ks=500`, `--set cloth.density=15`,
+    /// `--set sphere.radius=0.3` (the value is JSON).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Print per-stage times and `particle-updates/s` on stderr.
+    #[arg(long)]
+    stats: bool,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Most frames one run may ask for.
+const MAX_FRAMES: u32 = 1_000_000;
+
+/// The cloth as a shading mesh: its grid at the masses' positions.
+fn cloth_mesh(c: &Cloth) -> ShadeMesh {
+    let p = &c.scene.cloth;
+    let positions: Vec<Vec3> = c.positions.iter().map(|q| q.as_vec3()).collect();
+    ShadeMesh::grid(&positions, p.num_width_points, p.num_height_points)
+}
+
+/// The OBJ of the cloth's state: masses, uvs, normals, faces.
+fn cloth_obj(c: &Cloth) -> String {
+    use std::fmt::Write;
+    let m = cloth_mesh(c);
+    let mut out = String::new();
+    for p in &c.positions {
+        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+    }
+    for uv in &m.uvs {
+        let _ = writeln!(out, "vt {} {}", uv.x, uv.y);
+    }
+    for n in &m.normals {
+        let _ = writeln!(out, "vn {} {} {}", n.x, n.y, n.z);
+    }
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| i + 1);
+        let _ = writeln!(out, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
+    }
+    out
+}
+
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    use std::io::Write;
+    prism_image::write_atomic(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|source| prism_image::ImageError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+    })?;
+    Ok(())
+}
+
+/// The course app's view: looking at `(avg.x, avg.y / 2, avg.z)` of the starting masses
+/// from +z at `2 0.9 max(width, height)`, vertical field of view 35 degrees.
+fn course_view(c: &Cloth, w: u32, h: u32) -> View {
+    let n = c.positions.len() as f64;
+    let avg = c
+        .positions
+        .iter()
+        .fold(prism_math::glam::DVec3::ZERO, |a, p| a + *p)
+        / n;
+    let p = &c.scene.cloth;
+    let target = Vec3::new(avg.x as f32, (avg.y / 2.0) as f32, avg.z as f32);
+    let dist = (2.0 * 0.9 * p.width.max(p.height)) as f32;
+    View {
+        eye: target + Vec3::new(0.0, 0.0, dist),
+        target,
+        up: Vec3::Y,
+        fov_y: 35.0,
+        width: w,
+        height: h,
+    }
+}
+
+/// Runs `prism cloth`.
+pub fn run(a: &ClothArgs) -> Result<()> {
+    if a.frames == 0 || a.frames > MAX_FRAMES {
+        return Err(UserError(format!(
+            "--frames: expected 1 to {MAX_FRAMES}, found {}",
+            a.frames
+        ))
+        .into());
+    }
+    let (w, h) = (a.resolution[0], a.resolution[1]);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(UserError(format!(
+            "--resolution: expected 1 to 16384 pixels a side, found {w} x {h}"
+        ))
+        .into());
+    }
+    // Where the pictures go: a folder (one per frame) or one .png (the last frame).
+    let frames_dir = match &a.output {
+        Some(o) if o.is_dir() || o.to_string_lossy().ends_with('/') => {
+            if !o.is_dir() {
+                return Err(UserError(format!(
+                    "--output {}: the folder does not exist",
+                    o.display()
+                ))
+                .into());
+            }
+            Some(o.clone())
+        }
+        Some(o) => {
+            crate::output::image_output(o, "--output", &[crate::output::ImageFormat::Png])?;
+            None
+        }
+        None => None,
+    };
+    if let Some(o) = &a.obj {
+        if crate::output::extension(o) != "obj" {
+            return Err(UserError(format!("--obj {}: expected a .obj file", o.display())).into());
+        }
+        crate::output::check_folder(o, "--obj")?;
+    }
+    if let Some(d) = &a.obj_sequence {
+        if !d.is_dir() {
+            return Err(UserError(format!(
+                "--obj-sequence {}: expected an existing folder",
+                d.display()
+            ))
+            .into());
+        }
+    }
+    let shader = match a.shader {
+        ShaderArg::Normal => Shader::Normal,
+        ShaderArg::Wireframe => Shader::Wireframe,
+        ShaderArg::Diffuse => Shader::Diffuse,
+        ShaderArg::Phong => Shader::Phong,
+        other => {
+            return Err(UserError(format!(
+                "--shader {}: prism cloth draws with normal, wireframe, diffuse or phong; for \
+                 textures, write --obj and use prism shade",
+                other
+                    .to_possible_value()
+                    .map_or("?".into(), |v| v.get_name().to_string())
+            ))
+            .into())
+        }
+    };
+    let t0 = Instant::now();
+    let scene = read_scene(&a.scene, &a.set).map_err(|e| UserError(e.to_string()))?;
+    let read = t0.elapsed();
+    let mut cloth = Cloth::new(&scene);
+    let view = course_view(&cloth, w, h);
+    let mut obstacles = ShadeMesh::default();
+    if let Some(s) = scene.sphere {
+        obstacles.append(&ShadeMesh::sphere(
+            s.origin.as_vec3(),
+            0.92 * s.radius as f32,
+            40,
+        ));
+    }
+    if let Some(p) = scene.plane {
+        // A 2 m square around the plane's point.
+        let n = p.normal.as_vec3();
+        let t = n.any_orthonormal_vector();
+        let b = n.cross(t);
+        let c = p.point.as_vec3();
+        let corners = [c - t - b, c + t - b, c - t + b, c + t + b];
+        let mut quad = ShadeMesh::grid(&corners, 2, 2);
+        quad.normals = vec![n; 4];
+        obstacles.append(&quad);
+    }
+    let bar = crate::progress::bar(u64::from(a.frames), "cloth", a.quiet);
+    let mut simulate = Duration::ZERO;
+    let mut render = Duration::ZERO;
+    let mut write = Duration::ZERO;
+    let draw =
+        |cloth: &Cloth, path: &Path, render: &mut Duration, write: &mut Duration| -> Result<()> {
+            let t = Instant::now();
+            let mut mesh = cloth_mesh(cloth);
+            mesh.append(&obstacles);
+            let img = shade(
+                &mesh,
+                &view,
+                &shader,
+                &Uniforms::default(),
+                &ShadeOptions::default(),
+            )
+            .map_err(|e| UserError(e.to_string()))?;
+            let bytes = to_bytes(&img);
+            *render += t.elapsed();
+            let t = Instant::now();
+            prism_image::write_png(path, &bytes)
+                .with_context(|| format!("writing {}", path.display()))?;
+            *write += t.elapsed();
+            Ok(())
+        };
+    for f in 1..=a.frames {
+        let t = Instant::now();
+        cloth.frame();
+        simulate += t.elapsed();
+        if let Some(dir) = &frames_dir {
+            draw(
+                &cloth,
+                &dir.join(format!("frame_{f:04}.png")),
+                &mut render,
+                &mut write,
+            )?;
+        }
+        if let Some(dir) = &a.obj_sequence {
+            let t = Instant::now();
+            write_text(&dir.join(format!("frame_{f:04}.obj")), &cloth_obj(&cloth))?;
+            write += t.elapsed();
+        }
+        bar.set_position(u64::from(f));
+    }
+    bar.finish_and_clear();
+    if let (Some(o), None) = (&a.output, &frames_dir) {
+        draw(&cloth, o, &mut render, &mut write)?;
+    }
+    if let Some(o) = &a.obj {
+        let t = Instant::now();
+        write_text(o, &cloth_obj(&cloth))?;
+        write += t.elapsed();
+    }
+    let updates = cloth.positions.len() as f64 * f64::from(a.frames) * STEPS_PER_FRAME as f64;
+    if a.stats {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read: {:.1} ms", ms(read));
+        eprintln!("simulate: {:.1} ms", ms(simulate));
+        eprintln!("render: {:.1} ms", ms(render));
+        eprintln!("write: {:.1} ms", ms(write));
+        eprintln!(
+            "particle-updates/s: {:.0}",
+            updates / simulate.as_secs_f64().max(1e-9)
+        );
+    }
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        eprintln!(
+            "prism: simulated {} masses for {} frames ({:.1} s simulated) in {:.1} s ({:.2} M particle-updates/s)",
+            cloth.positions.len(),
+            a.frames,
+            f64::from(a.frames) / prism_cloth::FRAMES_PER_SECOND,
+            t0.elapsed().as_secs_f64(),
+            updates / simulate.as_secs_f64().max(1e-9) / 1e6
+        );
+    }
+    Ok(())
+}
