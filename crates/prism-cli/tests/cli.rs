@@ -1515,7 +1515,7 @@ fn shade_meshes_and_errors() {
         }
     }
     // PLY and COLLADA too, framed automatically.
-    for mesh in ["meshedit/dae/cow.dae"] {
+    for mesh in ["meshedit/dae/cow.dae", "meshedit/dae/teapot.dae"] {
         let out = dir.join("auto.png");
         let o = prism()
             .arg("shade")
@@ -1569,4 +1569,120 @@ fn shade_meshes_and_errors() {
         assert!(stderr(&o).contains(want), "{args:?}: {}", stderr(&o));
         assert!(!out.exists());
     }
+}
+
+/// `prism cloth`: a staged scene simulated, written as OBJ (masses first, row-major) and
+/// drawn; `--set` overrides; bad scenes are located errors with exit 2 and nothing written.
+#[test]
+fn cloth_runs_and_errors() {
+    let dir = scratch("cloth");
+    let scene = prism_testkit::shared_asset("clothsim/scene/pinned2.json");
+    let obj = dir.join("state.obj");
+    let png = dir.join("last.png");
+    let o = prism()
+        .arg("cloth")
+        .arg(&scene)
+        .args([
+            "--frames", "3", "-r", "64", "50", "--stats", "--set", "ks=500", "--obj",
+        ])
+        .arg(&obj)
+        .arg("-o")
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&obj).unwrap();
+    let v: Vec<&str> = text.lines().filter(|l| l.starts_with("v ")).collect();
+    assert_eq!(v.len(), 2500);
+    // Mass (49, 0) is pinned at (1, 1, 0).
+    let p: Vec<f64> = v[49][2..].split(' ').map(|x| x.parse().unwrap()).collect();
+    assert_eq!(p, [1.0, 1.0, 0.0]);
+    assert!(text.lines().any(|l| l.starts_with("f ")));
+    assert_eq!(prism_image::read_png(&png).unwrap().width(), 64);
+    let err = stderr(&o);
+    assert!(
+        err.lines().any(|l| l.starts_with("particle-updates/s: ")),
+        "{err}"
+    );
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let o = prism()
+        .arg("cloth")
+        .arg(&scene)
+        .args(["--frames", "2", "-r", "32", "24", "-o"])
+        .arg(&frames)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(frames.join("frame_0002.png").is_file());
+
+    let text = std::fs::read_to_string(&scene).unwrap();
+    for (name, bad, want) in [
+        (
+            "types.json",
+            text.replace("\"ks\": 5000.0", "\"ks\": \"x\""),
+            "types.json:5: ks: expected a number, found a string",
+        ),
+        (
+            "unknown.json",
+            text.replace("\"damping\"", "\"dampng\""),
+            "unknown.json:3: cloth: unknown key \"dampng\"",
+        ),
+        (
+            "missing.json",
+            text.replace("\"density\": 150.0,", ""),
+            "cloth: missing required key \"density\"",
+        ),
+        (
+            "nan.json",
+            text.replace("\"width\": 1", "\"width\": -1"),
+            "width: expected a number above 0",
+        ),
+        (
+            "grid.json",
+            text.replace("\"num_width_points\": 50", "\"num_width_points\": 1"),
+            "num_width_points: expected 2 to 4096 masses",
+        ),
+        (
+            "huge.json",
+            text.replace("\"num_width_points\": 50", "\"num_width_points\": 99999999"),
+            "num_width_points: expected 2 to 4096 masses",
+        ),
+        (
+            "pins.json",
+            text.replace("[49, 0]", "[49, 50]"),
+            "pinned: [49, 50] is outside the 50 x 50 grid",
+        ),
+        (
+            "broken.json",
+            text[..text.len() / 2].to_string(),
+            "broken.json:",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bad).unwrap();
+        let out = dir.join(format!("{name}.obj"));
+        let o = prism()
+            .arg("cloth")
+            .arg(&path)
+            .args(["--frames", "1", "--obj"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{name}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+    let o = prism()
+        .arg("cloth")
+        .arg(&scene)
+        .args(["--set", "sphere.radius=0"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("the scene has no \"sphere\""),
+        "{}",
+        stderr(&o)
+    );
 }
