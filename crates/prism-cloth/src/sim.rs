@@ -56,6 +56,20 @@ pub struct Cloth {
     pub mass: f64,
     forces: Vec<DVec3>,
     keys: Vec<(i64, i64, i64, u32)>,
+    cell_start: Vec<u32>,
+    cell_fill: Vec<u32>,
+    by_cell: Vec<u32>,
+}
+
+/// `floor(x)` as an integer, without a library call (saturating far out of range).
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
 }
 
 impl Cloth {
@@ -123,6 +137,9 @@ impl Cloth {
             mass: c.width * c.height * c.density / (nw * nh) as f64,
             forces: vec![DVec3::ZERO; n],
             keys: Vec::with_capacity(n),
+            cell_start: Vec::new(),
+            cell_fill: Vec::new(),
+            by_cell: Vec::new(),
         }
     }
 
@@ -231,51 +248,57 @@ impl Cloth {
 
     /// Step 3: boxes of `3 width/nw x 3 height/nh x max` from the positions after Verlet;
     /// each unpinned mass in index order moves by the mean of its corrections / 30, in
-    /// place.
+    /// place. Boxes are found through a hash table of cells filled by a counting sort
+    /// (stable, so a cell lists its masses in index order); masses sharing a cell but not a
+    /// box are told apart by their exact integer keys.
     fn self_collide(&mut self) {
         let c = &self.scene.cloth;
         let w = 3.0 * c.width / c.num_width_points as f64;
         let h = 3.0 * c.height / c.num_height_points as f64;
         let t = w.max(h);
         let two_t = 2.0 * c.thickness;
+        let n = self.positions.len();
+        let cells = (2 * n).next_power_of_two();
         self.keys.clear();
-        for (i, p) in self.positions.iter().enumerate() {
-            self.keys.push((
-                (p.x / w).floor() as i64,
-                (p.y / h).floor() as i64,
-                (p.z / t).floor() as i64,
-                i as u32,
-            ));
+        self.keys.extend(self.positions.iter().map(|p| {
+            let k = (floor_i64(p.x / w), floor_i64(p.y / h), floor_i64(p.z / t));
+            let hash = (k.0 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                ^ (k.1 as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+                ^ (k.2 as u64).wrapping_mul(0x1656_67b1_9e37_79f9);
+            (k.0, k.1, k.2, (hash >> 40) as u32 & (cells as u32 - 1))
+        }));
+        self.cell_start.clear();
+        self.cell_start.resize(cells + 1, 0);
+        for k in &self.keys {
+            self.cell_start[k.3 as usize + 1] += 1;
         }
-        // Boxes as runs of one sorted list, masses in index order within a box.
-        let mut order = self.keys.clone();
-        order.sort_unstable();
-        // Where each mass's box starts and ends in `order`.
-        let mut start = vec![0u32; self.positions.len()];
-        let mut end = vec![0u32; self.positions.len()];
-        let mut i = 0;
-        while i < order.len() {
-            let key = (order[i].0, order[i].1, order[i].2);
-            let mut j = i;
-            while j < order.len() && (order[j].0, order[j].1, order[j].2) == key {
-                j += 1;
-            }
-            for e in &order[i..j] {
-                start[e.3 as usize] = i as u32;
-                end[e.3 as usize] = j as u32;
-            }
-            i = j;
+        for i in 0..cells {
+            self.cell_start[i + 1] += self.cell_start[i];
         }
-        for m in 0..self.positions.len() {
+        self.cell_fill.clear();
+        self.cell_fill.extend_from_slice(&self.cell_start[..cells]);
+        self.by_cell.clear();
+        self.by_cell.resize(n, 0);
+        for (i, k) in self.keys.iter().enumerate() {
+            let slot = &mut self.cell_fill[k.3 as usize];
+            self.by_cell[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+        for m in 0..n {
             if self.pinned[m] {
                 continue;
             }
             let p = self.positions[m];
+            let km = self.keys[m];
+            let cell = km.3 as usize;
             let mut sum = DVec3::ZERO;
             let mut count = 0u32;
-            for e in &order[start[m] as usize..end[m] as usize] {
-                let q = e.3 as usize;
-                if q == m {
+            for &q in
+                &self.by_cell[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize]
+            {
+                let q = q as usize;
+                let kq = self.keys[q];
+                if q == m || (kq.0, kq.1, kq.2) != (km.0, km.1, km.2) {
                     continue;
                 }
                 let d = p - self.positions[q];
@@ -326,5 +349,70 @@ impl Cloth {
             })
             .sum();
         gravity + springs
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeMap;
+
+    /// Brute force: the hashed self-collision moves every mass exactly as a map from exact
+    /// box keys to masses in index order does, on a cloth crumpled into few boxes.
+    #[test]
+    fn hashed_self_collision_equals_an_exact_map() {
+        let text = r#"{"cloth": {"damping": 0.2, "density": 150.0, "ks": 5000.0,
+            "enable_structural": true, "enable_shearing": true, "enable_bending": true,
+            "orientation": 1, "width": 1, "height": 1, "num_width_points": 40,
+            "num_height_points": 40, "thickness": 0.02, "pinned": [[0, 0]]}}"#;
+        let scene = crate::parse_scene(text, "t.json", &[]).unwrap();
+        let mut a = Cloth::new(&scene);
+        // Crumple: squeeze everything into a small ball.
+        let mut g = GlibcRand::new(7);
+        for p in &mut a.positions {
+            let r = |g: &mut GlibcRand| f64::from(g.rand()) / f64::from(RAND_MAX) * 0.1;
+            *p = DVec3::new(r(&mut g), r(&mut g), r(&mut g));
+        }
+        let mut b = a.clone();
+        a.self_collide();
+        // The reference.
+        let c = &b.scene.cloth;
+        let w = 3.0 * c.width / c.num_width_points as f64;
+        let h = 3.0 * c.height / c.num_height_points as f64;
+        let t = w.max(h);
+        let two_t = 2.0 * c.thickness;
+        let mut boxes: BTreeMap<(i64, i64, i64), Vec<usize>> = BTreeMap::new();
+        let key = |p: DVec3| {
+            (
+                (p.x / w).floor() as i64,
+                (p.y / h).floor() as i64,
+                (p.z / t).floor() as i64,
+            )
+        };
+        for (i, p) in b.positions.iter().enumerate() {
+            boxes.entry(key(*p)).or_default().push(i);
+        }
+        let mut moved = 0;
+        for m in 0..b.positions.len() {
+            if b.pinned[m] {
+                continue;
+            }
+            let p = b.positions[m];
+            let (mut sum, mut count) = (DVec3::ZERO, 0u32);
+            for &q in &boxes[&key(p)] {
+                let d = p - b.positions[q];
+                let len = d.length();
+                if q != m && len > 0.0 && len < two_t {
+                    sum += (two_t - len) * (d / len);
+                    count += 1;
+                }
+            }
+            if count > 0 {
+                b.positions[m] = p + sum / f64::from(count) / STEPS_PER_FRAME as f64;
+                moved += 1;
+            }
+        }
+        assert!(moved > 100, "{moved}");
+        assert_eq!(a.positions, b.positions);
     }
 }
