@@ -54,7 +54,7 @@ pub struct ClothArgs {
 const MAX_FRAMES: u32 = 1_000_000;
 
 /// The cloth as a shading mesh: its grid at the masses' positions.
-fn cloth_mesh(c: &Cloth) -> ShadeMesh {
+pub fn cloth_mesh(c: &Cloth) -> ShadeMesh {
     let p = &c.scene.cloth;
     let positions: Vec<Vec3> = c.positions.iter().map(|q| q.as_vec3()).collect();
     ShadeMesh::grid(&positions, p.num_width_points, p.num_height_points)
@@ -95,7 +95,7 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
 
 /// The course app's view: looking at `(avg.x, avg.y / 2, avg.z)` of the starting masses
 /// from +z at `2 0.9 max(width, height)`, vertical field of view 35 degrees.
-fn course_view(c: &Cloth, w: u32, h: u32) -> View {
+pub fn course_view(c: &Cloth, w: u32, h: u32) -> View {
     let n = c.positions.len() as f64;
     let avg = c
         .positions
@@ -113,6 +113,31 @@ fn course_view(c: &Cloth, w: u32, h: u32) -> View {
         width: w,
         height: h,
     }
+}
+
+/// The sphere (at 0.92 of its radius, as the course app draws it) and the plane (a 2 m
+/// square around its point) as one shading mesh.
+pub fn obstacles(scene: &prism_cloth::ClothScene) -> ShadeMesh {
+    let mut obstacles = ShadeMesh::default();
+    if let Some(s) = scene.sphere {
+        obstacles.append(&ShadeMesh::sphere(
+            s.origin.as_vec3(),
+            0.92 * s.radius as f32,
+            40,
+        ));
+    }
+    if let Some(p) = scene.plane {
+        // A 2 m square around the plane's point.
+        let n = p.normal.as_vec3();
+        let t = n.any_orthonormal_vector();
+        let b = n.cross(t);
+        let c = p.point.as_vec3();
+        let corners = [c - t - b, c + t - b, c - t + b, c + t + b];
+        let mut quad = ShadeMesh::grid(&corners, 2, 2);
+        quad.normals = vec![n; 4];
+        obstacles.append(&quad);
+    }
+    obstacles
 }
 
 /// Runs `prism cloth`.
@@ -185,25 +210,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
     let read = t0.elapsed();
     let mut cloth = Cloth::new(&scene);
     let view = course_view(&cloth, w, h);
-    let mut obstacles = ShadeMesh::default();
-    if let Some(s) = scene.sphere {
-        obstacles.append(&ShadeMesh::sphere(
-            s.origin.as_vec3(),
-            0.92 * s.radius as f32,
-            40,
-        ));
-    }
-    if let Some(p) = scene.plane {
-        // A 2 m square around the plane's point.
-        let n = p.normal.as_vec3();
-        let t = n.any_orthonormal_vector();
-        let b = n.cross(t);
-        let c = p.point.as_vec3();
-        let corners = [c - t - b, c + t - b, c - t + b, c + t + b];
-        let mut quad = ShadeMesh::grid(&corners, 2, 2);
-        quad.normals = vec![n; 4];
-        obstacles.append(&quad);
-    }
+    let obstacles = obstacles(&scene);
     let bar = crate::progress::bar(u64::from(a.frames), "cloth", a.quiet);
     let mut simulate = Duration::ZERO;
     let mut render = Duration::ZERO;

@@ -182,10 +182,48 @@ fn group_svg() -> String {
     s
 }
 
-/// Draws a wireframe of a mesh and writes it to a PNG.
-fn write_wireframe(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> Result<()> {
-    let img = prism_raster::wireframe(mesh, size)?;
-    prism_image::write_png(out, &img).with_context(|| format!("writing {}", out.display()))
+/// Draws a mesh Blinn-Phong shaded with its edges on top, framed from the front and a
+/// little above, and writes it to a PNG.
+fn write_shaded(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -> Result<()> {
+    let mut m = prism_shade::ShadeMesh::from_polymesh(mesh);
+    let (lo, hi) = m.bounds().context("the mesh has vertices")?;
+    let centre = (lo + hi) * 0.5;
+    // A mesh wound inside out (the teapot's patches) is lit from outside all the same.
+    let outward: f32 = m
+        .positions
+        .iter()
+        .zip(&m.normals)
+        .map(|(p, n)| n.dot(*p - centre))
+        .sum();
+    if outward < 0.0 {
+        m.normals.iter_mut().for_each(|n| *n = -*n);
+    }
+    let r = (hi - lo).length() * 0.5;
+    let dir = prism_math::Vec3::new(0.35, 0.45, 1.0).normalize();
+    let view = prism_shade::View {
+        eye: centre + dir * (r / (22.5f32.to_radians().sin()) * 1.05),
+        target: centre,
+        up: prism_math::Vec3::Y,
+        fov_y: 45.0,
+        width: size,
+        height: size,
+    };
+    let u = prism_shade::Uniforms {
+        light_pos: centre + prism_math::Vec3::new(2.0, 3.0, 4.0) * r,
+        light_intensity: prism_math::Rgb::splat((29.0f32 * r * r).max(1e-6)),
+        ..prism_shade::Uniforms::default()
+    };
+    let opts = prism_shade::ShadeOptions {
+        samples: 4,
+        background: prism_math::Rgb::WHITE,
+        wireframe: Some(prism_math::Rgb::splat(0.15)),
+        // Thinner edges on dense meshes.
+        wire_width: if m.triangles.len() > 1000 { 0.3 } else { 0.75 },
+    };
+    let img = prism_shade::shade(&m, &view, &prism_shade::Shader::Phong, &u, &opts)
+        .map_err(|e| crate::UserError(e.to_string()))?;
+    prism_image::write_png(out, &prism_shade::to_bytes(&img))
+        .with_context(|| format!("writing {}", out.display()))
 }
 
 struct Entry {
@@ -265,7 +303,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         entries.push(Entry { file, caption });
         pb.inc(1);
     }
-    // Mesh editing: a de Casteljau construction, and Loop subdivision as wireframes.
+    // Mesh editing: a de Casteljau construction, and Loop subdivision, shaded with edges.
     let curve = [
         prism_math::DVec2::new(0.2, 0.35),
         prism_math::DVec2::new(0.3, 0.6),
@@ -292,7 +330,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
             mesh = prism_mesh::loop_subdivide(&he, prism_mesh::LoopWeights::Warren)?;
         }
         let file = format!("loop_level_{level}.png");
-        write_wireframe(&mesh, 300, &a.output.join(&file))?;
+        write_shaded(&mesh, 300, &a.output.join(&file))?;
         entries.push(Entry {
             file,
             caption: format!(
@@ -408,7 +446,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     for p in &mut teapot.positions {
         *p = prism_math::glam::DVec3::new(p.x, p.z, -p.y);
     }
-    write_wireframe(&teapot, 300, &a.output.join("bezier_teapot.png"))?;
+    write_shaded(&teapot, 300, &a.output.join("bezier_teapot.png"))?;
     entries.push(Entry {
         file: "bezier_teapot.png".into(),
         caption: format!(
@@ -419,6 +457,7 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     });
     pb.inc(1);
     raytrace_gallery(a, &mut entries)?;
+    cloth_gallery(a, &mut entries)?;
     pb.finish_and_clear();
     let mut html = String::from(
         "<!doctype html><meta charset=\"utf-8\"><title>prism gallery</title>\
@@ -616,5 +655,129 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
             ),
         });
     }
+    Ok(())
+}
+
+/// The cloth: the course's five scenes, the ks and density series, and a draped sphere with
+/// each shader, drawn by prism-shade with the course app's camera.
+fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
+    use prism_shade::Shader;
+    let scenes = a.assets.join("clothsim/scene");
+    let textures = a.assets.join("clothsim/textures");
+    if !scenes.is_dir() || !textures.is_dir() {
+        return Ok(());
+    }
+    let (w, h) = (240u32, 188u32);
+    let user = |e: prism_cloth::ClothError| crate::UserError(e.to_string());
+    let run = |name: &str, set: &[String], frames: u32| -> Result<prism_cloth::Cloth> {
+        let scene =
+            prism_cloth::read_scene(&scenes.join(format!("{name}.json")), set).map_err(user)?;
+        let mut c = prism_cloth::Cloth::new(&scene);
+        for _ in 0..frames {
+            c.frame();
+        }
+        Ok(c)
+    };
+    let draw = |c: &prism_cloth::Cloth,
+                view: &prism_shade::View,
+                shader: &Shader|
+     -> Result<prism_image::RgbImage> {
+        let mut mesh = crate::cloth::cloth_mesh(c);
+        mesh.append(&crate::cloth::obstacles(&c.scene));
+        prism_shade::shade(
+            &mesh,
+            view,
+            shader,
+            &prism_shade::Uniforms::default(),
+            &prism_shade::ShadeOptions::default(),
+        )
+        .map_err(|e| crate::UserError(e.to_string()).into())
+    };
+    let frames = 90;
+    let save = |name: &str, panels: &[prism_image::RgbImage], cols: usize| -> Result<()> {
+        let img = montage(panels, cols);
+        prism_image::write_png(&a.output.join(name), &prism_shade::to_bytes(&img))
+            .with_context(|| format!("writing {name}"))
+    };
+    // The five scenes after one simulated second.
+    let names = ["pinned2", "pinned4", "sphere", "plane", "selfCollision"];
+    let mut panels = Vec::new();
+    for n in names {
+        let start = run(n, &[], 0)?;
+        let view = crate::cloth::course_view(&start, w, h);
+        let c = run(n, &[], frames)?;
+        panels.push(draw(&c, &view, &Shader::Phong)?);
+    }
+    save("cloth_scenes.png", &panels, 5)?;
+    entries.push(Entry {
+        file: "cloth_scenes.png".into(),
+        caption: format!(
+            "prism cloth: {} after one simulated second",
+            names.join(", ")
+        ),
+    });
+    // The report's series on pinned2.
+    for (file, key, values) in [
+        ("cloth_ks.png", "ks", ["500", "5000", "50000"]),
+        ("cloth_density.png", "density", ["15", "150", "1500"]),
+    ] {
+        let mut panels = Vec::new();
+        for v in values {
+            let set = vec![format!("{key}={v}")];
+            let start = run("pinned2", &set, 0)?;
+            let view = crate::cloth::course_view(&start, w, h);
+            panels.push(draw(&run("pinned2", &set, frames)?, &view, &Shader::Phong)?);
+        }
+        save(file, &panels, 3)?;
+        entries.push(Entry {
+            file: file.into(),
+            caption: format!(
+                "pinned2 with {key} = {} (--set {key}=...)",
+                values.join(", ")
+            ),
+        });
+    }
+    // The draped sphere with each shader.
+    let load = |f: &str| -> Result<prism_image::RgbImage> {
+        Ok(prism_image::read_image(&textures.join(f))?
+            .to_rgb8()
+            .to_rgb_f32())
+    };
+    let tex = prism_shade::course_texture(load("texture_1.png")?);
+    let mut faces = Vec::new();
+    for name in prism_image::CUBE_FACES {
+        let path = ["png", "jpg"]
+            .iter()
+            .map(|e| format!("cube/{name}.{e}"))
+            .find(|p| textures.join(p).is_file())
+            .context("the course's cube map")?;
+        faces.push(load(&path)?);
+    }
+    let faces: [prism_image::RgbImage; 6] = faces.try_into().expect("six faces");
+    let cube = prism_image::CubeMap::new(faces)?;
+    let shaders = [
+        Shader::Normal,
+        Shader::Diffuse,
+        Shader::Phong,
+        Shader::Texture(tex.clone()),
+        Shader::Bump(tex.clone()),
+        Shader::Displacement(tex),
+        Shader::Mirror(cube),
+    ];
+    let start = run("sphere", &[], 0)?;
+    let view = crate::cloth::course_view(&start, w, h);
+    let c = run("sphere", &[], frames)?;
+    let panels: Vec<_> = shaders
+        .iter()
+        .map(|s| draw(&c, &view, s))
+        .collect::<Result<_>>()?;
+    save("cloth_shaders.png", &panels, 4)?;
+    entries.push(Entry {
+        file: "cloth_shaders.png".into(),
+        caption:
+            "the draped sphere with each shader: normal, diffuse, Blinn-Phong, texture, bump, \
+                  displacement, mirror (texture_1 as texture and height map)"
+                .into(),
+    });
     Ok(())
 }

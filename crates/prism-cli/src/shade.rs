@@ -303,6 +303,7 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         samples: a.samples,
         background,
         wireframe: wire,
+        ..ShadeOptions::default()
     };
     let read = t0.elapsed();
     let t1 = Instant::now();

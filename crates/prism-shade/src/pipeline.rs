@@ -70,6 +70,8 @@ pub struct ShadeOptions {
     pub background: Rgb,
     /// Draw every triangle's edges on top, in this colour, depth-tested.
     pub wireframe: Option<Rgb>,
+    /// Half the width of those edges, in pixels.
+    pub wire_width: f32,
 }
 
 impl Default for ShadeOptions {
@@ -78,6 +80,7 @@ impl Default for ShadeOptions {
             samples: 1,
             background: Rgb::BLACK,
             wireframe: None,
+            wire_width: 0.75,
         }
     }
 }
@@ -281,7 +284,13 @@ pub fn shade(
             }
             if let Some(c) = opts.wireframe {
                 for &i in &by_band[band] {
-                    raster_triangle(&tris[i as usize], i, &target, buf, Some(c));
+                    raster_triangle(
+                        &tris[i as usize],
+                        i,
+                        &target,
+                        buf,
+                        Some((c, opts.wire_width)),
+                    );
                 }
             }
             for (p, samples) in out.iter_mut().zip(buf.color.chunks(n)) {
@@ -340,9 +349,15 @@ struct Target {
 }
 
 /// Rasterizes triangle `id` into a band: the depth test and the visible triangle with its
-/// weights; with `wire`, only samples within 0.75 pixel of an edge, in that colour, the
+/// weights; with `wire`, only samples within the half width of an edge, in that colour, the
 /// depth test passing up to a small bias so that edges show on their own faces.
-fn raster_triangle(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band, wire: Option<Rgb>) {
+fn raster_triangle(
+    t: &[ScreenVertex; 3],
+    id: u32,
+    to: &Target,
+    buf: &mut Band,
+    wire: Option<(Rgb, f32)>,
+) {
     let Target {
         k,
         w,
@@ -406,9 +421,9 @@ fn raster_triangle(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band, 
                             buf.prim[s] = id;
                             buf.bary[s] = l;
                         }
-                        Some(col) => {
+                        Some((col, half_width)) => {
                             // Distance in pixels to the nearest edge.
-                            let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= 0.75);
+                            let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
                             if !near_edge || z > buf.depth[s] + 1e-4 {
                                 continue;
                             }
