@@ -240,6 +240,15 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         let t = Instant::now();
         cloth.frame();
         simulate += t.elapsed();
+        if !cloth.is_finite() {
+            bar.finish_and_clear();
+            return Err(UserError(format!(
+                "{}: the simulation diverged in frame {f} (positions left the finite numbers): \
+                 ks is too stiff for the masses at this time step",
+                a.scene.display()
+            ))
+            .into());
+        }
         if let Some(dir) = &frames_dir {
             draw(
                 &cloth,

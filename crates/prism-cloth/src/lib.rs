@@ -18,6 +18,6 @@ pub use json::{parse_json, Json, JsonValue, MAX_JSON_DEPTH};
 pub use random::{GlibcRand, RAND_MAX};
 pub use scene::{
     parse_scene, read_scene, ClothParams, ClothScene, Orientation, PlaneParams, SphereParams,
-    MAX_GRID_SIDE, MAX_MASSES, MAX_SCENE_BYTES,
+    MAX_DENSITY, MAX_GRID_SIDE, MAX_KS, MAX_MASSES, MAX_SCENE_BYTES, MAX_SIZE,
 };
 pub use sim::{Cloth, Spring, SpringKind, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};

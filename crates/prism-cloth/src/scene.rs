@@ -13,6 +13,12 @@ use crate::json::{parse_json, Json, JsonValue};
 pub const MAX_GRID_SIDE: usize = 4096;
 /// Most masses in a cloth.
 pub const MAX_MASSES: usize = 1 << 22;
+/// Largest size, coordinate or radius in metres.
+pub const MAX_SIZE: f64 = 1e6;
+/// Largest density.
+pub const MAX_DENSITY: f64 = 1e9;
+/// Largest spring constant.
+pub const MAX_KS: f64 = 1e12;
 /// Largest scene file read (16 MiB).
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 
@@ -303,11 +309,22 @@ impl Cx<'_> {
 
     fn vec3(&self, v: &Json, key: &str) -> Result<DVec3, ClothError> {
         match &v.value {
-            JsonValue::Array(a) if a.len() == 3 => Ok(DVec3::new(
-                self.number(&a[0], key)?,
-                self.number(&a[1], key)?,
-                self.number(&a[2], key)?,
-            )),
+            JsonValue::Array(a) if a.len() == 3 => {
+                let p = DVec3::new(
+                    self.number(&a[0], key)?,
+                    self.number(&a[1], key)?,
+                    self.number(&a[2], key)?,
+                );
+                if p.abs().max_element() > MAX_SIZE {
+                    return Err(self.err(
+                        v.line,
+                        format!(
+                            "{key}: expected coordinates of at most {MAX_SIZE} in size, found {p}"
+                        ),
+                    ));
+                }
+                Ok(p)
+            }
             o => Err(self.err(
                 v.line,
                 format!(
@@ -339,8 +356,19 @@ impl Cx<'_> {
         ];
         let f = self.object(v, "cloth", &keys)?;
         let req = |k: &str| self.field(f, v.line, "cloth", k);
-        let width = self.positive(req("width")?, "width")?;
-        let height = self.positive(req("height")?, "height")?;
+        let size = |k: &str| -> Result<f64, ClothError> {
+            let j = req(k)?;
+            let x = self.positive(j, k)?;
+            if x > MAX_SIZE {
+                return Err(self.err(
+                    j.line,
+                    format!("{k}: expected at most {MAX_SIZE} m, found {x}"),
+                ));
+            }
+            Ok(x)
+        };
+        let width = size("width")?;
+        let height = size("height")?;
         let side = |k: &str| -> Result<usize, ClothError> {
             let j = req(k)?;
             let n = self.integer(j, k)?;
@@ -364,8 +392,8 @@ impl Cx<'_> {
             req("thickness")?,
             "thickness",
             0.0,
-            f64::MAX,
-            "a thickness of at least 0",
+            width.max(height),
+            "a thickness from 0 to the cloth's larger side",
         )?;
         let o = req("orientation")?;
         let orientation = match self.integer(o, "orientation")? {
@@ -433,13 +461,19 @@ impl Cx<'_> {
                 100.0,
                 "a percentage from 0 to 100",
             )?,
-            density: self.positive(req("density")?, "density")?,
+            density: self.ranged(
+                req("density")?,
+                "density",
+                f64::MIN_POSITIVE,
+                MAX_DENSITY,
+                "a density above 0 and at most 1e9",
+            )?,
             ks: self.ranged(
                 req("ks")?,
                 "ks",
                 0.0,
-                f64::MAX,
-                "a spring constant of at least 0",
+                MAX_KS,
+                "a spring constant from 0 to 1e12",
             )?,
         })
     }
@@ -449,7 +483,13 @@ impl Cx<'_> {
         let req = |k: &str| self.field(f, v.line, "sphere", k);
         Ok(SphereParams {
             origin: self.vec3(req("origin")?, "origin")?,
-            radius: self.positive(req("radius")?, "radius")?,
+            radius: self.ranged(
+                req("radius")?,
+                "radius",
+                f64::MIN_POSITIVE,
+                MAX_SIZE,
+                "a radius above 0 and at most 1e6",
+            )?,
             friction: self.ranged(
                 req("friction")?,
                 "friction",

@@ -319,6 +319,13 @@ impl Cloth {
         }
     }
 
+    /// True while every position is finite (an unstable time step for the stiffness and
+    /// mass makes an explicit integrator diverge).
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.positions.iter().all(|p| p.is_finite())
+    }
+
     /// Kinetic energy from the last step's displacement, `sum m |x - x_last|² / (2 dt²)`.
     #[must_use]
     pub fn kinetic_energy(&self) -> f64 {

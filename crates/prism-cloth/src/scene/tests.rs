@@ -38,7 +38,7 @@ fn values_and_overrides() {
     let e = parse_scene(PINNED2, "p.json", &["ks=-1".into()]).unwrap_err();
     assert!(
         e.to_string()
-            .contains("ks: expected a spring constant of at least 0"),
+            .contains("ks: expected a spring constant from 0 to 1e12"),
         "{e}"
     );
 }
@@ -111,7 +111,7 @@ fn bad_scenes_are_located() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("radius: expected a number above 0, found 0"),
+        e.contains("radius: expected a radius above 0 and at most 1e6, found 0"),
         "{e}"
     );
     let plane = format!(
