@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_cloth::{read_scene, Cloth, STEPS_PER_FRAME};
+use prism_cloth::{read_scene, Cloth, FRAMES_PER_SECOND, STEPS_PER_FRAME};
 use prism_math::Vec3;
 use prism_shade::{shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
@@ -18,8 +18,8 @@ use crate::UserError;
 pub struct ClothArgs {
     /// The course's scene JSON (cloth, and optionally sphere and plane).
     scene: PathBuf,
-    /// Draw the run: a folder (one PNG per frame, `frame_0001.png`, ...), or a .png of
-    /// the last frame.
+    /// Draw the run: a folder (one PNG per frame, `frame_0001.png`, ...), or a .png (an
+    /// animated PNG of every frame, playing at 90 frames a second, in real time).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Frames to simulate (30 steps each, 90 frames a simulated second).
@@ -215,59 +215,90 @@ pub fn run(a: &ClothArgs) -> Result<()> {
     let mut simulate = Duration::ZERO;
     let mut render = Duration::ZERO;
     let mut write = Duration::ZERO;
-    let draw =
-        |cloth: &Cloth, path: &Path, render: &mut Duration, write: &mut Duration| -> Result<()> {
+    let picture = |cloth: &Cloth, render: &mut Duration| -> Result<prism_image::Rgb8Image> {
+        let t = Instant::now();
+        let mut mesh = cloth_mesh(cloth);
+        mesh.append(&obstacles);
+        let img = shade(
+            &mesh,
+            &view,
+            &shader,
+            &Uniforms::default(),
+            &ShadeOptions::default(),
+        )
+        .map_err(|e| UserError(e.to_string()))?;
+        let bytes = to_bytes(&img);
+        *render += t.elapsed();
+        Ok(bytes)
+    };
+    // Simulates every frame, calling `each` after it; stops at a diverged frame.
+    let mut run_frames = |each: &mut dyn FnMut(
+        u32,
+        &Cloth,
+        &mut Duration,
+        &mut Duration,
+    ) -> Result<()>|
+     -> Result<()> {
+        for f in 1..=a.frames {
             let t = Instant::now();
-            let mut mesh = cloth_mesh(cloth);
-            mesh.append(&obstacles);
-            let img = shade(
-                &mesh,
-                &view,
-                &shader,
-                &Uniforms::default(),
-                &ShadeOptions::default(),
-            )
-            .map_err(|e| UserError(e.to_string()))?;
-            let bytes = to_bytes(&img);
-            *render += t.elapsed();
+            cloth.frame();
+            simulate += t.elapsed();
+            if !cloth.is_finite() {
+                bar.finish_and_clear();
+                return Err(UserError(format!(
+                    "{}: the simulation diverged in frame {f} (positions left the finite numbers): \
+                     ks is too stiff for the masses at this time step",
+                    a.scene.display()
+                ))
+                .into());
+            }
+            each(f, &cloth, &mut render, &mut write)?;
+            if let Some(dir) = &a.obj_sequence {
+                let t = Instant::now();
+                write_text(&dir.join(format!("frame_{f:04}.obj")), &cloth_obj(&cloth))?;
+                write += t.elapsed();
+            }
+            bar.set_position(u64::from(f));
+        }
+        bar.finish_and_clear();
+        Ok(())
+    };
+    match (&a.output, &frames_dir) {
+        (_, Some(dir)) => run_frames(&mut |f, c, render, write| {
+            let img = picture(c, render)?;
             let t = Instant::now();
-            prism_image::write_png(path, &bytes)
+            let path = dir.join(format!("frame_{f:04}.png"));
+            prism_image::write_png(&path, &img)
                 .with_context(|| format!("writing {}", path.display()))?;
             *write += t.elapsed();
             Ok(())
-        };
-    for f in 1..=a.frames {
-        let t = Instant::now();
-        cloth.frame();
-        simulate += t.elapsed();
-        if !cloth.is_finite() {
-            bar.finish_and_clear();
-            return Err(UserError(format!(
-                "{}: the simulation diverged in frame {f} (positions left the finite numbers): \
-                 ks is too stiff for the masses at this time step",
-                a.scene.display()
-            ))
-            .into());
-        }
-        if let Some(dir) = &frames_dir {
-            draw(
-                &cloth,
-                &dir.join(format!("frame_{f:04}.png")),
-                &mut render,
-                &mut write,
+        })?,
+        (Some(path), None) => {
+            // The animation streams into a temporary file, renamed into place at the end.
+            prism_image::write_atomic_with(
+                path,
+                |out| -> Result<()> {
+                    let mut enc = prism_image::ApngEncoder::new(
+                        out,
+                        w,
+                        h,
+                        a.frames,
+                        FRAMES_PER_SECOND as u16,
+                    )?;
+                    run_frames(&mut |_, c, render, _| {
+                        let img = picture(c, render)?;
+                        enc.push(&img)?;
+                        Ok(())
+                    })?;
+                    enc.finish()?;
+                    Ok(())
+                },
+                |p, e| anyhow::anyhow!("writing {}: {e}", p.display()),
             )?;
         }
-        if let Some(dir) = &a.obj_sequence {
-            let t = Instant::now();
-            write_text(&dir.join(format!("frame_{f:04}.obj")), &cloth_obj(&cloth))?;
-            write += t.elapsed();
-        }
-        bar.set_position(u64::from(f));
+        (None, None) => run_frames(&mut |_, _, _, _| Ok(()))?,
     }
-    bar.finish_and_clear();
-    if let (Some(o), None) = (&a.output, &frames_dir) {
-        draw(&cloth, o, &mut render, &mut write)?;
-    }
+    let cloth = &cloth;
     if let Some(o) = &a.obj {
         let t = Instant::now();
         write_text(o, &cloth_obj(&cloth))?;

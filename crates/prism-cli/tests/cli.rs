@@ -1598,6 +1598,10 @@ fn cloth_runs_and_errors() {
     let p: Vec<f64> = v[49][2..].split(' ').map(|x| x.parse().unwrap()).collect();
     assert_eq!(p, [1.0, 1.0, 0.0]);
     assert!(text.lines().any(|l| l.starts_with("f ")));
+    // An animated PNG of the three frames.
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(bytes.windows(4).any(|w| w == b"acTL"), "not animated");
+    assert_eq!(bytes.windows(4).filter(|w| *w == b"fcTL").count(), 3);
     assert_eq!(prism_image::read_png(&png).unwrap().width(), 64);
     let err = stderr(&o);
     assert!(

@@ -1,8 +1,9 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
 //! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
-//! cube maps looked up as OpenGL does, heat maps, bloom, and BMP output.
+//! cube maps looked up as OpenGL does, heat maps, bloom, BMP output and animated PNGs.
 #![warn(missing_docs)]
 
+mod animation;
 mod bloom;
 mod cubemap;
 mod diff;
@@ -14,6 +15,7 @@ mod io;
 mod srgb;
 mod texture;
 
+pub use animation::ApngEncoder;
 pub use bloom::{bloom_weights, Bloom};
 pub use cubemap::{cube_face, CubeMap, CUBE_FACES};
 pub use diff::{compare_rgb8, DiffStats};
