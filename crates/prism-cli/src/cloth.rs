@@ -301,7 +301,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
     let cloth = &cloth;
     if let Some(o) = &a.obj {
         let t = Instant::now();
-        write_text(o, &cloth_obj(&cloth))?;
+        write_text(o, &cloth_obj(cloth))?;
         write += t.elapsed();
     }
     let updates = cloth.positions.len() as f64 * f64::from(a.frames) * STEPS_PER_FRAME as f64;
