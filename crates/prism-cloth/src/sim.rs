@@ -66,7 +66,7 @@ pub struct Cloth {
 fn floor_i64(x: f64) -> i64 {
     let t = x as i64;
     if (t as f64) > x {
-        t - 1
+        t.saturating_sub(1)
     } else {
         t
     }
