@@ -1,7 +1,7 @@
 //! `prism cloth`: the course's ClothSim scenes simulated exactly, written as OBJ and drawn
 //! through prism-shade with the course app's camera.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -10,6 +10,7 @@ use prism_cloth::{read_scene, Cloth, FRAMES_PER_SECOND, STEPS_PER_FRAME};
 use prism_math::Vec3;
 use prism_shade::{shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
+use crate::output::write_text;
 use crate::shade::ShaderArg;
 use crate::UserError;
 
@@ -79,18 +80,6 @@ fn cloth_obj(c: &Cloth) -> String {
         let _ = writeln!(out, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
     }
     out
-}
-
-fn write_text(path: &Path, text: &str) -> Result<()> {
-    use std::io::Write;
-    prism_image::write_atomic(path, |w| {
-        w.write_all(text.as_bytes())
-            .map_err(|source| prism_image::ImageError::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-    })?;
-    Ok(())
 }
 
 /// The course app's view: looking at `(avg.x, avg.y / 2, avg.z)` of the starting masses

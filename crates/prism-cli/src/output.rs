@@ -127,6 +127,19 @@ pub fn write_rgb8(path: &Path, format: ImageFormat, image: &prism_image::Rgb8Ima
     Ok(())
 }
 
+/// Writes text to `path` through a temporary file and a rename.
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    use std::io::Write;
+    prism_image::write_atomic(path, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|source| prism_image::ImageError::Io {
+                path: path.to_path_buf(),
+                source,
+            })
+    })?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,6 +14,7 @@ use prism_render::{
 };
 use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
 
+use crate::output::write_text;
 use crate::output::{image_output, ImageFormat};
 use crate::UserError;
 
@@ -166,19 +167,6 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
     path.with_file_name(format!("{stem}{suffix}"))
-}
-
-/// Writes text to `path` through a temporary file and a rename.
-fn write_text(path: &Path, text: &str) -> Result<()> {
-    use std::io::Write;
-    prism_image::write_atomic(path, |w| {
-        w.write_all(text.as_bytes())
-            .map_err(|source| prism_image::ImageError::Io {
-                path: path.to_path_buf(),
-                source,
-            })
-    })?;
-    Ok(())
 }
 
 /// What the command loads: the scene, its cameras, the config if any.

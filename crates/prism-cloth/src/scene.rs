@@ -490,14 +490,12 @@ impl Cx<'_> {
                 MAX_SIZE,
                 "a radius above 0 and at most 1e6",
             )?,
-            friction: self.ranged(
-                req("friction")?,
-                "friction",
-                0.0,
-                1.0,
-                "a friction from 0 to 1",
-            )?,
+            friction: self.friction(req("friction")?)?,
         })
+    }
+
+    fn friction(&self, v: &Json) -> Result<f64, ClothError> {
+        self.ranged(v, "friction", 0.0, 1.0, "a friction from 0 to 1")
     }
 
     fn plane(&self, v: &Json) -> Result<PlaneParams, ClothError> {
@@ -512,13 +510,7 @@ impl Cx<'_> {
         Ok(PlaneParams {
             point: self.vec3(req("point")?, "point")?,
             normal: normal / len,
-            friction: self.ranged(
-                req("friction")?,
-                "friction",
-                0.0,
-                1.0,
-                "a friction from 0 to 1",
-            )?,
+            friction: self.friction(req("friction")?)?,
         })
     }
 }
