@@ -258,7 +258,7 @@ pub fn shade(
             let rows = (out.len() / w as usize) as u32;
             let n = (k * k) as usize;
             // Every sample is cleared: the buffers are the worker's, reused band to band.
-            buf.clear(out.len() * n, opts.background);
+            buf.clear(out.len() * n);
             let target = Target {
                 k,
                 w,
@@ -272,7 +272,9 @@ pub fn shade(
             }
             for s in 0..buf.prim.len() {
                 let p = buf.prim[s];
-                if p != NONE {
+                if p == NONE {
+                    buf.color[s] = opts.background;
+                } else {
                     let [a, b, c] = &tris[p as usize];
                     let l = buf.bary[s];
                     let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
@@ -327,16 +329,17 @@ struct Band {
 }
 
 impl Band {
-    fn clear(&mut self, len: usize, background: Rgb) {
-        // Depth is cleared to 1 (the far plane); LESS passes below it.
+    /// Clears depth (to 1, the far plane: LESS passes below it) and the visible triangle;
+    /// weights and colours are written before they are read.
+    fn clear(&mut self, len: usize) {
         self.depth.clear();
         self.depth.resize(len, 1.0);
         self.prim.clear();
         self.prim.resize(len, NONE);
-        self.bary.clear();
-        self.bary.resize(len, [0.0; 3]);
-        self.color.clear();
-        self.color.resize(len, background);
+        if self.bary.len() != len {
+            self.bary.resize(len, [0.0; 3]);
+            self.color.resize(len, Rgb::BLACK);
+        }
     }
 }
 
