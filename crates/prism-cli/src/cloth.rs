@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use prism_cloth::{read_scene, Cloth, FRAMES_PER_SECOND, STEPS_PER_FRAME};
 use prism_math::Vec3;
-use prism_shade::{shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
+use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
 use crate::output::write_text;
 use crate::shade::ShaderArg;
@@ -208,7 +208,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         let t = Instant::now();
         let mut mesh = cloth_mesh(cloth);
         mesh.append(&obstacles);
-        let img = shade(
+        let bytes = shade_rgb8(
             &mesh,
             &view,
             &shader,
@@ -216,7 +216,6 @@ pub fn run(a: &ClothArgs) -> Result<()> {
             &ShadeOptions::default(),
         )
         .map_err(|e| UserError(e.to_string()))?;
-        let bytes = to_bytes(&img);
         *render += t.elapsed();
         Ok(bytes)
     };

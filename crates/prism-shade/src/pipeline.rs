@@ -221,6 +221,35 @@ pub fn shade(
     uniforms: &Uniforms,
     opts: &ShadeOptions,
 ) -> Result<RgbImage, ShadeError> {
+    render(mesh, view, shader, uniforms, opts, |c| c)
+}
+
+/// [`shade`] straight to the bytes [`to_bytes`] would make, without the floating-point
+/// picture in between.
+///
+/// # Errors
+/// As [`shade`].
+pub fn shade_rgb8(
+    mesh: &ShadeMesh,
+    view: &View,
+    shader: &Shader,
+    uniforms: &Uniforms,
+    opts: &ShadeOptions,
+) -> Result<prism_image::Rgb8Image, ShadeError> {
+    render(mesh, view, shader, uniforms, opts, |c| {
+        [byte(c.r), byte(c.g), byte(c.b)]
+    })
+}
+
+/// The pipeline, each pixel's clamped mean colour stored by `store`.
+fn render<T: Copy + Default + Send>(
+    mesh: &ShadeMesh,
+    view: &View,
+    shader: &Shader,
+    uniforms: &Uniforms,
+    opts: &ShadeOptions,
+    store: impl Fn(Rgb) -> T + Sync,
+) -> Result<Image<T>, ShadeError> {
     let k = (opts.samples as f64).sqrt().round() as u32;
     if k == 0 || k > 16 || k * k != opts.samples {
         return Err(ShadeError::Samples(opts.samples));
@@ -247,72 +276,83 @@ pub fn shade(
             band.push(i as u32);
         }
     }
-    let mut image = Image::new(w, h, opts.background);
+    let mut pixels = vec![T::default(); w as usize * h as usize];
     let rows_per_band = (BAND * w) as usize;
-    image
-        .pixels_mut()
+    pixels
         .par_chunks_mut(rows_per_band)
         .enumerate()
-        .for_each_init(Band::default, |buf, (band, out)| {
-            let y_start = band as u32 * BAND;
-            let rows = (out.len() / w as usize) as u32;
-            let n = (k * k) as usize;
-            // Every sample is cleared: the buffers are the worker's, reused band to band.
-            buf.clear(out.len() * n);
-            let target = Target {
-                k,
-                w,
-                y_start,
-                rows,
-            };
-            // Visibility first (depth LESS, the first of equals kept), then one fragment per
-            // visible sample: the same colours as shading each fragment as it passes.
-            for &i in &by_band[band] {
-                raster_triangle(&tris[i as usize], i, &target, buf, None);
-            }
-            for s in 0..buf.prim.len() {
-                let p = buf.prim[s];
-                if p == NONE {
-                    buf.color[s] = opts.background;
-                } else {
-                    let [a, b, c] = &tris[p as usize];
-                    let l = buf.bary[s];
-                    let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
-                    let inv = 1.0 / (pw[0] + pw[1] + pw[2]);
-                    let v =
-                        Varyings::blend(&a.v, &b.v, &c.v, [pw[0] * inv, pw[1] * inv, pw[2] * inv]);
-                    buf.color[s] = fragment(shader, &u, &v);
-                }
-            }
-            if let Some(c) = opts.wireframe {
-                for &i in &by_band[band] {
-                    raster_triangle(
-                        &tris[i as usize],
-                        i,
-                        &target,
-                        buf,
-                        Some((c, opts.wire_width)),
-                    );
-                }
-            }
-            for (p, samples) in out.iter_mut().zip(buf.color.chunks(n)) {
-                // Each sample is stored clamped, as in an 8-bit colour buffer.
-                let clamp = |c: Rgb| {
-                    Rgb::new(
-                        c.r.clamp(0.0, 1.0),
-                        c.g.clamp(0.0, 1.0),
-                        c.b.clamp(0.0, 1.0),
-                    )
+        .for_each(|(band, out)| {
+            // Each worker keeps its band buffers from band to band and call to call (rayon
+            // would make new ones for every piece of work it splits off).
+            BAND_BUFFERS.with_borrow_mut(|buf| {
+                let y_start = band as u32 * BAND;
+                let rows = (out.len() / w as usize) as u32;
+                let n = (k * k) as usize;
+                // Every sample is cleared: the buffers are the worker's, reused band to band.
+                buf.clear(out.len() * n);
+                let target = Target {
+                    k,
+                    w,
+                    y_start,
+                    rows,
                 };
-                if n == 1 {
-                    *p = clamp(samples[0]);
-                } else {
-                    let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
-                    *p = sum * (1.0 / n as f32);
+                // Visibility first (depth LESS, the first of equals kept), then one fragment per
+                // visible sample: the same colours as shading each fragment as it passes.
+                for &i in &by_band[band] {
+                    raster_triangle(&tris[i as usize], i, &target, buf, None);
                 }
-            }
+                for s in 0..buf.prim.len() {
+                    let p = buf.prim[s];
+                    if p == NONE {
+                        buf.color[s] = opts.background;
+                    } else {
+                        let [a, b, c] = &tris[p as usize];
+                        let l = buf.bary[s];
+                        let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
+                        let inv = 1.0 / (pw[0] + pw[1] + pw[2]);
+                        let v = Varyings::blend(
+                            &a.v,
+                            &b.v,
+                            &c.v,
+                            [pw[0] * inv, pw[1] * inv, pw[2] * inv],
+                        );
+                        buf.color[s] = fragment(shader, &u, &v);
+                    }
+                }
+                if let Some(c) = opts.wireframe {
+                    for &i in &by_band[band] {
+                        raster_triangle(
+                            &tris[i as usize],
+                            i,
+                            &target,
+                            buf,
+                            Some((c, opts.wire_width)),
+                        );
+                    }
+                }
+                for (p, samples) in out.iter_mut().zip(buf.color.chunks(n)) {
+                    // Each sample is stored clamped, as in an 8-bit colour buffer.
+                    let clamp = |c: Rgb| {
+                        Rgb::new(
+                            c.r.clamp(0.0, 1.0),
+                            c.g.clamp(0.0, 1.0),
+                            c.b.clamp(0.0, 1.0),
+                        )
+                    };
+                    *p = if n == 1 {
+                        store(clamp(samples[0]))
+                    } else {
+                        let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
+                        store(sum * (1.0 / n as f32))
+                    };
+                }
+            });
         });
-    Ok(image)
+    Ok(Image::from_vec(w, h, pixels))
+}
+
+thread_local! {
+    static BAND_BUFFERS: std::cell::RefCell<Band> = std::cell::RefCell::new(Band::default());
 }
 
 /// No triangle covers the sample.
@@ -440,18 +480,23 @@ fn raster_triangle(
     }
 }
 
+/// A channel as OpenGL stores it: `round(clamp(v, 0, 1) 255)`, halves to even.
+#[inline]
+fn byte(v: f32) -> u8 {
+    // Adding and taking away 2^23 rounds halves to even in the default rounding mode, for
+    // the values 0..=255 here (`round_ties_even` would be a library call on plain x86-64).
+    const SHIFT: f32 = 8_388_608.0;
+    ((v.clamp(0.0, 1.0) * 255.0 + SHIFT) - SHIFT) as u8
+}
+
 /// Colours to bytes as OpenGL writes them: `round(clamp(c, 0, 1) 255)` with halves to even
 /// (as the processor's conversion rounds; 0.3 is 76, not 77), no sRGB encoding.
 #[must_use]
 pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
-    // Adding and taking away 2^23 rounds halves to even in the default rounding mode, for
-    // the values 0..=255 here (`round_ties_even` would be a library call on plain x86-64).
-    const SHIFT: f32 = 8_388_608.0;
-    let b = |v: f32| ((v.clamp(0.0, 1.0) * 255.0 + SHIFT) - SHIFT) as u8;
     let bytes = img
         .pixels()
         .par_iter()
-        .map(|p| [b(p.r), b(p.g), b(p.b)])
+        .map(|p| [byte(p.r), byte(p.g), byte(p.b)])
         .collect();
     Image::from_vec(img.width(), img.height(), bytes)
 }
