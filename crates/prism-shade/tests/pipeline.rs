@@ -250,13 +250,7 @@ fn depth_test_in_both_orders() {
             (&far, &near)
         };
         let mut m = a.clone();
-        let off = m.positions.len() as u32;
-        m.positions.extend(&b.positions);
-        m.normals.extend(&b.normals);
-        m.uvs.extend(&b.uvs);
-        m.tangents.extend(&b.tangents);
-        m.triangles
-            .extend(b.triangles.iter().map(|t| t.map(|i| i + off)));
+        m.append(b);
         let img = shade(
             &m,
             &front(21, 21),
