@@ -204,33 +204,55 @@ pub fn run(a: &ClothArgs) -> Result<()> {
     let mut simulate = Duration::ZERO;
     let mut render = Duration::ZERO;
     let mut write = Duration::ZERO;
-    let picture = |cloth: &Cloth, render: &mut Duration| -> Result<prism_image::Rgb8Image> {
-        let t = Instant::now();
-        let mut mesh = cloth_mesh(cloth);
-        mesh.append(&obstacles);
-        let bytes = shade_rgb8(
-            &mesh,
-            &view,
-            &shader,
-            &Uniforms::default(),
-            &ShadeOptions::default(),
-        )
-        .map_err(|e| UserError(e.to_string()))?;
-        *render += t.elapsed();
-        Ok(bytes)
-    };
-    // Simulates every frame, calling `each` after it; stops at a diverged frame.
+    let draws = a.output.is_some();
+    let mut frames_wall = Duration::ZERO;
+    // Simulates every frame and, when drawing, draws frame f while simulating frame f + 1
+    // (on rayon: the picture of a frame depends only on that frame's positions, so the
+    // bytes are the same as drawing after each frame); `each` takes the pictures in order.
+    // Stops at a diverged frame.
     let mut run_frames = |each: &mut dyn FnMut(
         u32,
-        &Cloth,
-        &mut Duration,
+        prism_image::Rgb8Image,
         &mut Duration,
     ) -> Result<()>|
      -> Result<()> {
-        for f in 1..=a.frames {
-            let t = Instant::now();
-            cloth.frame();
-            simulate += t.elapsed();
+        let wall = Instant::now();
+        let mut pending: Option<(u32, ShadeMesh)> = None;
+        for f in 1..=a.frames + 1 {
+            let drawing = pending.take();
+            let simulating = f <= a.frames;
+            let (picture, sim_time) = rayon::join(
+                || {
+                    drawing.map(|(g, mesh)| {
+                        let t = Instant::now();
+                        let img = shade_rgb8(
+                            &mesh,
+                            &view,
+                            &shader,
+                            &Uniforms::default(),
+                            &ShadeOptions::default(),
+                        );
+                        (g, img, t.elapsed())
+                    })
+                },
+                || {
+                    simulating.then(|| {
+                        let t = Instant::now();
+                        cloth.frame();
+                        t.elapsed()
+                    })
+                },
+            );
+            if let Some(t) = sim_time {
+                simulate += t;
+            }
+            if let Some((g, img, t)) = picture {
+                render += t;
+                each(g, img.map_err(|e| UserError(e.to_string()))?, &mut write)?;
+            }
+            if !simulating {
+                break;
+            }
             if !cloth.is_finite() {
                 bar.finish_and_clear();
                 return Err(UserError(format!(
@@ -240,20 +262,24 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                 ))
                 .into());
             }
-            each(f, &cloth, &mut render, &mut write)?;
             if let Some(dir) = &a.obj_sequence {
                 let t = Instant::now();
                 write_text(&dir.join(format!("frame_{f:04}.obj")), &cloth_obj(&cloth))?;
                 write += t.elapsed();
             }
+            if draws {
+                let mut mesh = cloth_mesh(&cloth);
+                mesh.append(&obstacles);
+                pending = Some((f, mesh));
+            }
             bar.set_position(u64::from(f));
         }
         bar.finish_and_clear();
+        frames_wall = wall.elapsed();
         Ok(())
     };
     match (&a.output, &frames_dir) {
-        (_, Some(dir)) => run_frames(&mut |f, c, render, write| {
-            let img = picture(c, render)?;
+        (_, Some(dir)) => run_frames(&mut |f, img, write| {
             let t = Instant::now();
             let path = dir.join(format!("frame_{f:04}.png"));
             prism_image::write_png(&path, &img)
@@ -273,9 +299,10 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                         a.frames,
                         FRAMES_PER_SECOND as u16,
                     )?;
-                    run_frames(&mut |_, c, render, _| {
-                        let img = picture(c, render)?;
+                    run_frames(&mut |_, img, write| {
+                        let t = Instant::now();
                         enc.push(&img)?;
+                        *write += t.elapsed();
                         Ok(())
                     })?;
                     enc.finish()?;
@@ -284,7 +311,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                 |p, e| anyhow::anyhow!("writing {}: {e}", p.display()),
             )?;
         }
-        (None, None) => run_frames(&mut |_, _, _, _| Ok(()))?,
+        (None, None) => run_frames(&mut |_, _, _| Ok(()))?,
     }
     let cloth = &cloth;
     if let Some(o) = &a.obj {
@@ -299,6 +326,12 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         eprintln!("simulate: {:.1} ms", ms(simulate));
         eprintln!("render: {:.1} ms", ms(render));
         eprintln!("write: {:.1} ms", ms(write));
+        if draws {
+            // Simulated and drawn (not written) frames per second of wall time, drawing
+            // overlapped with simulating.
+            let drawn = frames_wall.saturating_sub(write).as_secs_f64().max(1e-9);
+            eprintln!("frames/s: {:.1}", f64::from(a.frames) / drawn);
+        }
         eprintln!(
             "particle-updates/s: {:.0}",
             updates / simulate.as_secs_f64().max(1e-9)
