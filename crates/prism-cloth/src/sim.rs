@@ -262,6 +262,7 @@ impl Cloth {
         let h = 3.0 * c.height / c.num_height_points as f64;
         let t = w.max(h);
         let two_t = 2.0 * c.thickness;
+        let far_enough = two_t * two_t * (1.0 + 1e-9);
         let n = self.positions.len();
         let cells = (2 * n).next_power_of_two();
         self.keys.clear();
@@ -307,6 +308,11 @@ impl Cloth {
                     continue;
                 }
                 let d = p - self.positions[q];
+                // Most neighbours are well outside 2 thickness: decide those without a square
+                // root (the margin keeps the decision the exact one's).
+                if d.length_squared() > far_enough {
+                    continue;
+                }
                 let len = d.length();
                 if len > 0.0 && len < two_t {
                     sum += (two_t - len) * (d / len);
