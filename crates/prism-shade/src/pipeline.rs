@@ -256,6 +256,7 @@ fn render<T: Copy + Default + Send>(
     }
     let mut u = *uniforms;
     u.cam_pos = view.eye;
+    let needs = shader.needs();
     let tris = screen_triangles(mesh, view, shader, &u)?;
     let (w, h) = (view.width, view.height);
     // Triangles by band of rows, in mesh order.
@@ -310,11 +311,12 @@ fn render<T: Copy + Default + Send>(
                         let l = buf.bary[s];
                         let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
                         let inv = 1.0 / (pw[0] + pw[1] + pw[2]);
-                        let v = Varyings::blend(
+                        let v = Varyings::blend_only(
                             &a.v,
                             &b.v,
                             &c.v,
                             [pw[0] * inv, pw[1] * inv, pw[2] * inv],
+                            needs,
                         );
                         buf.color[s] = fragment(shader, &u, &v);
                     }

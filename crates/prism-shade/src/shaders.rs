@@ -26,7 +26,45 @@ pub enum Shader {
     Mirror(CubeMap),
 }
 
+/// Which varyings a shader reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Needs {
+    /// The world position.
+    pub position: bool,
+    /// The tangent.
+    pub tangent: bool,
+    /// The texture coordinates.
+    pub uv: bool,
+}
+
 impl Shader {
+    /// The varyings the shader reads (the normal is always interpolated).
+    #[must_use]
+    pub fn needs(&self) -> Needs {
+        match self {
+            Shader::Normal | Shader::Wireframe => Needs {
+                position: false,
+                tangent: false,
+                uv: false,
+            },
+            Shader::Diffuse | Shader::Phong | Shader::Mirror(_) => Needs {
+                position: true,
+                tangent: false,
+                uv: false,
+            },
+            Shader::Texture(_) => Needs {
+                position: false,
+                tangent: false,
+                uv: true,
+            },
+            Shader::Bump(_) | Shader::Displacement(_) => Needs {
+                position: true,
+                tangent: true,
+                uv: true,
+            },
+        }
+    }
+
     /// The name used on the command line.
     #[must_use]
     pub fn name(&self) -> &'static str {
@@ -105,6 +143,41 @@ impl Varyings {
         }
     }
 
+    /// [`Varyings::blend`] of the varyings in `needs` and the normal; the rest are zero.
+    #[must_use]
+    pub fn blend_only(
+        a: &Varyings,
+        b: &Varyings,
+        c: &Varyings,
+        w: [f32; 3],
+        needs: Needs,
+    ) -> Varyings {
+        let zero = Varyings {
+            position: Vec3::ZERO,
+            normal: a.normal * w[0] + b.normal * w[1] + c.normal * w[2],
+            tangent: Vec3::ZERO,
+            uv: Vec2::ZERO,
+        };
+        Varyings {
+            position: if needs.position {
+                a.position * w[0] + b.position * w[1] + c.position * w[2]
+            } else {
+                zero.position
+            },
+            tangent: if needs.tangent {
+                a.tangent * w[0] + b.tangent * w[1] + c.tangent * w[2]
+            } else {
+                zero.tangent
+            },
+            uv: if needs.uv {
+                a.uv * w[0] + b.uv * w[1] + c.uv * w[2]
+            } else {
+                zero.uv
+            },
+            ..zero
+        }
+    }
+
     /// `a + t (b - a)`.
     #[must_use]
     pub fn lerp(a: &Varyings, b: &Varyings, t: f32) -> Varyings {
@@ -176,6 +249,51 @@ pub fn fragment(shader: &Shader, u: &Uniforms, f: &Varyings) -> Rgb {
             let d = -wo;
             let wi = d - 2.0 * n.dot(d) * n;
             cube.sample(wi)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Property: every shader gives the same colour from the varyings it says it needs as
+    /// from all of them.
+    #[test]
+    fn needs_cover_what_fragments_read() {
+        let tex = course_texture(prism_image::Image::from_fn(4, 4, |x, y| {
+            Rgb::new(x as f32 / 4.0, y as f32 / 4.0, 0.5)
+        }));
+        let faces: [prism_image::RgbImage; 6] = std::array::from_fn(|i| {
+            prism_image::Image::from_fn(2, 2, |x, y| Rgb::new(i as f32 / 6.0, x as f32, y as f32))
+        });
+        let cube = CubeMap::new(faces).unwrap();
+        let shaders = [
+            Shader::Normal,
+            Shader::Wireframe,
+            Shader::Diffuse,
+            Shader::Phong,
+            Shader::Texture(tex.clone()),
+            Shader::Bump(tex.clone()),
+            Shader::Displacement(tex),
+            Shader::Mirror(cube),
+        ];
+        let v = |k: f32| Varyings {
+            position: Vec3::new(0.1 * k, 0.3, -0.2 * k),
+            normal: Vec3::new(0.2, 1.0, 0.3 * k).normalize(),
+            tangent: Vec3::new(1.0, 0.1 * k, 0.0).normalize(),
+            uv: Vec2::new(0.3 * k, 0.7),
+        };
+        let (a, b, c) = (v(1.0), v(2.0), v(3.0));
+        let w = [0.2, 0.3, 0.5];
+        let u = Uniforms {
+            cam_pos: Vec3::new(0.0, 1.0, 3.0),
+            ..Uniforms::default()
+        };
+        for s in &shaders {
+            let full = fragment(s, &u, &Varyings::blend(&a, &b, &c, w));
+            let only = fragment(s, &u, &Varyings::blend_only(&a, &b, &c, w, s.needs()));
+            assert_eq!(full, only, "{}", s.name());
         }
     }
 }
