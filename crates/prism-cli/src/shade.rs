@@ -197,6 +197,18 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
     if a.samples == 0 || a.samples > 256 {
         return Err(UserError(format!("--samples: expected 1 to 256, found {}", a.samples)).into());
     }
+    // Sample buffers hold 32 bytes a sample: at most 2^28 samples in all, 2^20 a row.
+    let (per_row, all) = (
+        u64::from(w) * u64::from(a.samples),
+        u64::from(w) * u64::from(h) * u64::from(a.samples),
+    );
+    if per_row > 1 << 20 || all > 1 << 28 {
+        return Err(UserError(format!(
+            "--resolution {w} {h} with --samples {}: {all} samples is over the limit of 2^28 (and 2^20 a row)",
+            a.samples
+        ))
+        .into());
+    }
     let up = three(&a.up, "--up")?;
     let light = three(&a.light, "--light")?;
     let intensity = colour(&a.light_intensity, "--light-intensity")?;
