@@ -1551,6 +1551,17 @@ fn shade_meshes_and_errors() {
         (
             vec![
                 monkey.display().to_string(),
+                "-r".into(),
+                "16384".into(),
+                "16384".into(),
+                "--samples".into(),
+                "16".into(),
+            ],
+            "is over the limit of 2^28",
+        ),
+        (
+            vec![
+                monkey.display().to_string(),
                 "--eye=0,0,0".into(),
                 "--target=0,0,0".into(),
             ],
