@@ -324,6 +324,9 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
         eprintln!("read: {:.1} ms", ms(read));
         eprintln!("simulate: {:.1} ms", ms(simulate));
+        for (name, t) in prism_cloth::StepTimes::NAMES.iter().zip(cloth.times.steps) {
+            eprintln!("  {name}: {:.1} ms", ms(t));
+        }
         eprintln!("render: {:.1} ms", ms(render));
         eprintln!("write: {:.1} ms", ms(write));
         if draws {

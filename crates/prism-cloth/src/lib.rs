@@ -20,4 +20,4 @@ pub use scene::{
     parse_scene, read_scene, ClothParams, ClothScene, Orientation, PlaneParams, SphereParams,
     MAX_DENSITY, MAX_GRID_SIDE, MAX_KS, MAX_MASSES, MAX_SCENE_BYTES, MAX_SIZE,
 };
-pub use sim::{Cloth, Spring, SpringKind, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};
+pub use sim::{Cloth, Spring, SpringKind, StepTimes, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};

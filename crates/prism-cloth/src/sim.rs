@@ -4,9 +4,11 @@
 //! the sphere, and the sequential 10% length limit; f64 throughout.
 
 use prism_math::glam::DVec3;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
 
 use crate::random::{GlibcRand, RAND_MAX};
-use crate::scene::{ClothScene, Orientation};
+use crate::scene::{ClothScene, Orientation, PlaneParams, SphereParams};
 
 /// Frames per simulated second.
 pub const FRAMES_PER_SECOND: f64 = 90.0;
@@ -39,6 +41,30 @@ pub struct Spring {
     pub kind: SpringKind,
 }
 
+/// Wall time spent in each stage of the time step, summed over the steps taken.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepTimes {
+    /// Per stage, in order: the springs' forces; each mass's sum of forces, Verlet and
+    /// self-collision box; self-collision and the collision objects; the length limit.
+    pub steps: [Duration; 4],
+}
+
+impl StepTimes {
+    /// The stages' names, in the order of [`StepTimes::steps`].
+    pub const NAMES: [&'static str; 4] = [
+        "spring forces",
+        "verlet",
+        "self-collision and objects",
+        "length limit",
+    ];
+
+    fn add(&mut self, step: usize, since: Instant) -> Instant {
+        let now = Instant::now();
+        self.steps[step] += now - since;
+        now
+    }
+}
+
 /// The simulated cloth.
 #[derive(Clone, Debug)]
 pub struct Cloth {
@@ -54,11 +80,112 @@ pub struct Cloth {
     pub springs: Vec<Spring>,
     /// The mass of every point mass.
     pub mass: f64,
-    forces: Vec<DVec3>,
-    keys: Vec<(i64, i64, i64, u32)>,
+    /// Time spent in each of the five steps so far.
+    pub times: StepTimes,
+    spring_forces: Vec<ForceLanes>,
+    incident_start: Vec<u32>,
+    incident: Vec<u32>,
+    sorted: Vec<DVec3>,
+    marked: Vec<u64>,
+    keys: Vec<BoxKey>,
     cell_start: Vec<u32>,
     cell_fill: Vec<u32>,
     by_cell: Vec<u32>,
+}
+
+/// A mass's self-collision box: its exact integer key and its cell in the hash table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct BoxKey {
+    exact: [i64; 3],
+    cell: u32,
+}
+
+/// The self-collision boxes: their size, and the number of cells (a power of two) of the
+/// hash table that groups them.
+#[derive(Clone, Copy, Debug)]
+struct BoxGrid {
+    size: DVec3,
+    cells: u32,
+}
+
+impl BoxGrid {
+    /// The box of a position, `floor(p / size)` per axis.
+    #[inline(always)]
+    fn key(&self, p: DVec3) -> BoxKey {
+        let exact = [
+            floor_i64(p.x / self.size.x),
+            floor_i64(p.y / self.size.y),
+            floor_i64(p.z / self.size.z),
+        ];
+        let hash = (exact[0] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            ^ (exact[1] as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+            ^ (exact[2] as u64).wrapping_mul(0x1656_67b1_9e37_79f9);
+        BoxKey {
+            exact,
+            cell: (hash >> 40) as u32 & (self.cells - 1),
+        }
+    }
+}
+
+/// Step 4 for one unpinned mass: the plane, then the sphere.
+#[inline(always)]
+fn collide(
+    mut x: DVec3,
+    last: DVec3,
+    plane: Option<PlaneParams>,
+    sphere: Option<SphereParams>,
+) -> DVec3 {
+    if let Some(p) = plane {
+        let sc = (x - p.point).dot(p.normal);
+        let sl = (last - p.point).dot(p.normal);
+        if (sc < 0.0) != (sl < 0.0) {
+            let side = if sl < 0.0 { -1.0 } else { 1.0 };
+            let target = x - sc * p.normal + side * 0.0001 * p.normal;
+            x = last + (1.0 - p.friction) * (target - last);
+        }
+    }
+    if let Some(s) = sphere {
+        let d = x - s.origin;
+        let len = d.length();
+        if len < s.radius && len > 0.0 {
+            let tangent = s.origin + s.radius * (d / len);
+            x = last + (1.0 - s.friction) * (tangent - last);
+        }
+    }
+    x
+}
+
+/// The margin that keeps a "within the limit" decision made without a square root the
+/// exact one's.
+const WITHIN: f64 = 1.0 - 1e-9;
+
+/// How far a spring is past 1.1 times its rest length, along it from `a` to `b`; `None`
+/// within the limit.
+#[inline(always)]
+fn stretch(positions: &[DVec3], s: &Spring) -> Option<DVec3> {
+    let d = positions[s.b as usize] - positions[s.a as usize];
+    let most = 1.1 * s.rest;
+    if d.length_squared() < most * most * WITHIN {
+        return None;
+    }
+    let len = d.length();
+    if len <= most || len == 0.0 {
+        return None;
+    }
+    Some((len - most) * (d / len))
+}
+
+/// Bit `k` set where spring `k` of at most 64 may be over the limit: not decided within it
+/// without a square root (a superset of the springs [`stretch`] moves).
+#[inline(always)]
+fn over_limit(positions: &[DVec3], springs: &[Spring]) -> u64 {
+    let mut bits = 0u64;
+    for (k, s) in springs.iter().enumerate() {
+        let d = positions[s.b as usize] - positions[s.a as usize];
+        let most = 1.1 * s.rest;
+        bits |= u64::from(d.length_squared() >= most * most * WITHIN) << k;
+    }
+    bits
 }
 
 /// `floor(x)` as an integer, without a library call (saturating far out of range).
@@ -69,6 +196,142 @@ fn floor_i64(x: f64) -> i64 {
         t.saturating_sub(1)
     } else {
         t
+    }
+}
+
+/// The spring force law, `k (|pb - pa| - rest) (pb - pa) / |pb - pa|` on `a`, evaluated
+/// four springs at a time so that the square roots and divisions go through the processor's
+/// vector units (each lane is the same correctly rounded operation as the scalar one).
+#[derive(Clone, Copy)]
+struct SpringLaw {
+    k: [f64; 3],
+    enabled: [bool; 3],
+}
+
+/// Springs per [`ForceLanes`].
+const LANES: usize = 4;
+
+/// The forces of [`LANES`] consecutive springs, one array per axis.
+#[derive(Clone, Copy, Debug, Default)]
+struct ForceLanes {
+    x: [f64; LANES],
+    y: [f64; LANES],
+    z: [f64; LANES],
+}
+
+impl ForceLanes {
+    #[inline(always)]
+    fn get(lanes: &[ForceLanes], spring: usize) -> DVec3 {
+        let f = &lanes[spring / LANES];
+        let l = spring % LANES;
+        DVec3::new(f.x[l], f.y[l], f.z[l])
+    }
+}
+
+impl SpringLaw {
+    /// The force of every spring on its mass `a`; zero for a disabled family or a spring
+    /// of length zero.
+    fn forces(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.forces_avx(positions, springs, out) };
+        }
+        self.forces_lanes(positions, springs, out);
+    }
+
+    /// [`SpringLaw::forces`] with AVX: four springs per vector, each lane the scalar law's
+    /// operations in the scalar law's order.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn forces_avx(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
+        use std::arch::x86_64::{
+            _mm256_add_pd, _mm256_and_pd, _mm256_cmp_pd, _mm256_div_pd, _mm256_loadu_pd,
+            _mm256_mul_pd, _mm256_setzero_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
+            _CMP_NEQ_UQ,
+        };
+        let mut spring_chunks = springs.chunks_exact(LANES);
+        for (o, s) in out.iter_mut().zip(&mut spring_chunks) {
+            let lanes = self.load(positions, s);
+            // SAFETY: every pointer is to an array of four f64.
+            unsafe {
+                let [dx, dy, dz, rest, k] = lanes.map(|a| _mm256_loadu_pd(a.as_ptr()));
+                let len = _mm256_sqrt_pd(_mm256_add_pd(
+                    _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                    _mm256_mul_pd(dz, dz),
+                ));
+                let scale = _mm256_mul_pd(k, _mm256_sub_pd(len, rest));
+                let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(len, _mm256_setzero_pd());
+                let axis = |d| _mm256_and_pd(live, _mm256_mul_pd(scale, _mm256_div_pd(d, len)));
+                _mm256_storeu_pd(o.x.as_mut_ptr(), axis(dx));
+                _mm256_storeu_pd(o.y.as_mut_ptr(), axis(dy));
+                _mm256_storeu_pd(o.z.as_mut_ptr(), axis(dz));
+            }
+        }
+        self.forces_tail(positions, spring_chunks.remainder(), out);
+    }
+
+    /// The law lane by lane, for processors without AVX.
+    fn forces_lanes(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
+        let mut spring_chunks = springs.chunks_exact(LANES);
+        for (o, s) in out.iter_mut().zip(&mut spring_chunks) {
+            for (l, s) in s.iter().enumerate() {
+                let f = self.force(positions, s);
+                (o.x[l], o.y[l], o.z[l]) = (f.x, f.y, f.z);
+            }
+        }
+        self.forces_tail(positions, spring_chunks.remainder(), out);
+    }
+
+    /// The springs after the last whole group of [`LANES`], into the last group.
+    fn forces_tail(&self, positions: &[DVec3], tail: &[Spring], out: &mut [ForceLanes]) {
+        if tail.is_empty() {
+            return;
+        }
+        if let Some(o) = out.last_mut() {
+            for (l, s) in tail.iter().enumerate() {
+                let f = self.force(positions, s);
+                (o.x[l], o.y[l], o.z[l]) = (f.x, f.y, f.z);
+            }
+        }
+    }
+
+    /// The lanes' `pb - pa` per axis, rest lengths and stiffnesses (0 for a disabled family,
+    /// which adds a signed zero: no change to a sum).
+    #[inline(always)]
+    fn load(&self, positions: &[DVec3], s: &[Spring]) -> [[f64; LANES]; 5] {
+        let mut v = [[0.0; LANES]; 5];
+        for (l, s) in s.iter().enumerate().take(LANES) {
+            let (pa, pb) = (positions[s.a as usize], positions[s.b as usize]);
+            v[0][l] = pb.x - pa.x;
+            v[1][l] = pb.y - pa.y;
+            v[2][l] = pb.z - pa.z;
+            v[3][l] = s.rest;
+            let kind = s.kind as usize;
+            v[4][l] = if self.enabled[kind] {
+                self.k[kind]
+            } else {
+                0.0
+            };
+        }
+        v
+    }
+
+    /// One spring's force, the law as written.
+    #[inline(always)]
+    fn force(&self, positions: &[DVec3], s: &Spring) -> DVec3 {
+        if !self.enabled[s.kind as usize] {
+            return DVec3::ZERO;
+        }
+        let d = positions[s.b as usize] - positions[s.a as usize];
+        let len = d.length();
+        if len == 0.0 {
+            return DVec3::ZERO;
+        }
+        self.k[s.kind as usize] * (len - s.rest) * (d / len)
     }
 }
 
@@ -128,18 +391,41 @@ impl Cloth {
             }
         }
         let n = positions.len();
+        // Per mass, its springs in creation order: index << 1, and 1 where the mass is `b`.
+        let mut incident_start = vec![0u32; n + 1];
+        for s in &springs {
+            incident_start[s.a as usize + 1] += 1;
+            incident_start[s.b as usize + 1] += 1;
+        }
+        for i in 0..n {
+            incident_start[i + 1] += incident_start[i];
+        }
+        let mut fill = incident_start.clone();
+        let mut incident = vec![0u32; 2 * springs.len()];
+        for (i, s) in springs.iter().enumerate() {
+            for (mass, side) in [(s.a, 0), (s.b, 1)] {
+                incident[fill[mass as usize] as usize] = (i as u32) << 1 | side;
+                fill[mass as usize] += 1;
+            }
+        }
+        let count = springs.len();
         Cloth {
             scene: scene.clone(),
             last: positions.clone(),
             positions,
             pinned,
             springs,
+            times: StepTimes::default(),
             mass: c.width * c.height * c.density / (nw * nh) as f64,
-            forces: vec![DVec3::ZERO; n],
-            keys: Vec::with_capacity(n),
+            spring_forces: vec![ForceLanes::default(); count.div_ceil(LANES)],
+            incident_start,
+            incident,
+            sorted: vec![DVec3::ZERO; n],
+            marked: vec![0; count.div_ceil(64)],
+            keys: vec![BoxKey::default(); n],
             cell_start: Vec::new(),
             cell_fill: Vec::new(),
-            by_cell: Vec::new(),
+            by_cell: vec![0; n],
         }
     }
 
@@ -157,171 +443,255 @@ impl Cloth {
     }
 
     /// One time step: forces, Verlet, self-collision, collision objects, length limit.
+    ///
+    /// Work that is independent per spring or per mass runs on rayon, with the steps that
+    /// allow it fused into one pass; every sum is still taken in the course's order, so the
+    /// result is the same bytes on any number of threads.
     pub fn step(&mut self) {
-        let c = &self.scene.cloth;
-        let dt = Cloth::dt();
-        // 1. Forces.
-        let weight = GRAVITY * self.mass;
-        self.forces.iter_mut().for_each(|f| *f = weight);
-        for s in &self.springs {
-            let k = match s.kind {
-                SpringKind::Structural if c.enable_structural => c.ks,
-                SpringKind::Shearing if c.enable_shearing => c.ks,
-                SpringKind::Bending if c.enable_bending => 0.2 * c.ks,
-                _ => continue,
-            };
-            let (pa, pb) = (self.positions[s.a as usize], self.positions[s.b as usize]);
-            let d = pb - pa;
-            let len = d.length();
-            if len == 0.0 {
-                continue;
-            }
-            let f = k * (len - s.rest) * (d / len);
-            self.forces[s.a as usize] += f;
-            self.forces[s.b as usize] -= f;
-        }
-        // 2. Verlet.
-        let keep = 1.0 - c.damping / 100.0;
-        for i in 0..self.positions.len() {
-            if self.pinned[i] {
-                continue;
-            }
-            let x = self.positions[i];
-            let a = self.forces[i] / self.mass;
-            let next = x + keep * (x - self.last[i]) + a * dt * dt;
-            self.last[i] = x;
-            self.positions[i] = next;
-        }
-        // 3. Self-collision.
+        let t = Instant::now();
+        self.spring_forces();
+        let t = self.times.add(0, t);
+        self.verlet();
+        let t = self.times.add(1, t);
         self.self_collide();
-        // 4. Collision objects: the plane before the sphere.
-        let (plane, sphere) = (self.scene.plane, self.scene.sphere);
-        for i in 0..self.positions.len() {
-            if self.pinned[i] {
-                continue;
-            }
-            let last = self.last[i];
-            if let Some(p) = plane {
-                let x = self.positions[i];
-                let sc = (x - p.point).dot(p.normal);
-                let sl = (last - p.point).dot(p.normal);
-                if (sc < 0.0) != (sl < 0.0) {
-                    let side = if sl < 0.0 { -1.0 } else { 1.0 };
-                    let target = x - sc * p.normal + side * 0.0001 * p.normal;
-                    self.positions[i] = last + (1.0 - p.friction) * (target - last);
+        let t = self.times.add(2, t);
+        self.limit_lengths();
+        self.times.add(3, t);
+    }
+
+    /// Step 1, first half: each spring's force on its own.
+    fn spring_forces(&mut self) {
+        let c = &self.scene.cloth;
+        let law = SpringLaw {
+            k: [c.ks, c.ks, 0.2 * c.ks],
+            enabled: [c.enable_structural, c.enable_shearing, c.enable_bending],
+        };
+        let positions = &self.positions;
+        self.spring_forces
+            .par_chunks_mut(4096 / LANES)
+            .zip(self.springs.par_chunks(4096))
+            .for_each(|(out, springs)| law.forces(positions, springs, out));
+    }
+
+    /// Step 1, second half, and step 2, per mass: the forces of the mass's springs added
+    /// in creation order (the order in which the course's single loop over the springs
+    /// adds them, so every sum is bit for bit the sequential one), Verlet with damping in
+    /// percent for unpinned masses, then the mass's self-collision box.
+    fn verlet(&mut self) {
+        let dt = Cloth::dt();
+        let keep = 1.0 - self.scene.cloth.damping / 100.0;
+        let mass = self.mass;
+        // Adding a zero force leaves a running sum unchanged: the sum starts at the weight,
+        // so it is never -0.
+        let weight = GRAVITY * mass;
+        let grid = self.box_grid();
+        let (start, incident, forces) = (&self.incident_start, &self.incident, &self.spring_forces);
+        self.positions
+            .par_iter_mut()
+            .zip(self.last.par_iter_mut())
+            .zip(self.keys.par_iter_mut().zip(self.pinned.par_iter()))
+            .enumerate()
+            .with_min_len(1024)
+            .for_each(|(m, ((x, last), (key, &pinned)))| {
+                if !pinned {
+                    let mut f = weight;
+                    for &e in &incident[start[m] as usize..start[m + 1] as usize] {
+                        let spring = ForceLanes::get(forces, (e >> 1) as usize);
+                        if e & 1 == 0 {
+                            f += spring;
+                        } else {
+                            f -= spring;
+                        }
+                    }
+                    let now = *x;
+                    let a = f / mass;
+                    *x = now + keep * (now - *last) + a * dt * dt;
+                    *last = now;
                 }
-            }
-            if let Some(s) = sphere {
-                let x = self.positions[i];
-                let d = x - s.origin;
-                let len = d.length();
-                if len < s.radius && len > 0.0 {
-                    let tangent = s.origin + s.radius * (d / len);
-                    self.positions[i] = last + (1.0 - s.friction) * (tangent - last);
-                }
-            }
+                *key = grid.key(*x);
+            });
+    }
+
+    /// The self-collision boxes for this cloth.
+    fn box_grid(&self) -> BoxGrid {
+        let c = &self.scene.cloth;
+        let w = 3.0 * c.width / c.num_width_points as f64;
+        let h = 3.0 * c.height / c.num_height_points as f64;
+        BoxGrid {
+            size: DVec3::new(w, h, w.max(h)),
+            cells: self.positions.len().next_power_of_two() as u32,
         }
-        // 5. Length limit, sequential in creation order.
-        for s in &self.springs {
-            let (a, b) = (s.a as usize, s.b as usize);
-            let (pin_a, pin_b) = (self.pinned[a], self.pinned[b]);
-            if pin_a && pin_b {
-                continue;
-            }
-            let d = self.positions[b] - self.positions[a];
-            let most = 1.1 * s.rest;
-            // Most springs are well inside the limit: decide those without a square root
-            // (the margin keeps the decision the exact one's).
-            if d.length_squared() < most * most * (1.0 - 1e-9) {
-                continue;
-            }
-            let len = d.length();
-            if len <= most || len == 0.0 {
-                continue;
-            }
-            let fix = (len - most) * (d / len);
-            if pin_a {
-                self.positions[b] -= fix;
-            } else if pin_b {
-                self.positions[a] += fix;
-            } else {
-                self.positions[a] += 0.5 * fix;
-                self.positions[b] -= 0.5 * fix;
+    }
+
+    /// Step 5: the 10% length limit, sequential over the springs in creation order.
+    ///
+    /// The springs over the limit at the start of the pass are marked all at once, in a bit
+    /// set; the sequential pass then visits, in creation order, only marked springs, and a
+    /// correction marks the later springs of the masses it moved. Any other spring sees the
+    /// positions it would have seen in a plain loop, within the limit, and a plain loop
+    /// would leave it alone: the result is exactly the plain loop's.
+    fn limit_lengths(&mut self) {
+        let positions = &self.positions;
+        let springs = &self.springs;
+        self.marked
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(64)
+            .for_each(|(w, word)| {
+                let first = w * 64;
+                let group = &springs[first..springs.len().min(first + 64)];
+                *word = over_limit(positions, group);
+            });
+        for w in 0..self.marked.len() {
+            while self.marked[w] != 0 {
+                let k = self.marked[w].trailing_zeros() as usize;
+                self.marked[w] &= self.marked[w] - 1;
+                let i = w * 64 + k;
+                let s = self.springs[i];
+                let (a, b) = (s.a as usize, s.b as usize);
+                let (pin_a, pin_b) = (self.pinned[a], self.pinned[b]);
+                if pin_a && pin_b {
+                    continue;
+                }
+                let Some(fix) = stretch(&self.positions, &s) else {
+                    continue;
+                };
+                if pin_a {
+                    self.positions[b] -= fix;
+                } else if pin_b {
+                    self.positions[a] += fix;
+                } else {
+                    self.positions[a] += 0.5 * fix;
+                    self.positions[b] -= 0.5 * fix;
+                }
+                for m in [a, b] {
+                    let incident = &self.incident
+                        [self.incident_start[m] as usize..self.incident_start[m + 1] as usize];
+                    // The incident springs are in creation order: mark the later ones.
+                    let later = incident.partition_point(|&e| (e >> 1) as usize <= i);
+                    for &e in &incident[later..] {
+                        let j = (e >> 1) as usize;
+                        self.marked[j / 64] |= 1 << (j % 64);
+                    }
+                }
             }
         }
     }
 
-    /// Step 3: boxes of `3 width/nw x 3 height/nh x max` from the positions after Verlet;
-    /// each unpinned mass in index order moves by the mean of its corrections / 30, in
-    /// place. Boxes are found through a hash table of cells filled by a counting sort
-    /// (stable, so a cell lists its masses in index order); masses sharing a cell but not a
-    /// box are told apart by their exact integer keys.
+    /// Steps 3 and 4. Step 3: boxes of `3 width/nw x 3 height/nh x max` from the positions
+    /// after Verlet; each unpinned mass in index order moves by the mean of its corrections
+    /// / 30, in place. Boxes are found through a hash table of cells filled by a counting
+    /// sort (stable, so a cell lists its masses in index order); masses sharing a cell but
+    /// not a box are told apart by their exact integer keys. A mass only ever reads masses
+    /// of its own box, so cells are worked on in parallel, each in index order: the same
+    /// result as one pass over all masses. Step 4 (the plane, then the sphere, per unpinned
+    /// mass on its own) follows in the same pass, once a cell is done.
     fn self_collide(&mut self) {
         let c = &self.scene.cloth;
-        let w = 3.0 * c.width / c.num_width_points as f64;
-        let h = 3.0 * c.height / c.num_height_points as f64;
-        let t = w.max(h);
         let two_t = 2.0 * c.thickness;
         let far_enough = two_t * two_t * (1.0 + 1e-9);
         let n = self.positions.len();
-        let cells = (2 * n).next_power_of_two();
-        self.keys.clear();
-        self.keys.extend(self.positions.iter().map(|p| {
-            let k = (floor_i64(p.x / w), floor_i64(p.y / h), floor_i64(p.z / t));
-            let hash = (k.0 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                ^ (k.1 as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
-                ^ (k.2 as u64).wrapping_mul(0x1656_67b1_9e37_79f9);
-            (k.0, k.1, k.2, (hash >> 40) as u32 & (cells as u32 - 1))
-        }));
+        let cells = self.box_grid().cells as usize;
         self.cell_start.clear();
         self.cell_start.resize(cells + 1, 0);
-        for k in &self.keys {
-            self.cell_start[k.3 as usize + 1] += 1;
+        for key in &self.keys {
+            self.cell_start[key.cell as usize + 1] += 1;
         }
         for i in 0..cells {
             self.cell_start[i + 1] += self.cell_start[i];
         }
         self.cell_fill.clear();
         self.cell_fill.extend_from_slice(&self.cell_start[..cells]);
-        self.by_cell.clear();
-        self.by_cell.resize(n, 0);
-        for (i, k) in self.keys.iter().enumerate() {
-            let slot = &mut self.cell_fill[k.3 as usize];
+        for (i, key) in self.keys.iter().enumerate() {
+            let slot = &mut self.cell_fill[key.cell as usize];
             self.by_cell[*slot as usize] = i as u32;
             *slot += 1;
         }
-        for m in 0..n {
-            if self.pinned[m] {
-                continue;
+        for (j, &m) in self.by_cell.iter().enumerate() {
+            self.sorted[j] = self.positions[m as usize];
+        }
+        // Cut the cells into runs of about equal mass counts, each a disjoint slice.
+        let runs = 64.min(n);
+        let mut pieces = Vec::with_capacity(runs);
+        let mut rest: &mut [DVec3] = &mut self.sorted;
+        let (mut cell, mut offset) = (0usize, 0usize);
+        for r in 1..=runs {
+            let goal = n * r / runs;
+            let mut end_cell = cell;
+            while end_cell < cells && (self.cell_start[end_cell] as usize) < goal {
+                end_cell += 1;
             }
-            let p = self.positions[m];
-            let km = self.keys[m];
-            let cell = km.3 as usize;
-            let mut sum = DVec3::ZERO;
-            let mut count = 0u32;
-            for &q in
-                &self.by_cell[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize]
-            {
-                let q = q as usize;
-                let kq = self.keys[q];
-                if q == m || (kq.0, kq.1, kq.2) != (km.0, km.1, km.2) {
-                    continue;
-                }
-                let d = p - self.positions[q];
-                // Most neighbours are well outside 2 thickness: decide those without a square
-                // root (the margin keeps the decision the exact one's).
-                if d.length_squared() > far_enough {
-                    continue;
-                }
-                let len = d.length();
-                if len > 0.0 && len < two_t {
-                    sum += (two_t - len) * (d / len);
-                    count += 1;
-                }
+            if r == runs {
+                end_cell = cells;
             }
-            if count > 0 {
-                self.positions[m] = p + sum / f64::from(count) / STEPS_PER_FRAME as f64;
-            }
+            let end = self.cell_start[end_cell] as usize;
+            let (piece, tail) = std::mem::take(&mut rest).split_at_mut(end - offset);
+            pieces.push((cell, end_cell, offset, piece));
+            rest = tail;
+            (cell, offset) = (end_cell, end);
+        }
+        let (cell_start, by_cell, keys, pinned, last) = (
+            &self.cell_start,
+            &self.by_cell,
+            &self.keys,
+            &self.pinned,
+            &self.last,
+        );
+        let (plane, sphere) = (self.scene.plane, self.scene.sphere);
+        pieces
+            .into_par_iter()
+            .for_each(|(first, end_cell, offset, piece)| {
+                for cell in first..end_cell {
+                    let range = cell_start[cell] as usize..cell_start[cell + 1] as usize;
+                    let ids = &by_cell[range.clone()];
+                    if ids.is_empty() {
+                        continue;
+                    }
+                    let members = &mut piece[range.start - offset..range.end - offset];
+                    // Usually a cell holds one box: then no key needs comparing.
+                    let box0 = keys[ids[0] as usize].exact;
+                    let one_box = ids.iter().all(|&q| keys[q as usize].exact == box0);
+                    for j in 0..members.len() {
+                        let m = ids[j] as usize;
+                        if pinned[m] || members.len() < 2 {
+                            continue;
+                        }
+                        let p = members[j];
+                        let mut sum = DVec3::ZERO;
+                        let mut count = 0u32;
+                        for (i, &q) in members.iter().enumerate() {
+                            if i == j || (!one_box && keys[ids[i] as usize].exact != keys[m].exact)
+                            {
+                                continue;
+                            }
+                            let d = p - q;
+                            // Most neighbours are well outside 2 thickness: decide those
+                            // without a square root (the margin keeps the decision exact).
+                            if d.length_squared() > far_enough {
+                                continue;
+                            }
+                            let len = d.length();
+                            if len > 0.0 && len < two_t {
+                                sum += (two_t - len) * (d / len);
+                                count += 1;
+                            }
+                        }
+                        if count > 0 {
+                            members[j] = p + sum / f64::from(count) / STEPS_PER_FRAME as f64;
+                        }
+                    }
+                    if plane.is_none() && sphere.is_none() {
+                        continue;
+                    }
+                    for (x, &m) in members.iter_mut().zip(ids) {
+                        if !pinned[m as usize] {
+                            *x = collide(*x, last[m as usize], plane, sphere);
+                        }
+                    }
+                }
+            });
+        for (sorted, &m) in self.sorted.iter().zip(&self.by_cell) {
+            self.positions[m as usize] = *sorted;
         }
     }
 
@@ -392,6 +762,8 @@ mod tests {
             *p = DVec3::new(r(&mut g), r(&mut g), r(&mut g));
         }
         let mut b = a.clone();
+        let grid = a.box_grid();
+        a.keys = a.positions.iter().map(|p| grid.key(*p)).collect();
         a.self_collide();
         // The reference.
         let c = &b.scene.cloth;
