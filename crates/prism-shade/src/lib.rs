@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 mod error;
+mod lanes;
 mod mesh;
 mod pipeline;
 mod shaders;

@@ -10,8 +10,9 @@ use prism_math::{Rgb, Transform, Vec3};
 use rayon::prelude::*;
 
 use crate::error::ShadeError;
+use crate::lanes::{F8, LANES, M8, V8};
 use crate::mesh::ShadeMesh;
-use crate::shaders::{fragment, height, Shader, Uniforms, Varyings};
+use crate::shaders::{fragment, fragment_lanes, height, Shader, Uniforms, Varyings};
 
 /// Near and far planes.
 pub const NEAR: f32 = 0.01;
@@ -256,7 +257,6 @@ fn render<T: Copy + Default + Send>(
     }
     let mut u = *uniforms;
     u.cam_pos = view.eye;
-    let needs = shader.needs();
     let tris = screen_triangles(mesh, view, shader, &u)?;
     let (w, h) = (view.width, view.height);
     // Triangles by band of rows, in mesh order.
@@ -277,6 +277,15 @@ fn render<T: Copy + Default + Send>(
             band.push(i as u32);
         }
     }
+    let frame = Frame {
+        tris: &tris,
+        by_band: &by_band,
+        k,
+        w,
+        shader,
+        u: &u,
+        opts,
+    };
     let mut pixels = vec![T::default(); w as usize * h as usize];
     let rows_per_band = (BAND * w) as usize;
     pixels
@@ -285,72 +294,204 @@ fn render<T: Copy + Default + Send>(
         .for_each(|(band, out)| {
             // Each worker keeps its band buffers from band to band and call to call (rayon
             // would make new ones for every piece of work it splits off).
-            BAND_BUFFERS.with_borrow_mut(|buf| {
-                let y_start = band as u32 * BAND;
-                let rows = (out.len() / w as usize) as u32;
-                let n = (k * k) as usize;
-                // Every sample is cleared: the buffers are the worker's, reused band to band.
-                buf.clear(out.len() * n);
-                let target = Target {
-                    k,
-                    w,
-                    y_start,
-                    rows,
-                };
-                // Visibility first (depth LESS, the first of equals kept), then one fragment per
-                // visible sample: the same colours as shading each fragment as it passes.
-                for &i in &by_band[band] {
-                    raster_triangle(&tris[i as usize], i, &target, buf, None);
+            BAND_BUFFERS.with_borrow_mut(|buf| frame.band(band as u32, out, buf, &store));
+        });
+    Ok(Image::from_vec(w, h, pixels))
+}
+
+/// What every band of one frame reads.
+struct Frame<'a> {
+    tris: &'a [[ScreenVertex; 3]],
+    by_band: &'a [Vec<u32>],
+    k: u32,
+    w: u32,
+    shader: &'a Shader,
+    u: &'a Uniforms,
+    opts: &'a ShadeOptions,
+}
+
+impl Frame<'_> {
+    /// Draws band `band` into `out`, its rows of pixels.
+    fn band<T>(&self, band: u32, out: &mut [T], buf: &mut Band, store: &impl Fn(Rgb) -> T) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2.
+            return unsafe { self.band_avx2(band, out, buf, store) };
+        }
+        self.band_with(band, out, buf, store);
+    }
+
+    /// [`Frame::band`] compiled for AVX2 (the lanes become vector instructions).
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn band_avx2<T>(
+        &self,
+        band: u32,
+        out: &mut [T],
+        buf: &mut Band,
+        store: &impl Fn(Rgb) -> T,
+    ) {
+        self.band_with(band, out, buf, store);
+    }
+
+    #[inline(always)]
+    fn band_with<T>(&self, band: u32, out: &mut [T], buf: &mut Band, store: &impl Fn(Rgb) -> T) {
+        let (k, w) = (self.k, self.w);
+        let y_start = band * BAND;
+        let rows = (out.len() / w as usize) as u32;
+        let n = (k * k) as usize;
+        let row_len = (w * k) as usize;
+        let len = rows as usize * k as usize * row_len;
+        // Every sample is cleared: the buffers are the worker's, reused band to band.
+        buf.clear(len, k, row_len);
+        let target = Target {
+            k,
+            w,
+            y_start,
+            rows,
+        };
+        // Visibility first (depth LESS, the first of equals kept), then one fragment per
+        // visible sample: the same colours as shading each fragment as it passes.
+        for &i in &self.by_band[band as usize] {
+            raster_fill(&self.tris[i as usize], i, &target, buf);
+        }
+        self.shade_samples(buf, len);
+        if let Some(c) = self.opts.wireframe {
+            for &i in &self.by_band[band as usize] {
+                raster_wire(
+                    &self.tris[i as usize],
+                    &target,
+                    buf,
+                    c,
+                    self.opts.wire_width,
+                );
+            }
+        }
+        // Each sample is stored clamped, as in an 8-bit colour buffer; a pixel is the mean
+        // of its samples in row order.
+        let clamp = |c: Rgb| {
+            Rgb::new(
+                c.r.clamp(0.0, 1.0),
+                c.g.clamp(0.0, 1.0),
+                c.b.clamp(0.0, 1.0),
+            )
+        };
+        for (i, p) in out.iter_mut().enumerate() {
+            let (px, py) = (i % w as usize, i / w as usize);
+            let first = py * k as usize * row_len + px * k as usize;
+            let color = |s: usize| Rgb::new(buf.color[0][s], buf.color[1][s], buf.color[2][s]);
+            *p = if n == 1 {
+                store(clamp(color(first)))
+            } else {
+                let mut sum = Rgb::BLACK;
+                for sy in 0..k as usize {
+                    for sx in 0..k as usize {
+                        sum += clamp(color(first + sy * row_len + sx));
+                    }
                 }
-                for s in 0..buf.prim.len() {
-                    let p = buf.prim[s];
-                    if p == NONE {
-                        buf.color[s] = opts.background;
+                store(sum * (1.0 / n as f32))
+            };
+        }
+    }
+
+    /// The colour of every sample: the background, or the fragment of the triangle seen,
+    /// eight samples at a time where the shader has a lane form.
+    #[inline(always)]
+    fn shade_samples(&self, buf: &mut Band, len: usize) {
+        let (u, shader, tris) = (self.u, self.shader, self.tris);
+        let background = self.opts.background;
+        let needs = shader.needs();
+        let Band {
+            prim, bary, color, ..
+        } = buf;
+        let mut s = 0;
+        while s < len {
+            let mut ids = [NONE; LANES];
+            ids.copy_from_slice(&prim[s..s + LANES]);
+            let live = (len - s).min(LANES);
+            if ids[..live].iter().all(|&p| p == NONE) {
+                color[0][s..s + live].fill(background.r);
+                color[1][s..s + live].fill(background.g);
+                color[2][s..s + live].fill(background.b);
+                s += LANES;
+                continue;
+            }
+            // Perspective-correct weights and the position and normal they blend, with
+            // each lane's corners gathered (a lane that sees nothing borrows triangle 0).
+            let mut inv_w = [F8::default(); 3];
+            let mut normals = [V8::default(); 3];
+            let mut positions = [V8::default(); 3];
+            if ids.iter().all(|&p| p == ids[0]) {
+                // One triangle under all eight: its corners, once.
+                for (c, v) in tris[ids[0] as usize].iter().enumerate() {
+                    inv_w[c] = F8::splat(v.inv_w);
+                    normals[c] = V8::splat(v.v.normal);
+                    positions[c] = V8::splat(v.v.position);
+                }
+            } else {
+                for l in 0..LANES {
+                    let t = &tris[if ids[l] == NONE { 0 } else { ids[l] as usize }];
+                    for c in 0..3 {
+                        inv_w[c].0[l] = t[c].inv_w;
+                        let (n, p) = (t[c].v.normal, t[c].v.position);
+                        (normals[c].x.0[l], normals[c].y.0[l], normals[c].z.0[l]) = (n.x, n.y, n.z);
+                        (
+                            positions[c].x.0[l],
+                            positions[c].y.0[l],
+                            positions[c].z.0[l],
+                        ) = (p.x, p.y, p.z);
+                    }
+                }
+            }
+            let pw = [
+                F8::load(&bary[0][s..]) * inv_w[0],
+                F8::load(&bary[1][s..]) * inv_w[1],
+                F8::load(&bary[2][s..]) * inv_w[2],
+            ];
+            let inv = F8::splat(1.0) / (pw[0] + pw[1] + pw[2]);
+            let wt = [pw[0] * inv, pw[1] * inv, pw[2] * inv];
+            let blend = |v: &[V8; 3]| v[0] * wt[0] + v[1] * wt[1] + v[2] * wt[2];
+            let normal = blend(&normals);
+            let lanes = if matches!(shader, Shader::Normal | Shader::Wireframe) {
+                fragment_lanes(shader, u, V8::default(), normal)
+            } else if matches!(shader, Shader::Diffuse | Shader::Phong) {
+                fragment_lanes(shader, u, blend(&positions), normal)
+            } else {
+                None
+            };
+            if let Some(lanes) = lanes {
+                let mut seen = [0i32; LANES];
+                for (m, &p) in seen.iter_mut().zip(&ids) {
+                    *m = -i32::from(p != NONE);
+                }
+                let back = [background.r, background.g, background.b];
+                for ch in 0..3 {
+                    F8::select(M8(seen), lanes[ch], F8::splat(back[ch])).store(&mut color[ch][s..]);
+                }
+            } else {
+                for l in 0..live {
+                    let c = if ids[l] == NONE {
+                        background
                     } else {
-                        let [a, b, c] = &tris[p as usize];
-                        let l = buf.bary[s];
-                        let pw = [l[0] * a.inv_w, l[1] * b.inv_w, l[2] * c.inv_w];
-                        let inv = 1.0 / (pw[0] + pw[1] + pw[2]);
+                        let [a, b, c] = &tris[ids[l] as usize];
                         let v = Varyings::blend_only(
                             &a.v,
                             &b.v,
                             &c.v,
-                            [pw[0] * inv, pw[1] * inv, pw[2] * inv],
+                            [wt[0].0[l], wt[1].0[l], wt[2].0[l]],
                             needs,
                         );
-                        buf.color[s] = fragment(shader, &u, &v);
-                    }
-                }
-                if let Some(c) = opts.wireframe {
-                    for &i in &by_band[band] {
-                        raster_triangle(
-                            &tris[i as usize],
-                            i,
-                            &target,
-                            buf,
-                            Some((c, opts.wire_width)),
-                        );
-                    }
-                }
-                for (p, samples) in out.iter_mut().zip(buf.color.chunks(n)) {
-                    // Each sample is stored clamped, as in an 8-bit colour buffer.
-                    let clamp = |c: Rgb| {
-                        Rgb::new(
-                            c.r.clamp(0.0, 1.0),
-                            c.g.clamp(0.0, 1.0),
-                            c.b.clamp(0.0, 1.0),
-                        )
+                        fragment(shader, u, &v)
                     };
-                    *p = if n == 1 {
-                        store(clamp(samples[0]))
-                    } else {
-                        let sum = samples.iter().fold(Rgb::BLACK, |a, &c| a + clamp(c));
-                        store(sum * (1.0 / n as f32))
-                    };
+                    (color[0][s + l], color[1][s + l], color[2][s + l]) = (c.r, c.g, c.b);
                 }
-            });
-        });
-    Ok(Image::from_vec(w, h, pixels))
+            }
+            s += LANES;
+        }
+    }
 }
 
 thread_local! {
@@ -360,29 +501,46 @@ thread_local! {
 /// No triangle covers the sample.
 const NONE: u32 = u32::MAX;
 
-/// A worker's sample buffers for one band: depth, the triangle seen with its screen-space
-/// barycentric weights, and the colour.
+/// A worker's sample buffers for one band, sample row after sample row (`k` per row of
+/// pixels, `w k` samples each): depth, the triangle seen with its screen-space barycentric
+/// weights (one buffer per corner), the colour, and each sample column's x. Every buffer
+/// has [`LANES`] spare samples at the end, so that a group of lanes never runs out.
 #[derive(Default)]
 struct Band {
     depth: Vec<f32>,
     prim: Vec<u32>,
-    bary: Vec<[f32; 3]>,
-    color: Vec<Rgb>,
+    bary: [Vec<f32>; 3],
+    color: [Vec<f32>; 3],
+    xs: Vec<f32>,
 }
 
 impl Band {
     /// Clears depth (to 1, the far plane: LESS passes below it) and the visible triangle;
     /// weights and colours are written before they are read.
-    fn clear(&mut self, len: usize) {
+    fn clear(&mut self, len: usize, k: u32, row_len: usize) {
+        let padded = len + LANES;
         self.depth.clear();
-        self.depth.resize(len, 1.0);
+        self.depth.resize(padded, 1.0);
         self.prim.clear();
-        self.prim.resize(len, NONE);
-        if self.bary.len() != len {
-            self.bary.resize(len, [0.0; 3]);
-            self.color.resize(len, Rgb::BLACK);
+        self.prim.resize(padded, NONE);
+        for b in &mut self.bary {
+            b.resize(padded, 0.0);
         }
+        for c in &mut self.color {
+            c.resize(padded, 0.0);
+        }
+        self.xs.clear();
+        self.xs.extend((0..row_len + LANES).map(|j| {
+            let (px, sx) = (j as u32 / k, j as u32 % k);
+            px as f32 + sample_offset(sx, k)
+        }));
     }
+}
+
+/// Where sample `i` of `k` lies across a pixel: `(i + 1/2) / k`.
+#[inline]
+fn sample_offset(i: u32, k: u32) -> f32 {
+    (i as f32 + 0.5) / k as f32
 }
 
 /// Where a band's samples lie: `k x k` per pixel, `w` pixels a row, rows `y_start` on.
@@ -393,90 +551,164 @@ struct Target {
     rows: u32,
 }
 
+/// A triangle's set-up for rasterization: its sign and area, its pixel bounds clipped to
+/// the band, and which of its edges own the samples exactly on them.
+struct Setup {
+    sign: f32,
+    inv_area: f32,
+    x: (u32, u32),
+    y: (u32, u32),
+    own: [bool; 3],
+}
+
+impl Setup {
+    #[inline(always)]
+    fn new(t: &[ScreenVertex; 3], to: &Target) -> Option<Setup> {
+        let [a, b, c] = t;
+        let area = edge(a.x, a.y, b.x, b.y, c.x, c.y);
+        if area == 0.0 || !area.is_finite() {
+            return None;
+        }
+        let sign = area.signum();
+        let min_x = a.x.min(b.x).min(c.x).floor().max(0.0);
+        let max_x = a.x.max(b.x).max(c.x).ceil().min(to.w as f32);
+        let min_y = a.y.min(b.y).min(c.y).floor().max(to.y_start as f32);
+        let max_y =
+            a.y.max(b.y)
+                .max(c.y)
+                .ceil()
+                .min((to.y_start + to.rows) as f32);
+        if !(min_x < max_x && min_y < max_y) {
+            return None;
+        }
+        Some(Setup {
+            sign,
+            inv_area: 1.0 / (area * sign),
+            x: (min_x as u32, max_x as u32),
+            y: (min_y as u32, max_y as u32),
+            own: [
+                owns_edge(b.x, b.y, c.x, c.y, sign),
+                owns_edge(c.x, c.y, a.x, a.y, sign),
+                owns_edge(a.x, a.y, b.x, b.y, sign),
+            ],
+        })
+    }
+}
+
 /// Rasterizes triangle `id` into a band: the depth test and the visible triangle with its
-/// weights; with `wire`, only samples within the half width of an edge, in that colour, the
-/// depth test passing up to a small bias so that edges show on their own faces.
-fn raster_triangle(
-    t: &[ScreenVertex; 3],
-    id: u32,
-    to: &Target,
-    buf: &mut Band,
-    wire: Option<(Rgb, f32)>,
-) {
-    let Target {
-        k,
-        w,
-        y_start,
-        rows,
-    } = *to;
+/// weights, eight samples of a sample row at a time. Each lane evaluates the edge
+/// functions exactly as [`edge`] does.
+#[inline(always)]
+fn raster_fill(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
+    let Some(set) = Setup::new(t, to) else {
+        return;
+    };
     let [a, b, c] = t;
-    let area = edge(a.x, a.y, b.x, b.y, c.x, c.y);
-    if area == 0.0 || !area.is_finite() {
-        return;
-    }
-    let sign = area.signum();
-    let inv_area = 1.0 / (area * sign);
-    let min_x = a.x.min(b.x).min(c.x).floor().max(0.0);
-    let max_x = a.x.max(b.x).max(c.x).ceil().min(w as f32);
-    let min_y = a.y.min(b.y).min(c.y).floor().max(y_start as f32);
-    let max_y = a.y.max(b.y).max(c.y).ceil().min((y_start + rows) as f32);
-    if !(min_x < max_x && min_y < max_y) {
-        return;
-    }
-    let own = [
-        owns_edge(b.x, b.y, c.x, c.y, sign),
-        owns_edge(c.x, c.y, a.x, a.y, sign),
-        owns_edge(a.x, a.y, b.x, b.y, sign),
+    let k = to.k;
+    let row_len = (to.w * k) as usize;
+    let (j0, j1) = ((set.x.0 * k) as usize, (set.x.1 * k) as usize);
+    let sign = F8::splat(set.sign);
+    let zero = F8::splat(0.0);
+    let strict = set.own.map(|o| M8::splat(!o));
+    // Edges b -> c, c -> a, a -> b: from which corner, and along what.
+    let from = [(b.x, b.y), (c.x, c.y), (a.x, a.y)];
+    let along = [
+        (c.x - b.x, c.y - b.y),
+        (a.x - c.x, a.y - c.y),
+        (b.x - a.x, b.y - a.y),
     ];
+    for py in set.y.0..set.y.1 {
+        for sy in 0..k {
+            let y = py as f32 + sample_offset(sy, k);
+            let row = ((py - to.y_start) * k + sy) as usize * row_len;
+            // edge(p) = dx (y - fy) - dy (x - fx): the first product is the row's.
+            let across = [
+                along[0].0 * (y - from[0].1),
+                along[1].0 * (y - from[1].1),
+                along[2].0 * (y - from[2].1),
+            ];
+            let mut j = j0;
+            while j < j1 {
+                let xs = F8::load(&buf.xs[j..]);
+                let edge_at = |i: usize| {
+                    (F8::splat(across[i]) - F8::splat(along[i].1) * (xs - from[i].0)) * sign
+                };
+                let e = [edge_at(0), edge_at(1), edge_at(2)];
+                // Outside: below zero, or on an edge the triangle does not own.
+                let mut inside = M8::first(j1 - j);
+                for i in 0..3 {
+                    inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
+                }
+                if inside.any() {
+                    let l = [
+                        e[0] * set.inv_area,
+                        e[1] * set.inv_area,
+                        e[2] * set.inv_area,
+                    ];
+                    let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
+                    let s = row + j;
+                    let depth = F8::load(&buf.depth[s..]);
+                    // LESS: a NaN depth never passes.
+                    let pass = inside & z.lt(depth);
+                    F8::select(pass, z, depth).store(&mut buf.depth[s..]);
+                    for (corner, weights) in l.iter().zip(&mut buf.bary) {
+                        let old = F8::load(&weights[s..]);
+                        F8::select(pass, *corner, old).store(&mut weights[s..]);
+                    }
+                    for (lane, p) in buf.prim[s..s + LANES].iter_mut().enumerate() {
+                        if pass.get(lane) {
+                            *p = id;
+                        }
+                    }
+                }
+                j += LANES;
+            }
+        }
+    }
+}
+
+/// Draws a triangle's edges into a band: samples within `half_width` pixels of an edge,
+/// inside the triangle, take `color`, the depth test passing up to a small bias so that
+/// edges show on their own faces.
+fn raster_wire(t: &[ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, half_width: f32) {
+    let Some(set) = Setup::new(t, to) else {
+        return;
+    };
+    let [a, b, c] = t;
+    let k = to.k;
+    let row_len = (to.w * k) as usize;
     let edge_len = [
         ((c.x - b.x).powi(2) + (c.y - b.y).powi(2)).sqrt(),
         ((a.x - c.x).powi(2) + (a.y - c.y).powi(2)).sqrt(),
         ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt(),
     ];
-    let n = (k * k) as usize;
-    // Sample offsets inside a pixel (at most 16 x 16 samples).
-    let mut offsets = [0.0f32; 16];
-    for (i, o) in offsets.iter_mut().enumerate().take(k as usize) {
-        *o = (i as f32 + 0.5) / k as f32;
-    }
-    for py in min_y as u32..max_y as u32 {
-        for px in min_x as u32..max_x as u32 {
-            for sy in 0..k {
-                for sx in 0..k {
-                    let x = px as f32 + offsets[sx as usize];
-                    let y = py as f32 + offsets[sy as usize];
-                    let e = [
-                        edge(b.x, b.y, c.x, c.y, x, y) * sign,
-                        edge(c.x, c.y, a.x, a.y, x, y) * sign,
-                        edge(a.x, a.y, b.x, b.y, x, y) * sign,
-                    ];
-                    if e.iter().zip(own).any(|(&v, o)| v < 0.0 || (v == 0.0 && !o)) {
-                        continue;
-                    }
-                    let l = [e[0] * inv_area, e[1] * inv_area, e[2] * inv_area];
-                    let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
-                    let s = ((py - y_start) * w + px) as usize * n + (sy * k + sx) as usize;
-                    match wire {
-                        None => {
-                            // LESS: a NaN depth never passes.
-                            if z.is_nan() || z >= buf.depth[s] {
-                                continue;
-                            }
-                            buf.depth[s] = z;
-                            buf.prim[s] = id;
-                            buf.bary[s] = l;
-                        }
-                        Some((col, half_width)) => {
-                            // Distance in pixels to the nearest edge.
-                            let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
-                            if !near_edge || z > buf.depth[s] + 1e-4 {
-                                continue;
-                            }
-                            buf.depth[s] = z;
-                            buf.color[s] = col;
-                        }
-                    }
+    for py in set.y.0..set.y.1 {
+        for sy in 0..k {
+            let y = py as f32 + sample_offset(sy, k);
+            let row = ((py - to.y_start) * k + sy) as usize * row_len;
+            for j in (set.x.0 * k) as usize..(set.x.1 * k) as usize {
+                let x = buf.xs[j];
+                let e = [
+                    edge(b.x, b.y, c.x, c.y, x, y) * set.sign,
+                    edge(c.x, c.y, a.x, a.y, x, y) * set.sign,
+                    edge(a.x, a.y, b.x, b.y, x, y) * set.sign,
+                ];
+                if e.iter()
+                    .zip(set.own)
+                    .any(|(&v, o)| v < 0.0 || (v == 0.0 && !o))
+                {
+                    continue;
                 }
+                let l = e.map(|v| v * set.inv_area);
+                let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
+                // Distance in pixels to the nearest edge.
+                let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
+                let s = row + j;
+                if !near_edge || z > buf.depth[s] + 1e-4 {
+                    continue;
+                }
+                buf.depth[s] = z;
+                (buf.color[0][s], buf.color[1][s], buf.color[2][s]) = (color.r, color.g, color.b);
             }
         }
     }

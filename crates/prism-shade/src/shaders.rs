@@ -5,6 +5,8 @@
 use prism_image::{CubeMap, PixelSampling, Texture, Wrap};
 use prism_math::{Rgb, Vec2, Vec3};
 
+use crate::lanes::{F8, V8};
+
 /// A shader with the images it reads.
 #[derive(Clone, Debug)]
 pub enum Shader {
@@ -250,6 +252,63 @@ pub fn fragment(shader: &Shader, u: &Uniforms, f: &Varyings) -> Rgb {
             let wi = d - 2.0 * n.dot(d) * n;
             cube.sample(wi)
         }
+    }
+}
+
+/// [`fragment`] for eight fragments at once, from their world positions and interpolated
+/// normals, for the shaders that read nothing else (normal, wireframe, diffuse, Blinn-Phong):
+/// each lane is bit for bit the scalar formula. `None` for the other shaders.
+#[inline(always)]
+pub(crate) fn fragment_lanes(
+    shader: &Shader,
+    u: &Uniforms,
+    position: V8,
+    normal: V8,
+) -> Option<[F8; 3]> {
+    let one = F8::splat(1.0);
+    match shader {
+        Shader::Normal => Some([
+            (normal.x + 1.0) * 0.5,
+            (normal.y + 1.0) * 0.5,
+            (normal.z + 1.0) * 0.5,
+        ]),
+        Shader::Wireframe => Some([
+            F8::splat(u.color.r),
+            F8::splat(u.color.g),
+            F8::splat(u.color.b),
+        ]),
+        Shader::Diffuse => {
+            let n = normal.normalize();
+            let to_light = V8::splat(u.light_pos) - position;
+            let r2 = to_light.dot(to_light);
+            let l = to_light.normalize();
+            let s = n.dot(l).max0() / r2;
+            let i = u.light_intensity;
+            Some([F8::splat(i.r) * s, F8::splat(i.g) * s, F8::splat(i.b) * s])
+        }
+        Shader::Phong => {
+            let n = normal.normalize();
+            let to_light = V8::splat(u.light_pos) - position;
+            let r2 = to_light.dot(to_light);
+            let l = to_light.normalize();
+            let v = (V8::splat(u.cam_pos) - position).normalize();
+            let h = (l + v).normalize();
+            let inv_r2 = one / r2;
+            let s = n.dot(h).max0();
+            let s2 = s * s;
+            let s4 = s2 * s2;
+            let s8 = s4 * s4;
+            let s16 = s8 * s8;
+            let spec = (s16 * s16) * 0.5;
+            let diffuse = F8::splat(0.8) * n.dot(l).max0();
+            let i = u.light_intensity;
+            let channel = |i: f32| {
+                let e = F8::splat(i) * inv_r2;
+                (F8::splat(0.1) + e * diffuse) + e * spec
+            };
+            Some([channel(i.r), channel(i.g), channel(i.b)])
+        }
+        _ => None,
     }
 }
 

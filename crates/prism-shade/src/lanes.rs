@@ -1,0 +1,290 @@
+//! [`F8`], [`M8`] and [`V8`]: eight samples side by side (numbers, masks, vectors), with
+//! each operation the scalar one lane by lane, so that results equal the scalar code's bit
+//! for bit; compiled for AVX they become single vector instructions.
+
+// Plain index loops over the lanes are what the vectoriser turns into single instructions.
+#![allow(clippy::needless_range_loop)]
+
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Not, Sub};
+
+use prism_math::Vec3;
+
+/// Lanes per group.
+pub(crate) const LANES: usize = 8;
+
+/// Eight `f32`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct F8(pub [f32; LANES]);
+
+/// Eight lane conditions: all ones where true.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct M8(pub [i32; LANES]);
+
+/// Eight 3-vectors, one [`F8`] per axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct V8 {
+    pub x: F8,
+    pub y: F8,
+    pub z: F8,
+}
+
+macro_rules! lanewise {
+    ($trait:ident, $f:ident, $op:tt) => {
+        impl $trait for F8 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: F8) -> F8 {
+                let mut r = [0.0; LANES];
+                for i in 0..LANES {
+                    r[i] = self.0[i] $op o.0[i];
+                }
+                F8(r)
+            }
+        }
+        impl $trait<f32> for F8 {
+            type Output = F8;
+            #[inline(always)]
+            fn $f(self, o: f32) -> F8 {
+                let mut r = [0.0; LANES];
+                for i in 0..LANES {
+                    r[i] = self.0[i] $op o;
+                }
+                F8(r)
+            }
+        }
+    };
+}
+lanewise!(Add, add, +);
+lanewise!(Sub, sub, -);
+lanewise!(Mul, mul, *);
+lanewise!(Div, div, /);
+
+impl F8 {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: f32) -> F8 {
+        F8([v; LANES])
+    }
+
+    /// The first eight values of `s`.
+    #[inline(always)]
+    pub fn load(s: &[f32]) -> F8 {
+        let mut r = [0.0; LANES];
+        r.copy_from_slice(&s[..LANES]);
+        F8(r)
+    }
+
+    /// Writes the lanes to the first eight values of `s`.
+    #[inline(always)]
+    pub fn store(self, s: &mut [f32]) {
+        s[..LANES].copy_from_slice(&self.0);
+    }
+
+    /// Square roots.
+    #[inline(always)]
+    pub fn sqrt(self) -> F8 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].sqrt();
+        }
+        F8(r)
+    }
+
+    /// `max(v, 0)`, 0 for NaN (as `f32::max(v, 0.0)`; the sign of a zero may differ).
+    #[inline(always)]
+    pub fn max0(self) -> F8 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = if self.0[i] > 0.0 { self.0[i] } else { 0.0 };
+        }
+        F8(r)
+    }
+
+    /// `self < o`.
+    #[inline(always)]
+    pub fn lt(self, o: F8) -> M8 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = -i32::from(self.0[i] < o.0[i]);
+        }
+        M8(r)
+    }
+
+    /// `self == o`.
+    #[inline(always)]
+    pub fn eq(self, o: F8) -> M8 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = -i32::from(self.0[i] == o.0[i]);
+        }
+        M8(r)
+    }
+
+    /// `a` where `m`, else `b`.
+    #[inline(always)]
+    pub fn select(m: M8, a: F8, b: F8) -> F8 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = if m.0[i] != 0 { a.0[i] } else { b.0[i] };
+        }
+        F8(r)
+    }
+}
+
+impl M8 {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: bool) -> M8 {
+        M8([-i32::from(v); LANES])
+    }
+
+    /// Lanes `i < n`.
+    #[inline(always)]
+    pub fn first(n: usize) -> M8 {
+        let mut r = [0; LANES];
+        for (i, m) in r.iter_mut().enumerate() {
+            *m = -i32::from(i < n);
+        }
+        M8(r)
+    }
+
+    /// True if any lane is.
+    #[inline(always)]
+    pub fn any(self) -> bool {
+        self.0.iter().fold(0, |a, &m| a | m) != 0
+    }
+
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn get(self, i: usize) -> bool {
+        self.0[i] != 0
+    }
+}
+
+impl BitAnd for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitand(self, o: M8) -> M8 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i] & o.0[i];
+        }
+        M8(r)
+    }
+}
+
+impl BitOr for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn bitor(self, o: M8) -> M8 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i] | o.0[i];
+        }
+        M8(r)
+    }
+}
+
+impl Not for M8 {
+    type Output = M8;
+    #[inline(always)]
+    fn not(self) -> M8 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = !self.0[i];
+        }
+        M8(r)
+    }
+}
+
+impl V8 {
+    /// Every lane `v`.
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> V8 {
+        V8 {
+            x: F8::splat(v.x),
+            y: F8::splat(v.y),
+            z: F8::splat(v.z),
+        }
+    }
+
+    /// `x x' + y y' + z z'`, in glam's order.
+    #[inline(always)]
+    pub fn dot(self, o: V8) -> F8 {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// `self * (1 / |self|)`, as glam's `normalize`.
+    #[inline(always)]
+    pub fn normalize(self) -> V8 {
+        let r = F8::splat(1.0) / self.dot(self).sqrt();
+        self * r
+    }
+}
+
+impl Add for V8 {
+    type Output = V8;
+    #[inline(always)]
+    fn add(self, o: V8) -> V8 {
+        V8 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl Sub for V8 {
+    type Output = V8;
+    #[inline(always)]
+    fn sub(self, o: V8) -> V8 {
+        V8 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl Mul<F8> for V8 {
+    type Output = V8;
+    #[inline(always)]
+    fn mul(self, s: F8) -> V8 {
+        V8 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Property: every lane operation equals glam's scalar one bit for bit.
+    #[test]
+    fn lanes_equal_scalar_glam() {
+        let v: Vec<Vec3> = (0..LANES)
+            .map(|i| {
+                let t = i as f32 * 0.37 + 0.11;
+                Vec3::new(t.sin() * 3.1, (t * 1.7).cos() - 0.2, t * t - 1.3)
+            })
+            .collect();
+        let lanes = V8 {
+            x: F8(std::array::from_fn(|i| v[i].x)),
+            y: F8(std::array::from_fn(|i| v[i].y)),
+            z: F8(std::array::from_fn(|i| v[i].z)),
+        };
+        let n = lanes.normalize();
+        let d = lanes.dot(V8::splat(Vec3::new(0.3, -0.8, 0.1)));
+        for i in 0..LANES {
+            let s = v[i].normalize();
+            assert_eq!([n.x.0[i], n.y.0[i], n.z.0[i]], s.to_array());
+            assert_eq!(d.0[i], v[i].dot(Vec3::new(0.3, -0.8, 0.1)));
+            assert_eq!(d.max0().0[i], d.0[i].max(0.0) + 0.0);
+        }
+        assert_eq!(F8::splat(f32::NAN).max0(), F8::splat(0.0));
+        assert!(M8::first(3).get(2) && !M8::first(3).get(3));
+    }
+}
