@@ -103,12 +103,40 @@ struct ScreenVertex {
     v: Varyings,
 }
 
+/// A convex polygon of at most 9 corners: a triangle clipped by two planes.
+#[derive(Clone, Copy)]
+struct Polygon {
+    corners: [ClipVertex; 9],
+    len: usize,
+}
+
+impl Polygon {
+    fn new(tri: [ClipVertex; 3]) -> Polygon {
+        let mut corners = [tri[0]; 9];
+        corners[..3].copy_from_slice(&tri);
+        Polygon { corners, len: 3 }
+    }
+
+    fn corners(&self) -> &[ClipVertex] {
+        &self.corners[..self.len]
+    }
+
+    fn push(&mut self, v: ClipVertex) {
+        self.corners[self.len] = v;
+        self.len += 1;
+    }
+}
+
 /// Clips a polygon against `plane(c) >= 0`, interpolating in clip space.
-fn clip_polygon(poly: &[ClipVertex], plane: impl Fn(&[f32; 4]) -> f32) -> Vec<ClipVertex> {
-    let mut out = Vec::with_capacity(poly.len() + 2);
-    for i in 0..poly.len() {
-        let a = &poly[i];
-        let b = &poly[(i + 1) % poly.len()];
+fn clip_polygon(poly: &Polygon, plane: impl Fn(&[f32; 4]) -> f32) -> Polygon {
+    let mut out = Polygon {
+        corners: poly.corners,
+        len: 0,
+    };
+    let corners = poly.corners();
+    for i in 0..corners.len() {
+        let a = &corners[i];
+        let b = &corners[(i + 1) % corners.len()];
         let (da, db) = (plane(&a.clip), plane(&b.clip));
         if da >= 0.0 {
             out.push(*a);
@@ -125,19 +153,37 @@ fn clip_polygon(poly: &[ClipVertex], plane: impl Fn(&[f32; 4]) -> f32) -> Vec<Cl
     out
 }
 
-/// The screen-space triangles of the mesh: vertex stage, clipping, viewport.
-fn screen_triangles(
-    mesh: &ShadeMesh,
+/// The mesh in window coordinates: vertices, and triangles over them in mesh order (the
+/// mesh's own list when nothing needed clipping).
+struct ScreenMesh<'a> {
+    verts: Vec<ScreenVertex>,
+    tris: std::borrow::Cow<'a, [[u32; 3]]>,
+}
+
+impl ScreenMesh<'_> {
+    /// The corners of triangle `i`.
+    #[inline(always)]
+    fn tri(&self, i: u32) -> [&ScreenVertex; 3] {
+        self.tris[i as usize].map(|v| &self.verts[v as usize])
+    }
+}
+
+/// The screen-space triangles of the mesh: vertex stage (per vertex on rayon), clipping
+/// against the near and far planes, viewport.
+fn screen_triangles<'a>(
+    mesh: &'a ShadeMesh,
     view: &View,
     shader: &Shader,
     u: &Uniforms,
-) -> Result<Vec<[ScreenVertex; 3]>, ShadeError> {
+) -> Result<ScreenMesh<'a>, ShadeError> {
     let clip_from_world = view.clip_from_world()?.matrix();
     let displace = match shader {
         Shader::Displacement(map) => Some(map),
         _ => None,
     };
-    let verts: Vec<ClipVertex> = (0..mesh.positions.len())
+    let clipped: Vec<ClipVertex> = (0..mesh.positions.len())
+        .into_par_iter()
+        .with_min_len(4096)
         .map(|i| {
             let n = mesh.normals[i];
             let mut p = mesh.positions[i];
@@ -162,37 +208,50 @@ fn screen_triangles(
         })
         .collect();
     let (w, h) = (view.width as f32, view.height as f32);
-    let mut out = Vec::with_capacity(mesh.triangles.len());
+    let to_screen = |c: &ClipVertex| {
+        let inv_w = 1.0 / c.clip[3];
+        ScreenVertex {
+            x: (c.clip[0] * inv_w + 1.0) * 0.5 * w,
+            y: (1.0 - c.clip[1] * inv_w) * 0.5 * h,
+            z: (c.clip[2] * inv_w + 1.0) * 0.5,
+            inv_w,
+            v: c.v,
+        }
+    };
+    let inside = |c: &[f32; 4]| c[2] >= -c[3] && c[2] <= c[3];
+    let mut verts: Vec<ScreenVertex> = clipped.par_iter().map(to_screen).collect();
+    let all_inside = |t: &[u32; 3]| t.iter().all(|&i| inside(&clipped[i as usize].clip));
+    if mesh.triangles.par_iter().all(all_inside) {
+        return Ok(ScreenMesh {
+            verts,
+            tris: std::borrow::Cow::Borrowed(&mesh.triangles),
+        });
+    }
+    // Some triangles cross the near or far plane: clip those and fan their polygons, in
+    // mesh order, with the new corners appended.
+    let mut tris = Vec::with_capacity(mesh.triangles.len());
     for t in &mesh.triangles {
-        let tri = t.map(|i| verts[i as usize]);
-        let inside = |c: &[f32; 4]| c[2] >= -c[3] && c[2] <= c[3];
-        let poly = if tri.iter().all(|v| inside(&v.clip)) {
-            tri.to_vec()
-        } else {
-            let near = clip_polygon(&tri, |c| c[2] + c[3]);
-            clip_polygon(&near, |c| c[3] - c[2])
-        };
-        if poly.len() < 3 {
+        if all_inside(t) {
+            tris.push(*t);
             continue;
         }
-        let screen: Vec<ScreenVertex> = poly
-            .iter()
-            .map(|c| {
-                let inv_w = 1.0 / c.clip[3];
-                ScreenVertex {
-                    x: (c.clip[0] * inv_w + 1.0) * 0.5 * w,
-                    y: (1.0 - c.clip[1] * inv_w) * 0.5 * h,
-                    z: (c.clip[2] * inv_w + 1.0) * 0.5,
-                    inv_w,
-                    v: c.v,
-                }
-            })
-            .collect();
-        for i in 1..screen.len() - 1 {
-            out.push([screen[0], screen[i], screen[i + 1]]);
+        let tri = Polygon::new(t.map(|i| clipped[i as usize]));
+        let near = clip_polygon(&tri, |c| c[2] + c[3]);
+        let poly = clip_polygon(&near, |c| c[3] - c[2]);
+        let corners = poly.corners();
+        if corners.len() < 3 {
+            continue;
+        }
+        let first = verts.len() as u32;
+        verts.extend(corners.iter().map(to_screen));
+        for i in 1..corners.len() as u32 - 1 {
+            tris.push([first, first + i, first + i + 1]);
         }
     }
-    Ok(out)
+    Ok(ScreenMesh {
+        verts,
+        tris: std::borrow::Cow::Owned(tris),
+    })
 }
 
 /// Twice the signed area of `(a, b, p)`.
@@ -262,8 +321,9 @@ fn render<T: Copy + Default + Send>(
     // Triangles by band of rows, in mesh order.
     let bands = h.div_ceil(BAND) as usize;
     let mut by_band: Vec<Vec<u32>> = vec![Vec::new(); bands];
-    for (i, t) in tris.iter().enumerate() {
-        let (y0, y1) = t
+    for i in 0..tris.tris.len() as u32 {
+        let (y0, y1) = tris
+            .tri(i)
             .iter()
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
                 (a.min(v.y), b.max(v.y))
@@ -301,7 +361,7 @@ fn render<T: Copy + Default + Send>(
 
 /// What every band of one frame reads.
 struct Frame<'a> {
-    tris: &'a [[ScreenVertex; 3]],
+    tris: &'a ScreenMesh<'a>,
     by_band: &'a [Vec<u32>],
     k: u32,
     w: u32,
@@ -356,18 +416,12 @@ impl Frame<'_> {
         // Visibility first (depth LESS, the first of equals kept), then one fragment per
         // visible sample: the same colours as shading each fragment as it passes.
         for &i in &self.by_band[band as usize] {
-            raster_fill(&self.tris[i as usize], i, &target, buf);
+            raster_fill(self.tris.tri(i), i, &target, buf);
         }
         self.shade_samples(buf, len);
         if let Some(c) = self.opts.wireframe {
             for &i in &self.by_band[band as usize] {
-                raster_wire(
-                    &self.tris[i as usize],
-                    &target,
-                    buf,
-                    c,
-                    self.opts.wire_width,
-                );
+                raster_wire(self.tris.tri(i), &target, buf, c, self.opts.wire_width);
             }
         }
         // Each sample is stored clamped, as in an 8-bit colour buffer; a pixel is the mean
@@ -379,21 +433,25 @@ impl Frame<'_> {
                 c.b.clamp(0.0, 1.0),
             )
         };
-        for (i, p) in out.iter_mut().enumerate() {
-            let (px, py) = (i % w as usize, i / w as usize);
-            let first = py * k as usize * row_len + px * k as usize;
-            let color = |s: usize| Rgb::new(buf.color[0][s], buf.color[1][s], buf.color[2][s]);
-            *p = if n == 1 {
-                store(clamp(color(first)))
-            } else {
+        let color = |s: usize| Rgb::new(buf.color[0][s], buf.color[1][s], buf.color[2][s]);
+        for (py, row) in out.chunks_mut(w as usize).enumerate() {
+            let row_start = py * k as usize * row_len;
+            if n == 1 {
+                for (px, p) in row.iter_mut().enumerate() {
+                    *p = store(clamp(color(row_start + px)));
+                }
+                continue;
+            }
+            for (px, p) in row.iter_mut().enumerate() {
+                let first = row_start + px * k as usize;
                 let mut sum = Rgb::BLACK;
                 for sy in 0..k as usize {
                     for sx in 0..k as usize {
                         sum += clamp(color(first + sy * row_len + sx));
                     }
                 }
-                store(sum * (1.0 / n as f32))
-            };
+                *p = store(sum * (1.0 / n as f32));
+            }
         }
     }
 
@@ -426,14 +484,14 @@ impl Frame<'_> {
             let mut positions = [V8::default(); 3];
             if ids.iter().all(|&p| p == ids[0]) {
                 // One triangle under all eight: its corners, once.
-                for (c, v) in tris[ids[0] as usize].iter().enumerate() {
+                for (c, v) in tris.tri(ids[0]).iter().enumerate() {
                     inv_w[c] = F8::splat(v.inv_w);
                     normals[c] = V8::splat(v.v.normal);
                     positions[c] = V8::splat(v.v.position);
                 }
             } else {
                 for l in 0..LANES {
-                    let t = &tris[if ids[l] == NONE { 0 } else { ids[l] as usize }];
+                    let t = tris.tri(if ids[l] == NONE { 0 } else { ids[l] });
                     for c in 0..3 {
                         inv_w[c].0[l] = t[c].inv_w;
                         let (n, p) = (t[c].v.normal, t[c].v.position);
@@ -476,7 +534,7 @@ impl Frame<'_> {
                     let c = if ids[l] == NONE {
                         background
                     } else {
-                        let [a, b, c] = &tris[ids[l] as usize];
+                        let [a, b, c] = tris.tri(ids[l]);
                         let v = Varyings::blend_only(
                             &a.v,
                             &b.v,
@@ -563,7 +621,7 @@ struct Setup {
 
 impl Setup {
     #[inline(always)]
-    fn new(t: &[ScreenVertex; 3], to: &Target) -> Option<Setup> {
+    fn new(t: [&ScreenVertex; 3], to: &Target) -> Option<Setup> {
         let [a, b, c] = t;
         let area = edge(a.x, a.y, b.x, b.y, c.x, c.y);
         if area == 0.0 || !area.is_finite() {
@@ -599,7 +657,7 @@ impl Setup {
 /// weights, eight samples of a sample row at a time. Each lane evaluates the edge
 /// functions exactly as [`edge`] does.
 #[inline(always)]
-fn raster_fill(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
+fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
     let Some(set) = Setup::new(t, to) else {
         return;
     };
@@ -627,15 +685,18 @@ fn raster_fill(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
                 along[1].0 * (y - from[1].1),
                 along[2].0 * (y - from[2].1),
             ];
-            let mut j = j0;
-            while j < j1 {
+            let Some((lo, hi)) = row_span(&across, &along, &from, set.sign, k, (j0, j1)) else {
+                continue;
+            };
+            let mut j = lo;
+            while j < hi {
                 let xs = F8::load(&buf.xs[j..]);
                 let edge_at = |i: usize| {
                     (F8::splat(across[i]) - F8::splat(along[i].1) * (xs - from[i].0)) * sign
                 };
                 let e = [edge_at(0), edge_at(1), edge_at(2)];
                 // Outside: below zero, or on an edge the triangle does not own.
-                let mut inside = M8::first(j1 - j);
+                let mut inside = M8::first(hi - j);
                 for i in 0..3 {
                     inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
                 }
@@ -667,10 +728,64 @@ fn raster_fill(t: &[ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
     }
 }
 
+/// The sample columns of a sample row, within `cols`, that can lie inside a triangle: a
+/// range a little wider than where the three edge functions `(across - dy (x - fx)) sign`
+/// are at least 0 (every sample in it is still tested exactly), or `None` when no sample
+/// of the row can be inside.
+#[inline(always)]
+fn row_span(
+    across: &[f32; 3],
+    along: &[(f32, f32); 3],
+    from: &[(f32, f32); 3],
+    sign: f32,
+    k: u32,
+    cols: (usize, usize),
+) -> Option<(usize, usize)> {
+    let (mut lo, mut hi) = (f32::NEG_INFINITY, f32::INFINITY);
+    let mut scale = 0.0f32;
+    for i in 0..3 {
+        let (g, m) = (across[i] * sign, along[i].1 * sign);
+        if m == 0.0 {
+            // The edge function is `g` along the whole row.
+            if g < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let x = from[i].0 + g / m;
+        scale = scale.max(x.abs()).max(from[i].0.abs());
+        if m > 0.0 {
+            hi = hi.min(x);
+        } else {
+            lo = lo.max(x);
+        }
+    }
+    // A pixel and a relative margin cover rounding in the bound and in the exact test.
+    let margin = 1.0 + scale * 1e-4;
+    // (A NaN bound was dropped by `min`/`max`: only a looser range.)
+    if !margin.is_finite() {
+        return Some(cols);
+    }
+    let k = k as f32;
+    let first = ((lo - margin) * k).floor();
+    let last = ((hi + margin) * k).ceil();
+    let first = if first > cols.0 as f32 {
+        first as usize
+    } else {
+        cols.0
+    };
+    let last = if last < cols.1 as f32 {
+        last.max(0.0) as usize
+    } else {
+        cols.1
+    };
+    (first < last).then_some((first, last))
+}
+
 /// Draws a triangle's edges into a band: samples within `half_width` pixels of an edge,
 /// inside the triangle, take `color`, the depth test passing up to a small bias so that
 /// edges show on their own faces.
-fn raster_wire(t: &[ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, half_width: f32) {
+fn raster_wire(t: [&ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, half_width: f32) {
     let Some(set) = Setup::new(t, to) else {
         return;
     };
