@@ -334,7 +334,7 @@ fn render<T: Copy + Default + Send>(
         let first = (y0.max(0.0) as u32 / BAND) as usize;
         let last = ((y1.min(h as f32 - 1.0).max(0.0) as u32) / BAND) as usize;
         for band in by_band.iter_mut().take(last.min(bands - 1) + 1).skip(first) {
-            band.push(i as u32);
+            band.push(i);
         }
     }
     let frame = Frame {
@@ -490,8 +490,8 @@ impl Frame<'_> {
                     positions[c] = V8::splat(v.v.position);
                 }
             } else {
-                for l in 0..LANES {
-                    let t = tris.tri(if ids[l] == NONE { 0 } else { ids[l] });
+                for (l, &id) in ids.iter().enumerate() {
+                    let t = tris.tri(if id == NONE { 0 } else { id });
                     for c in 0..3 {
                         inv_w[c].0[l] = t[c].inv_w;
                         let (n, p) = (t[c].v.normal, t[c].v.position);
