@@ -1,6 +1,6 @@
-//! [`F8`], [`M8`] and [`V8`]: eight samples side by side (numbers, masks, vectors), with
+//! [`F16`], [`M16`] and [`V16`]: sixteen samples side by side (numbers, masks, vectors), with
 //! each operation the scalar one lane by lane, so that results equal the scalar code's bit
-//! for bit; compiled for AVX they become single vector instructions.
+//! for bit; compiled for AVX-512 they become single vector instructions (two with AVX2).
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
@@ -10,46 +10,46 @@ use std::ops::{Add, BitAnd, BitOr, Div, Mul, Not, Sub};
 use prism_math::Vec3;
 
 /// Lanes per group.
-pub(crate) const LANES: usize = 8;
+pub(crate) const LANES: usize = 16;
 
-/// Eight `f32`.
+/// Sixteen `f32`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct F8(pub [f32; LANES]);
+pub(crate) struct F16(pub [f32; LANES]);
 
-/// Eight lane conditions: all ones where true.
+/// Sixteen lane conditions: all ones where true.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct M8(pub [i32; LANES]);
+pub(crate) struct M16(pub [i32; LANES]);
 
-/// Eight 3-vectors, one [`F8`] per axis.
+/// Sixteen 3-vectors, one [`F16`] per axis.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct V8 {
-    pub x: F8,
-    pub y: F8,
-    pub z: F8,
+pub(crate) struct V16 {
+    pub x: F16,
+    pub y: F16,
+    pub z: F16,
 }
 
 macro_rules! lanewise {
     ($trait:ident, $f:ident, $op:tt) => {
-        impl $trait for F8 {
-            type Output = F8;
+        impl $trait for F16 {
+            type Output = F16;
             #[inline(always)]
-            fn $f(self, o: F8) -> F8 {
+            fn $f(self, o: F16) -> F16 {
                 let mut r = [0.0; LANES];
                 for i in 0..LANES {
                     r[i] = self.0[i] $op o.0[i];
                 }
-                F8(r)
+                F16(r)
             }
         }
-        impl $trait<f32> for F8 {
-            type Output = F8;
+        impl $trait<f32> for F16 {
+            type Output = F16;
             #[inline(always)]
-            fn $f(self, o: f32) -> F8 {
+            fn $f(self, o: f32) -> F16 {
                 let mut r = [0.0; LANES];
                 for i in 0..LANES {
                     r[i] = self.0[i] $op o;
                 }
-                F8(r)
+                F16(r)
             }
         }
     };
@@ -59,22 +59,22 @@ lanewise!(Sub, sub, -);
 lanewise!(Mul, mul, *);
 lanewise!(Div, div, /);
 
-impl F8 {
+impl F16 {
     /// Every lane `v`.
     #[inline(always)]
-    pub fn splat(v: f32) -> F8 {
-        F8([v; LANES])
+    pub fn splat(v: f32) -> F16 {
+        F16([v; LANES])
     }
 
-    /// The first eight values of `s`.
+    /// The first sixteen values of `s`.
     #[inline(always)]
-    pub fn load(s: &[f32]) -> F8 {
+    pub fn load(s: &[f32]) -> F16 {
         let mut r = [0.0; LANES];
         r.copy_from_slice(&s[..LANES]);
-        F8(r)
+        F16(r)
     }
 
-    /// Writes the lanes to the first eight values of `s`.
+    /// Writes the lanes to the first sixteen values of `s`.
     #[inline(always)]
     pub fn store(self, s: &mut [f32]) {
         s[..LANES].copy_from_slice(&self.0);
@@ -82,70 +82,70 @@ impl F8 {
 
     /// Square roots.
     #[inline(always)]
-    pub fn sqrt(self) -> F8 {
+    pub fn sqrt(self) -> F16 {
         let mut r = [0.0; LANES];
         for i in 0..LANES {
             r[i] = self.0[i].sqrt();
         }
-        F8(r)
+        F16(r)
     }
 
     /// `max(v, 0)`, 0 for NaN (as `f32::max(v, 0.0)`; the sign of a zero may differ).
     #[inline(always)]
-    pub fn max0(self) -> F8 {
+    pub fn max0(self) -> F16 {
         let mut r = [0.0; LANES];
         for i in 0..LANES {
             r[i] = if self.0[i] > 0.0 { self.0[i] } else { 0.0 };
         }
-        F8(r)
+        F16(r)
     }
 
     /// `self < o`.
     #[inline(always)]
-    pub fn lt(self, o: F8) -> M8 {
+    pub fn lt(self, o: F16) -> M16 {
         let mut r = [0; LANES];
         for i in 0..LANES {
             r[i] = -i32::from(self.0[i] < o.0[i]);
         }
-        M8(r)
+        M16(r)
     }
 
     /// `self == o`.
     #[inline(always)]
-    pub fn eq(self, o: F8) -> M8 {
+    pub fn eq(self, o: F16) -> M16 {
         let mut r = [0; LANES];
         for i in 0..LANES {
             r[i] = -i32::from(self.0[i] == o.0[i]);
         }
-        M8(r)
+        M16(r)
     }
 
     /// `a` where `m`, else `b`.
     #[inline(always)]
-    pub fn select(m: M8, a: F8, b: F8) -> F8 {
+    pub fn select(m: M16, a: F16, b: F16) -> F16 {
         let mut r = [0.0; LANES];
         for i in 0..LANES {
             r[i] = if m.0[i] != 0 { a.0[i] } else { b.0[i] };
         }
-        F8(r)
+        F16(r)
     }
 }
 
-impl M8 {
+impl M16 {
     /// Every lane `v`.
     #[inline(always)]
-    pub fn splat(v: bool) -> M8 {
-        M8([-i32::from(v); LANES])
+    pub fn splat(v: bool) -> M16 {
+        M16([-i32::from(v); LANES])
     }
 
     /// Lanes `i < n`.
     #[inline(always)]
-    pub fn first(n: usize) -> M8 {
+    pub fn first(n: usize) -> M16 {
         let mut r = [0; LANES];
         for (i, m) in r.iter_mut().enumerate() {
             *m = -i32::from(i < n);
         }
-        M8(r)
+        M16(r)
     }
 
     /// True if any lane is.
@@ -161,72 +161,72 @@ impl M8 {
     }
 }
 
-impl BitAnd for M8 {
-    type Output = M8;
+impl BitAnd for M16 {
+    type Output = M16;
     #[inline(always)]
-    fn bitand(self, o: M8) -> M8 {
+    fn bitand(self, o: M16) -> M16 {
         let mut r = [0; LANES];
         for i in 0..LANES {
             r[i] = self.0[i] & o.0[i];
         }
-        M8(r)
+        M16(r)
     }
 }
 
-impl BitOr for M8 {
-    type Output = M8;
+impl BitOr for M16 {
+    type Output = M16;
     #[inline(always)]
-    fn bitor(self, o: M8) -> M8 {
+    fn bitor(self, o: M16) -> M16 {
         let mut r = [0; LANES];
         for i in 0..LANES {
             r[i] = self.0[i] | o.0[i];
         }
-        M8(r)
+        M16(r)
     }
 }
 
-impl Not for M8 {
-    type Output = M8;
+impl Not for M16 {
+    type Output = M16;
     #[inline(always)]
-    fn not(self) -> M8 {
+    fn not(self) -> M16 {
         let mut r = [0; LANES];
         for i in 0..LANES {
             r[i] = !self.0[i];
         }
-        M8(r)
+        M16(r)
     }
 }
 
-impl V8 {
+impl V16 {
     /// Every lane `v`.
     #[inline(always)]
-    pub fn splat(v: Vec3) -> V8 {
-        V8 {
-            x: F8::splat(v.x),
-            y: F8::splat(v.y),
-            z: F8::splat(v.z),
+    pub fn splat(v: Vec3) -> V16 {
+        V16 {
+            x: F16::splat(v.x),
+            y: F16::splat(v.y),
+            z: F16::splat(v.z),
         }
     }
 
     /// `x x' + y y' + z z'`, in glam's order.
     #[inline(always)]
-    pub fn dot(self, o: V8) -> F8 {
+    pub fn dot(self, o: V16) -> F16 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// `self * (1 / |self|)`, as glam's `normalize`.
     #[inline(always)]
-    pub fn normalize(self) -> V8 {
-        let r = F8::splat(1.0) / self.dot(self).sqrt();
+    pub fn normalize(self) -> V16 {
+        let r = F16::splat(1.0) / self.dot(self).sqrt();
         self * r
     }
 }
 
-impl Add for V8 {
-    type Output = V8;
+impl Add for V16 {
+    type Output = V16;
     #[inline(always)]
-    fn add(self, o: V8) -> V8 {
-        V8 {
+    fn add(self, o: V16) -> V16 {
+        V16 {
             x: self.x + o.x,
             y: self.y + o.y,
             z: self.z + o.z,
@@ -234,11 +234,11 @@ impl Add for V8 {
     }
 }
 
-impl Sub for V8 {
-    type Output = V8;
+impl Sub for V16 {
+    type Output = V16;
     #[inline(always)]
-    fn sub(self, o: V8) -> V8 {
-        V8 {
+    fn sub(self, o: V16) -> V16 {
+        V16 {
             x: self.x - o.x,
             y: self.y - o.y,
             z: self.z - o.z,
@@ -246,11 +246,11 @@ impl Sub for V8 {
     }
 }
 
-impl Mul<F8> for V8 {
-    type Output = V8;
+impl Mul<F16> for V16 {
+    type Output = V16;
     #[inline(always)]
-    fn mul(self, s: F8) -> V8 {
-        V8 {
+    fn mul(self, s: F16) -> V16 {
+        V16 {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
@@ -271,20 +271,20 @@ mod tests {
                 Vec3::new(t.sin() * 3.1, (t * 1.7).cos() - 0.2, t * t - 1.3)
             })
             .collect();
-        let lanes = V8 {
-            x: F8(std::array::from_fn(|i| v[i].x)),
-            y: F8(std::array::from_fn(|i| v[i].y)),
-            z: F8(std::array::from_fn(|i| v[i].z)),
+        let lanes = V16 {
+            x: F16(std::array::from_fn(|i| v[i].x)),
+            y: F16(std::array::from_fn(|i| v[i].y)),
+            z: F16(std::array::from_fn(|i| v[i].z)),
         };
         let n = lanes.normalize();
-        let d = lanes.dot(V8::splat(Vec3::new(0.3, -0.8, 0.1)));
+        let d = lanes.dot(V16::splat(Vec3::new(0.3, -0.8, 0.1)));
         for i in 0..LANES {
             let s = v[i].normalize();
             assert_eq!([n.x.0[i], n.y.0[i], n.z.0[i]], s.to_array());
             assert_eq!(d.0[i], v[i].dot(Vec3::new(0.3, -0.8, 0.1)));
             assert_eq!(d.max0().0[i], d.0[i].max(0.0) + 0.0);
         }
-        assert_eq!(F8::splat(f32::NAN).max0(), F8::splat(0.0));
-        assert!(M8::first(3).get(2) && !M8::first(3).get(3));
+        assert_eq!(F16::splat(f32::NAN).max0(), F16::splat(0.0));
+        assert!(M16::first(3).get(2) && !M16::first(3).get(3));
     }
 }

@@ -10,7 +10,7 @@ use prism_math::{Rgb, Transform, Vec3};
 use rayon::prelude::*;
 
 use crate::error::ShadeError;
-use crate::lanes::{F8, LANES, M8, V8};
+use crate::lanes::{F16, LANES, M16, V16};
 use crate::mesh::ShadeMesh;
 use crate::shaders::{fragment, fragment_lanes, height, Shader, Uniforms, Varyings};
 
@@ -374,14 +374,36 @@ impl Frame<'_> {
     /// Draws band `band` into `out`, its rows of pixels.
     fn band<T>(&self, band: u32, out: &mut [T], buf: &mut Band, store: &impl Fn(Rgb) -> T) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor has AVX2.
-            return unsafe { self.band_avx2(band, out, buf, store) };
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the processor has AVX-512F.
+                return unsafe { self.band_avx512(band, out, buf, store) };
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor has AVX2.
+                return unsafe { self.band_avx2(band, out, buf, store) };
+            }
         }
         self.band_with(band, out, buf, store);
     }
 
-    /// [`Frame::band`] compiled for AVX2 (the lanes become vector instructions).
+    /// [`Frame::band`] compiled for AVX-512 (a group of lanes is one vector).
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn band_avx512<T>(
+        &self,
+        band: u32,
+        out: &mut [T],
+        buf: &mut Band,
+        store: &impl Fn(Rgb) -> T,
+    ) {
+        self.band_with(band, out, buf, store);
+    }
+
+    /// [`Frame::band`] compiled for AVX2 (a group of lanes is two vectors).
     ///
     /// # Safety
     /// The processor must support AVX2.
@@ -456,7 +478,7 @@ impl Frame<'_> {
     }
 
     /// The colour of every sample: the background, or the fragment of the triangle seen,
-    /// eight samples at a time where the shader has a lane form.
+    /// sixteen samples at a time where the shader has a lane form.
     #[inline(always)]
     fn shade_samples(&self, buf: &mut Band, len: usize) {
         let (u, shader, tris) = (self.u, self.shader, self.tris);
@@ -479,15 +501,15 @@ impl Frame<'_> {
             }
             // Perspective-correct weights and the position and normal they blend, with
             // each lane's corners gathered (a lane that sees nothing borrows triangle 0).
-            let mut inv_w = [F8::default(); 3];
-            let mut normals = [V8::default(); 3];
-            let mut positions = [V8::default(); 3];
+            let mut inv_w = [F16::default(); 3];
+            let mut normals = [V16::default(); 3];
+            let mut positions = [V16::default(); 3];
             if ids.iter().all(|&p| p == ids[0]) {
-                // One triangle under all eight: its corners, once.
+                // One triangle under all the lanes: its corners, once.
                 for (c, v) in tris.tri(ids[0]).iter().enumerate() {
-                    inv_w[c] = F8::splat(v.inv_w);
-                    normals[c] = V8::splat(v.v.normal);
-                    positions[c] = V8::splat(v.v.position);
+                    inv_w[c] = F16::splat(v.inv_w);
+                    normals[c] = V16::splat(v.v.normal);
+                    positions[c] = V16::splat(v.v.position);
                 }
             } else {
                 for (l, &id) in ids.iter().enumerate() {
@@ -505,16 +527,16 @@ impl Frame<'_> {
                 }
             }
             let pw = [
-                F8::load(&bary[0][s..]) * inv_w[0],
-                F8::load(&bary[1][s..]) * inv_w[1],
-                F8::load(&bary[2][s..]) * inv_w[2],
+                F16::load(&bary[0][s..]) * inv_w[0],
+                F16::load(&bary[1][s..]) * inv_w[1],
+                F16::load(&bary[2][s..]) * inv_w[2],
             ];
-            let inv = F8::splat(1.0) / (pw[0] + pw[1] + pw[2]);
+            let inv = F16::splat(1.0) / (pw[0] + pw[1] + pw[2]);
             let wt = [pw[0] * inv, pw[1] * inv, pw[2] * inv];
-            let blend = |v: &[V8; 3]| v[0] * wt[0] + v[1] * wt[1] + v[2] * wt[2];
+            let blend = |v: &[V16; 3]| v[0] * wt[0] + v[1] * wt[1] + v[2] * wt[2];
             let normal = blend(&normals);
             let lanes = if matches!(shader, Shader::Normal | Shader::Wireframe) {
-                fragment_lanes(shader, u, V8::default(), normal)
+                fragment_lanes(shader, u, V16::default(), normal)
             } else if matches!(shader, Shader::Diffuse | Shader::Phong) {
                 fragment_lanes(shader, u, blend(&positions), normal)
             } else {
@@ -527,7 +549,8 @@ impl Frame<'_> {
                 }
                 let back = [background.r, background.g, background.b];
                 for ch in 0..3 {
-                    F8::select(M8(seen), lanes[ch], F8::splat(back[ch])).store(&mut color[ch][s..]);
+                    F16::select(M16(seen), lanes[ch], F16::splat(back[ch]))
+                        .store(&mut color[ch][s..]);
                 }
             } else {
                 for l in 0..live {
@@ -654,7 +677,7 @@ impl Setup {
 }
 
 /// Rasterizes triangle `id` into a band: the depth test and the visible triangle with its
-/// weights, eight samples of a sample row at a time. Each lane evaluates the edge
+/// weights, sixteen samples of a sample row at a time. Each lane evaluates the edge
 /// functions exactly as [`edge`] does.
 #[inline(always)]
 fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
@@ -665,9 +688,9 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
     let k = to.k;
     let row_len = (to.w * k) as usize;
     let (j0, j1) = ((set.x.0 * k) as usize, (set.x.1 * k) as usize);
-    let sign = F8::splat(set.sign);
-    let zero = F8::splat(0.0);
-    let strict = set.own.map(|o| M8::splat(!o));
+    let sign = F16::splat(set.sign);
+    let zero = F16::splat(0.0);
+    let strict = set.own.map(|o| M16::splat(!o));
     // Edges b -> c, c -> a, a -> b: from which corner, and along what.
     let from = [(b.x, b.y), (c.x, c.y), (a.x, a.y)];
     let along = [
@@ -690,13 +713,13 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
             };
             let mut j = lo;
             while j < hi {
-                let xs = F8::load(&buf.xs[j..]);
+                let xs = F16::load(&buf.xs[j..]);
                 let edge_at = |i: usize| {
-                    (F8::splat(across[i]) - F8::splat(along[i].1) * (xs - from[i].0)) * sign
+                    (F16::splat(across[i]) - F16::splat(along[i].1) * (xs - from[i].0)) * sign
                 };
                 let e = [edge_at(0), edge_at(1), edge_at(2)];
                 // Outside: below zero, or on an edge the triangle does not own.
-                let mut inside = M8::first(hi - j);
+                let mut inside = M16::first(hi - j);
                 for i in 0..3 {
                     inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
                 }
@@ -708,13 +731,13 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
                     ];
                     let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
                     let s = row + j;
-                    let depth = F8::load(&buf.depth[s..]);
+                    let depth = F16::load(&buf.depth[s..]);
                     // LESS: a NaN depth never passes.
                     let pass = inside & z.lt(depth);
-                    F8::select(pass, z, depth).store(&mut buf.depth[s..]);
+                    F16::select(pass, z, depth).store(&mut buf.depth[s..]);
                     for (corner, weights) in l.iter().zip(&mut buf.bary) {
-                        let old = F8::load(&weights[s..]);
-                        F8::select(pass, *corner, old).store(&mut weights[s..]);
+                        let old = F16::load(&weights[s..]);
+                        F16::select(pass, *corner, old).store(&mut weights[s..]);
                     }
                     for (lane, p) in buf.prim[s..s + LANES].iter_mut().enumerate() {
                         if pass.get(lane) {

@@ -5,7 +5,7 @@
 use prism_image::{CubeMap, PixelSampling, Texture, Wrap};
 use prism_math::{Rgb, Vec2, Vec3};
 
-use crate::lanes::{F8, V8};
+use crate::lanes::{F16, V16};
 
 /// A shader with the images it reads.
 #[derive(Clone, Debug)]
@@ -255,17 +255,17 @@ pub fn fragment(shader: &Shader, u: &Uniforms, f: &Varyings) -> Rgb {
     }
 }
 
-/// [`fragment`] for eight fragments at once, from their world positions and interpolated
+/// [`fragment`] for sixteen fragments at once, from their world positions and interpolated
 /// normals, for the shaders that read nothing else (normal, wireframe, diffuse, Blinn-Phong):
 /// each lane is bit for bit the scalar formula. `None` for the other shaders.
 #[inline(always)]
 pub(crate) fn fragment_lanes(
     shader: &Shader,
     u: &Uniforms,
-    position: V8,
-    normal: V8,
-) -> Option<[F8; 3]> {
-    let one = F8::splat(1.0);
+    position: V16,
+    normal: V16,
+) -> Option<[F16; 3]> {
+    let one = F16::splat(1.0);
     match shader {
         Shader::Normal => Some([
             (normal.x + 1.0) * 0.5,
@@ -273,25 +273,29 @@ pub(crate) fn fragment_lanes(
             (normal.z + 1.0) * 0.5,
         ]),
         Shader::Wireframe => Some([
-            F8::splat(u.color.r),
-            F8::splat(u.color.g),
-            F8::splat(u.color.b),
+            F16::splat(u.color.r),
+            F16::splat(u.color.g),
+            F16::splat(u.color.b),
         ]),
         Shader::Diffuse => {
             let n = normal.normalize();
-            let to_light = V8::splat(u.light_pos) - position;
+            let to_light = V16::splat(u.light_pos) - position;
             let r2 = to_light.dot(to_light);
             let l = to_light.normalize();
             let s = n.dot(l).max0() / r2;
             let i = u.light_intensity;
-            Some([F8::splat(i.r) * s, F8::splat(i.g) * s, F8::splat(i.b) * s])
+            Some([
+                F16::splat(i.r) * s,
+                F16::splat(i.g) * s,
+                F16::splat(i.b) * s,
+            ])
         }
         Shader::Phong => {
             let n = normal.normalize();
-            let to_light = V8::splat(u.light_pos) - position;
+            let to_light = V16::splat(u.light_pos) - position;
             let r2 = to_light.dot(to_light);
             let l = to_light.normalize();
-            let v = (V8::splat(u.cam_pos) - position).normalize();
+            let v = (V16::splat(u.cam_pos) - position).normalize();
             let h = (l + v).normalize();
             let inv_r2 = one / r2;
             let s = n.dot(h).max0();
@@ -300,11 +304,11 @@ pub(crate) fn fragment_lanes(
             let s8 = s4 * s4;
             let s16 = s8 * s8;
             let spec = (s16 * s16) * 0.5;
-            let diffuse = F8::splat(0.8) * n.dot(l).max0();
+            let diffuse = F16::splat(0.8) * n.dot(l).max0();
             let i = u.light_intensity;
             let channel = |i: f32| {
-                let e = F8::splat(i) * inv_r2;
-                (F8::splat(0.1) + e * diffuse) + e * spec
+                let e = F16::splat(i) * inv_r2;
+                (F16::splat(0.1) + e * diffuse) + e * spec
             };
             Some([channel(i.r), channel(i.g), channel(i.b)])
         }
@@ -353,6 +357,54 @@ mod tests {
             let full = fragment(s, &u, &Varyings::blend(&a, &b, &c, w));
             let only = fragment(s, &u, &Varyings::blend_only(&a, &b, &c, w, s.needs()));
             assert_eq!(full, only, "{}", s.name());
+        }
+    }
+
+    /// Property: the lane forms of normal, wireframe, diffuse and Blinn-Phong equal the
+    /// scalar fragment shader bit for bit, lane by lane.
+    #[test]
+    fn lane_shaders_equal_scalar_fragments() {
+        use crate::lanes::LANES;
+        let u = Uniforms {
+            cam_pos: Vec3::new(0.3, 1.1, 2.9),
+            ..Uniforms::default()
+        };
+        for round in 0..50 {
+            let f = |l: usize, k: f32| ((l * 7 + round * 13) as f32 * k).sin();
+            let p: Vec<Vec3> = (0..LANES)
+                .map(|l| Vec3::new(f(l, 0.7), f(l, 1.3) * 0.5, f(l, 2.1)))
+                .collect();
+            let n: Vec<Vec3> = (0..LANES)
+                .map(|l| Vec3::new(f(l, 0.3), 1.0 + f(l, 0.9), f(l, 1.7)) * 0.9)
+                .collect();
+            let lanes = |v: &[Vec3]| V16 {
+                x: F16(std::array::from_fn(|l| v[l].x)),
+                y: F16(std::array::from_fn(|l| v[l].y)),
+                z: F16(std::array::from_fn(|l| v[l].z)),
+            };
+            for shader in [
+                Shader::Normal,
+                Shader::Wireframe,
+                Shader::Diffuse,
+                Shader::Phong,
+            ] {
+                let [r, g, b] = fragment_lanes(&shader, &u, lanes(&p), lanes(&n)).unwrap();
+                for l in 0..LANES {
+                    let v = Varyings {
+                        position: p[l],
+                        normal: n[l],
+                        tangent: Vec3::X,
+                        uv: Vec2::ZERO,
+                    };
+                    let c = fragment(&shader, &u, &v);
+                    assert_eq!(
+                        [r.0[l], g.0[l], b.0[l]],
+                        [c.r, c.g, c.b],
+                        "{} lane {l}",
+                        shader.name()
+                    );
+                }
+            }
         }
     }
 }
