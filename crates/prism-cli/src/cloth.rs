@@ -19,8 +19,9 @@ use crate::UserError;
 pub struct ClothArgs {
     /// The course's scene JSON (cloth, and optionally sphere and plane).
     scene: PathBuf,
-    /// Draw the run: a folder (one PNG per frame, `frame_0001.png`, ...), or a .png (an
-    /// animated PNG of every frame, playing at 90 frames a second, in real time).
+    /// Draw the run: a folder (one PNG per frame, `frame_0001.png`, ...), a .png (an
+    /// animated PNG of every frame, playing at 90 frames a second, in real time) or a .gif
+    /// (every frame in 256 colours, playing at 50 frames a second, GIF's fastest).
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Frames to simulate (30 steps each, 90 frames a simulated second).
@@ -145,7 +146,8 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         ))
         .into());
     }
-    // Where the pictures go: a folder (one per frame) or one .png (the last frame).
+    // Where the pictures go: a folder (one per frame) or one animation (.png or .gif).
+    let mut gif = false;
     let frames_dir = match &a.output {
         Some(o) if o.is_dir() || o.to_string_lossy().ends_with('/') => {
             if !o.is_dir() {
@@ -158,7 +160,10 @@ pub fn run(a: &ClothArgs) -> Result<()> {
             Some(o.clone())
         }
         Some(o) => {
-            crate::output::image_output(o, "--output", &[crate::output::ImageFormat::Png])?;
+            use crate::output::ImageFormat;
+            let format =
+                crate::output::image_output(o, "--output", &[ImageFormat::Png, ImageFormat::Gif])?;
+            gif = format == ImageFormat::Gif;
             None
         }
         None => None,
@@ -292,13 +297,19 @@ pub fn run(a: &ClothArgs) -> Result<()> {
             prism_image::write_atomic_with(
                 path,
                 |out| -> Result<()> {
-                    let mut enc = prism_image::ApngEncoder::new(
-                        out,
-                        w,
-                        h,
-                        a.frames,
-                        FRAMES_PER_SECOND as u16,
-                    )?;
+                    let fps = FRAMES_PER_SECOND as u16;
+                    if gif {
+                        let mut enc = prism_image::GifEncoder::new(out, w, h, fps)?;
+                        run_frames(&mut |_, img, write| {
+                            let t = Instant::now();
+                            enc.push(&img)?;
+                            *write += t.elapsed();
+                            Ok(())
+                        })?;
+                        enc.finish()?;
+                        return Ok(());
+                    }
+                    let mut enc = prism_image::ApngEncoder::new(out, w, h, a.frames, fps)?;
                     run_frames(&mut |_, img, write| {
                         let t = Instant::now();
                         enc.push(&img)?;

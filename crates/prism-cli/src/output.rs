@@ -20,6 +20,8 @@ pub enum ImageFormat {
     Exr,
     /// `.bmp`: 24-bit uncompressed bitmap.
     Bmp,
+    /// `.gif`: an animation, 256 colours a frame.
+    Gif,
 }
 
 impl ImageFormat {
@@ -29,6 +31,7 @@ impl ImageFormat {
             ImageFormat::Jpeg => ".jpg",
             ImageFormat::Exr => ".exr",
             ImageFormat::Bmp => ".bmp",
+            ImageFormat::Gif => ".gif",
         }
     }
 }
@@ -48,6 +51,7 @@ pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<
         "jpg" | "jpeg" => Some(ImageFormat::Jpeg),
         "exr" => Some(ImageFormat::Exr),
         "bmp" => Some(ImageFormat::Bmp),
+        "gif" => Some(ImageFormat::Gif),
         _ => None,
     };
     match format {

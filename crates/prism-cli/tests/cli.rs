@@ -1630,6 +1630,24 @@ fn cloth_runs_and_errors() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(frames.join("frame_0002.png").is_file());
+    // A GIF of the two frames, at GIF's shortest honoured frame time.
+    let gif = dir.join("run.gif");
+    let o = prism()
+        .arg("cloth")
+        .arg(&scene)
+        .args(["--frames", "2", "-r", "32", "24", "-o"])
+        .arg(&gif)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut dec = gif::DecodeOptions::new()
+        .read_info(std::fs::File::open(&gif).unwrap())
+        .unwrap();
+    assert_eq!((dec.width(), dec.height()), (32, 24));
+    for _ in 0..2 {
+        assert_eq!(dec.read_next_frame().unwrap().unwrap().delay, 2);
+    }
+    assert!(dec.read_next_frame().unwrap().is_none());
 
     let text = std::fs::read_to_string(&scene).unwrap();
     for (name, bad, want) in [

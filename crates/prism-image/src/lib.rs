@@ -15,7 +15,7 @@ mod io;
 mod srgb;
 mod texture;
 
-pub use animation::ApngEncoder;
+pub use animation::{ApngEncoder, GifEncoder};
 pub use bloom::{bloom_weights, Bloom};
 pub use cubemap::{cube_face, CubeMap, CUBE_FACES};
 pub use diff::{compare_rgb8, DiffStats};
