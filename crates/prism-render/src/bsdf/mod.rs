@@ -136,8 +136,9 @@ impl Bsdf {
         match *self {
             Bsdf::Diffuse { .. } => cosine_hemisphere_pdf(wi.z),
             Bsdf::Conductor { alpha, .. } => {
+                // Visible normals: D_wo(h) / (4 wo.h) = G1(wo, h) D(h) / (4 wo.z).
                 let h = (wo + wi).normalize();
-                beckmann_d(h, alpha) * h.z / (4.0 * wo.dot(h))
+                smith_g1(wo, h, alpha) * beckmann_d(h, alpha) / (4.0 * wo.z)
             }
             _ => 0.0,
         }
@@ -177,7 +178,7 @@ impl Bsdf {
             }),
             Bsdf::Conductor { alpha, .. } => {
                 let wo_up = flip(wo);
-                let h = sample_beckmann(u2, alpha);
+                let h = sample_beckmann_visible(wo_up, alpha, u2);
                 let wi = 2.0 * wo_up.dot(h) * h - wo_up;
                 if wi.z <= 0.0 || wo_up.dot(h) <= 0.0 {
                     return None;
@@ -250,13 +251,98 @@ fn beckmann_d(h: Vec3, alpha: f32) -> f32 {
     (-tan2 / (alpha * alpha)).exp() / (PI * alpha * alpha * c2 * c2)
 }
 
-/// Samples a Beckmann normal with density `D(h) cos(theta_h)`.
-fn sample_beckmann(u: Vec2, alpha: f32) -> Vec3 {
-    let tan2 = -alpha * alpha * (1.0 - u.x).max(f32::MIN_POSITIVE).ln();
-    let cos = 1.0 / (1.0 + tan2).sqrt();
+/// Samples a Beckmann normal visible from `wo` (upper hemisphere), with density
+/// `D_wo(h) = G1(wo, h) max(0, wo.h) D(h) / wo.z` (Heitz and d'Eon 2014, the default in
+/// Mitsuba): `wo` is stretched to roughness 1, a slope is drawn from the distribution of
+/// slopes seen from there, rotated back to `wo`'s azimuth and unstretched.
+fn sample_beckmann_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+    let stretched = Vec3::new(alpha * wo.x, alpha * wo.y, wo.z).normalize();
+    let (sx, sy) = beckmann_visible_slopes(stretched.z, u);
+    let r = (stretched.x * stretched.x + stretched.y * stretched.y).sqrt();
+    let (cos_phi, sin_phi) = if r > 0.0 {
+        (stretched.x / r, stretched.y / r)
+    } else {
+        (1.0, 0.0)
+    };
+    let tx = alpha * (cos_phi * sx - sin_phi * sy);
+    let ty = alpha * (sin_phi * sx + cos_phi * sy);
+    Vec3::new(-tx, -ty, 1.0).normalize()
+}
+
+/// Slopes `(x, y)` of roughness-1 Beckmann normals visible from a direction with cosine
+/// `cos` to the normal, azimuth 0. `y` is Gaussian; `x` inverts its conditional CDF
+/// `(1 + b + tan e^(-s^2) / sqrt(pi)) / (1 + erf(cot) + tan e^(-cot^2) / sqrt(pi))`, `b =
+/// erf(s)`, by Newton's method in `b` from a fitted first guess.
+fn beckmann_visible_slopes(cos: f32, u: Vec2) -> (f32, f32) {
+    let y = erf_inv(2.0 * u.y.clamp(1e-6, 1.0 - 1e-6) - 1.0);
+    if cos > 0.9999 {
+        // Seen from above: the plain distribution of slopes, x Gaussian too.
+        return (erf_inv(2.0 * u.x.clamp(1e-6, 1.0 - 1e-6) - 1.0), y);
+    }
+    let ux = u.x.clamp(1e-6, 1.0 - 1e-6);
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+    let tan = sin / cos;
+    let cot = cos / sin;
+    let top = erf(cot);
+    let inv_sqrt_pi = 1.0 / PI.sqrt();
+    let norm = 1.0 / (1.0 + top + inv_sqrt_pi * tan * (-cot * cot).exp());
+    let theta = cos.acos();
+    let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
+    let mut b = top - (1.0 + top) * (1.0 - ux).powf(fit);
+    for _ in 0..3 {
+        let s = erf_inv(b);
+        let value = norm * (1.0 + b + inv_sqrt_pi * tan * (-s * s).exp()) - ux;
+        let slope = norm * (1.0 - s * tan);
+        if slope.abs() > 1e-12 {
+            b = (b - value / slope).clamp(-1.0 + 1e-6, top.min(1.0 - 1e-6));
+        }
+    }
+    (erf_inv(b), y)
+}
+
+/// The error function, to 1.5e-7 (Abramowitz and Stegun 7.1.26).
+fn erf(x: f32) -> f32 {
+    let a = x.abs();
+    let t = 1.0 / (1.0 + 0.327_591_1 * a);
+    let poly = t
+        * (0.254_829_6
+            + t * (-0.284_496_74 + t * (1.421_413_7 + t * (-1.453_152 + t * 1.061_405_4))));
+    (1.0 - poly * (-a * a).exp()).copysign(x)
+}
+
+/// The inverse error function on (-1, 1) (Giles' single-precision approximation, 2010).
+fn erf_inv(x: f32) -> f32 {
+    let w = -((1.0 - x) * (1.0 + x)).ln();
+    let p = if w < 5.0 {
+        let w = w - 2.5;
+        [
+            3.432_739_4e-7,
+            -3.523_387_7e-6,
+            -4.391_506_5e-6,
+            2.185_808_7e-4,
+            -1.253_725e-3,
+            -4.177_681_6e-3,
+            0.246_640_73,
+            1.501_409_4,
+        ]
+        .iter()
+        .fold(2.810_226_4e-8, |p, c| c + p * w)
+    } else {
+        let w = w.sqrt() - 3.0;
+        [
+            1.009_505_6e-4,
+            1.349_343_2e-3,
+            -3.673_428_4e-3,
+            5.739_507_7e-3,
+            -7.622_461_3e-3,
+            9.438_870_5e-3,
+            1.001_674_1,
+            2.832_976_8,
+        ]
+        .iter()
+        .fold(-2.002_142_6e-4, |p, c| c + p * w)
+    };
+    p * x
 }
 
 /// Smith's masking for Beckmann with Walter's rational approximation.

@@ -149,3 +149,50 @@ fn glass_sampling() {
     let back = g.sample(t.wi, 0.999, Vec2::ZERO).unwrap();
     assert!((back.wi - wo).length() < 1e-4 && (back.weight.r - 2.25).abs() < 1e-4);
 }
+
+/// Closed forms: erf at tabulated points (to 2e-7), and erf_inv inverts it.
+#[test]
+fn erf_and_its_inverse() {
+    for (x, want) in [
+        (0.0, 0.0),
+        (0.5, 0.520_499_9),
+        (1.0, 0.842_700_8),
+        (2.0, 0.995_322_3),
+        (-1.5, -0.966_105_1),
+    ] {
+        assert!((erf(x) - want).abs() < 2e-7, "erf({x}) = {}", erf(x));
+    }
+    for x in [-2.5f32, -1.0, -0.3, 0.0, 0.2, 0.9, 1.7, 2.6] {
+        assert!((erf_inv(erf(x)) - x).abs() < 2e-3 * x.abs().max(1.0), "{x}");
+    }
+}
+
+/// Property of visible-normal sampling: the weight `eval / pdf` is `F G1(wi)`, never
+/// above the Fresnel term (so at most 1 for a conductor that reflects at most everything).
+#[test]
+fn visible_normal_weights_are_bounded() {
+    let c = Bsdf::Conductor {
+        alpha: 0.4,
+        eta: Rgb::new(0.2, 0.9, 1.1),
+        k: Rgb::new(3.9, 2.4, 2.2),
+    };
+    let mut rng = Pcg32::new(3, 9);
+    for theta in [0.0, 20.0, 60.0, 85.0] {
+        let wo = dir(theta, 0.4);
+        for _ in 0..10_000 {
+            let u = Vec2::new(rng.next_f32(), rng.next_f32());
+            if let Some(s) = c.sample(wo, 0.5, u) {
+                let h = (wo + s.wi).normalize();
+                let f = fresnel_conductor(
+                    s.wi.dot(h),
+                    Rgb::new(0.2, 0.9, 1.1),
+                    Rgb::new(3.9, 2.4, 2.2),
+                );
+                assert!(
+                    s.weight.r <= f.r * 1.001 && s.weight.g <= f.g * 1.001,
+                    "{theta}"
+                );
+            }
+        }
+    }
+}
