@@ -32,7 +32,7 @@ pub use integrators::whitted::{
 };
 pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;
-pub use lights::{LightSample, RenderLight};
+pub use lights::{LightSample, MeshLight, RenderLight};
 pub use overlay::{palette, Overlay};
 pub use raytrace::{raytrace, trace_pixel, PixelTrace, RaytraceOptions, Raytraced};
 pub use render_scene::RenderScene;

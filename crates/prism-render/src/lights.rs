@@ -1,6 +1,6 @@
 //! Lights as the integrators see them: [`RenderLight`] (point, directional, area rectangle,
-//! hemisphere, constant and mapped environment) and the [`LightSample`] each one draws, with
-//! the density of every sample (pbrt's `lights`).
+//! emissive mesh, hemisphere, constant and mapped environment) and the [`LightSample`] each
+//! one draws, with the density of every sample (pbrt's `lights`).
 
 use prism_math::warp::{
     cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf,
@@ -41,6 +41,8 @@ pub enum RenderLight {
         /// Radiance.
         radiance: Rgb,
     },
+    /// An emissive mesh, sampled by area.
+    Mesh(std::sync::Arc<MeshLight>),
     /// Radiance from the upper hemisphere (world +Y), hidden from camera rays.
     Hemisphere {
         /// Radiance.
@@ -53,6 +55,66 @@ pub enum RenderLight {
     },
     /// Radiance from every direction read from a map, seen by every ray.
     EnvironmentMap(std::sync::Arc<EnvMap>),
+}
+
+/// The triangles of an emissive mesh (both sides emit, as the course's emission BSDF
+/// does), with the cumulative areas that pick one in proportion to its area.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshLight {
+    triangles: Vec<[Vec3; 3]>,
+    /// `cumulative[i]`: the area of triangles `0..=i`.
+    cumulative: Vec<f32>,
+    area: f32,
+    radiance: Rgb,
+}
+
+impl MeshLight {
+    /// The light of triangles emitting `radiance`; `None` when they have no area.
+    #[must_use]
+    pub fn new(triangles: Vec<[Vec3; 3]>, radiance: Rgb) -> Option<MeshLight> {
+        let mut sum = 0.0f64;
+        let cumulative: Vec<f32> = triangles
+            .iter()
+            .map(|[a, b, c]| {
+                sum += f64::from(0.5 * (*b - *a).cross(*c - *a).length());
+                sum as f32
+            })
+            .collect();
+        let area = sum as f32;
+        (area > 0.0 && area.is_finite()).then_some(MeshLight {
+            triangles,
+            cumulative,
+            area,
+            radiance,
+        })
+    }
+
+    /// The total area.
+    #[must_use]
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// A point uniform over the mesh's area and its unit normal: a triangle chosen by area
+    /// with `u.x`, which is then reused, stretched, inside it.
+    fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
+        let target = u.x * self.area;
+        let i = self
+            .cumulative
+            .partition_point(|&c| c <= target)
+            .min(self.triangles.len() - 1);
+        let before = if i == 0 { 0.0 } else { self.cumulative[i - 1] };
+        let width = self.cumulative[i] - before;
+        let ux = if width > 0.0 {
+            ((target - before) / width).clamp(0.0, 1.0 - f32::EPSILON)
+        } else {
+            0.5
+        };
+        let [a, b, c] = self.triangles[i];
+        let r = ux.sqrt();
+        let point = a * (1.0 - r) + b * (r * (1.0 - u.y)) + c * (r * u.y);
+        (point, (b - a).cross(c - a).normalize_or_zero())
+    }
 }
 
 /// A sample of incident light at a point.
@@ -144,6 +206,24 @@ impl RenderLight {
                     delta: false,
                 })
             }
+            RenderLight::Mesh(ref mesh) => {
+                let (q, n) = mesh.sample_point(u);
+                let d = q - p;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                if dist <= 0.0 {
+                    return None;
+                }
+                let wi = d / dist;
+                let cos_l = wi.dot(n).abs();
+                (cos_l > 0.0).then(|| LightSample {
+                    wi,
+                    dist,
+                    li: mesh.radiance,
+                    pdf: dist2 / (mesh.area * cos_l),
+                    delta: false,
+                })
+            }
             RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
                 dist: f32::INFINITY,
@@ -165,11 +245,20 @@ impl RenderLight {
         }
     }
 
-    /// The density with which [`RenderLight::sample`] picks direction `wi` that reaches the light
-    /// at distance `dist` (area lights) or escapes (hemisphere and environment lights).
+    /// The density with which [`RenderLight::sample`] picks direction `wi` that reaches the
+    /// light at distance `dist` where its surface has geometric normal `ng` (area and mesh
+    /// lights), or escapes (hemisphere and environment lights).
     #[must_use]
-    pub fn pdf(&self, wi: Vec3, dist: f32) -> f32 {
+    pub fn pdf(&self, wi: Vec3, dist: f32, ng: Vec3) -> f32 {
         match *self {
+            RenderLight::Mesh(ref mesh) => {
+                let cos_l = wi.dot(ng).abs();
+                if cos_l > 0.0 {
+                    dist * dist / (mesh.area * cos_l)
+                } else {
+                    0.0
+                }
+            }
             RenderLight::Area { normal, area, .. } => {
                 let cos_l = -wi.dot(normal);
                 if cos_l > 0.0 {
@@ -183,5 +272,80 @@ impl RenderLight {
             RenderLight::EnvironmentMap(ref map) => map.pdf(wi),
             _ => 0.0,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use prism_math::Pcg32;
+
+    /// The solid angle of triangle `abc` seen from the origin (Van Oosterom and Strackee).
+    fn solid_angle(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+        let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let num = a.dot(b.cross(c)).abs();
+        let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+        2.0 * num.atan2(den)
+    }
+
+    /// Oracles for area sampling of an emissive mesh, from a point that sees both sides of
+    /// it: the mean of `1 / pdf` is the solid angle the mesh subtends (closed form, per
+    /// triangle); `pdf` recomputes every sample's density; triangles are chosen in
+    /// proportion to their areas.
+    #[test]
+    fn mesh_light_samples_by_area() {
+        let p = Vec3::new(0.1, -0.3, 0.2);
+        let tris = vec![
+            [
+                Vec3::new(-0.5, 1.0, -0.4),
+                Vec3::new(0.7, 1.1, -0.3),
+                Vec3::new(0.2, 0.9, 0.6),
+            ],
+            [
+                Vec3::new(1.5, 0.2, 0.0),
+                Vec3::new(1.6, 0.9, 0.1),
+                Vec3::new(1.4, 0.5, 0.9),
+            ],
+        ];
+        let light = MeshLight::new(tris.clone(), Rgb::splat(2.0)).unwrap();
+        let areas: Vec<f32> = tris
+            .iter()
+            .map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length())
+            .collect();
+        assert!((light.area() - areas[0] - areas[1]).abs() < 1e-5);
+        let omega: f64 = tris
+            .iter()
+            .map(|[a, b, c]| solid_angle(*a - p, *b - p, *c - p))
+            .sum();
+        let l = RenderLight::Mesh(std::sync::Arc::new(light));
+        let mut rng = Pcg32::new(5, 1);
+        let n = 400_000;
+        let (mut sum, mut first) = (0.0f64, 0usize);
+        for _ in 0..n {
+            let s = l
+                .sample(p, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
+            assert!(!s.delta && s.li == Rgb::splat(2.0));
+            sum += 1.0 / f64::from(s.pdf);
+            let q = p + s.wi * s.dist;
+            let on_first = q.x < 1.0;
+            first += usize::from(on_first);
+            let [a, b, c] = tris[usize::from(!on_first)];
+            let ng = (b - a).cross(c - a).normalize();
+            let again = l.pdf(s.wi, s.dist, ng);
+            assert!((again / s.pdf - 1.0).abs() < 1e-3, "{again} vs {}", s.pdf);
+        }
+        let estimate = sum / f64::from(n);
+        assert!(
+            (estimate / omega - 1.0).abs() < 0.01,
+            "E[1/pdf] {estimate} vs solid angle {omega}"
+        );
+        let share = first as f64 / f64::from(n);
+        let want = f64::from(areas[0] / (areas[0] + areas[1]));
+        // Four binomial standard deviations.
+        let sd = (want * (1.0 - want) / f64::from(n)).sqrt();
+        assert!((share - want).abs() < 4.0 * sd, "{share} vs {want}");
+        assert!(MeshLight::new(vec![[Vec3::ZERO; 3]], Rgb::WHITE).is_none());
     }
 }

@@ -1,6 +1,6 @@
 //! [`RenderScene`], the scene as the integrators see it: one BVH over every triangle, sphere
-//! and area-light rectangle, the BSDFs and emission of its materials, and its lights; it
-//! answers closest-hit, shadow and escaped-ray queries.
+//! and area-light rectangle, the BSDFs and emission of its materials, and its lights
+//! (emissive meshes among them); it answers closest-hit, shadow and escaped-ray queries.
 
 use prism_accel::{BuildOptions, Bvh, BvhStats, Sphere};
 use prism_math::{Ray, Rgb, Vec3};
@@ -9,7 +9,7 @@ use prism_scene::{Light, Scene, Shading};
 use crate::bsdf::Bsdf;
 use crate::envmap::EnvMap;
 use crate::interaction::Interaction;
-use crate::lights::RenderLight;
+use crate::lights::{MeshLight, RenderLight};
 
 /// What a BVH primitive is.
 #[derive(Clone, Copy, Debug)]
@@ -27,6 +27,8 @@ struct MeshRec {
     triangles: Vec<[u32; 3]>,
     shading: Shading,
     material: usize,
+    /// The light it is, if it emits.
+    light: Option<usize>,
 }
 
 /// The prepared scene.
@@ -132,6 +134,26 @@ impl RenderScene {
                 }
             }
         }
+        // Every emitting mesh is also a light, sampled by area.
+        let mut mesh_light = vec![None; scene.meshes.len()];
+        for (mi, m) in scene.meshes.iter().enumerate() {
+            let radiance = match scene.materials.get(m.material) {
+                Some(prism_scene::Material::Emission { radiance }) => *radiance,
+                _ => continue,
+            };
+            if radiance.max_channel() <= 0.0 {
+                continue;
+            }
+            let tris = m
+                .triangles
+                .iter()
+                .map(|t| t.map(|i| m.positions[i as usize]))
+                .collect();
+            if let Some(light) = MeshLight::new(tris, radiance) {
+                mesh_light[mi] = Some(lights.len());
+                lights.push(RenderLight::Mesh(std::sync::Arc::new(light)));
+            }
+        }
         let spheres: Vec<Sphere> = scene
             .spheres
             .iter()
@@ -150,11 +172,13 @@ impl RenderScene {
             meshes: scene
                 .meshes
                 .iter()
-                .map(|m| MeshRec {
+                .zip(mesh_light)
+                .map(|(m, light)| MeshRec {
                     positions: m.positions.clone(),
                     triangles: m.triangles.clone(),
                     shading: m.shading.clone(),
                     material: m.material,
+                    light,
                 })
                 .collect(),
             spheres: spheres
@@ -227,7 +251,7 @@ impl RenderScene {
                     ns,
                     bsdf: self.bsdfs[m.material],
                     emitted: self.emission[m.material].unwrap_or(Rgb::BLACK),
-                    light: None,
+                    light: m.light,
                     t: hit.t,
                 }
             }

@@ -272,3 +272,84 @@ fn sky_map_lights_like_the_hemisphere_light() {
         "map {map} vs hemisphere {hemi}"
     );
 }
+
+/// Oracle: the irradiance under the centre of a rectangle parallel to the floor, in closed
+/// form (the form factor of a rectangle to a parallel element, summed over the four
+/// quarters). The rectangle is an emissive *mesh* (two triangles, radiance 10), the only
+/// light: light sampling of the direct integrator, the hemisphere estimator and the path
+/// integrator (next-event estimation on the mesh, MIS with BSDF hits on it) must all give
+/// `albedo L F` at a floor point seen through a tiny field of view.
+#[test]
+fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
+    let (a, b, h, radiance, albedo) = (0.6f32, 0.8f32, 1.0f32, 10.0f32, 0.5f32);
+    let quad = |y: f32, hx: f32, hz: f32| {
+        vec![
+            Vec3::new(-hx, y, -hz),
+            Vec3::new(hx, y, -hz),
+            Vec3::new(hx, y, hz),
+            Vec3::new(-hx, y, hz),
+        ]
+    };
+    let mesh = |positions: Vec<Vec3>, material: usize| prism_scene::TriangleMesh {
+        name: String::new(),
+        positions,
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        shading: prism_scene::Shading::Flat,
+        material,
+        uvs: None,
+    };
+    let scene = Scene {
+        meshes: vec![
+            mesh(quad(0.0, 20.0, 20.0), 0),
+            mesh(quad(h, a / 2.0, b / 2.0), 1),
+        ],
+        spheres: vec![],
+        materials: vec![
+            Material::Diffuse {
+                reflectance: Rgb::splat(albedo),
+            },
+            Material::Emission {
+                radiance: Rgb::splat(radiance),
+            },
+        ],
+        material_names: vec![],
+        lights: vec![],
+        camera: Camera {
+            eye: Vec3::new(0.0, 0.5, 0.0),
+            target: Vec3::ZERO,
+            up: Vec3::Z,
+            hfov: 0.2,
+            vfov: 0.2,
+            near: 0.01,
+            far: 100.0,
+            lens: None,
+        },
+        warnings: vec![],
+    };
+    let corner = |x: f64, y: f64| {
+        let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+        (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+    };
+    let f = 4.0 * corner(f64::from(a / 2.0 / h), f64::from(b / 2.0 / h));
+    let want = (f64::from(albedo * radiance) * f) as f32;
+    let scene = RenderScene::new(&scene);
+    for (integrator, spp) in [
+        (Integrator::Direct { hemisphere: false }, 64),
+        (Integrator::Direct { hemisphere: true }, 8192),
+        (Integrator::Path, 256),
+    ] {
+        let opts = RenderOptions {
+            width: 8,
+            height: 8,
+            spp,
+            max_bounces: 1,
+            integrator,
+            ..RenderOptions::default()
+        };
+        let got = mean(&render(&scene, &opts, &|_| {}).image).g;
+        assert!(
+            (got / want - 1.0).abs() < 0.01,
+            "{integrator:?}: {got} vs the closed form {want}"
+        );
+    }
+}

@@ -1,7 +1,7 @@
 //! The path integrator: next-event estimation and BSDF sampling combined by multiple
 //! importance sampling (power heuristic), with Russian roulette.
 
-use prism_math::{Ray, Rgb};
+use prism_math::{Ray, Rgb, Vec3};
 
 use super::direct::direct_lights;
 use super::power;
@@ -65,7 +65,11 @@ pub(super) fn path(
                         let w = if s.delta || !hit.bsdf.is_smooth() {
                             1.0
                         } else {
-                            power(1.0, s.pdf, nlights * scene.lights[i].pdf(wi, f32::INFINITY))
+                            power(
+                                1.0,
+                                s.pdf,
+                                nlights * scene.lights[i].pdf(wi, f32::INFINITY, Vec3::ZERO),
+                            )
                         };
                         l += beta * le * w;
                     }
@@ -76,7 +80,7 @@ pub(super) fn path(
                 if keep(bounce) && h.emitted.max_channel() > 0.0 {
                     let w = match h.light {
                         Some(li) if !s.delta && hit.bsdf.is_smooth() => {
-                            power(1.0, s.pdf, nlights * scene.lights[li].pdf(wi, h.t))
+                            power(1.0, s.pdf, nlights * scene.lights[li].pdf(wi, h.t, h.ng))
                         }
                         _ => 1.0,
                     };
