@@ -29,6 +29,8 @@ struct MeshRec {
     material: usize,
     /// The light it is, if it emits.
     light: Option<usize>,
+    /// Texture coordinates per vertex, if it has them.
+    uvs: Option<Vec<prism_math::Vec2>>,
 }
 
 /// The prepared scene.
@@ -38,6 +40,8 @@ pub struct RenderScene {
     meshes: Vec<MeshRec>,
     spheres: Vec<(Sphere, usize)>,
     bsdfs: Vec<Bsdf>,
+    /// Per material, the texture its diffuse albedo is multiplied by.
+    textures: Vec<Option<prism_image::Texture>>,
     emission: Vec<Option<Rgb>>,
     /// Lights.
     pub lights: Vec<RenderLight>,
@@ -179,6 +183,7 @@ impl RenderScene {
                     shading: m.shading.clone(),
                     material: m.material,
                     light,
+                    uvs: m.uvs.clone(),
                 })
                 .collect(),
             spheres: spheres
@@ -186,6 +191,19 @@ impl RenderScene {
                 .zip(scene.spheres.iter().map(|s| s.material))
                 .collect(),
             bsdfs: scene.materials.iter().map(Bsdf::from_material).collect(),
+            textures: scene
+                .materials
+                .iter()
+                .map(|m| match m {
+                    prism_scene::Material::Diffuse {
+                        texture: Some(t), ..
+                    } => Some(
+                        prism_image::Texture::new((*t.image).clone())
+                            .with_wrap(prism_image::Wrap::Repeat, prism_image::Wrap::Repeat),
+                    ),
+                    _ => None,
+                })
+                .collect(),
             emission: scene
                 .materials
                 .iter()
@@ -245,11 +263,25 @@ impl RenderScene {
                 }
                 .unwrap_or(ng);
                 let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
+                let mut bsdf = self.bsdfs[m.material];
+                if let (Some(tex), Some(uvs), Bsdf::Diffuse { albedo }) =
+                    (&self.textures[m.material], &m.uvs, &mut bsdf)
+                {
+                    // The texture's rows run down the image; v runs up it.
+                    let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
+                    let uv = b0 * ua + hit.b1 * ub + hit.b2 * uc;
+                    let texel = tex.sample_level(
+                        prism_math::Vec2::new(uv.x, 1.0 - uv.y),
+                        0,
+                        prism_image::PixelSampling::Bilinear,
+                    );
+                    *albedo = *albedo * texel;
+                }
                 Interaction {
                     p,
                     ng,
                     ns,
-                    bsdf: self.bsdfs[m.material],
+                    bsdf,
                     emitted: self.emission[m.material].unwrap_or(Rgb::BLACK),
                     light: m.light,
                     t: hit.t,

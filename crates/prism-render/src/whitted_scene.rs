@@ -54,7 +54,17 @@ impl PhongMaterial {
                 transparency: *transparency,
                 name,
             },
-            Material::Diffuse { reflectance } => plain(*reflectance, Rgb::BLACK),
+            // A textured diffuse (the path tracer's) shows its texture's mean albedo.
+            Material::Diffuse {
+                reflectance,
+                texture,
+            } => {
+                let mean = texture.as_ref().map_or(Rgb::WHITE, |t| {
+                    let px = t.image.pixels();
+                    px.iter().fold(Rgb::BLACK, |a, &c| a + c) * (1.0 / px.len().max(1) as f32)
+                });
+                plain(*reflectance * mean, Rgb::BLACK)
+            }
             Material::Emission { radiance } => plain(*radiance, Rgb::BLACK),
             Material::Mirror { reflectance } => plain(Rgb::BLACK, *reflectance),
             Material::Glass { .. } | Material::Refraction { .. } | Material::Microfacet { .. } => {

@@ -54,6 +54,7 @@ fn white_furnace() {
         (
             Material::Diffuse {
                 reflectance: Rgb::WHITE,
+                texture: None,
             },
             1.0,
         ),
@@ -85,6 +86,7 @@ fn white_furnace() {
     // Half albedo: the sphere's pixels are 0.5, the background 1.
     let scene = RenderScene::new(&furnace(Material::Diffuse {
         reflectance: Rgb::splat(0.5),
+        texture: None,
     }));
     let out = render(&scene, &opts, &|_| {});
     let centre = out.image.get(24, 24);
@@ -196,6 +198,7 @@ fn constant_map_renders_as_the_constant_environment() {
     };
     let white = Material::Diffuse {
         reflectance: Rgb::WHITE,
+        texture: None,
     };
     let mut scene = furnace(white.clone());
     scene.lights = vec![Light::EnvironmentMap {
@@ -307,6 +310,7 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
         materials: vec![
             Material::Diffuse {
                 reflectance: Rgb::splat(albedo),
+                texture: None,
             },
             Material::Emission {
                 radiance: Rgb::splat(radiance),
@@ -352,4 +356,112 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
             "{integrator:?}: {got} vs the closed form {want}"
         );
     }
+}
+
+/// A COLLADA file whose effect's diffuse is a `<texture>` of `image` (a PNG beside it), on a
+/// unit square in z = 0 with uvs equal to its x and y; loaded from disk.
+fn textured_square(image: &prism_image::Rgb8Image, name: &str) -> Scene {
+    let dir = std::env::temp_dir().join(format!("prism-textured-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    prism_image::write_png(&dir.join("tex.png"), image).unwrap();
+    let dae = r##"<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><up_axis>Y_UP</up_axis></asset>
+  <library_images><image id="img"><init_from>tex.png</init_from></image></library_images>
+  <library_effects><effect id="fx"><profile_COMMON>
+    <newparam sid="surf"><surface type="2D"><init_from>img</init_from></surface></newparam>
+    <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
+    <technique sid="common"><lambert><diffuse><texture texture="samp" texcoord="UVMap"/></diffuse></lambert></technique>
+  </profile_COMMON></effect></library_effects>
+  <library_materials><material id="m"><instance_effect url="#fx"/></material></library_materials>
+  <library_geometries><geometry id="sq"><mesh>
+    <source id="p"><float_array id="pa" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+      <technique_common><accessor source="#pa" count="4" stride="3"/></technique_common></source>
+    <source id="t"><float_array id="ta" count="8">0 0 1 0 1 1 0 1</float_array>
+      <technique_common><accessor source="#ta" count="4" stride="2"/></technique_common></source>
+    <vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+    <triangles material="paint" count="2">
+      <input semantic="VERTEX" source="#v" offset="0"/>
+      <input semantic="TEXCOORD" source="#t" offset="1" set="0"/>
+      <p>0 0 1 1 2 2  0 0 2 2 3 3</p>
+    </triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="s"><node id="n" name="N"><instance_geometry url="#sq">
+    <bind_material><technique_common><instance_material symbol="paint" target="#m"/></technique_common></bind_material>
+  </instance_geometry></node></visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>"##;
+    let path = dir.join("square.dae");
+    std::fs::write(&path, dae).unwrap();
+    let mut scene = prism_scene::load(&path, &prism_scene::SceneOptions::default()).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    scene.lights = vec![Light::Environment {
+        radiance: Rgb::WHITE,
+    }];
+    scene.camera = Camera {
+        eye: Vec3::new(0.5, 0.5, 2.0),
+        target: Vec3::new(0.5, 0.5, 0.0),
+        up: Vec3::Y,
+        hfov: 20.0,
+        vfov: 20.0,
+        near: 0.01,
+        far: 100.0,
+        lens: None,
+    };
+    scene
+}
+
+/// Oracles for textured diffuse: a flat surface under a unit environment reflects exactly
+/// its albedo (the white furnace), so the picture is the texture, sRGB-decoded, with v up
+/// the image (a texture red in its top half and blue in its bottom half renders red above
+/// and blue below); and a constant texture renders as the untextured diffuse of its
+/// colour.
+#[test]
+fn textured_diffuse_shows_its_texture_the_right_way_up() {
+    let halves =
+        prism_image::Image::from_fn(4, 4, |_, y| if y < 2 { [255, 0, 0] } else { [0, 0, 255] });
+    let scene = RenderScene::new(&textured_square(&halves, "halves"));
+    let opts = RenderOptions {
+        width: 16,
+        height: 16,
+        spp: 16,
+        ..RenderOptions::default()
+    };
+    let img = render(&scene, &RenderOptions { spp: 64, ..opts }, &|_| {}).image;
+    // The mean of rows 1..4 (a quarter up from the top) and 12..15 (from the bottom).
+    let band = |rows: std::ops::Range<u32>| {
+        let n = (rows.len() * 16) as f32;
+        rows.flat_map(|y| (0..16).map(move |x| (x, y)))
+            .fold(Rgb::BLACK, |a, (x, y)| a + img.get(x, y))
+            * (1.0 / n)
+    };
+    let (top, bottom) = (band(1..4), band(12..15));
+    assert!(
+        (top.r - 1.0).abs() < 0.02 && top.b == 0.0,
+        "top {top:?} should be red"
+    );
+    assert!(
+        (bottom.b - 1.0).abs() < 0.02 && bottom.r == 0.0,
+        "bottom {bottom:?} should be blue"
+    );
+    let grey = prism_image::Image::from_fn(3, 3, |_, _| [128u8, 128, 128]);
+    let textured = mean(
+        &render(
+            &RenderScene::new(&textured_square(&grey, "grey")),
+            &opts,
+            &|_| {},
+        )
+        .image,
+    );
+    let mut plain = textured_square(&grey, "plain");
+    let linear = prism_image::srgb_to_linear(128.0 / 255.0);
+    plain.materials[0] = Material::Diffuse {
+        reflectance: Rgb::splat(linear),
+        texture: None,
+    };
+    let untextured = mean(&render(&RenderScene::new(&plain), &opts, &|_| {}).image);
+    assert!(
+        (textured.g / untextured.g - 1.0).abs() < 1e-5 && (textured.g / linear - 1.0).abs() < 0.02,
+        "{textured:?} vs {untextured:?} (albedo {linear})"
+    );
 }

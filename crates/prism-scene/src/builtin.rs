@@ -13,15 +13,18 @@ use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, Triangl
 pub fn cornell_box() -> Scene {
     let grey = |v: f32| Material::Diffuse {
         reflectance: Rgb::splat(v),
+        texture: None,
     };
     let materials = vec![
         grey(0.8),
         grey(0.6),
         Material::Diffuse {
             reflectance: Rgb::new(0.6, 0.2, 0.2),
+            texture: None,
         },
         Material::Diffuse {
             reflectance: Rgb::new(0.2, 0.2, 0.6),
+            texture: None,
         },
     ];
     let back = -0.995_684;

@@ -26,6 +26,7 @@ mod obj;
 mod presets;
 mod render_config;
 mod scene;
+mod texture_file;
 
 pub use builtin::cornell_box;
 pub use collada::{

@@ -12,8 +12,11 @@ use prism_math::{Rgb, Transform, Vec2, Vec3};
 pub enum Material {
     /// Lambertian reflection.
     Diffuse {
-        /// Albedo per channel.
+        /// Albedo per channel (times the texture's texel where there is one).
         reflectance: Rgb,
+        /// An image of albedos over the surface's texture coordinates (linear values; `v`
+        /// up from the image's bottom row, as COLLADA and Blender lay images out).
+        texture: Option<MaterialTexture>,
     },
     /// A black surface that emits `radiance` from both sides.
     Emission {

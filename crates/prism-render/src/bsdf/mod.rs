@@ -71,7 +71,7 @@ impl Bsdf {
     #[must_use]
     pub fn from_material(m: &Material) -> Bsdf {
         match *m {
-            Material::Diffuse { reflectance } => Bsdf::Diffuse {
+            Material::Diffuse { reflectance, .. } => Bsdf::Diffuse {
                 albedo: reflectance,
             },
             Material::Emission { .. } => Bsdf::Black,

@@ -2,6 +2,7 @@
 
 use prism_math::Rgb;
 use roxmltree::Node as XmlNode;
+use std::collections::HashMap;
 
 use super::{child, children, floats, Cx};
 use crate::error::SceneError;
@@ -102,6 +103,10 @@ pub struct EffectDef {
     /// Why it cannot be read, if it cannot (the material is then diffuse 0.5); using it is
     /// then an error.
     pub defect: Option<SceneError>,
+    /// The image file of the common profile's diffuse `<texture>` (as written, relative to
+    /// the document), with the line of the `<texture>`: the material is then diffuse white
+    /// times that image.
+    pub diffuse_texture: Option<(String, u32)>,
 }
 
 impl EffectDef {
@@ -112,8 +117,10 @@ impl EffectDef {
             line: cx.line(e),
             material: Material::Diffuse {
                 reflectance: Rgb::splat(0.5),
+                texture: None,
             },
             defect: None,
+            diffuse_texture: None,
         }
     }
 }
@@ -173,6 +180,7 @@ fn cgl_bsdf(cx: &Cx, b: XmlNode) -> Result<Option<Material>, SceneError> {
     Ok(Some(match b.tag_name().name() {
         "diffuse" => Material::Diffuse {
             reflectance: c("albedo").or_else(|_| c("reflectance"))?,
+            texture: None,
         },
         "emission" => Material::Emission {
             radiance: c("radiance")?,
@@ -205,13 +213,66 @@ fn cgl_bsdf(cx: &Cx, b: XmlNode) -> Result<Option<Material>, SceneError> {
     }))
 }
 
-/// Reads one `<effect>`.
+/// The image file a common-profile `<texture texture="X">` reads: `X` names a `<newparam>`
+/// of the effect holding a `<sampler2D>`, whose `<source>` names a `<newparam>` holding a
+/// `<surface>` whose `<init_from>` is an image id (COLLADA 1.4.1); or the sampler's
+/// `<instance_image url="#id">` (1.5); or `X` is an image id itself (as some exporters
+/// write it). `images` maps image ids to their files.
+fn texture_file(
+    cx: &Cx,
+    e: XmlNode,
+    t: XmlNode,
+    images: &HashMap<String, String>,
+) -> Result<String, SceneError> {
+    let name = t
+        .attribute("texture")
+        .ok_or_else(|| cx.err(t, "expected a texture attribute"))?;
+    let param = |sid: &str| {
+        e.descendants()
+            .find(|n| n.has_tag_name("newparam") && n.attribute("sid") == Some(sid))
+    };
+    let image_id = match param(name).and_then(|p| child(p, "sampler2D")) {
+        Some(sampler) => {
+            if let Some(url) = child(sampler, "instance_image").and_then(|i| i.attribute("url")) {
+                url.trim_start_matches('#').to_string()
+            } else {
+                let source = child(sampler, "source")
+                    .and_then(|s| s.text())
+                    .map(str::trim)
+                    .ok_or_else(|| cx.err(sampler, "expected a <source> in the <sampler2D>"))?;
+                let surface = param(source)
+                    .and_then(|p| child(p, "surface"))
+                    .ok_or_else(|| {
+                        cx.err(
+                            sampler,
+                            format!("no <newparam> {source:?} with a <surface>"),
+                        )
+                    })?;
+                child(surface, "init_from")
+                    .and_then(|i| i.text())
+                    .map(|s| s.trim().to_string())
+                    .ok_or_else(|| cx.err(surface, "expected an <init_from> in the <surface>"))?
+            }
+        }
+        None => name.to_string(),
+    };
+    images.get(&image_id).cloned().ok_or_else(|| {
+        cx.err(
+            t,
+            format!("no <image> with id {image_id:?} for texture {name:?}"),
+        )
+    })
+}
+
+/// Reads one `<effect>`; `images` maps `<image>` ids to their files.
 pub(super) fn effect(
     cx: &Cx,
     e: XmlNode,
+    images: &HashMap<String, String>,
     warn: &mut dyn FnMut(&str, String),
 ) -> Result<EffectDef, SceneError> {
     let mut material = None;
+    let mut diffuse_texture = None;
     for t in e
         .children()
         .filter(|c| c.has_tag_name("extra"))
@@ -244,16 +305,14 @@ pub(super) fn effect(
         if let Some(colour) = diffuse.and_then(|d| child(d, "color")) {
             material = Some(Material::Diffuse {
                 reflectance: color3(cx, colour)?,
+                texture: None,
             });
         } else if let Some(t) = diffuse.and_then(|d| child(d, "texture")) {
-            warn(
-                "diffuse:texture",
-                format!(
-                    "{}:{}: diffuse textures are not read; the effect is diffuse 0.5",
-                    cx.file,
-                    cx.line(t)
-                ),
-            );
+            diffuse_texture = Some((texture_file(cx, e, t, images)?, cx.line(t)));
+            material = Some(Material::Diffuse {
+                reflectance: Rgb::WHITE,
+                texture: None,
+            });
         }
     }
     Ok(EffectDef {
@@ -261,8 +320,10 @@ pub(super) fn effect(
         line: cx.line(e),
         material: material.unwrap_or(Material::Diffuse {
             reflectance: Rgb::splat(0.5),
+            texture: None,
         }),
         defect: None,
+        diffuse_texture,
     })
 }
 

@@ -401,9 +401,26 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
             }
         }
     }
+    // Image ids and their files (`file://` dropped), the first of each id.
+    let mut images: HashMap<String, String> = HashMap::new();
+    for lib in children(root, "library_images") {
+        for i in children(lib, "image") {
+            let file = child(i, "init_from").and_then(|f| {
+                // 1.4.1 holds the path as text; 1.5 in a <ref>.
+                child(f, "ref").and_then(|r| r.text()).or_else(|| f.text())
+            });
+            if let (Some(id), Some(file)) = (i.attribute("id"), file) {
+                let file = file.trim();
+                let file = file.strip_prefix("file://").unwrap_or(file);
+                images
+                    .entry(id.to_string())
+                    .or_insert_with(|| file.to_string());
+            }
+        }
+    }
     for lib in children(root, "library_effects") {
         for e in children(lib, "effect") {
-            let effect = match library::effect(&cx, e, &mut |k, m| warn(&mut out, k, m)) {
+            let effect = match library::effect(&cx, e, &images, &mut |k, m| warn(&mut out, k, m)) {
                 Ok(effect) => effect,
                 Err(err) => EffectDef {
                     defect: defect(&mut out, err),

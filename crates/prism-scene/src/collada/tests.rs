@@ -330,7 +330,7 @@ fn unsupported_features_warn() {
         );
     let c = parse_collada(&text, "w.dae").unwrap();
     let all = c.warnings.join("\n");
-    for want in ["<spotlight>", "diffuse textures", "<velvet>"] {
+    for want in ["<spotlight>", "<velvet>"] {
         assert!(all.contains(want), "{want} not warned: {all}");
     }
 }
@@ -495,4 +495,58 @@ fn missing_instance_targets_fail_only_their_users() {
     assert!(c.world_mesh(true).is_ok());
     let e = crate::Scene::from_collada(&c, &crate::SceneOptions::default(), "m.dae").unwrap_err();
     assert!(e.to_string().contains("no <light> with id \"moon\""), "{e}");
+}
+
+/// A common-profile diffuse `<texture>` names its image through the effect's sampler and
+/// surface parameters (COLLADA 1.4.1), or names an image id directly; an image id that
+/// is not in `<library_images>` is a located error once the effect is used.
+#[test]
+fn diffuse_textures_resolve_to_image_files() {
+    let images = r#"<library_images><image id="checker-img"><init_from>tex/checker.png</init_from></image>
+      <image id="other"><init_from>file://other.jpg</init_from></image></library_images>"#;
+    let chain = r#"<profile_COMMON><newparam sid="surf"><surface type="2D"><init_from>checker-img</init_from></surface></newparam>
+      <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
+      <technique sid="common"><phong><diffuse><texture texture="samp" texcoord="UVMap"/></diffuse></phong></technique></profile_COMMON>"#;
+    let base = doc("Y_UP", SQUARE, &node(""));
+    let with = |effect_body: &str| {
+        let start = base.find("<profile_COMMON>").unwrap();
+        let end = base.find("</profile_COMMON>").unwrap() + "</profile_COMMON>".len();
+        format!("{}{}{}", &base[..start], effect_body, &base[end..])
+            .replace("<library_effects>", &format!("{images}<library_effects>"))
+    };
+    let text = with(chain);
+    let c = parse_collada(&text, "t.dae").unwrap();
+    let line = line_of(&text, "<texture texture=");
+    assert_eq!(
+        c.effects[0].diffuse_texture,
+        Some(("tex/checker.png".to_string(), line))
+    );
+    let direct = with(
+        r#"<profile_COMMON><technique sid="common"><phong><diffuse><texture texture="other" texcoord="UVMap"/></diffuse></phong></technique></profile_COMMON>"#,
+    );
+    let c = parse_collada(&direct, "t.dae").unwrap();
+    assert_eq!(
+        c.effects[0].diffuse_texture.as_ref().unwrap().0,
+        "other.jpg"
+    );
+    let missing = text.replace(
+        "<init_from>checker-img</init_from>",
+        "<init_from>nothing</init_from>",
+    );
+    let c = parse_collada(&missing, "t.dae").unwrap();
+    let e = crate::Scene::from_collada(&c, &crate::SceneOptions::default(), "t.dae").unwrap_err();
+    assert!(
+        e.to_string().contains(&format!("t.dae:{line}"))
+            && e.to_string().contains("no <image> with id \"nothing\""),
+        "{e}"
+    );
+    // The texture file itself missing: located at the <texture>.
+    let c = parse_collada(&text, "/no/such/dir/t.dae").unwrap();
+    let e = crate::Scene::from_collada(&c, &crate::SceneOptions::default(), "/no/such/dir/t.dae")
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("tex/checker.png: cannot read the texture"),
+        "{e}"
+    );
 }

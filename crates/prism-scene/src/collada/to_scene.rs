@@ -100,25 +100,39 @@ impl Scene {
                             return Err(e.clone());
                         }
                         let material = match effect {
-                            Some(e) => *effect_material[e].get_or_insert_with(|| {
-                                scene.materials.push(doc.effects[e].material.clone());
-                                scene.materials.len() - 1
-                            }),
+                            Some(e) => match effect_material[e] {
+                                Some(m) => m,
+                                None => {
+                                    let m = effect_material_of(&doc.effects[e], file)?;
+                                    scene.materials.push(m);
+                                    effect_material[e] = Some(scene.materials.len() - 1);
+                                    scene.materials.len() - 1
+                                }
+                            },
                             None => *default_material.get_or_insert_with(|| {
                                 scene.materials.push(Material::Diffuse {
                                     reflectance: Rgb::splat(0.5),
+                                    texture: None,
                                 });
                                 scene.materials.len() - 1
                             }),
                         };
                         match &g.shape {
                             Shape::Mesh(m) => {
+                                let textured = matches!(
+                                    scene.materials[material],
+                                    Material::Diffuse {
+                                        texture: Some(_),
+                                        ..
+                                    }
+                                );
                                 scene.meshes.push(mesh(
                                     m,
                                     world,
                                     material,
                                     &node.name,
                                     opts.normals,
+                                    textured,
                                 ));
                             }
                             Shape::Sphere { radius } => {
@@ -242,12 +256,47 @@ impl Scene {
     }
 }
 
+/// An effect's material, its diffuse texture read from the file it names (relative to the
+/// document `file`) and its sRGB encoding undone.
+fn effect_material_of(
+    effect: &crate::collada::EffectDef,
+    file: &str,
+) -> Result<Material, SceneError> {
+    let Some((name, line)) = &effect.diffuse_texture else {
+        return Ok(effect.material.clone());
+    };
+    let located = |message: String| SceneError::Element {
+        file: file.to_string(),
+        line: *line,
+        element: "texture".to_string(),
+        message,
+    };
+    let dir = std::path::Path::new(file)
+        .parent()
+        .unwrap_or(std::path::Path::new(""));
+    let bytes = std::fs::read(dir.join(name))
+        .map_err(|e| located(format!("{name}: cannot read the texture: {e}")))?;
+    let image = crate::texture_file::decode_color_texture(&bytes, name)
+        .map_err(|e| located(format!("{name}: {e}")))?;
+    Ok(Material::Diffuse {
+        reflectance: Rgb::WHITE,
+        texture: Some(crate::MaterialTexture {
+            path: name.clone(),
+            image: std::sync::Arc::new(image),
+        }),
+    })
+}
+
+/// A mesh node's world-space triangles. With `uvs`, texture coordinates are kept: per
+/// vertex when every corner of a vertex agrees, else every triangle corner becomes its own
+/// vertex (shading normals computed first, then kept per corner).
 fn mesh(
     m: &crate::collada::MeshData,
     world: DMat4,
     material: usize,
     name: &str,
     normals: NormalsMode,
+    uvs: bool,
 ) -> TriangleMesh {
     let positions64: Vec<DVec3> = m
         .mesh
@@ -296,13 +345,51 @@ fn mesh(
         }
         _ => area(),
     };
-    TriangleMesh {
-        name: name.to_string(),
-        positions: positions64.into_iter().map(v3).collect(),
-        triangles,
-        shading,
-        material,
-        uvs: None,
+    let positions: Vec<Vec3> = positions64.into_iter().map(v3).collect();
+    let uv = |p: prism_math::glam::DVec2| prism_math::Vec2::new(p.x as f32, p.y as f32);
+    match (&m.mesh.uvs, &m.corner_uvs) {
+        (Some(per_vertex), _) if uvs => TriangleMesh {
+            name: name.to_string(),
+            positions,
+            triangles,
+            shading,
+            material,
+            uvs: Some(per_vertex.iter().map(|&p| uv(p)).collect()),
+        },
+        (None, Some(per_corner)) if uvs => {
+            let shading = match shading {
+                Shading::Smooth(n) => {
+                    Shading::Corners(triangles.iter().map(|t| t.map(|i| n[i as usize])).collect())
+                }
+                other => other,
+            };
+            TriangleMesh {
+                name: name.to_string(),
+                positions: triangles
+                    .iter()
+                    .flat_map(|t| t.map(|i| positions[i as usize]))
+                    .collect(),
+                triangles: (0..triangles.len() as u32)
+                    .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                    .collect(),
+                shading,
+                material,
+                uvs: Some(
+                    corners
+                        .iter()
+                        .flat_map(|c| c.map(|k| uv(per_corner[k])))
+                        .collect(),
+                ),
+            }
+        }
+        _ => TriangleMesh {
+            name: name.to_string(),
+            positions,
+            triangles,
+            shading,
+            material,
+            uvs: None,
+        },
     }
 }
 

@@ -327,7 +327,7 @@ fn to_material(m: &mtl::MtlMaterial, companions: &Companions<'_>) -> Result<Mate
                     m.name
                 ))
             })?;
-            let image = decode_texture(&bytes, name)
+            let image = crate::texture_file::decode_texture(&bytes, name)
                 .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
             Some(MaterialTexture {
                 path: name.clone(),
@@ -342,19 +342,6 @@ fn to_material(m: &mtl::MtlMaterial, companions: &Companions<'_>) -> Result<Mate
         kd_texture,
         transparency: m.dissolve,
     })
-}
-
-/// Decodes a PNG or JPEG texture as linear values `byte / 255` (no sRGB decoding), row 0
-/// the file's top row.
-fn decode_texture(bytes: &[u8], name: &str) -> Result<prism_image::RgbImage, String> {
-    let img = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
-        prism_image::decode_png(bytes, name)
-    } else if bytes.starts_with(&[0xff, 0xd8]) {
-        prism_image::decode_jpeg(bytes, name)
-    } else {
-        return Err("expected a PNG or JPEG image".into());
-    };
-    Ok(img.map_err(|e| e.to_string())?.to_rgb8().to_rgb_f32())
 }
 
 /// Key of a vertex for de-duplication: the bits of its values, with -0 read as 0.
