@@ -274,7 +274,8 @@ fn effect_material_of(
     let dir = std::path::Path::new(file)
         .parent()
         .unwrap_or(std::path::Path::new(""));
-    let bytes = std::fs::read(dir.join(name))
+    // A regular file of bounded size (never a device that reads forever).
+    let bytes = crate::obj::read_bytes(&dir.join(name))
         .map_err(|e| located(format!("{name}: cannot read the texture: {e}")))?;
     let image = crate::texture_file::decode_color_texture(&bytes, name)
         .map_err(|e| located(format!("{name}: {e}")))?;
