@@ -16,11 +16,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(64);
-    let names = std::env::var("PRISM_RENDER_SCENES").unwrap_or_else(|_| {
-        "CBspheres_lambertian,CBbunny,CBspheres_microfacet_al_ag".to_string()
-    });
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/assets/pathtracer/dae/sky");
+    let names = std::env::var("PRISM_RENDER_SCENES")
+        .unwrap_or_else(|_| "CBspheres_lambertian,CBbunny,CBspheres_microfacet_al_ag".to_string());
+    let dir =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/pathtracer/dae/sky");
     for name in names.split(',') {
         let scene = prism_scene::load(&dir.join(format!("{name}.dae")), &SceneOptions::default())
             .expect("the staged scene loads");
