@@ -298,26 +298,18 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                 path,
                 |out| -> Result<()> {
                     let fps = FRAMES_PER_SECOND as u16;
-                    if gif {
-                        let mut enc = prism_image::GifEncoder::new(out, w, h, fps)?;
-                        run_frames(&mut |_, img, write| {
-                            let t = Instant::now();
-                            enc.push(&img)?;
-                            *write += t.elapsed();
-                            Ok(())
-                        })?;
-                        enc.finish()?;
-                        return Ok(());
-                    }
-                    let mut enc = prism_image::ApngEncoder::new(out, w, h, a.frames, fps)?;
+                    let mut enc = if gif {
+                        Animation::Gif(prism_image::GifEncoder::new(out, w, h, fps)?)
+                    } else {
+                        Animation::Png(prism_image::ApngEncoder::new(out, w, h, a.frames, fps)?)
+                    };
                     run_frames(&mut |_, img, write| {
                         let t = Instant::now();
                         enc.push(&img)?;
                         *write += t.elapsed();
                         Ok(())
                     })?;
-                    enc.finish()?;
-                    Ok(())
+                    enc.finish()
                 },
                 |p, e| anyhow::anyhow!("writing {}: {e}", p.display()),
             )?;
@@ -362,4 +354,28 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The animation `-o OUT.png` or `-o OUT.gif` writes.
+enum Animation<W: std::io::Write> {
+    Png(prism_image::ApngEncoder<W>),
+    Gif(prism_image::GifEncoder<W>),
+}
+
+impl<W: std::io::Write> Animation<W> {
+    fn push(&mut self, frame: &prism_image::Rgb8Image) -> Result<()> {
+        match self {
+            Animation::Png(e) => e.push(frame)?,
+            Animation::Gif(e) => e.push(frame)?,
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> Result<()> {
+        match self {
+            Animation::Png(e) => e.finish()?,
+            Animation::Gif(e) => e.finish()?,
+        }
+        Ok(())
+    }
 }

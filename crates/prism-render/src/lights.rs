@@ -117,6 +117,33 @@ impl MeshLight {
     }
 }
 
+/// The light sample at `p` of point `q`, drawn uniformly over an emitter of `area` and
+/// `radiance` whose emitting cosine toward a direction `wi` (from `p`) is `cos_at(wi)`: the
+/// solid-angle density is `dist^2 / (area cos)`; `None` where the cosine is not positive.
+fn toward_surface(
+    p: Vec3,
+    q: Vec3,
+    cos_at: impl Fn(Vec3) -> f32,
+    area: f32,
+    radiance: Rgb,
+) -> Option<LightSample> {
+    let d = q - p;
+    let dist2 = d.length_squared();
+    let dist = dist2.sqrt();
+    if dist <= 0.0 {
+        return None;
+    }
+    let wi = d / dist;
+    let cos_l = cos_at(wi);
+    (cos_l > 0.0).then(|| LightSample {
+        wi,
+        dist,
+        li: radiance,
+        pdf: dist2 / (area * cos_l),
+        delta: false,
+    })
+}
+
 /// A sample of incident light at a point.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSample {
@@ -190,39 +217,13 @@ impl RenderLight {
                 radiance,
             } => {
                 let q = corner + u.x * e1 + u.y * e2;
-                let d = q - p;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                if dist <= 0.0 {
-                    return None;
-                }
-                let wi = d / dist;
-                let cos_l = -wi.dot(normal);
-                (cos_l > 0.0).then(|| LightSample {
-                    wi,
-                    dist,
-                    li: radiance,
-                    pdf: dist2 / (area * cos_l),
-                    delta: false,
-                })
+                // One-sided: only the normal's side emits.
+                toward_surface(p, q, |wi| -wi.dot(normal), area, radiance)
             }
             RenderLight::Mesh(ref mesh) => {
                 let (q, n) = mesh.sample_point(u);
-                let d = q - p;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                if dist <= 0.0 {
-                    return None;
-                }
-                let wi = d / dist;
-                let cos_l = wi.dot(n).abs();
-                (cos_l > 0.0).then(|| LightSample {
-                    wi,
-                    dist,
-                    li: mesh.radiance,
-                    pdf: dist2 / (mesh.area * cos_l),
-                    delta: false,
-                })
+                // Both sides emit.
+                toward_surface(p, q, |wi| wi.dot(n).abs(), mesh.area, mesh.radiance)
             }
             RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
