@@ -216,7 +216,9 @@ impl Texture {
                 let (x0, y0) = (gx.floor(), gy.floor());
                 let (tx, ty) = ((gx - x0) as f32, (gy - y0) as f32);
                 let (x0, y0) = (x0 as i64, y0 as i64);
-                let (xa, xb, ya, yb) = (clamp_x(x0), clamp_x(x0 + 1), clamp_y(y0), clamp_y(y0 + 1));
+                // (Coordinates far out saturate; the next texel must not overflow past them.)
+                let (xa, xb) = (clamp_x(x0), clamp_x(x0.saturating_add(1)));
+                let (ya, yb) = (clamp_y(y0), clamp_y(y0.saturating_add(1)));
                 let top = im.get(xa, ya).lerp(im.get(xb, ya), tx);
                 let bottom = im.get(xa, yb).lerp(im.get(xb, yb), tx);
                 top.lerp(bottom, ty)
@@ -482,5 +484,21 @@ mod tests {
         assert_eq!(at(1.25, 0.5), at(0.25, 0.5));
         assert_eq!(at(-0.75, 0.5), at(0.25, 0.5));
         assert_eq!(at(0.375, -3.0), at(0.375, 0.0));
+    }
+
+    /// Property: coordinates far out of range (even past i64 once scaled) or not finite
+    /// sample some texel of the image, with either wrap, never a panic.
+    #[test]
+    fn far_and_non_finite_coordinates_sample_a_texel() {
+        let img = crate::Image::from_fn(3, 2, |x, y| prism_math::Rgb::new(x as f32, y as f32, 0.5));
+        for wrap in [Wrap::Clamp, Wrap::Repeat] {
+            let t = Texture::new(img.clone()).with_wrap(wrap, wrap);
+            for v in [1e30f32, -1e30, 3e38, f32::INFINITY, f32::NAN, 1e19] {
+                for mode in [PixelSampling::Nearest, PixelSampling::Bilinear] {
+                    let c = t.sample_level(Vec2::new(v, -v), 0, mode);
+                    assert!(c.b == 0.5, "{v} {mode:?} {wrap:?}: {c:?}");
+                }
+            }
+        }
     }
 }
