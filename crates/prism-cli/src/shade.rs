@@ -7,9 +7,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use prism_math::{Rgb, Vec3};
-use prism_shade::{
-    course_texture, shade, to_bytes, ShadeMesh, ShadeOptions, Shader, Uniforms, View,
-};
+use prism_shade::{course_texture, shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
 use crate::output::{image_output, ImageFormat};
 use crate::UserError;
@@ -319,9 +317,8 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
     };
     let read = t0.elapsed();
     let t1 = Instant::now();
-    let img =
-        shade(&mesh, &view, &shader, &uniforms, &opts).map_err(|e| UserError(e.to_string()))?;
-    let bytes = to_bytes(&img);
+    let bytes = shade_rgb8(&mesh, &view, &shader, &uniforms, &opts)
+        .map_err(|e| UserError(e.to_string()))?;
     let render = t1.elapsed();
     let t2 = Instant::now();
     crate::output::write_rgb8(&a.output, format, &bytes).context("writing the picture")?;

@@ -307,3 +307,39 @@ fn supersampling_and_threads() {
     };
     assert_eq!(run(1).pixels(), run(2).pixels());
 }
+
+/// Property: straight-to-bytes rendering (what `prism shade` writes) is the float picture
+/// converted by `to_bytes`, for shaders with and without a lane form, 1 and 4 samples, with
+/// a wireframe on top.
+#[test]
+fn bytes_straight_equal_bytes_converted() {
+    let mut m = ShadeMesh::sphere(Vec3::new(0.1, -0.1, 0.0), 1.2, 24);
+    m.append(&square(2.0, -0.5));
+    let tex = course_texture(Image::from_fn(8, 8, |x, y| {
+        Rgb::new(x as f32 / 8.0, y as f32 / 8.0, 0.3)
+    }));
+    for shader in [
+        Shader::Phong,
+        Shader::Diffuse,
+        Shader::Normal,
+        Shader::Texture(tex.clone()),
+        Shader::Bump(tex),
+    ] {
+        for (samples, wireframe) in [(1, None), (4, Some(Rgb::new(1.0, 0.5, 0.0)))] {
+            let opts = ShadeOptions {
+                samples,
+                wireframe,
+                ..ShadeOptions::default()
+            };
+            let u = Uniforms::default();
+            let float = shade(&m, &front(73, 41), &shader, &u, &opts).unwrap();
+            let straight = prism_shade::shade_rgb8(&m, &front(73, 41), &shader, &u, &opts).unwrap();
+            assert_eq!(
+                to_bytes(&float).pixels(),
+                straight.pixels(),
+                "{}",
+                shader.name()
+            );
+        }
+    }
+}
