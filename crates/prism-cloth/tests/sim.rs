@@ -173,17 +173,13 @@ fn no_penetration_and_pinned_masses_stay() {
 fn identical_on_one_and_two_threads() {
     let s = scene(30, 30, 1, "", "[[0, 29], [29, 29]]");
     let run = |t: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut c = Cloth::new(&s);
-                for _ in 0..20 {
-                    c.frame();
-                }
-                c.positions
-            })
+        prism_testkit::on_threads(t, || {
+            let mut c = Cloth::new(&s);
+            for _ in 0..20 {
+                c.frame();
+            }
+            c.positions
+        })
     };
     assert_eq!(run(1), run(2));
 }

@@ -109,13 +109,8 @@ fn deterministic_across_thread_counts() {
             batch: 4,
             ..RenderOptions::default()
         };
-        let run = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| render(&scene, &opts, &|_| {}))
-        };
+        let run =
+            |threads: usize| prism_testkit::on_threads(threads, || render(&scene, &opts, &|_| {}));
         let (a, b) = (run(1), run(2));
         let bits = |r: &prism_render::Rendered| -> Vec<u32> {
             r.image

@@ -321,11 +321,9 @@ fn identical_on_one_and_two_threads() {
         },
     );
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| raytrace(&ws, &OrbitCamera::default(), &o, &|_| {}))
+        prism_testkit::on_threads(threads, || {
+            raytrace(&ws, &OrbitCamera::default(), &o, &|_| {})
+        })
     };
     let (a, b) = (run(1), run(2));
     assert_eq!(a.image.pixels(), b.image.pixels());

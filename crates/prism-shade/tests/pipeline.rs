@@ -290,20 +290,16 @@ fn supersampling_and_threads() {
     };
     assert!(shade(&m, &view, &Shader::Wireframe, &Uniforms::default(), &bad).is_err());
     let run = |t: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
+        prism_testkit::on_threads(t, || {
+            shade(
+                &square(2.0, 0.0),
+                &front(97, 61),
+                &Shader::Phong,
+                &Uniforms::default(),
+                &opts,
+            )
             .unwrap()
-            .install(|| {
-                shade(
-                    &square(2.0, 0.0),
-                    &front(97, 61),
-                    &Shader::Phong,
-                    &Uniforms::default(),
-                    &opts,
-                )
-                .unwrap()
-            })
+        })
     };
     assert_eq!(run(1).pixels(), run(2).pixels());
 }

@@ -172,6 +172,19 @@ pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, f64) {
     (stat, k * (1.0 - c + z * c.sqrt()).powi(3))
 }
 
+/// Runs `f` on a rayon pool of exactly `threads` threads (for tests that an output does not
+/// depend on the thread count).
+///
+/// # Panics
+/// If the pool cannot be made.
+pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
+        .install(f)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
