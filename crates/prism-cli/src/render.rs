@@ -13,8 +13,11 @@ use crate::UserError;
 /// The estimator.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum IntegratorArg {
-    /// Path tracing with next-event estimation, MIS and Russian roulette.
+    /// Path tracing with next-event estimation, MIS and Russian roulette (a tile's paths
+    /// advance together, stage by stage).
     Path,
+    /// The same path tracer one path at a time: the reference `path` equals bit for bit.
+    PathScalar,
     /// Emission plus one bounce of direct light.
     Direct,
     /// Shading normals as colours.
@@ -193,7 +196,7 @@ fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Res
                 .into())
             }
             IntegratorArg::Direct => 1,
-            IntegratorArg::Path => a.max_bounces,
+            IntegratorArg::Path | IntegratorArg::PathScalar => a.max_bounces,
         };
         if m > most {
             let why = match a.integrator {
@@ -355,6 +358,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         max_bounces: a.max_bounces,
         integrator: match a.integrator {
             IntegratorArg::Path => Integrator::Path,
+            IntegratorArg::PathScalar => Integrator::PathScalar,
             IntegratorArg::Direct => Integrator::Direct {
                 hemisphere: a.hemisphere,
             },

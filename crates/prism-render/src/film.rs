@@ -6,7 +6,7 @@ use prism_math::Rgb;
 use rayon::prelude::*;
 
 use crate::camera::Perspective;
-use crate::integrators::{radiance, Integrator};
+use crate::integrators::{radiance, wavefront, Integrator};
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
 
@@ -87,12 +87,17 @@ pub fn render(
     let results: Vec<Vec<(Rgb, u32)>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
-            let mut out = Vec::with_capacity((TILE * TILE) as usize);
-            for y in y0..(y0 + TILE).min(h) {
-                for x in x0..(x0 + TILE).min(w) {
-                    out.push(pixel(scene, &camera, opts, x, y));
-                }
-            }
+            let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
+                .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+                .collect();
+            let out = if opts.integrator == Integrator::Path {
+                wavefront::tile(scene, &camera, opts, &pixels)
+            } else {
+                pixels
+                    .iter()
+                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y))
+                    .collect()
+            };
             let n: u64 = out.iter().map(|&(_, k)| u64::from(k)).sum();
             progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
             out

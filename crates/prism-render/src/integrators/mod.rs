@@ -1,10 +1,12 @@
 //! The integrators: [`Integrator`] names the estimator, [`radiance`] dispatches a camera ray
 //! to it (`normals`, `direct`, `path`), and the multiple-importance-sampling weight they share;
+//! `wavefront` runs a tile's paths together, stage by stage, to the same result as `path`;
 //! `whitted` is the Delft ray tracer's recursive integrator.
 
 mod direct;
 mod normals;
 mod path;
+pub(crate) mod wavefront;
 pub mod whitted;
 
 use prism_math::{Ray, Rgb};
@@ -25,8 +27,14 @@ pub enum Integrator {
         hemisphere: bool,
     },
     /// Path tracing: next-event estimation and BSDF sampling combined by multiple importance
-    /// sampling (power heuristic), Russian roulette.
+    /// sampling (power heuristic), Russian roulette; a tile's paths advance together, stage
+    /// by stage (the wavefront integrator).
     Path,
+    /// The same estimator one path at a time, camera to end: the reference that [`Path`]
+    /// equals bit for bit.
+    ///
+    /// [`Path`]: Integrator::Path
+    PathScalar,
 }
 
 /// Radiance arriving along a camera ray.
@@ -48,7 +56,7 @@ pub fn radiance(
         Integrator::Direct { hemisphere } => {
             direct::direct(scene, &hit, ray, sampler, opts, hemisphere)
         }
-        Integrator::Path => path::path(scene, hit, ray, sampler, opts),
+        Integrator::Path | Integrator::PathScalar => path::path(scene, hit, ray, sampler, opts),
     }
 }
 

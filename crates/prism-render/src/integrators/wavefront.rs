@@ -1,0 +1,360 @@
+//! The wavefront path integrator: a tile's paths advance together, one stage at a time
+//! (closest hits for every path, then emission, light sampling and BSDF sampling for every
+//! path, then every shadow ray), instead of one path from camera to end after another. Each
+//! path draws the same random numbers in the same order and adds the same terms in the same
+//! order as the one-path-at-a-time integrator (`path`), so the two give identical images.
+
+use prism_math::{Ray, Rgb, Vec3};
+
+use super::power;
+use crate::camera::Perspective;
+use crate::film::RenderOptions;
+use crate::interaction::Interaction;
+use crate::render_scene::RenderScene;
+use crate::sampler::Sampler;
+
+/// A path in flight: its pixel, random numbers, the ray to trace next, and what it carries.
+struct PathState {
+    /// Index of the pixel in the tile's list.
+    pixel: usize,
+    sampler: Sampler,
+    ray: Ray,
+    /// Radiance gathered so far.
+    l: Rgb,
+    /// Throughput.
+    beta: Rgb,
+    /// Bounces taken by `ray` (0 for the camera ray).
+    bounce: u32,
+    /// The density of the BSDF sample that chose `ray`.
+    pdf: f32,
+    /// True if emission found by `ray` is weighted against light sampling (the sample was
+    /// not a delta lobe, and the BSDF is smooth).
+    mis: bool,
+}
+
+/// A light sample waiting for its shadow ray: the ray, and the term it adds if unblocked.
+struct Shadow {
+    ray: Ray,
+    dist: f32,
+    term: Rgb,
+}
+
+/// Next-event estimation of one path at one surface, waiting for its shadow rays: the
+/// throughput it is scaled by, and its lights (a range of `LightTerms`).
+#[derive(Clone, Copy)]
+struct Pending {
+    beta: Rgb,
+    lights: (usize, usize),
+}
+
+/// One light's samples at one surface: a range of `Shadow`s, and the samples taken.
+#[derive(Clone, Copy)]
+struct LightTerms {
+    shadows: (usize, usize),
+    count: u32,
+}
+
+/// The buffers of a sample pass, kept from pass to pass.
+#[derive(Default)]
+struct Buffers {
+    paths: Vec<PathState>,
+    hits: Vec<Option<Interaction>>,
+    shadows: Vec<Shadow>,
+    lights: Vec<LightTerms>,
+    pending: Vec<Option<Pending>>,
+    alive: Vec<bool>,
+    blocked: Vec<bool>,
+}
+
+/// Radiance and sample counts of the pixels `(x, y)` of one tile, in order.
+pub(crate) fn tile(
+    scene: &RenderScene,
+    camera: &Perspective,
+    opts: &RenderOptions,
+    pixels: &[(u32, u32)],
+) -> Vec<(Rgb, u32)> {
+    let mut sums = vec![Rgb::BLACK; pixels.len()];
+    let mut moments = vec![(0.0f64, 0.0f64); pixels.len()];
+    let mut counts = vec![0u32; pixels.len()];
+    let mut active: Vec<usize> = (0..pixels.len()).collect();
+    let mut radiance = vec![Rgb::BLACK; pixels.len()];
+    let mut buffers = Buffers::default();
+    let mut n = 0u32;
+    while n < opts.spp && !active.is_empty() {
+        sample_pass(
+            scene,
+            camera,
+            opts,
+            pixels,
+            &active,
+            n,
+            &mut radiance,
+            &mut buffers,
+        );
+        n += 1;
+        active.retain(|&k| {
+            let mut l = radiance[k];
+            if !l.is_finite() {
+                l = Rgb::BLACK;
+            }
+            sums[k] += l;
+            let i = f64::from(l.luminance());
+            moments[k].0 += i;
+            moments[k].1 += i * i;
+            counts[k] = n;
+            match opts.adaptive {
+                Some(tol) if n.is_multiple_of(opts.batch.max(1)) && n > 1 => {
+                    let (s1, s2) = moments[k];
+                    let mean = s1 / f64::from(n);
+                    let var = ((s2 - s1 * s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
+                    let interval = 1.96 * (var / f64::from(n)).sqrt();
+                    interval > f64::from(tol) * mean
+                }
+                _ => true,
+            }
+        });
+    }
+    sums.iter()
+        .zip(&counts)
+        .map(|(&s, &c)| (s * (1.0 / c as f32), c))
+        .collect()
+}
+
+/// Traces sample `n` of each pixel of `active` to its end, writing its radiance.
+#[allow(clippy::too_many_arguments)]
+fn sample_pass(
+    scene: &RenderScene,
+    camera: &Perspective,
+    opts: &RenderOptions,
+    pixels: &[(u32, u32)],
+    active: &[usize],
+    n: u32,
+    radiance: &mut [Rgb],
+    b: &mut Buffers,
+) {
+    b.paths.clear();
+    b.paths.extend(active.iter().map(|&k| {
+        let (x, y) = pixels[k];
+        let index = u64::from(y) * u64::from(opts.width) + u64::from(x);
+        let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
+        let u = sampler.next_2d();
+        let lens = if camera.has_lens() {
+            sampler.next_2d()
+        } else {
+            prism_math::Vec2::ZERO
+        };
+        PathState {
+            pixel: k,
+            ray: camera.ray(x as f32 + u.x, y as f32 + u.y, lens),
+            sampler,
+            l: Rgb::BLACK,
+            beta: Rgb::WHITE,
+            bounce: 0,
+            pdf: 0.0,
+            mis: false,
+        }
+    }));
+    while !b.paths.is_empty() {
+        b.hits.clear();
+        b.hits
+            .extend(b.paths.iter().map(|p| scene.intersect(&p.ray)));
+        b.shadows.clear();
+        b.lights.clear();
+        b.pending.clear();
+        b.alive.clear();
+        // Emission found by each ray, then the next bounce's light and BSDF samples.
+        for (p, hit) in b.paths.iter_mut().zip(b.hits.drain(..)) {
+            let mut waiting = None;
+            let alive = scatter(
+                scene,
+                opts,
+                p,
+                hit,
+                (&mut b.shadows, &mut b.lights),
+                &mut waiting,
+            );
+            b.alive.push(alive.is_some());
+            b.pending.push(waiting);
+        }
+        b.blocked.clear();
+        b.blocked
+            .extend(b.shadows.iter().map(|s| scene.occluded(&s.ray, s.dist)));
+        for (p, w) in b.paths.iter_mut().zip(&b.pending) {
+            let Some(w) = w else {
+                continue;
+            };
+            let mut total = Rgb::BLACK;
+            for light in &b.lights[w.lights.0..w.lights.1] {
+                let mut acc = Rgb::BLACK;
+                for k in light.shadows.0..light.shadows.1 {
+                    if !b.blocked[k] {
+                        acc += b.shadows[k].term;
+                    }
+                }
+                total += acc * (1.0 / light.count as f32);
+            }
+            p.l += w.beta * total;
+        }
+        let mut i = 0;
+        let alive = &b.alive;
+        b.paths.retain(|p| {
+            let keep_going = alive[i];
+            i += 1;
+            if !keep_going {
+                radiance[p.pixel] = p.l;
+            }
+            keep_going
+        });
+    }
+}
+
+/// One path's step at the surface its ray found (or its escape): adds the emission seen,
+/// samples the lights (their shadow rays go to `shadows`, the estimate's bookkeeping to
+/// `waiting`) and the BSDF. Returns `Some(())` if the path goes on with a new ray.
+fn scatter(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    p: &mut PathState,
+    hit: Option<Interaction>,
+    (shadows, light_terms): (&mut Vec<Shadow>, &mut Vec<LightTerms>),
+    waiting: &mut Option<Pending>,
+) -> Option<()> {
+    let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
+    let last = opts
+        .only_bounce
+        .map_or(opts.max_bounces, |m| m.min(opts.max_bounces));
+    let nlights = opts.light_samples.max(1) as f32;
+    let dir = p.ray.dir;
+    // Emission along the ray.
+    let hit = if p.bounce == 0 {
+        match hit {
+            None => {
+                if keep(0) {
+                    p.l = scene.escaped(dir, true);
+                }
+                return None;
+            }
+            Some(h) => {
+                if keep(0) {
+                    p.l = h.emitted;
+                }
+                h
+            }
+        }
+    } else {
+        let bounce = p.bounce;
+        match hit {
+            None => {
+                if let (Some(i), true) = (scene.infinite, keep(bounce)) {
+                    let le = scene.escaped(dir, false);
+                    if le.max_channel() > 0.0 {
+                        let w = if p.mis {
+                            power(
+                                1.0,
+                                p.pdf,
+                                nlights * scene.lights[i].pdf(dir, f32::INFINITY, Vec3::ZERO),
+                            )
+                        } else {
+                            1.0
+                        };
+                        p.l += p.beta * le * w;
+                    }
+                }
+                return None;
+            }
+            Some(h) => {
+                if keep(bounce) && h.emitted.max_channel() > 0.0 {
+                    let w = match h.light {
+                        Some(li) if p.mis => {
+                            power(1.0, p.pdf, nlights * scene.lights[li].pdf(dir, h.t, h.ng))
+                        }
+                        _ => 1.0,
+                    };
+                    p.l += p.beta * h.emitted * w;
+                }
+                h
+            }
+        }
+    };
+    // The next bounce from this surface.
+    let bounce = p.bounce + 1;
+    if bounce > last || hit.bsdf == crate::bsdf::Bsdf::Black {
+        return None;
+    }
+    let wo = -dir;
+    let (frame, wo_l) = hit.shading_frame(wo);
+    if keep(bounce) {
+        let first_light = light_terms.len();
+        if hit.bsdf.is_smooth() {
+            for light in &scene.lights {
+                let count = if light.is_delta() {
+                    1
+                } else {
+                    opts.light_samples.max(1)
+                };
+                let first = shadows.len();
+                for _ in 0..count {
+                    let u = p.sampler.next_2d();
+                    let Some(ls) = light.sample(hit.p, u) else {
+                        continue;
+                    };
+                    if !hit.consistent(wo, ls.wi) {
+                        continue;
+                    }
+                    let wi_l = frame.to_local(ls.wi);
+                    let f = hit.bsdf.eval(wo_l, wi_l);
+                    if f.max_channel() <= 0.0 {
+                        continue;
+                    }
+                    let dist = if ls.dist.is_finite() {
+                        ls.dist * (1.0 - 1e-4) - 1e-4
+                    } else {
+                        f32::INFINITY
+                    };
+                    let mis = if ls.delta {
+                        1.0
+                    } else {
+                        power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
+                    };
+                    shadows.push(Shadow {
+                        ray: hit.spawn(ls.wi),
+                        dist,
+                        term: f * ls.li * (mis / ls.pdf),
+                    });
+                }
+                light_terms.push(LightTerms {
+                    shadows: (first, shadows.len()),
+                    count,
+                });
+            }
+        }
+        *waiting = Some(Pending {
+            beta: p.beta,
+            lights: (first_light, light_terms.len()),
+        });
+    }
+    let u1 = p.sampler.next_1d();
+    let u2 = p.sampler.next_2d();
+    let s = hit.bsdf.sample(wo_l, u1, u2)?;
+    let wi = frame.to_world(s.wi);
+    if !hit.consistent(wo, wi) {
+        return None;
+    }
+    p.beta = p.beta * s.weight;
+    if p.beta.max_channel() <= 0.0 {
+        return None;
+    }
+    // Russian roulette, decided before the ray is traced (Mitsuba's rule and depth).
+    if bounce >= opts.rr_bounces {
+        let q = p.beta.max_channel().min(0.95);
+        if p.sampler.next_1d() >= q {
+            return None;
+        }
+        p.beta *= 1.0 / q;
+    }
+    p.ray = hit.spawn(wi);
+    p.bounce = bounce;
+    p.pdf = s.pdf;
+    p.mis = !s.delta && hit.bsdf.is_smooth();
+    Some(())
+}
