@@ -1,11 +1,12 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
-//! boxes and frames, 4x4 transforms named destination-from-source, warps with their
-//! densities, deterministic random numbers, and line numbers of byte offsets for the
-//! readers' error messages.
+//! boxes and frames, 4x4 transforms named destination-from-source, sixteen-lane numbers for
+//! SIMD kernels, warps with their densities, deterministic random numbers, and line numbers
+//! of byte offsets for the readers' error messages.
 #![warn(missing_docs)]
 
 mod color;
 mod geometry;
+pub mod lanes;
 mod random;
 mod text;
 mod transform;

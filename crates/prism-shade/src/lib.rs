@@ -9,7 +9,6 @@
 #![warn(missing_docs)]
 
 mod error;
-mod lanes;
 mod mesh;
 mod pipeline;
 mod shaders;

@@ -10,9 +10,9 @@ use prism_math::{Rgb, Transform, Vec3};
 use rayon::prelude::*;
 
 use crate::error::ShadeError;
-use crate::lanes::{F16, LANES, M16, V16};
 use crate::mesh::ShadeMesh;
 use crate::shaders::{fragment, fragment_lanes, height, Shader, Uniforms, Varyings};
+use prism_math::lanes::{F16, LANES, M16, V16};
 
 /// Near and far planes.
 pub const NEAR: f32 = 0.01;

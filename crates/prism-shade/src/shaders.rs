@@ -5,7 +5,7 @@
 use prism_image::{CubeMap, PixelSampling, Texture, Wrap};
 use prism_math::{Rgb, Vec2, Vec3};
 
-use crate::lanes::{F16, V16};
+use prism_math::lanes::{F16, V16};
 
 /// A shader with the images it reads.
 #[derive(Clone, Debug)]
@@ -364,7 +364,7 @@ mod tests {
     /// scalar fragment shader bit for bit, lane by lane.
     #[test]
     fn lane_shaders_equal_scalar_fragments() {
-        use crate::lanes::LANES;
+        use prism_math::lanes::LANES;
         let u = Uniforms {
             cam_pos: Vec3::new(0.3, 1.1, 2.9),
             ..Uniforms::default()

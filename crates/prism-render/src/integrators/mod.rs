@@ -3,6 +3,7 @@
 //! `wavefront` runs a tile's paths together, stage by stage, to the same result as `path`;
 //! `whitted` is the Delft ray tracer's recursive integrator.
 
+mod diffuse16;
 mod direct;
 mod normals;
 mod path;

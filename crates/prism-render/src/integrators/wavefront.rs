@@ -6,7 +6,9 @@
 
 use prism_math::{Ray, Rgb, Vec3};
 
-use super::power;
+use prism_math::lanes::LANES;
+
+use super::{diffuse16, power};
 use crate::camera::Perspective;
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
@@ -14,44 +16,44 @@ use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
 
 /// A path in flight: its pixel, random numbers, the ray to trace next, and what it carries.
-struct PathState {
+pub(super) struct PathState {
     /// Index of the pixel in the tile's list.
     pixel: usize,
-    sampler: Sampler,
-    ray: Ray,
+    pub(super) sampler: Sampler,
+    pub(super) ray: Ray,
     /// Radiance gathered so far.
     l: Rgb,
     /// Throughput.
-    beta: Rgb,
+    pub(super) beta: Rgb,
     /// Bounces taken by `ray` (0 for the camera ray).
-    bounce: u32,
+    pub(super) bounce: u32,
     /// The density of the BSDF sample that chose `ray`.
-    pdf: f32,
+    pub(super) pdf: f32,
     /// True if emission found by `ray` is weighted against light sampling (the sample was
     /// not a delta lobe, and the BSDF is smooth).
-    mis: bool,
+    pub(super) mis: bool,
 }
 
 /// A light sample waiting for its shadow ray: the ray, and the term it adds if unblocked.
-struct Shadow {
-    ray: Ray,
-    dist: f32,
-    term: Rgb,
+pub(super) struct Shadow {
+    pub(super) ray: Ray,
+    pub(super) dist: f32,
+    pub(super) term: Rgb,
 }
 
 /// Next-event estimation of one path at one surface, waiting for its shadow rays: the
 /// throughput it is scaled by, and its lights (a range of `LightTerms`).
 #[derive(Clone, Copy)]
-struct Pending {
-    beta: Rgb,
-    lights: (usize, usize),
+pub(super) struct Pending {
+    pub(super) beta: Rgb,
+    pub(super) lights: (usize, usize),
 }
 
 /// One light's samples at one surface: a range of `Shadow`s, and the samples taken.
 #[derive(Clone, Copy)]
-struct LightTerms {
-    shadows: (usize, usize),
-    count: u32,
+pub(super) struct LightTerms {
+    pub(super) shadows: (usize, usize),
+    pub(super) count: u32,
 }
 
 /// The buffers of a sample pass, kept from pass to pass.
@@ -59,6 +61,10 @@ struct LightTerms {
 struct Buffers {
     paths: Vec<PathState>,
     hits: Vec<Option<Interaction>>,
+    /// Per path, the surface it scatters from next (none if it ends).
+    surfs: Vec<Option<Interaction>>,
+    /// Paths whose step runs sixteen at a time.
+    fast: Vec<usize>,
     shadows: Vec<Shadow>,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
@@ -79,6 +85,8 @@ pub(crate) fn tile(
     let mut active: Vec<usize> = (0..pixels.len()).collect();
     let mut radiance = vec![Rgb::BLACK; pixels.len()];
     let mut buffers = Buffers::default();
+    // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
+    let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
     let mut n = 0u32;
     while n < opts.spp && !active.is_empty() {
         sample_pass(
@@ -90,6 +98,7 @@ pub(crate) fn tile(
             n,
             &mut radiance,
             &mut buffers,
+            area.as_deref(),
         );
         n += 1;
         active.retain(|&k| {
@@ -131,6 +140,7 @@ fn sample_pass(
     n: u32,
     radiance: &mut [Rgb],
     b: &mut Buffers,
+    area: Option<&[diffuse16::AreaLight]>,
 ) {
     b.paths.clear();
     b.paths.extend(active.iter().map(|&k| {
@@ -160,21 +170,46 @@ fn sample_pass(
             .extend(b.paths.iter().map(|p| scene.intersect(&p.ray)));
         b.shadows.clear();
         b.lights.clear();
-        b.pending.clear();
-        b.alive.clear();
-        // Emission found by each ray, then the next bounce's light and BSDF samples.
+        b.surfs.clear();
         for (p, hit) in b.paths.iter_mut().zip(b.hits.drain(..)) {
-            let mut waiting = None;
-            let alive = scatter(
+            b.surfs.push(emit(scene, opts, p, hit));
+        }
+        let count = b.paths.len();
+        b.pending.clear();
+        b.pending.resize(count, None);
+        b.alive.clear();
+        b.alive.resize(count, false);
+        b.fast.clear();
+        // The next bounce's light and BSDF samples: diffuse surfaces under area lights
+        // sixteen at a time, the others one by one.
+        for (i, surf) in b.surfs.iter().enumerate() {
+            let Some(hit) = surf else {
+                continue;
+            };
+            if area.is_some() && diffuse16::diffuse_albedo(hit).is_some() {
+                b.fast.push(i);
+                continue;
+            }
+            b.alive[i] = scatter(
                 scene,
                 opts,
-                p,
+                &mut b.paths[i],
                 hit,
                 (&mut b.shadows, &mut b.lights),
-                &mut waiting,
-            );
-            b.alive.push(alive.is_some());
-            b.pending.push(waiting);
+                &mut b.pending[i],
+            )
+            .is_some();
+        }
+        if let Some(lights) = area {
+            let mut out = diffuse16::Outputs {
+                shadows: &mut b.shadows,
+                light_terms: &mut b.lights,
+                pending: &mut b.pending,
+                alive: &mut b.alive,
+            };
+            for group in b.fast.chunks(LANES) {
+                diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.surfs, group, &mut out);
+            }
         }
         b.blocked.clear();
         b.blocked
@@ -208,21 +243,15 @@ fn sample_pass(
     }
 }
 
-/// One path's step at the surface its ray found (or its escape): adds the emission seen,
-/// samples the lights (their shadow rays go to `shadows`, the estimate's bookkeeping to
-/// `waiting`) and the BSDF. Returns `Some(())` if the path goes on with a new ray.
-fn scatter(
+/// Adds the emission a path's ray found (or what it sees escaping); returns the surface the
+/// path scatters from next, or none if it ends there.
+fn emit(
     scene: &RenderScene,
     opts: &RenderOptions,
     p: &mut PathState,
     hit: Option<Interaction>,
-    (shadows, light_terms): (&mut Vec<Shadow>, &mut Vec<LightTerms>),
-    waiting: &mut Option<Pending>,
-) -> Option<()> {
+) -> Option<Interaction> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
-    let last = opts
-        .only_bounce
-        .map_or(opts.max_bounces, |m| m.min(opts.max_bounces));
     let nlights = opts.light_samples.max(1) as f32;
     let dir = p.ray.dir;
     // Emission along the ray.
@@ -276,11 +305,30 @@ fn scatter(
             }
         }
     };
-    // The next bounce from this surface.
     let bounce = p.bounce + 1;
+    let last = opts
+        .only_bounce
+        .map_or(opts.max_bounces, |m| m.min(opts.max_bounces));
     if bounce > last || hit.bsdf == crate::bsdf::Bsdf::Black {
         return None;
     }
+    Some(hit)
+}
+
+/// One path's step at `hit`: samples the lights (their shadow rays go to `shadows`, the
+/// estimate's bookkeeping to `waiting`) and the BSDF. Returns `Some(())` if the path goes
+/// on with a new ray.
+fn scatter(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    p: &mut PathState,
+    hit: &Interaction,
+    (shadows, light_terms): (&mut Vec<Shadow>, &mut Vec<LightTerms>),
+    waiting: &mut Option<Pending>,
+) -> Option<()> {
+    let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
+    let dir = p.ray.dir;
+    let bounce = p.bounce + 1;
     let wo = -dir;
     let (frame, wo_l) = hit.shading_frame(wo);
     if keep(bounce) {

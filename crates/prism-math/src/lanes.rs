@@ -5,26 +5,29 @@
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
 
-use std::ops::{Add, BitAnd, BitOr, Div, Mul, Not, Sub};
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
 
-use prism_math::Vec3;
+use crate::Vec3;
 
 /// Lanes per group.
-pub(crate) const LANES: usize = 16;
+pub const LANES: usize = 16;
 
 /// Sixteen `f32`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct F16(pub [f32; LANES]);
+pub struct F16(pub [f32; LANES]);
 
 /// Sixteen lane conditions: all ones where true.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct M16(pub [i32; LANES]);
+pub struct M16(pub [i32; LANES]);
 
 /// Sixteen 3-vectors, one [`F16`] per axis.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct V16 {
+pub struct V16 {
+    /// x coordinates.
     pub x: F16,
+    /// y coordinates.
     pub y: F16,
+    /// z coordinates.
     pub z: F16,
 }
 
@@ -110,6 +113,80 @@ impl F16 {
         M16(r)
     }
 
+    /// `self > o`.
+    #[inline(always)]
+    pub fn gt(self, o: F16) -> M16 {
+        o.lt(self)
+    }
+
+    /// `self <= o`.
+    #[inline(always)]
+    pub fn le(self, o: F16) -> M16 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = -i32::from(self.0[i] <= o.0[i]);
+        }
+        M16(r)
+    }
+
+    /// `self != o` (true for NaN lanes).
+    #[inline(always)]
+    pub fn ne(self, o: F16) -> M16 {
+        !self.eq(o)
+    }
+
+    /// The larger of the two ignoring NaN, as `f32::max`.
+    #[inline(always)]
+    pub fn max_num(self, o: F16) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            let (a, b) = (self.0[i], o.0[i]);
+            r[i] = if a > b || b.is_nan() { a } else { b };
+        }
+        F16(r)
+    }
+
+    /// The smaller of the two ignoring NaN, as `f32::min`.
+    #[inline(always)]
+    pub fn min_num(self, o: F16) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            let (a, b) = (self.0[i], o.0[i]);
+            r[i] = if a < b || b.is_nan() { a } else { b };
+        }
+        F16(r)
+    }
+
+    /// Absolute values.
+    #[inline(always)]
+    pub fn abs(self) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].abs();
+        }
+        F16(r)
+    }
+
+    /// The magnitudes of `self` with the signs of `sign`, as `f32::copysign`.
+    #[inline(always)]
+    pub fn copysign(self, sign: F16) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i].copysign(sign.0[i]);
+        }
+        F16(r)
+    }
+
+    /// Lanes that are neither infinite nor NaN.
+    #[inline(always)]
+    pub fn is_finite(self) -> M16 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = -i32::from(self.0[i].is_finite());
+        }
+        M16(r)
+    }
+
     /// `self == o`.
     #[inline(always)]
     pub fn eq(self, o: F16) -> M16 {
@@ -159,6 +236,26 @@ impl M16 {
     pub fn get(self, i: usize) -> bool {
         self.0[i] != 0
     }
+
+    /// Bit `i` set where lane `i` is true.
+    #[inline(always)]
+    pub fn bits(self) -> u32 {
+        let mut b = 0;
+        for i in 0..LANES {
+            b |= u32::from(self.0[i] != 0) << i;
+        }
+        b
+    }
+
+    /// Lane `i` true where bit `i` of `bits` is set.
+    #[inline(always)]
+    pub fn from_bits(bits: u32) -> M16 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = -(((bits >> i) & 1) as i32);
+        }
+        M16(r)
+    }
 }
 
 impl BitAnd for M16 {
@@ -185,6 +282,18 @@ impl BitOr for M16 {
     }
 }
 
+impl BitXor for M16 {
+    type Output = M16;
+    #[inline(always)]
+    fn bitxor(self, o: M16) -> M16 {
+        let mut r = [0; LANES];
+        for i in 0..LANES {
+            r[i] = self.0[i] ^ o.0[i];
+        }
+        M16(r)
+    }
+}
+
 impl Not for M16 {
     type Output = M16;
     #[inline(always)]
@@ -194,6 +303,30 @@ impl Not for M16 {
             r[i] = !self.0[i];
         }
         M16(r)
+    }
+}
+
+impl Neg for F16 {
+    type Output = F16;
+    #[inline(always)]
+    fn neg(self) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = -self.0[i];
+        }
+        F16(r)
+    }
+}
+
+impl Neg for V16 {
+    type Output = V16;
+    #[inline(always)]
+    fn neg(self) -> V16 {
+        V16 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
     }
 }
 

@@ -1,0 +1,378 @@
+//! The wavefront's step for sixteen paths at once at diffuse surfaces in scenes lit by area
+//! lights only (the course's Cornell boxes): shading frames, light samples with their MIS
+//! weights and shadow rays, the BSDF sample and Russian roulette on sixteen lanes. Each lane
+//! does the scalar code's operations in the same order (the random numbers and the disk's
+//! sine and cosine are drawn lane by lane with the scalar functions), so the result is the
+//! scalar path's, bit for bit.
+
+// Plain index loops over the lanes are what the vectoriser turns into single instructions.
+#![allow(clippy::needless_range_loop)]
+
+use prism_math::lanes::{F16, LANES, M16, V16};
+use prism_math::{Ray, Rgb, Vec3};
+
+use super::wavefront::{LightTerms, PathState, Pending, Shadow};
+use crate::bsdf::Bsdf;
+use crate::film::RenderOptions;
+use crate::interaction::Interaction;
+use crate::lights::RenderLight;
+
+/// An area light's sampling data.
+#[derive(Clone, Copy)]
+pub(super) struct AreaLight {
+    corner: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    normal: Vec3,
+    area: f32,
+    radiance: Rgb,
+}
+
+/// The scene's lights as area lights, if every one is.
+pub(super) fn area_lights(lights: &[RenderLight]) -> Option<Vec<AreaLight>> {
+    lights
+        .iter()
+        .map(|l| match *l {
+            RenderLight::Area {
+                corner,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+            } => Some(AreaLight {
+                corner,
+                e1,
+                e2,
+                normal,
+                area,
+                radiance,
+            }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The albedo of a surface this step handles.
+pub(super) fn diffuse_albedo(hit: &Interaction) -> Option<Rgb> {
+    match hit.bsdf {
+        Bsdf::Diffuse { albedo } => Some(albedo),
+        _ => None,
+    }
+}
+
+/// What the step reads and writes besides the paths.
+pub(super) struct Outputs<'a> {
+    pub shadows: &'a mut Vec<Shadow>,
+    pub light_terms: &'a mut Vec<LightTerms>,
+    pub pending: &'a mut [Option<Pending>],
+    pub alive: &'a mut [bool],
+}
+
+fn v16(f: impl Fn(usize) -> Vec3) -> V16 {
+    let mut v = V16::default();
+    for i in 0..LANES {
+        let p = f(i);
+        v.x.0[i] = p.x;
+        v.y.0[i] = p.y;
+        v.z.0[i] = p.z;
+    }
+    v
+}
+
+fn f16(f: impl Fn(usize) -> f32) -> F16 {
+    F16(std::array::from_fn(f))
+}
+
+/// `v.x v'.x + v.y v'.y + v.z v'.z` against one vector, in glam's order.
+#[inline(always)]
+fn dot1(v: V16, o: Vec3) -> F16 {
+    v.x * o.x + v.y * o.y + v.z * o.z
+}
+
+/// `f32::max` over the three channels, in `Rgb::max_channel`'s order.
+#[inline(always)]
+fn max_channel(c: &[F16; 3]) -> F16 {
+    c[0].max_num(c[1]).max_num(c[2])
+}
+
+/// The shading frame of `Frame::from_normal`, lane by lane.
+#[inline(always)]
+fn frame(n: V16) -> (V16, V16) {
+    let one = F16::splat(1.0);
+    let sign = one.copysign(n.z);
+    let a = F16::splat(-1.0) / (sign + n.z);
+    let b = n.x * n.y * a;
+    let s = V16 {
+        x: one + sign * n.x * n.x * a,
+        y: sign * b,
+        z: -sign * n.x,
+    };
+    let t = V16 {
+        x: b,
+        y: sign + n.y * n.y * a,
+        z: -n.y,
+    };
+    (s, t)
+}
+
+/// `Interaction::spawn`'s ray origin, lane by lane.
+#[inline(always)]
+fn spawn(p: V16, ng: V16, dir: V16) -> V16 {
+    let m = p.x.abs().max_num(p.y.abs().max_num(p.z.abs()));
+    let eps = F16::splat(1e-4) * (F16::splat(1.0) + m);
+    let front = F16::splat(0.0).le(dir.dot(ng));
+    let side = V16 {
+        x: F16::select(front, ng.x, -ng.x),
+        y: F16::select(front, ng.y, -ng.y),
+        z: F16::select(front, ng.z, -ng.z),
+    };
+    p + side * eps
+}
+
+/// The power heuristic of `super::power`, lane by lane.
+#[inline(always)]
+fn power(nf: f32, f: F16, g: F16) -> F16 {
+    let a = F16::splat(nf) * f;
+    let zero = F16::splat(0.0);
+    let both = a.eq(zero) & g.eq(zero);
+    F16::select(both, zero, a * a / (a * a + g * g))
+}
+
+/// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces are
+/// diffuse, in a scene lit by `lights` only, with light sampling kept at this bounce.
+#[inline(always)]
+pub(super) fn step(
+    opts: &RenderOptions,
+    lights: &[AreaLight],
+    paths: &mut [PathState],
+    surfs: &[Option<Interaction>],
+    group: &[usize],
+    out: &mut Outputs,
+) {
+    let m = group.len();
+    let lane_in = M16::first(m);
+    let at = |i: usize| group[i.min(m - 1)];
+    let surf = |i: usize| {
+        surfs[at(i)]
+            .as_ref()
+            .expect("scattering paths have a surface")
+    };
+    let p = v16(|i| surf(i).p);
+    let ng = v16(|i| surf(i).ng);
+    let n = v16(|i| surf(i).ns);
+    let wo = v16(|i| -paths[at(i)].ray.dir);
+    let albedo: [F16; 3] = [0, 1, 2].map(|c| {
+        f16(|i| {
+            let a = diffuse_albedo(surf(i)).unwrap_or(Rgb::BLACK);
+            [a.r, a.g, a.b][c]
+        })
+    });
+    let beta: [F16; 3] = [0, 1, 2].map(|c| {
+        f16(|i| {
+            let b = paths[at(i)].beta;
+            [b.r, b.g, b.b][c]
+        })
+    });
+    let (s, t) = frame(n);
+    let local = |v: V16| V16 {
+        x: v.dot(s),
+        y: v.dot(t),
+        z: v.dot(n),
+    };
+    let wo_l = local(wo);
+    let wo_front = F16::splat(0.0).lt(wo.dot(ng));
+    let zero = F16::splat(0.0);
+    let flip = wo_l.z.lt(zero);
+
+    // Light samples: per light, `count` samples, each a possible shadow ray.
+    let count = opts.light_samples.max(1);
+    let samples = lights.len() * count as usize;
+    let mut cand: Vec<(M16, V16, V16, F16, [F16; 3])> = Vec::with_capacity(samples);
+    for light in lights {
+        for _ in 0..count {
+            let mut ux = F16::default();
+            let mut uy = F16::default();
+            for i in 0..m {
+                let u = paths[group[i]].sampler.next_2d();
+                ux.0[i] = u.x;
+                uy.0[i] = u.y;
+            }
+            let q =
+                V16::splat(light.corner) + V16::splat(light.e1) * ux + V16::splat(light.e2) * uy;
+            let d = q - p;
+            let dist2 = d.dot(d);
+            let dist = dist2.sqrt();
+            let mut ok = zero.lt(dist) & lane_in;
+            let wi = V16 {
+                x: d.x / dist,
+                y: d.y / dist,
+                z: d.z / dist,
+            };
+            let cos_l = -dot1(wi, light.normal);
+            ok = ok & zero.lt(cos_l);
+            let pdf = dist2 / (F16::splat(light.area) * cos_l);
+            ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
+            let wi_l = local(wi);
+            ok = ok & !(wo_l.z * wi_l.z).le(zero);
+            let wiz = F16::select(flip, -wi_l.z, wi_l.z);
+            let scale = wiz / F16::splat(std::f32::consts::PI);
+            let f = [albedo[0] * scale, albedo[1] * scale, albedo[2] * scale];
+            ok = ok & !max_channel(&f).le(zero);
+            let bsdf_pdf = wiz.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
+            let mis = power(count as f32, pdf, bsdf_pdf);
+            let w = mis / pdf;
+            let li = [light.radiance.r, light.radiance.g, light.radiance.b];
+            let term = [0, 1, 2].map(|c| f[c] * F16::splat(li[c]) * w);
+            let shadow_dist = F16::select(
+                dist.is_finite(),
+                dist * F16::splat(1.0 - 1e-4) - F16::splat(1e-4),
+                F16::splat(f32::INFINITY),
+            );
+            let origin = spawn(p, ng, wi);
+            cand.push((ok, origin, wi, shadow_dist, term));
+        }
+    }
+    for i in 0..m {
+        let first_light = out.light_terms.len();
+        for (l, _) in lights.iter().enumerate() {
+            let first = out.shadows.len();
+            for c in &cand[l * count as usize..(l + 1) * count as usize] {
+                if c.0.get(i) {
+                    out.shadows.push(Shadow {
+                        ray: Ray::new(
+                            Vec3::new(c.1.x.0[i], c.1.y.0[i], c.1.z.0[i]),
+                            Vec3::new(c.2.x.0[i], c.2.y.0[i], c.2.z.0[i]),
+                        ),
+                        dist: c.3 .0[i],
+                        term: Rgb::new(c.4[0].0[i], c.4[1].0[i], c.4[2].0[i]),
+                    });
+                }
+            }
+            out.light_terms.push(LightTerms {
+                shadows: (first, out.shadows.len()),
+                count,
+            });
+        }
+        out.pending[group[i]] = Some(Pending {
+            beta: paths[group[i]].beta,
+            lights: (first_light, out.light_terms.len()),
+        });
+    }
+
+    // The BSDF sample: a cosine-weighted direction (the disk's trigonometry lane by lane).
+    let bounce = paths[group[0]].bounce + 1;
+    let roulette = bounce >= opts.rr_bounces;
+    let mut dl = V16::default();
+    let mut rr = F16::default();
+    for i in 0..m {
+        let path = &mut paths[group[i]];
+        let _lobe = path.sampler.next_1d();
+        let d = prism_math::warp::cosine_hemisphere(path.sampler.next_2d());
+        dl.x.0[i] = d.x;
+        dl.y.0[i] = d.y;
+        dl.z.0[i] = d.z;
+        if roulette {
+            rr.0[i] = path.sampler.next_1d();
+        }
+    }
+    let mut ok = lane_in & !wo_l.z.eq(zero) & zero.lt(dl.z);
+    let pdf = dl.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
+    let wi_l = V16 {
+        x: dl.x,
+        y: dl.y,
+        z: F16::select(flip, -dl.z, dl.z),
+    };
+    let wi = s * wi_l.x + t * wi_l.y + n * wi_l.z;
+    ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
+    let mut b = [
+        beta[0] * albedo[0],
+        beta[1] * albedo[1],
+        beta[2] * albedo[2],
+    ];
+    let bmax = max_channel(&b);
+    ok = ok & !bmax.le(zero);
+    // Paths of one pass advance together: the group's paths are at the same bounce.
+    debug_assert!(group.iter().all(|&k| paths[k].bounce + 1 == bounce));
+    if roulette {
+        let q = bmax.min_num(F16::splat(0.95));
+        // The path ends where `u >= q` (false for NaN, as in the scalar test).
+        ok = ok & !q.le(rr);
+        let inv = F16::splat(1.0) / q;
+        b = b.map(|c| c * inv);
+    }
+    let origin = spawn(p, ng, wi);
+    for i in 0..m {
+        let k = group[i];
+        let alive = ok.get(i);
+        out.alive[k] = alive;
+        if alive {
+            let path = &mut paths[k];
+            path.beta = Rgb::new(b[0].0[i], b[1].0[i], b[2].0[i]);
+            path.ray = Ray::new(
+                Vec3::new(origin.x.0[i], origin.y.0[i], origin.z.0[i]),
+                Vec3::new(wi.x.0[i], wi.y.0[i], wi.z.0[i]),
+            );
+            path.bounce = bounce;
+            path.pdf = pdf.0[i];
+            path.mis = true;
+        }
+    }
+}
+
+/// [`step`] compiled for AVX-512.
+///
+/// # Safety
+/// The processor must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn step_avx512(
+    opts: &RenderOptions,
+    lights: &[AreaLight],
+    paths: &mut [PathState],
+    surfs: &[Option<Interaction>],
+    group: &[usize],
+    out: &mut Outputs,
+) {
+    step(opts, lights, paths, surfs, group, out);
+}
+
+/// [`step`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn step_avx2(
+    opts: &RenderOptions,
+    lights: &[AreaLight],
+    paths: &mut [PathState],
+    surfs: &[Option<Interaction>],
+    group: &[usize],
+    out: &mut Outputs,
+) {
+    step(opts, lights, paths, surfs, group, out);
+}
+
+/// [`step`] on the best instructions the processor has.
+pub(super) fn step_dispatch(
+    opts: &RenderOptions,
+    lights: &[AreaLight],
+    paths: &mut [PathState],
+    surfs: &[Option<Interaction>],
+    group: &[usize],
+    out: &mut Outputs,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the processor has AVX-512F.
+            return unsafe { step_avx512(opts, lights, paths, surfs, group, out) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2.
+            return unsafe { step_avx2(opts, lights, paths, surfs, group, out) };
+        }
+    }
+    step(opts, lights, paths, surfs, group, out);
+}
