@@ -1,6 +1,7 @@
 //! [`Sampler`], the deterministic sampler: uniform samples as a pure function of (seed,
 //! pixel, sample index, dimension).
 
+use prism_math::lanes::{F16, LANES};
 use prism_math::{hash_words, unit_f32, Vec2};
 
 /// Independent uniform samples whose values are a pure function of (seed, pixel, sample
@@ -23,13 +24,79 @@ impl Sampler {
 
     /// The next dimension's value in `[0, 1)`.
     pub fn next_1d(&mut self) -> f32 {
-        let h = prism_math::mix64(self.key ^ self.dim.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let h = prism_math::mix64(self.key ^ self.dim.wrapping_mul(DIM_MUL));
         self.dim += 1;
         unit_f32((h >> 32) as u32)
+    }
+
+    /// The key and the next dimension, for drawing by lanes ([`lane_values`]).
+    pub(crate) fn state(&self) -> (u64, u64) {
+        (self.key, self.dim)
+    }
+
+    /// Skips `n` dimensions (drawn by lanes).
+    pub(crate) fn advance(&mut self, n: u64) {
+        self.dim += n;
     }
 
     /// The next two dimensions.
     pub fn next_2d(&mut self) -> Vec2 {
         Vec2::new(self.next_1d(), self.next_1d())
+    }
+}
+
+/// The multiplier that spreads dimensions before mixing.
+const DIM_MUL: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// For sixteen samplers at once (keys `key`, next dimensions `dim`): the value each draws
+/// `j` dimensions later, the value [`Sampler::next_1d`] gives, bit for bit.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+pub(crate) fn lane_values(key: &[u64; LANES], dim: &[u64; LANES], j: u64) -> F16 {
+    let mut z = [0u64; LANES];
+    for i in 0..LANES {
+        z[i] = key[i] ^ dim[i].wrapping_add(j).wrapping_mul(DIM_MUL);
+    }
+    for i in 0..LANES {
+        z[i] = (z[i] ^ (z[i] >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    }
+    for i in 0..LANES {
+        z[i] = (z[i] ^ (z[i] >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    }
+    let mut r = [0.0; LANES];
+    for i in 0..LANES {
+        let h = z[i] ^ (z[i] >> 31);
+        // The top 24 bits, as `unit_f32` takes them; exact in i32 and in f32.
+        r[i] = ((h >> 40) as i32) as f32 * (1.0 / 16_777_216.0);
+    }
+    F16(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Property: drawing by lanes gives `next_1d`'s values bit for bit.
+    #[test]
+    fn lane_values_equal_next_1d() {
+        let mut samplers: Vec<Sampler> = (0..LANES as u64)
+            .map(|i| {
+                let mut s = Sampler::new(7, i * 977, i);
+                s.advance(i % 5);
+                s
+            })
+            .collect();
+        let key = std::array::from_fn(|i| samplers[i].state().0);
+        let dim = std::array::from_fn(|i| samplers[i].state().1);
+        for j in 0..9 {
+            let lanes = lane_values(&key, &dim, j);
+            for (i, s) in samplers.iter_mut().enumerate() {
+                assert_eq!(
+                    lanes.0[i].to_bits(),
+                    s.next_1d().to_bits(),
+                    "lane {i}, draw {j}"
+                );
+            }
+        }
     }
 }

@@ -1,8 +1,8 @@
 //! The wavefront's step for sixteen paths at once at diffuse surfaces in scenes lit by area
 //! lights only (the course's Cornell boxes): shading frames, light samples with their MIS
-//! weights and shadow rays, the BSDF sample and Russian roulette on sixteen lanes. Each lane
-//! does the scalar code's operations in the same order (the random numbers and the disk's
-//! sine and cosine are drawn lane by lane with the scalar functions), so the result is the
+//! weights and shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random
+//! numbers too. Each lane does the scalar code's operations in the same order (the disk's
+//! sine and cosine are taken lane by lane with the scalar functions), so the result is the
 //! scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
@@ -16,6 +16,7 @@ use crate::bsdf::Bsdf;
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
+use crate::sampler::lane_values;
 
 /// An area light's sampling data.
 #[derive(Clone, Copy)]
@@ -69,19 +70,12 @@ pub(super) struct Outputs<'a> {
     pub alive: &'a mut [bool],
 }
 
-fn v16(f: impl Fn(usize) -> Vec3) -> V16 {
-    let mut v = V16::default();
-    for i in 0..LANES {
-        let p = f(i);
-        v.x.0[i] = p.x;
-        v.y.0[i] = p.y;
-        v.z.0[i] = p.z;
-    }
-    v
-}
-
-fn f16(f: impl Fn(usize) -> f32) -> F16 {
-    F16(std::array::from_fn(f))
+/// Sets lane `lane` of `v`.
+#[inline(always)]
+fn put(v: &mut V16, lane: usize, p: Vec3) {
+    v.x.0[lane] = p.x;
+    v.y.0[lane] = p.y;
+    v.z.0[lane] = p.z;
 }
 
 /// `v.x v'.x + v.y v'.y + v.z v'.z` against one vector, in glam's order.
@@ -152,28 +146,27 @@ pub(super) fn step(
 ) {
     let m = group.len();
     let lane_in = M16::first(m);
-    let at = |i: usize| group[i.min(m - 1)];
-    let surf = |i: usize| {
-        surfs[at(i)]
-            .as_ref()
-            .expect("scattering paths have a surface")
-    };
-    let p = v16(|i| surf(i).p);
-    let ng = v16(|i| surf(i).ng);
-    let n = v16(|i| surf(i).ns);
-    let wo = v16(|i| -paths[at(i)].ray.dir);
-    let albedo: [F16; 3] = [0, 1, 2].map(|c| {
-        f16(|i| {
-            let a = diffuse_albedo(surf(i)).unwrap_or(Rgb::BLACK);
-            [a.r, a.g, a.b][c]
-        })
-    });
-    let beta: [F16; 3] = [0, 1, 2].map(|c| {
-        f16(|i| {
-            let b = paths[at(i)].beta;
-            [b.r, b.g, b.b][c]
-        })
-    });
+    let (mut p, mut ng, mut n, mut wo) = Default::default();
+    let mut albedo = [F16::default(); 3];
+    let mut beta = [F16::default(); 3];
+    let mut key = [0u64; LANES];
+    let mut dim = [0u64; LANES];
+    for lane in 0..LANES {
+        let k = group[lane.min(m - 1)];
+        let hit = surfs[k].as_ref().expect("scattering paths have a surface");
+        let path = &paths[k];
+        (key[lane], dim[lane]) = path.sampler.state();
+        put(&mut p, lane, hit.p);
+        put(&mut ng, lane, hit.ng);
+        put(&mut n, lane, hit.ns);
+        put(&mut wo, lane, -path.ray.dir);
+        let a = diffuse_albedo(hit).unwrap_or(Rgb::BLACK);
+        let b = path.beta;
+        for (c, (a, b)) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)].into_iter().enumerate() {
+            albedo[c].0[lane] = a;
+            beta[c].0[lane] = b;
+        }
+    }
     let (s, t) = frame(n);
     let local = |v: V16| V16 {
         x: v.dot(s),
@@ -189,15 +182,12 @@ pub(super) fn step(
     let count = opts.light_samples.max(1);
     let samples = lights.len() * count as usize;
     let mut cand: Vec<(M16, V16, V16, F16, [F16; 3])> = Vec::with_capacity(samples);
+    let mut draw = 0;
     for light in lights {
         for _ in 0..count {
-            let mut ux = F16::default();
-            let mut uy = F16::default();
-            for i in 0..m {
-                let u = paths[group[i]].sampler.next_2d();
-                ux.0[i] = u.x;
-                uy.0[i] = u.y;
-            }
+            let ux = lane_values(&key, &dim, draw);
+            let uy = lane_values(&key, &dim, draw + 1);
+            draw += 2;
             let q =
                 V16::splat(light.corner) + V16::splat(light.e1) * ux + V16::splat(light.e2) * uy;
             let d = q - p;
@@ -263,18 +253,18 @@ pub(super) fn step(
     // The BSDF sample: a cosine-weighted direction (the disk's trigonometry lane by lane).
     let bounce = paths[group[0]].bounce + 1;
     let roulette = bounce >= opts.rr_bounces;
+    // The lobe choice (unused by a diffuse BSDF), the direction, then the roulette's.
+    let (u2x, u2y) = (
+        lane_values(&key, &dim, draw + 1),
+        lane_values(&key, &dim, draw + 2),
+    );
+    let rr = lane_values(&key, &dim, draw + 3);
+    let drawn = draw + 3 + u64::from(roulette);
     let mut dl = V16::default();
-    let mut rr = F16::default();
     for i in 0..m {
-        let path = &mut paths[group[i]];
-        let _lobe = path.sampler.next_1d();
-        let d = prism_math::warp::cosine_hemisphere(path.sampler.next_2d());
-        dl.x.0[i] = d.x;
-        dl.y.0[i] = d.y;
-        dl.z.0[i] = d.z;
-        if roulette {
-            rr.0[i] = path.sampler.next_1d();
-        }
+        let d = prism_math::warp::cosine_hemisphere(prism_math::Vec2::new(u2x.0[i], u2y.0[i]));
+        put(&mut dl, i, d);
+        paths[group[i]].sampler.advance(drawn);
     }
     let mut ok = lane_in & !wo_l.z.eq(zero) & zero.lt(dl.z);
     let pdf = dl.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
@@ -320,12 +310,12 @@ pub(super) fn step(
     }
 }
 
-/// [`step`] compiled for AVX-512.
+/// [`step`] compiled for AVX-512 (DQ for the samplers' 64-bit products).
 ///
 /// # Safety
-/// The processor must support AVX-512F.
+/// The processor must support AVX-512F and AVX-512DQ.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512dq")]
 pub(super) unsafe fn step_avx512(
     opts: &RenderOptions,
     lights: &[AreaLight],
@@ -365,8 +355,10 @@ pub(super) fn step_dispatch(
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the processor has AVX-512F.
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+        {
+            // SAFETY: the processor has AVX-512F and AVX-512DQ.
             return unsafe { step_avx512(opts, lights, paths, surfs, group, out) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {

@@ -60,9 +60,9 @@ pub(super) struct LightTerms {
 #[derive(Default)]
 struct Buffers {
     paths: Vec<PathState>,
+    /// Per path, the surface its ray found, then the surface it scatters from next (none
+    /// if it ends).
     hits: Vec<Option<Interaction>>,
-    /// Per path, the surface it scatters from next (none if it ends).
-    surfs: Vec<Option<Interaction>>,
     /// Paths whose step runs sixteen at a time.
     fast: Vec<usize>,
     shadows: Vec<Shadow>,
@@ -170,9 +170,8 @@ fn sample_pass(
             .extend(b.paths.iter().map(|p| scene.intersect(&p.ray)));
         b.shadows.clear();
         b.lights.clear();
-        b.surfs.clear();
-        for (p, hit) in b.paths.iter_mut().zip(b.hits.drain(..)) {
-            b.surfs.push(emit(scene, opts, p, hit));
+        for (p, hit) in b.paths.iter_mut().zip(b.hits.iter_mut()) {
+            emit(scene, opts, p, hit);
         }
         let count = b.paths.len();
         b.pending.clear();
@@ -182,7 +181,7 @@ fn sample_pass(
         b.fast.clear();
         // The next bounce's light and BSDF samples: diffuse surfaces under area lights
         // sixteen at a time, the others one by one.
-        for (i, surf) in b.surfs.iter().enumerate() {
+        for (i, surf) in b.hits.iter().enumerate() {
             let Some(hit) = surf else {
                 continue;
             };
@@ -208,7 +207,7 @@ fn sample_pass(
                 alive: &mut b.alive,
             };
             for group in b.fast.chunks(LANES) {
-                diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.surfs, group, &mut out);
+                diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.hits, group, &mut out);
             }
         }
         b.blocked.clear();
@@ -243,14 +242,26 @@ fn sample_pass(
     }
 }
 
-/// Adds the emission a path's ray found (or what it sees escaping); returns the surface the
-/// path scatters from next, or none if it ends there.
+/// Adds the emission a path's ray found (or what it sees escaping); leaves in `hit` the
+/// surface the path scatters from next, or none if it ends there.
 fn emit(
     scene: &RenderScene,
     opts: &RenderOptions,
     p: &mut PathState,
-    hit: Option<Interaction>,
-) -> Option<Interaction> {
+    hit: &mut Option<Interaction>,
+) {
+    if emitted(scene, opts, p, hit.as_ref()).is_none() {
+        *hit = None;
+    }
+}
+
+/// [`emit`]'s work: `Some(())` if the path goes on from the surface.
+fn emitted(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    p: &mut PathState,
+    hit: Option<&Interaction>,
+) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
     let nlights = opts.light_samples.max(1) as f32;
     let dir = p.ray.dir;
@@ -312,7 +323,7 @@ fn emit(
     if bounce > last || hit.bsdf == crate::bsdf::Bsdf::Black {
         return None;
     }
-    Some(hit)
+    Some(())
 }
 
 /// One path's step at `hit`: samples the lights (their shadow rays go to `shadows`, the
