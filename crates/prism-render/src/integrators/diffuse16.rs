@@ -1,9 +1,8 @@
 //! The wavefront's step for sixteen paths at once at diffuse surfaces in scenes lit by area
 //! lights only (the course's Cornell boxes): shading frames, light samples with their MIS
 //! weights and shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random
-//! numbers too. Each lane does the scalar code's operations in the same order (the disk's
-//! sine and cosine are taken lane by lane with the scalar functions), so the result is the
-//! scalar path's, bit for bit.
+//! numbers and the cosine-weighted directions too. Each lane does the scalar code's
+//! operations in the same order, so the result is the scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
@@ -260,11 +259,9 @@ pub(super) fn step(
     );
     let rr = lane_values(&key, &dim, draw + 3);
     let drawn = draw + 3 + u64::from(roulette);
-    let mut dl = V16::default();
-    for i in 0..m {
-        let d = prism_math::warp::cosine_hemisphere(prism_math::Vec2::new(u2x.0[i], u2y.0[i]));
-        put(&mut dl, i, d);
-        paths[group[i]].sampler.advance(drawn);
+    let dl = prism_math::warp::cosine_hemisphere_lanes(u2x, u2y);
+    for &k in group {
+        paths[k].sampler.advance(drawn);
     }
     let mut ok = lane_in & !wo_l.z.eq(zero) & zero.lt(dl.z);
     let pdf = dl.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
