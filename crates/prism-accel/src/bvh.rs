@@ -611,6 +611,84 @@ impl Bvh {
         }
     }
 
+    /// [`Bvh::intersect`] for each ray of `rays` (`hits[i]` for `rays[i]`), in one call:
+    /// the same hits, with the per-call work done once for the whole batch.
+    ///
+    /// # Panics
+    /// If `hits` is not as long as `rays`.
+    pub fn intersect_batch(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len());
+        if self.nodes.is_empty() {
+            hits.fill(None);
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.intersect_batch_avx(rays, tmin, tmax, hits) };
+        }
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.intersect_with::<false>(ray, tmin, tmax);
+        }
+    }
+
+    /// [`Bvh::intersect_batch`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn intersect_batch_avx(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.intersect_with::<true>(ray, tmin, tmax);
+        }
+    }
+
+    /// [`Bvh::occluded`] for each ray of `rays` with its own end (`blocked[i]` for `rays[i]`
+    /// and `tmax[i]`), in one call.
+    ///
+    /// # Panics
+    /// If the slices differ in length.
+    pub fn occluded_batch(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
+        assert!(rays.len() == tmax.len() && rays.len() == blocked.len());
+        if self.nodes.is_empty() {
+            blocked.fill(false);
+            return;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.occluded_batch_avx(rays, tmin, tmax, blocked) };
+        }
+        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
+            *b = self.occluded_with::<false>(ray, tmin, t);
+        }
+    }
+
+    /// [`Bvh::occluded_batch`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn occluded_batch_avx(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
+        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
+            *b = self.occluded_with::<true>(ray, tmin, t);
+        }
+    }
+
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {

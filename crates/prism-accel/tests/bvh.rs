@@ -89,6 +89,26 @@ proptest! {
             }
         }
     }
+
+    /// Oracle: the one-ray calls. A batch gets exactly their hits and occlusions, ray by
+    /// ray, with each shadow ray's own end.
+    #[test]
+    fn batches_equal_single_rays(
+        (tris, spheres) in scene(),
+        rays in prop::collection::vec((v3(), v3(), 0.5f32..20.0), 0..70),
+    ) {
+        let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+        let (rays, ends): (Vec<Ray>, Vec<f32>) =
+            rays.into_iter().map(|(o, d, t)| (Ray::new(o, d), t)).unzip();
+        let mut hits = vec![None; rays.len()];
+        bvh.intersect_batch(&rays, 1e-3, 15.0, &mut hits);
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
+        for (i, ray) in rays.iter().enumerate() {
+            prop_assert_eq!(hits[i], bvh.intersect(ray, 1e-3, 15.0));
+            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
+        }
+    }
 }
 
 /// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at

@@ -242,12 +242,43 @@ impl RenderScene {
         self.bvh.occluded(ray, 0.0, dist)
     }
 
+    /// True for each ray blocked before its distance (`blocked[i]` for `rays[i]` and
+    /// `dist[i]`): [`RenderScene::occluded`] for a batch in one call.
+    pub fn occluded_batch(&self, rays: &[Ray], dist: &[f32], blocked: &mut [bool]) {
+        self.bvh.occluded_batch(rays, 0.0, dist, blocked);
+    }
+
+    /// The closest surface along each ray, with its shading data (`out[i]` for `rays[i]`):
+    /// [`RenderScene::intersect`] for a batch, the hierarchy traversed in one call.
+    /// `hits` is scratch space.
+    pub fn intersect_batch(
+        &self,
+        rays: &[Ray],
+        hits: &mut Vec<Option<prism_accel::Hit>>,
+        out: &mut Vec<Option<Interaction>>,
+    ) {
+        hits.clear();
+        hits.resize(rays.len(), None);
+        self.bvh.intersect_batch(rays, 0.0, f32::INFINITY, hits);
+        out.clear();
+        out.extend(
+            rays.iter()
+                .zip(hits.iter())
+                .map(|(ray, hit)| hit.map(|h| self.interaction(ray, h))),
+        );
+    }
+
     /// The closest surface along the ray, with its shading data.
     #[must_use]
     pub fn intersect(&self, ray: &Ray) -> Option<Interaction> {
         let hit = self.bvh.intersect(ray, 0.0, f32::INFINITY)?;
+        Some(self.interaction(ray, hit))
+    }
+
+    /// The shading data of `hit` along `ray`.
+    fn interaction(&self, ray: &Ray, hit: prism_accel::Hit) -> Interaction {
         let b0 = 1.0 - hit.b1 - hit.b2;
-        Some(match self.prims[hit.prim as usize] {
+        match self.prims[hit.prim as usize] {
             Prim::Mesh { mesh, tri } => {
                 let m = &self.meshes[mesh as usize];
                 let t = m.triangles[tri as usize];
@@ -319,6 +350,6 @@ impl RenderScene {
                     t: hit.t,
                 }
             }
-        })
+        }
     }
 }

@@ -63,6 +63,12 @@ struct Buffers {
     /// Per path, the surface its ray found, then the surface it scatters from next (none
     /// if it ends).
     hits: Vec<Option<Interaction>>,
+    /// The rays of the paths, and the hierarchy's hits along them.
+    rays: Vec<Ray>,
+    bvh_hits: Vec<Option<prism_accel::Hit>>,
+    /// The shadow rays and their ends.
+    shadow_rays: Vec<Ray>,
+    shadow_dists: Vec<f32>,
     /// Paths whose step runs sixteen at a time.
     fast: Vec<usize>,
     shadows: Vec<Shadow>,
@@ -165,9 +171,9 @@ fn sample_pass(
         }
     }));
     while !b.paths.is_empty() {
-        b.hits.clear();
-        b.hits
-            .extend(b.paths.iter().map(|p| scene.intersect(&p.ray)));
+        b.rays.clear();
+        b.rays.extend(b.paths.iter().map(|p| p.ray));
+        scene.intersect_batch(&b.rays, &mut b.bvh_hits, &mut b.hits);
         b.shadows.clear();
         b.lights.clear();
         for (p, hit) in b.paths.iter_mut().zip(b.hits.iter_mut()) {
@@ -210,9 +216,13 @@ fn sample_pass(
                 diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.hits, group, &mut out);
             }
         }
+        b.shadow_rays.clear();
+        b.shadow_rays.extend(b.shadows.iter().map(|s| s.ray));
+        b.shadow_dists.clear();
+        b.shadow_dists.extend(b.shadows.iter().map(|s| s.dist));
         b.blocked.clear();
-        b.blocked
-            .extend(b.shadows.iter().map(|s| scene.occluded(&s.ray, s.dist)));
+        b.blocked.resize(b.shadows.len(), false);
+        scene.occluded_batch(&b.shadow_rays, &b.shadow_dists, &mut b.blocked);
         for (p, w) in b.paths.iter_mut().zip(&b.pending) {
             let Some(w) = w else {
                 continue;
