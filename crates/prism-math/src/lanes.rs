@@ -420,4 +420,46 @@ mod tests {
         assert_eq!(F16::splat(f32::NAN).max0(), F16::splat(0.0));
         assert!(M16::first(3).get(2) && !M16::first(3).get(3));
     }
+
+    /// Property: comparisons, `f32::max`/`min` (NaN ignored), `abs`, `copysign`, negation,
+    /// finiteness and mask bits equal the scalar operations lane by lane, NaN, infinities and
+    /// signed zeros included.
+    #[test]
+    fn lane_operations_equal_scalar() {
+        let specials = [
+            0.0,
+            -0.0,
+            1.5,
+            -2.25,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            3e-39,
+        ];
+        let a = F16(std::array::from_fn(|i| specials[i % 8]));
+        let b = F16(std::array::from_fn(|i| specials[(i * 3 + 1) % 8]));
+        for i in 0..LANES {
+            let (x, y) = (a.0[i], b.0[i]);
+            assert_eq!(a.lt(b).get(i), x < y);
+            assert_eq!(a.gt(b).get(i), x > y);
+            assert_eq!(a.le(b).get(i), x <= y);
+            assert_eq!(a.ne(b).get(i), x != y);
+            assert_eq!(a.is_finite().get(i), x.is_finite());
+            let (mx, mn) = (a.max_num(b).0[i], a.min_num(b).0[i]);
+            assert!(
+                mx == x.max(y) || (mx.is_nan() && x.max(y).is_nan()),
+                "{x} {y}"
+            );
+            assert!(
+                mn == x.min(y) || (mn.is_nan() && x.min(y).is_nan()),
+                "{x} {y}"
+            );
+            assert_eq!(a.abs().0[i].to_bits(), x.abs().to_bits());
+            assert_eq!(a.copysign(b).0[i].to_bits(), x.copysign(y).to_bits());
+            assert_eq!((-a).0[i].to_bits(), (-x).to_bits());
+        }
+        let m = a.lt(b);
+        assert_eq!(M16::from_bits(m.bits()), m);
+        assert_eq!((m ^ M16::splat(true)), !m);
+    }
 }

@@ -2,7 +2,8 @@
 //! `camera`), a deterministic sampler (`sampler`), BSDFs (`bsdf`), lights (`lights`, the
 //! environment map's data in `envmap`), the render scene with its BVH (`render_scene`) and the
 //! hit records it returns (`interaction`), the integrators (`integrators`: `normals`,
-//! `direct`, `path`) and the film that loops over pixels with adaptive sampling (`film`),
+//! `direct`, `path`, and `wavefront`, which runs a tile's paths together and sixteen at a time
+//! where it can) and the film that loops over pixels with adaptive sampling (`film`),
 //! over a scene from prism-scene. The Whitted ray tracer of the Delft project has its scene
 //! (`whitted_scene`), integrator (`integrators::whitted`), orbit camera (`camera`) and film
 //! with per-pixel ray recording (`raytrace`).
