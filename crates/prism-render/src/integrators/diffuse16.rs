@@ -10,7 +10,7 @@
 use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::{Ray, Rgb, Vec3};
 
-use super::wavefront::{LightTerms, PathState, Pending, Shadow};
+use super::wavefront::{LightTerms, PathState, Pending, Shadows};
 use crate::bsdf::Bsdf;
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
@@ -63,7 +63,7 @@ pub(super) fn diffuse_albedo(hit: &Interaction) -> Option<Rgb> {
 
 /// What the step reads and writes besides the paths.
 pub(super) struct Outputs<'a> {
-    pub shadows: &'a mut Vec<Shadow>,
+    pub shadows: &'a mut Shadows,
     pub light_terms: &'a mut Vec<LightTerms>,
     pub pending: &'a mut [Option<Pending>],
     pub alive: &'a mut [bool],
@@ -228,14 +228,14 @@ pub(super) fn step(
             let first = out.shadows.len();
             for c in &cand[l * count as usize..(l + 1) * count as usize] {
                 if c.0.get(i) {
-                    out.shadows.push(Shadow {
-                        ray: Ray::new(
+                    out.shadows.push(
+                        Ray::new(
                             Vec3::new(c.1.x.0[i], c.1.y.0[i], c.1.z.0[i]),
                             Vec3::new(c.2.x.0[i], c.2.y.0[i], c.2.z.0[i]),
                         ),
-                        dist: c.3 .0[i],
-                        term: Rgb::new(c.4[0].0[i], c.4[1].0[i], c.4[2].0[i]),
-                    });
+                        c.3 .0[i],
+                        Rgb::new(c.4[0].0[i], c.4[1].0[i], c.4[2].0[i]),
+                    );
                 }
             }
             out.light_terms.push(LightTerms {

@@ -34,11 +34,34 @@ pub(super) struct PathState {
     pub(super) mis: bool,
 }
 
-/// A light sample waiting for its shadow ray: the ray, and the term it adds if unblocked.
-pub(super) struct Shadow {
-    pub(super) ray: Ray,
-    pub(super) dist: f32,
-    pub(super) term: Rgb,
+/// Light samples waiting for their shadow rays: the rays, where each ends, and the term each
+/// adds if unblocked (arrays side by side, as the batched query takes them).
+#[derive(Default)]
+pub(super) struct Shadows {
+    rays: Vec<Ray>,
+    dists: Vec<f32>,
+    terms: Vec<Rgb>,
+}
+
+impl Shadows {
+    /// Adds a sample.
+    #[inline]
+    pub(super) fn push(&mut self, ray: Ray, dist: f32, term: Rgb) {
+        self.rays.push(ray);
+        self.dists.push(dist);
+        self.terms.push(term);
+    }
+
+    /// Samples held.
+    pub(super) fn len(&self) -> usize {
+        self.rays.len()
+    }
+
+    fn clear(&mut self) {
+        self.rays.clear();
+        self.dists.clear();
+        self.terms.clear();
+    }
 }
 
 /// Next-event estimation of one path at one surface, waiting for its shadow rays: the
@@ -49,7 +72,7 @@ pub(super) struct Pending {
     pub(super) lights: (usize, usize),
 }
 
-/// One light's samples at one surface: a range of `Shadow`s, and the samples taken.
+/// One light's samples at one surface: a range of `Shadows`, and the samples taken.
 #[derive(Clone, Copy)]
 pub(super) struct LightTerms {
     pub(super) shadows: (usize, usize),
@@ -66,12 +89,9 @@ struct Buffers {
     /// The rays of the paths, and the hierarchy's hits along them.
     rays: Vec<Ray>,
     bvh_hits: Vec<Option<prism_accel::Hit>>,
-    /// The shadow rays and their ends.
-    shadow_rays: Vec<Ray>,
-    shadow_dists: Vec<f32>,
     /// Paths whose step runs sixteen at a time.
     fast: Vec<usize>,
-    shadows: Vec<Shadow>,
+    shadows: Shadows,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
     alive: Vec<bool>,
@@ -216,13 +236,9 @@ fn sample_pass(
                 diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.hits, group, &mut out);
             }
         }
-        b.shadow_rays.clear();
-        b.shadow_rays.extend(b.shadows.iter().map(|s| s.ray));
-        b.shadow_dists.clear();
-        b.shadow_dists.extend(b.shadows.iter().map(|s| s.dist));
         b.blocked.clear();
         b.blocked.resize(b.shadows.len(), false);
-        scene.occluded_batch(&b.shadow_rays, &b.shadow_dists, &mut b.blocked);
+        scene.occluded_batch(&b.shadows.rays, &b.shadows.dists, &mut b.blocked);
         for (p, w) in b.paths.iter_mut().zip(&b.pending) {
             let Some(w) = w else {
                 continue;
@@ -232,7 +248,7 @@ fn sample_pass(
                 let mut acc = Rgb::BLACK;
                 for k in light.shadows.0..light.shadows.1 {
                     if !b.blocked[k] {
-                        acc += b.shadows[k].term;
+                        acc += b.shadows.terms[k];
                     }
                 }
                 total += acc * (1.0 / light.count as f32);
@@ -344,7 +360,7 @@ fn scatter(
     opts: &RenderOptions,
     p: &mut PathState,
     hit: &Interaction,
-    (shadows, light_terms): (&mut Vec<Shadow>, &mut Vec<LightTerms>),
+    (shadows, light_terms): (&mut Shadows, &mut Vec<LightTerms>),
     waiting: &mut Option<Pending>,
 ) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
@@ -385,11 +401,7 @@ fn scatter(
                     } else {
                         power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
                     };
-                    shadows.push(Shadow {
-                        ray: hit.spawn(ls.wi),
-                        dist,
-                        term: f * ls.li * (mis / ls.pdf),
-                    });
+                    shadows.push(hit.spawn(ls.wi), dist, f * ls.li * (mis / ls.pdf));
                 }
                 light_terms.push(LightTerms {
                     shadows: (first, shadows.len()),
