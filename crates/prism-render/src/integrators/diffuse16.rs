@@ -63,10 +63,22 @@ pub(super) fn diffuse_albedo(hit: &Interaction) -> Option<Rgb> {
 
 /// What the step reads and writes besides the paths.
 pub(super) struct Outputs<'a> {
+    /// Scratch: the light samples of a group, kept between groups.
+    pub samples: &'a mut Vec<Candidate>,
     pub shadows: &'a mut Shadows,
     pub light_terms: &'a mut Vec<LightTerms>,
     pub pending: &'a mut [Option<Pending>],
     pub alive: &'a mut [bool],
+}
+
+/// Sixteen light samples: the lanes that keep theirs, and their shadow rays' origins,
+/// directions and ends, and the terms they add if unblocked.
+pub(super) struct Candidate {
+    keep: M16,
+    origin: V16,
+    dir: V16,
+    end: F16,
+    term: [F16; 3],
 }
 
 /// Sets lane `lane` of `v`.
@@ -180,7 +192,9 @@ pub(super) fn step(
     // Light samples: per light, `count` samples, each a possible shadow ray.
     let count = opts.light_samples.max(1);
     let samples = lights.len() * count as usize;
-    let mut cand: Vec<(M16, V16, V16, F16, [F16; 3])> = Vec::with_capacity(samples);
+    let cand = &mut *out.samples;
+    cand.clear();
+    cand.reserve(samples);
     let mut draw = 0;
     for light in lights {
         for _ in 0..count {
@@ -219,22 +233,26 @@ pub(super) fn step(
                 F16::splat(f32::INFINITY),
             );
             let origin = spawn(p, ng, wi);
-            cand.push((ok, origin, wi, shadow_dist, term));
+            cand.push(Candidate {
+                keep: ok,
+                origin,
+                dir: wi,
+                end: shadow_dist,
+                term,
+            });
         }
     }
     for i in 0..m {
         let first_light = out.light_terms.len();
         for (l, _) in lights.iter().enumerate() {
             let first = out.shadows.len();
-            for c in &cand[l * count as usize..(l + 1) * count as usize] {
-                if c.0.get(i) {
+            for c in &out.samples[l * count as usize..(l + 1) * count as usize] {
+                if c.keep.get(i) {
+                    let at = |v: &V16| Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i]);
                     out.shadows.push(
-                        Ray::new(
-                            Vec3::new(c.1.x.0[i], c.1.y.0[i], c.1.z.0[i]),
-                            Vec3::new(c.2.x.0[i], c.2.y.0[i], c.2.z.0[i]),
-                        ),
-                        c.3 .0[i],
-                        Rgb::new(c.4[0].0[i], c.4[1].0[i], c.4[2].0[i]),
+                        Ray::new(at(&c.origin), at(&c.dir)),
+                        c.end.0[i],
+                        Rgb::new(c.term[0].0[i], c.term[1].0[i], c.term[2].0[i]),
                     );
                 }
             }

@@ -91,6 +91,8 @@ struct Buffers {
     bvh_hits: Vec<Option<prism_accel::Hit>>,
     /// Paths whose step runs sixteen at a time.
     fast: Vec<usize>,
+    /// Their light samples, sixteen at a time.
+    samples: Vec<diffuse16::Candidate>,
     shadows: Shadows,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
@@ -227,6 +229,7 @@ fn sample_pass(
         }
         if let Some(lights) = area {
             let mut out = diffuse16::Outputs {
+                samples: &mut b.samples,
                 shadows: &mut b.shadows,
                 light_terms: &mut b.lights,
                 pending: &mut b.pending,
