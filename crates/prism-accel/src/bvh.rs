@@ -637,8 +637,20 @@ impl Bvh {
                 return unsafe { self.intersect_batch_avx(rays, tmin, tmax, hits) };
             }
         }
+        self.intersect_batch_with::<false>(rays, tmin, tmax, hits);
+    }
+
+    /// The loop of [`Bvh::intersect_batch`], inlined into each compiled variant.
+    #[inline(always)]
+    fn intersect_batch_with<const AVX: bool>(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
         for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<false>(ray, tmin, tmax);
+            *hit = self.intersect_with::<AVX>(ray, tmin, tmax);
         }
     }
 
@@ -656,9 +668,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<true>(ray, tmin, tmax);
-        }
+        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX2 (one-instruction broadcasts).
@@ -674,9 +684,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<true>(ray, tmin, tmax);
-        }
+        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX.
@@ -692,9 +700,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<true>(ray, tmin, tmax);
-        }
+        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::occluded`] for each ray of `rays` with its own end (`blocked[i]` for `rays[i]`
@@ -723,8 +729,20 @@ impl Bvh {
                 return unsafe { self.occluded_batch_avx(rays, tmin, tmax, blocked) };
             }
         }
+        self.occluded_batch_with::<false>(rays, tmin, tmax, blocked);
+    }
+
+    /// The loop of [`Bvh::occluded_batch`], inlined into each compiled variant.
+    #[inline(always)]
+    fn occluded_batch_with<const AVX: bool>(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<false>(ray, tmin, t);
+            *b = self.occluded_with::<AVX>(ray, tmin, t);
         }
     }
 
@@ -741,9 +759,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t);
-        }
+        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX2.
@@ -759,9 +775,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t);
-        }
+        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX.
@@ -777,9 +791,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t);
-        }
+        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).

@@ -2,7 +2,7 @@
 //! adaptive sampling, and the [`Rendered`] image with its sample counts.
 
 use prism_image::Image;
-use prism_math::Rgb;
+use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
 use crate::camera::Perspective;
@@ -125,8 +125,70 @@ pub fn render(
     }
 }
 
-fn illuminance(c: Rgb) -> f32 {
-    c.luminance()
+/// A pixel's running sums: its radiance, and its illuminance's first two moments for
+/// adaptive sampling.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PixelSum {
+    sum: Rgb,
+    s1: f64,
+    s2: f64,
+    /// Samples taken.
+    pub(crate) n: u32,
+    converged: bool,
+}
+
+impl PixelSum {
+    /// Adds a sample (a non-finite one counts as black), then checks convergence every
+    /// `batch` samples when sampling is adaptive.
+    pub(crate) fn add(&mut self, l: Rgb, opts: &RenderOptions) {
+        let l = if l.is_finite() { l } else { Rgb::BLACK };
+        self.sum += l;
+        let i = f64::from(l.luminance());
+        self.s1 += i;
+        self.s2 += i * i;
+        self.n += 1;
+        let n = self.n;
+        if let Some(tol) = opts.adaptive {
+            if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
+                let mean = self.s1 / f64::from(n);
+                let var =
+                    ((self.s2 - self.s1 * self.s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
+                let interval = 1.96 * (var / f64::from(n)).sqrt();
+                self.converged = interval <= f64::from(tol) * mean;
+            }
+        }
+    }
+
+    /// True while the pixel takes more samples.
+    pub(crate) fn wants_more(&self, opts: &RenderOptions) -> bool {
+        self.n < opts.spp && !self.converged
+    }
+
+    /// The mean radiance and the samples taken.
+    pub(crate) fn result(&self) -> (Rgb, u32) {
+        (self.sum * (1.0 / self.n as f32), self.n)
+    }
+}
+
+/// Sample `n` of pixel `(x, y)`: its sampler, past the film and lens dimensions, and its
+/// camera ray.
+pub(crate) fn camera_sample(
+    camera: &Perspective,
+    opts: &RenderOptions,
+    (x, y): (u32, u32),
+    n: u32,
+) -> (Sampler, Ray) {
+    let index = u64::from(y) * u64::from(opts.width) + u64::from(x);
+    let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
+    let u = sampler.next_2d();
+    // The lens takes dimensions only when there is one: pinhole images keep their bytes.
+    let lens = if camera.has_lens() {
+        sampler.next_2d()
+    } else {
+        prism_math::Vec2::ZERO
+    };
+    let ray = camera.ray(x as f32 + u.x, y as f32 + u.y, lens);
+    (sampler, ray)
 }
 
 fn pixel(
@@ -136,39 +198,10 @@ fn pixel(
     x: u32,
     y: u32,
 ) -> (Rgb, u32) {
-    let index = u64::from(y) * u64::from(opts.width) + u64::from(x);
-    let mut sum = Rgb::BLACK;
-    let (mut s1, mut s2) = (0.0f64, 0.0f64);
-    let mut n = 0u32;
-    while n < opts.spp {
-        let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
-        let u = sampler.next_2d();
-        // The lens takes dimensions only when there is one: pinhole images keep their bytes.
-        let lens = if camera.has_lens() {
-            sampler.next_2d()
-        } else {
-            prism_math::Vec2::ZERO
-        };
-        let ray = camera.ray(x as f32 + u.x, y as f32 + u.y, lens);
-        let mut l = radiance(scene, &ray, &mut sampler, opts);
-        if !l.is_finite() {
-            l = Rgb::BLACK;
-        }
-        sum += l;
-        let i = f64::from(illuminance(l));
-        s1 += i;
-        s2 += i * i;
-        n += 1;
-        if let Some(tol) = opts.adaptive {
-            if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
-                let mean = s1 / f64::from(n);
-                let var = ((s2 - s1 * s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
-                let interval = 1.96 * (var / f64::from(n)).sqrt();
-                if interval <= f64::from(tol) * mean {
-                    break;
-                }
-            }
-        }
+    let mut px = PixelSum::default();
+    while px.wants_more(opts) {
+        let (mut sampler, ray) = camera_sample(camera, opts, (x, y), px.n);
+        px.add(radiance(scene, &ray, &mut sampler, opts), opts);
     }
-    (sum * (1.0 / n as f32), n)
+    px.result()
 }

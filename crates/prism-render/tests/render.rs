@@ -31,6 +31,15 @@ fn furnace(material: Material) -> Scene {
     }
 }
 
+/// The image's bits, channel by channel, for exact comparisons.
+fn bits(r: &prism_render::Rendered) -> Vec<u32> {
+    r.image
+        .pixels()
+        .iter()
+        .flat_map(|p| [p.r.to_bits(), p.g.to_bits(), p.b.to_bits()])
+        .collect()
+}
+
 fn mean(img: &prism_image::Image<Rgb>) -> Rgb {
     let n = img.pixels().len() as f32;
     img.pixels().iter().fold(Rgb::BLACK, |a, &p| a + p) * (1.0 / n)
@@ -112,13 +121,6 @@ fn deterministic_across_thread_counts() {
         let run =
             |threads: usize| prism_testkit::on_threads(threads, || render(&scene, &opts, &|_| {}));
         let (a, b) = (run(1), run(2));
-        let bits = |r: &prism_render::Rendered| -> Vec<u32> {
-            r.image
-                .pixels()
-                .iter()
-                .flat_map(|p| [p.r.to_bits(), p.g.to_bits(), p.b.to_bits()])
-                .collect()
-        };
         assert_eq!(bits(&a), bits(&b));
         assert_eq!(a.samples.pixels(), b.samples.pixels());
         assert!(
@@ -470,13 +472,6 @@ fn textured_diffuse_shows_its_texture_the_right_way_up() {
 /// paths, early roulette).
 #[test]
 fn wavefront_equals_path_scalar_bit_for_bit() {
-    let bits = |r: &prism_render::Rendered| -> Vec<u32> {
-        r.image
-            .pixels()
-            .iter()
-            .flat_map(|p| [p.r.to_bits(), p.g.to_bits(), p.b.to_bits()])
-            .collect()
-    };
     let same = |scene: &RenderScene, opts: RenderOptions, what: &str| {
         let a = render(scene, &opts, &|_| {});
         let b = render(

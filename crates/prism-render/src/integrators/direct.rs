@@ -7,6 +7,7 @@ use prism_math::{Frame, Ray, Rgb, Vec3};
 use super::power;
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
+use crate::lights::RenderLight;
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
 
@@ -56,36 +57,51 @@ pub(super) fn direct_lights(
         let mut acc = Rgb::BLACK;
         for _ in 0..count {
             let u = sampler.next_2d();
-            let Some(ls) = light.sample(hit.p, u) else {
+            let Some((shadow, dist, term)) =
+                light_term(hit, light, u, (frame, wo, wo_l), count, mis)
+            else {
                 continue;
             };
-            if !hit.consistent(wo, ls.wi) {
-                continue;
+            if !scene.occluded(&shadow, dist) {
+                acc += term;
             }
-            let wi_l = frame.to_local(ls.wi);
-            let f = hit.bsdf.eval(wo_l, wi_l);
-            if f.max_channel() <= 0.0 {
-                continue;
-            }
-            let shadow = hit.spawn(ls.wi);
-            let dist = if ls.dist.is_finite() {
-                ls.dist * (1.0 - 1e-4) - 1e-4
-            } else {
-                f32::INFINITY
-            };
-            if scene.occluded(&shadow, dist) {
-                continue;
-            }
-            let w = if mis && !ls.delta {
-                power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
-            } else {
-                1.0
-            };
-            acc += f * ls.li * (w / ls.pdf);
         }
         total += acc * (1.0 / count as f32);
     }
     total
+}
+
+/// One sample `u` of `light` at `hit`, one of `count`: its shadow ray, where that ray must
+/// reach unblocked, and the term it adds then (weighted against BSDF sampling with `mis`);
+/// none if the sample cannot contribute.
+pub(super) fn light_term(
+    hit: &Interaction,
+    light: &RenderLight,
+    u: prism_math::Vec2,
+    (frame, wo, wo_l): (&Frame, Vec3, Vec3),
+    count: u32,
+    mis: bool,
+) -> Option<(Ray, f32, Rgb)> {
+    let ls = light.sample(hit.p, u)?;
+    if !hit.consistent(wo, ls.wi) {
+        return None;
+    }
+    let wi_l = frame.to_local(ls.wi);
+    let f = hit.bsdf.eval(wo_l, wi_l);
+    if f.max_channel() <= 0.0 {
+        return None;
+    }
+    let dist = if ls.dist.is_finite() {
+        ls.dist * (1.0 - 1e-4) - 1e-4
+    } else {
+        f32::INFINITY
+    };
+    let w = if mis && !ls.delta {
+        power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
+    } else {
+        1.0
+    };
+    Some((hit.spawn(ls.wi), dist, f * ls.li * (w / ls.pdf)))
 }
 
 /// The course's uniform hemisphere estimator of direct light.

@@ -8,9 +8,10 @@ use prism_math::{Ray, Rgb, Vec3};
 
 use prism_math::lanes::LANES;
 
+use super::direct::light_term;
 use super::{diffuse16, power};
 use crate::camera::Perspective;
-use crate::film::RenderOptions;
+use crate::film::{camera_sample, PixelSum, RenderOptions};
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
@@ -107,16 +108,15 @@ pub(crate) fn tile(
     opts: &RenderOptions,
     pixels: &[(u32, u32)],
 ) -> Vec<(Rgb, u32)> {
-    let mut sums = vec![Rgb::BLACK; pixels.len()];
-    let mut moments = vec![(0.0f64, 0.0f64); pixels.len()];
-    let mut counts = vec![0u32; pixels.len()];
+    let mut sums = vec![PixelSum::default(); pixels.len()];
     let mut active: Vec<usize> = (0..pixels.len()).collect();
     let mut radiance = vec![Rgb::BLACK; pixels.len()];
     let mut buffers = Buffers::default();
     // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
     let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
     let mut n = 0u32;
-    while n < opts.spp && !active.is_empty() {
+    active.retain(|&k| sums[k].wants_more(opts));
+    while !active.is_empty() {
         sample_pass(
             scene,
             camera,
@@ -130,31 +130,11 @@ pub(crate) fn tile(
         );
         n += 1;
         active.retain(|&k| {
-            let mut l = radiance[k];
-            if !l.is_finite() {
-                l = Rgb::BLACK;
-            }
-            sums[k] += l;
-            let i = f64::from(l.luminance());
-            moments[k].0 += i;
-            moments[k].1 += i * i;
-            counts[k] = n;
-            match opts.adaptive {
-                Some(tol) if n.is_multiple_of(opts.batch.max(1)) && n > 1 => {
-                    let (s1, s2) = moments[k];
-                    let mean = s1 / f64::from(n);
-                    let var = ((s2 - s1 * s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
-                    let interval = 1.96 * (var / f64::from(n)).sqrt();
-                    interval > f64::from(tol) * mean
-                }
-                _ => true,
-            }
+            sums[k].add(radiance[k], opts);
+            sums[k].wants_more(opts)
         });
     }
-    sums.iter()
-        .zip(&counts)
-        .map(|(&s, &c)| (s * (1.0 / c as f32), c))
-        .collect()
+    sums.iter().map(PixelSum::result).collect()
 }
 
 /// Traces sample `n` of each pixel of `active` to its end, writing its radiance.
@@ -172,18 +152,10 @@ fn sample_pass(
 ) {
     b.paths.clear();
     b.paths.extend(active.iter().map(|&k| {
-        let (x, y) = pixels[k];
-        let index = u64::from(y) * u64::from(opts.width) + u64::from(x);
-        let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
-        let u = sampler.next_2d();
-        let lens = if camera.has_lens() {
-            sampler.next_2d()
-        } else {
-            prism_math::Vec2::ZERO
-        };
+        let (sampler, ray) = camera_sample(camera, opts, pixels[k], n);
         PathState {
             pixel: k,
-            ray: camera.ray(x as f32 + u.x, y as f32 + u.y, lens),
+            ray,
             sampler,
             l: Rgb::BLACK,
             beta: Rgb::WHITE,
@@ -383,28 +355,11 @@ fn scatter(
                 let first = shadows.len();
                 for _ in 0..count {
                     let u = p.sampler.next_2d();
-                    let Some(ls) = light.sample(hit.p, u) else {
-                        continue;
-                    };
-                    if !hit.consistent(wo, ls.wi) {
-                        continue;
+                    if let Some((ray, dist, term)) =
+                        light_term(hit, light, u, (&frame, wo, wo_l), count, true)
+                    {
+                        shadows.push(ray, dist, term);
                     }
-                    let wi_l = frame.to_local(ls.wi);
-                    let f = hit.bsdf.eval(wo_l, wi_l);
-                    if f.max_channel() <= 0.0 {
-                        continue;
-                    }
-                    let dist = if ls.dist.is_finite() {
-                        ls.dist * (1.0 - 1e-4) - 1e-4
-                    } else {
-                        f32::INFINITY
-                    };
-                    let mis = if ls.delta {
-                        1.0
-                    } else {
-                        power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
-                    };
-                    shadows.push(hit.spawn(ls.wi), dist, f * ls.li * (mis / ls.pdf));
                 }
                 light_terms.push(LightTerms {
                     shadows: (first, shadows.len()),
