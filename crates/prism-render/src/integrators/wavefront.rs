@@ -4,9 +4,8 @@
 //! path draws the same random numbers in the same order and adds the same terms in the same
 //! order as the one-path-at-a-time integrator (`path`), so the two give identical images.
 
-use prism_math::{Ray, Rgb, Vec3};
-
 use prism_math::lanes::LANES;
+use prism_math::{Ray, Rgb, Vec3};
 
 use super::direct::light_term;
 use super::{diffuse16, power};
