@@ -632,25 +632,19 @@ impl Bvh {
                 // SAFETY: the processor has AVX2.
                 return unsafe { self.intersect_batch_avx2(rays, tmin, tmax, hits) };
             }
-            if std::arch::is_x86_feature_detected!("avx") {
-                // SAFETY: the processor has AVX.
-                return unsafe { self.intersect_batch_avx(rays, tmin, tmax, hits) };
-            }
         }
-        self.intersect_batch_with::<false>(rays, tmin, tmax, hits);
+        // Older processors: ray by ray, each call choosing AVX or SSE.
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.intersect(ray, tmin, tmax);
+        }
     }
 
     /// The loop of [`Bvh::intersect_batch`], inlined into each compiled variant.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_with<const AVX: bool>(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: f32,
-        hits: &mut [Option<Hit>],
-    ) {
+    fn intersect_batch_with(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
         for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<AVX>(ray, tmin, tmax);
+            *hit = self.intersect_with::<true>(ray, tmin, tmax);
         }
     }
 
@@ -668,7 +662,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
+        self.intersect_batch_with(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX2 (one-instruction broadcasts).
@@ -684,23 +678,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
-    }
-
-    /// [`Bvh::intersect_batch`] compiled for AVX.
-    ///
-    /// # Safety
-    /// The processor must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn intersect_batch_avx(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: f32,
-        hits: &mut [Option<Hit>],
-    ) {
-        self.intersect_batch_with::<true>(rays, tmin, tmax, hits);
+        self.intersect_batch_with(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::occluded`] for each ray of `rays` with its own end (`blocked[i]` for `rays[i]`
@@ -724,25 +702,19 @@ impl Bvh {
                 // SAFETY: the processor has AVX2.
                 return unsafe { self.occluded_batch_avx2(rays, tmin, tmax, blocked) };
             }
-            if std::arch::is_x86_feature_detected!("avx") {
-                // SAFETY: the processor has AVX.
-                return unsafe { self.occluded_batch_avx(rays, tmin, tmax, blocked) };
-            }
         }
-        self.occluded_batch_with::<false>(rays, tmin, tmax, blocked);
+        // Older processors: ray by ray, each call choosing AVX or SSE.
+        for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
+            *b = self.occluded(ray, tmin, t);
+        }
     }
 
     /// The loop of [`Bvh::occluded_batch`], inlined into each compiled variant.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn occluded_batch_with<const AVX: bool>(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: &[f32],
-        blocked: &mut [bool],
-    ) {
+    fn occluded_batch_with(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<AVX>(ray, tmin, t);
+            *b = self.occluded_with::<true>(ray, tmin, t);
         }
     }
 
@@ -759,7 +731,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX2.
@@ -775,23 +747,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
-    }
-
-    /// [`Bvh::occluded_batch`] compiled for AVX.
-    ///
-    /// # Safety
-    /// The processor must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn occluded_batch_avx(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: &[f32],
-        blocked: &mut [bool],
-    ) {
-        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with(rays, tmin, tmax, blocked);
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
