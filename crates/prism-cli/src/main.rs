@@ -9,6 +9,7 @@ mod progress;
 mod raytrace;
 mod render;
 mod shade;
+mod split;
 mod svg;
 
 use std::process::ExitCode;
@@ -39,6 +40,8 @@ enum Command {
     Shade(shade::ShadeArgs),
     /// Simulate the course's ClothSim scenes exactly; write OBJ and draw the run.
     Cloth(cloth::ClothArgs),
+    /// Check the part files of a split render and assemble its picture.
+    Merge(split::MergeArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -90,6 +93,7 @@ fn main() -> ExitCode {
         Command::Raytrace(a) => raytrace::run(&a),
         Command::Shade(a) => shade::run(&a),
         Command::Cloth(a) => cloth::run(&a),
+        Command::Merge(a) => split::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

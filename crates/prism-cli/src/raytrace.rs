@@ -9,8 +9,8 @@ use clap::Args;
 use prism_image::Bloom;
 use prism_math::Rgb;
 use prism_render::{
-    palette, raytrace, trace_pixel, OrbitView, Overlay, RayKind, RaytraceOptions, WhittedScene,
-    WhittedSettings,
+    palette, raytrace, raytrace_share, trace_pixel, OrbitView, Overlay, Part, RayKind,
+    RaytraceOptions, Share, WhittedScene, WhittedSettings,
 };
 use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
 
@@ -93,6 +93,11 @@ pub struct RaytraceArgs {
     /// Draw leaf K of the BVH (its box and its triangles) over the render.
     #[arg(long, value_name = "K")]
     bvh_leaf: Option<usize>,
+    /// Render only share I of N (I from 0) of the image's 32x32 tiles, dealt round-robin,
+    /// and write a part file (-o PART.exr; NAME-0.exr, ... with several cameras) for
+    /// `prism merge`, which adds bloom.
+    #[arg(long, value_name = "I/N", value_parser = crate::split::parse_tile)]
+    tile: Option<(u32, u32)>,
     /// Seed of the jitter: the same seed gives the same image.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -299,6 +304,21 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         ))
         .into());
     }
+    if a.tile.is_some() {
+        let mut pictures = Vec::new();
+        for (given, flag) in [
+            (a.exr.is_some(), "--exr"),
+            (a.bloom_debug, "--bloom-debug"),
+            (a.debug_pixel.is_some(), "--debug-pixel"),
+            (a.bvh_level.is_some(), "--bvh-level"),
+            (a.bvh_leaf.is_some(), "--bvh-leaf"),
+        ] {
+            if given {
+                pictures.push(flag);
+            }
+        }
+        crate::split::check_part_output(&a.output, &pictures)?;
+    }
     let t0 = Instant::now();
     let loaded = load(a)?;
     let mut features = loaded.features;
@@ -412,6 +432,48 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let mut counts = prism_render::RayCounts::default();
     let mut render_time = std::time::Duration::ZERO;
     let mut write_time = std::time::Duration::ZERO;
+    if let Some((part, parts)) = a.tile {
+        let fingerprint = format!("{:016x}", loaded.scene.fingerprint());
+        for (ci, camera) in loaded.cameras.iter().enumerate() {
+            let rays = if opts.settings.features.multiple_rays_per_pixel {
+                opts.spp.max(1)
+            } else {
+                1
+            };
+            let share = Share {
+                part,
+                parts,
+                samples: 0..rays,
+            };
+            let bar = crate::progress::bar(u64::from(h), "raytrace", a.quiet);
+            let (sums, _) = pool.install(|| {
+                raytrace_share(&scene, camera, &opts, &share, &|done| {
+                    bar.set_position(done);
+                })
+            });
+            bar.finish_and_clear();
+            let bloom = opts.settings.features.bloom.then_some(&opts.bloom);
+            let identity = [
+                ("kind", "raytrace".to_string()),
+                ("version", env!("CARGO_PKG_VERSION").to_string()),
+                ("scene", fingerprint.clone()),
+                ("camera", format!("{camera:?}")),
+                ("width", w.to_string()),
+                ("height", h.to_string()),
+                ("spp", rays.to_string()),
+                ("settings", format!("{:?}", opts.settings)),
+                ("bloom", crate::split::bloom_setting(bloom)),
+                ("seed", opts.seed.to_string()),
+                ("encoding", "truncated".to_string()),
+            ]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+            let part = Part::new(identity, share, sums);
+            crate::split::write_part(&part, &numbered(&a.output, ci, n), a.quiet, t0)?;
+        }
+        return Ok(());
+    }
     for (ci, camera) in loaded.cameras.iter().enumerate() {
         let bar = crate::progress::bar(u64::from(h), "raytrace", a.quiet);
         let t2 = Instant::now();

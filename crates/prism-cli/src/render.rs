@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_render::{render, Integrator, RenderOptions, RenderScene};
+use prism_render::{render, render_share, Integrator, Part, RenderOptions, RenderScene, Share};
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
 use crate::UserError;
@@ -119,9 +119,96 @@ pub struct RenderArgs {
     /// Print BVH statistics, per-stage times (`render: 12.3 ms`) and samples/s on stderr.
     #[arg(long)]
     stats: bool,
+    /// Render only share I of N (I from 0) of the image's 32x32 tiles, dealt round-robin,
+    /// and write a part file (-o PART.exr) for `prism merge`.
+    #[arg(long, value_name = "I/N", value_parser = crate::split::parse_tile)]
+    tile: Option<(u32, u32)>,
+    /// Render only sample indices FROM.. of each pixel (default 0) and write a part file
+    /// (-o PART.exr) for `prism merge`; not with --adaptive.
+    #[arg(long, value_name = "FROM")]
+    samples_from: Option<u32>,
+    /// Render only sample indices ..TO of each pixel, exclusive (default --spp) and write a
+    /// part file (-o PART.exr) for `prism merge`; not with --adaptive.
+    #[arg(long, value_name = "TO")]
+    samples_to: Option<u32>,
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// The share of the render asked for with --tile, --samples-from and --samples-to, checked;
+/// `None` for the whole render.
+fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
+    if a.tile.is_none() && a.samples_from.is_none() && a.samples_to.is_none() {
+        return Ok(None);
+    }
+    let (from, to) = (a.samples_from.unwrap_or(0), a.samples_to.unwrap_or(a.spp));
+    if a.samples_from.is_some() || a.samples_to.is_some() {
+        if adaptive.is_some() {
+            return Err(UserError(
+                "--samples-from/--samples-to with --adaptive: adaptive sampling decides per \
+                 pixel when to stop, so its samples cannot be split into ranges; split by \
+                 --tile instead"
+                    .into(),
+            )
+            .into());
+        }
+        if !(from < to && to <= a.spp) {
+            return Err(UserError(format!(
+                "--samples-from {from} --samples-to {to}: expected 0 <= FROM < TO <= --spp ({})",
+                a.spp
+            ))
+            .into());
+        }
+    }
+    let mut pictures = Vec::new();
+    if a.exr.is_some() {
+        pictures.push("--exr");
+    }
+    if a.heatmap.is_some() {
+        pictures.push("--heatmap");
+    }
+    crate::split::check_part_output(&a.output, &pictures)?;
+    let (part, parts) = a.tile.unwrap_or((0, 1));
+    Ok(Some(Share {
+        part,
+        parts,
+        samples: from..to,
+    }))
+}
+
+/// Every setting of `opts` and `a` that changes pixels, by name, for a part file; the scene,
+/// with its camera, lens, normals and lights, is in its fingerprint.
+fn identity(scene: &prism_scene::Scene, opts: &RenderOptions) -> Vec<(String, String)> {
+    let integrator = match opts.integrator {
+        // Both give the same bytes.
+        Integrator::Path | Integrator::PathScalar => "path".to_string(),
+        Integrator::Direct { hemisphere } => format!("direct hemisphere={hemisphere}"),
+        Integrator::Normals => "normals".to_string(),
+    };
+    let opt = |v: Option<String>| v.unwrap_or_else(|| "off".into());
+    [
+        ("kind", "render".to_string()),
+        ("version", env!("CARGO_PKG_VERSION").to_string()),
+        ("scene", format!("{:016x}", scene.fingerprint())),
+        ("width", opts.width.to_string()),
+        ("height", opts.height.to_string()),
+        ("spp", opts.spp.to_string()),
+        ("light_samples", opts.light_samples.to_string()),
+        ("max_bounces", opts.max_bounces.to_string()),
+        ("integrator", integrator),
+        ("only_bounce", opt(opts.only_bounce.map(|m| m.to_string()))),
+        (
+            "adaptive",
+            opt(opts.adaptive.map(|t| format!("{t} batch={}", opts.batch))),
+        ),
+        ("rr_bounces", opts.rr_bounces.to_string()),
+        ("seed", opts.seed.to_string()),
+        ("encoding", "srgb".to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
 }
 
 /// Samples between adaptive-sampling checks when --batch is not given.
@@ -257,6 +344,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         .transpose()?;
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
+    let share = share(a, adaptive)?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(UserError(format!(
@@ -377,6 +465,24 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
         b.build().context("starting worker threads")?
     };
+    if let Some(share) = share {
+        let tiles = prism_render::tiles(w, h);
+        let pixels: u64 = tiles
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| share.has_tile(k))
+            .map(|(_, &(x0, y0))| {
+                u64::from((w - x0).min(prism_render::TILE))
+                    * u64::from((h - y0).min(prism_render::TILE))
+            })
+            .sum();
+        let bar = crate::progress::samples_bar(pixels * share.samples.len() as u64, a.quiet);
+        let sums = pool
+            .install(|| render_share(&prepared, &options, &share, &|done| bar.set_position(done)));
+        bar.finish_and_clear();
+        let part = Part::new(identity(&scene, &options), share, sums);
+        return crate::split::write_part(&part, &a.output, a.quiet, t0);
+    }
     let bar = crate::progress::samples_bar(u64::from(w) * u64::from(h) * u64::from(a.spp), a.quiet);
     let t2 = Instant::now();
     let out = pool.install(|| render(&prepared, &options, &|done| bar.set_position(done)));

@@ -1,5 +1,8 @@
-//! The film: [`RenderOptions`], the pixel loop over tiles on rayon, each pixel's samples with
-//! adaptive sampling, and the [`Rendered`] image with its sample counts.
+//! The film: [`RenderOptions`], the pixel loop over 32x32 tiles on rayon, each pixel's samples
+//! with adaptive sampling into its [`PixelSum`], the [`Share`] of tiles and sample indices a
+//! split render computes, and the [`Rendered`] image with its sample counts.
+
+use std::ops::Range;
 
 use prism_image::Image;
 use prism_math::{Ray, Rgb};
@@ -69,7 +72,55 @@ pub struct Rendered {
     pub total_samples: u64,
 }
 
-const TILE: u32 = 32;
+/// The side of a film tile in pixels: the unit of work of a thread and of a split render.
+pub const TILE: u32 = 32;
+
+/// The tiles of a `width x height` film, in row-major order: `(x0, y0)` of each.
+#[must_use]
+pub fn tiles(width: u32, height: u32) -> Vec<(u32, u32)> {
+    (0..height.div_ceil(TILE))
+        .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect()
+}
+
+/// The row-major index of the tile holding pixel `(x, y)` of a film `width` pixels wide.
+#[must_use]
+pub fn tile_of(x: u32, y: u32, width: u32) -> usize {
+    (y / TILE) as usize * width.div_ceil(TILE) as usize + (x / TILE) as usize
+}
+
+/// The share of a render one process computes: tiles dealt round-robin into `parts` shares
+/// (tile `k`, counted row by row, goes to share `k mod parts`, so shares differ by at most
+/// one tile and each holds tiles from all over the picture), and sample indices
+/// `samples` of each of their pixels. A pixel's samples depend only on the seed, the pixel
+/// and the sample index, so shares are independent.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Share {
+    /// This share's index, from 0.
+    pub part: u32,
+    /// How many shares the tiles are dealt into.
+    pub parts: u32,
+    /// The sample indices taken in each pixel.
+    pub samples: Range<u32>,
+}
+
+impl Share {
+    /// Every tile, samples `0..spp`: the whole render.
+    #[must_use]
+    pub fn whole(spp: u32) -> Share {
+        Share {
+            part: 0,
+            parts: 1,
+            samples: 0..spp,
+        }
+    }
+
+    /// True if tile `k` belongs to this share.
+    #[must_use]
+    pub fn has_tile(&self, k: usize) -> bool {
+        k % self.parts.max(1) as usize == self.part as usize
+    }
+}
 
 /// Renders the scene. `progress` is called with the number of samples taken so far after
 /// each tile (from worker threads). The image is the same whatever the thread count.
@@ -78,63 +129,77 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
+    let sums = render_share(scene, opts, &Share::whole(opts.spp), progress);
+    Rendered {
+        image: sums.map(|p| p.mean()),
+        samples: sums.map(|p| p.n),
+        total_samples: sums.pixels().iter().map(|p| u64::from(p.n)).sum(),
+    }
+}
+
+/// Renders one share of the scene: the sums of the share's pixels; the other pixels hold no
+/// samples. Each pixel's sums equal those of the whole render when the share starts at sample
+/// 0, whatever the thread count. `progress` is called as in [`render`].
+pub fn render_share(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    share: &Share,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Image<PixelSum> {
     let (w, h) = (opts.width, opts.height);
     let camera = Perspective::new(&scene.camera, w, h);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+    let tiles: Vec<(u32, u32)> = tiles(w, h)
+        .into_iter()
+        .enumerate()
+        .filter(|&(k, _)| share.has_tile(k))
+        .map(|(_, t)| t)
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
-    let results: Vec<Vec<(Rgb, u32)>> = tiles
+    let results: Vec<Vec<PixelSum>> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
                 .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
                 .collect();
             let out = if opts.integrator == Integrator::Path {
-                wavefront::tile(scene, &camera, opts, &pixels)
+                wavefront::tile(scene, &camera, opts, &pixels, &share.samples)
             } else {
                 pixels
                     .iter()
-                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y))
+                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y, &share.samples))
                     .collect()
             };
-            let n: u64 = out.iter().map(|&(_, k)| u64::from(k)).sum();
+            let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
             progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
             out
         })
         .collect();
-    let mut image = Image::new(w, h, Rgb::BLACK);
-    let mut samples = Image::new(w, h, 0u32);
-    let mut total = 0u64;
+    let mut sums = Image::new(w, h, PixelSum::default());
     for (&(x0, y0), tile) in tiles.iter().zip(&results) {
         let mut k = 0;
         for y in y0..(y0 + TILE).min(h) {
             for x in x0..(x0 + TILE).min(w) {
-                let (c, n) = tile[k];
+                sums.set(x, y, tile[k]);
                 k += 1;
-                image.set(x, y, c);
-                samples.set(x, y, n);
-                total += u64::from(n);
             }
         }
     }
-    Rendered {
-        image,
-        samples,
-        total_samples: total,
-    }
+    sums
 }
 
 /// A pixel's running sums: its radiance, and its illuminance's first two moments for
 /// adaptive sampling.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct PixelSum {
-    sum: Rgb,
-    s1: f64,
-    s2: f64,
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSum {
+    /// The sum of the radiance samples (a non-finite sample counts as black).
+    pub sum: Rgb,
+    /// The sum of the samples' luminances.
+    pub moment1: f64,
+    /// The sum of the samples' squared luminances.
+    pub moment2: f64,
     /// Samples taken.
-    pub(crate) n: u32,
-    converged: bool,
+    pub n: u32,
+    pub(crate) converged: bool,
 }
 
 impl PixelSum {
@@ -144,29 +209,42 @@ impl PixelSum {
         let l = if l.is_finite() { l } else { Rgb::BLACK };
         self.sum += l;
         let i = f64::from(l.luminance());
-        self.s1 += i;
-        self.s2 += i * i;
+        self.moment1 += i;
+        self.moment2 += i * i;
         self.n += 1;
         let n = self.n;
         if let Some(tol) = opts.adaptive {
             if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
-                let mean = self.s1 / f64::from(n);
-                let var =
-                    ((self.s2 - self.s1 * self.s1 / f64::from(n)) / f64::from(n - 1)).max(0.0);
+                let mean = self.moment1 / f64::from(n);
+                let var = ((self.moment2 - self.moment1 * self.moment1 / f64::from(n))
+                    / f64::from(n - 1))
+                .max(0.0);
                 let interval = 1.96 * (var / f64::from(n)).sqrt();
                 self.converged = interval <= f64::from(tol) * mean;
             }
         }
     }
 
-    /// True while the pixel takes more samples.
-    pub(crate) fn wants_more(&self, opts: &RenderOptions) -> bool {
-        self.n < opts.spp && !self.converged
+    /// True while the pixel takes more of its `most` samples.
+    pub(crate) fn wants_more(&self, most: u32) -> bool {
+        self.n < most && !self.converged
     }
 
-    /// The mean radiance and the samples taken.
-    pub(crate) fn result(&self) -> (Rgb, u32) {
-        (self.sum * (1.0 / self.n as f32), self.n)
+    /// Adds the sums of another share of this pixel's samples.
+    pub fn merge(&mut self, other: &PixelSum) {
+        self.sum += other.sum;
+        self.moment1 += other.moment1;
+        self.moment2 += other.moment2;
+        self.n += other.n;
+    }
+
+    /// The mean radiance (black without samples).
+    #[must_use]
+    pub fn mean(&self) -> Rgb {
+        if self.n == 0 {
+            return Rgb::BLACK;
+        }
+        self.sum * (1.0 / self.n as f32)
     }
 }
 
@@ -197,11 +275,13 @@ fn pixel(
     opts: &RenderOptions,
     x: u32,
     y: u32,
-) -> (Rgb, u32) {
+    samples: &Range<u32>,
+) -> PixelSum {
     let mut px = PixelSum::default();
-    while px.wants_more(opts) {
-        let (mut sampler, ray) = camera_sample(camera, opts, (x, y), px.n);
+    let most = samples.len() as u32;
+    while px.wants_more(most) {
+        let (mut sampler, ray) = camera_sample(camera, opts, (x, y), samples.start + px.n);
         px.add(radiance(scene, &ray, &mut sampler, opts), opts);
     }
-    px.result()
+    px
 }

@@ -4,7 +4,7 @@
 //! hit records it returns (`interaction`), the integrators (`integrators`: `normals`,
 //! `direct`, `path`, and `wavefront`, which runs a tile's paths together and sixteen at a time
 //! where it can) and the film that loops over pixels with adaptive sampling (`film`),
-//! over a scene from prism-scene. The Whitted ray tracer of the Delft project has its scene
+//! over a scene from prism-scene; a split render's part files and their merge (`parts`). The Whitted ray tracer of the Delft project has its scene
 //! (`whitted_scene`), integrator (`integrators::whitted`), orbit camera (`camera`) and film
 //! with per-pixel ray recording (`raytrace`).
 #![warn(missing_docs)]
@@ -18,6 +18,7 @@ mod integrators;
 mod interaction;
 mod lights;
 mod overlay;
+mod parts;
 mod raytrace;
 mod render_scene;
 mod sampler;
@@ -26,7 +27,9 @@ mod whitted_scene;
 pub use bsdf::{Bsdf, BsdfSample};
 pub use camera::{OrbitView, Perspective};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
-pub use film::{render, RenderOptions, Rendered};
+pub use film::{
+    render, render_share, tile_of, tiles, PixelSum, RenderOptions, Rendered, Share, TILE,
+};
 pub use integrators::whitted::{
     parallelogram_color, parallelogram_grid, phong, DebugRay, PixelSampler, RayCounts, RayKind,
     WhittedSettings, WhittedTracer, MISS_LENGTH, RAY_EPSILON,
@@ -35,7 +38,10 @@ pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;
 pub use lights::{LightSample, MeshLight, RenderLight};
 pub use overlay::{palette, Overlay};
-pub use raytrace::{raytrace, trace_pixel, PixelTrace, RaytraceOptions, Raytraced};
+pub use parts::{merge, Merged, Part, PartError};
+pub use raytrace::{
+    raytrace, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions, Raytraced,
+};
 pub use render_scene::RenderScene;
 pub use sampler::Sampler;
 pub use whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};

@@ -1,6 +1,6 @@
 //! The Whitted film: [`RaytraceOptions`], the pixel loop over rows on rayon (one ray through
-//! each pixel's lower-left corner, or jittered rays), bloom, and the ray tree of one pixel
-//! for visual debugging.
+//! each pixel's lower-left corner, or jittered rays), a share of its tiles for split renders,
+//! bloom, and the ray tree of one pixel for visual debugging.
 
 use std::sync::Mutex;
 
@@ -9,6 +9,7 @@ use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
 use crate::camera::OrbitView;
+use crate::film::{tile_of, PixelSum, Share};
 use crate::integrators::whitted::{
     DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
 };
@@ -66,7 +67,7 @@ struct Frame<'a> {
     opts: &'a RaytraceOptions,
 }
 
-/// The colour of the pixel at written position `(x, row)` (row 0 at the top), its single
+/// The sums of the pixel at written position `(x, row)` (row 0 at the top), its single
 /// ray along `corner_dir` if given, with every ray recorded into `record` if given.
 fn pixel(
     f: &Frame<'_>,
@@ -75,11 +76,11 @@ fn pixel(
     corner_dir: Option<prism_math::Vec3>,
     counts: &mut RayCounts,
     record: Option<&mut Vec<DebugRay>>,
-) -> Rgb {
+) -> PixelSum {
     let (scene, view, opts) = (f.scene, &f.view, f.opts);
     let y = opts.height - 1 - row;
     let n = rays_per_pixel(opts);
-    let mut sum = Rgb::BLACK;
+    let mut px = PixelSum::default();
     let mut rec: Option<Vec<DebugRay>> = record.as_ref().map(|_| Vec::new());
     for s in 0..n {
         let mut sampler = pixel_sampler(opts, x, row, s);
@@ -99,14 +100,19 @@ fn pixel(
             counts: RayCounts::default(),
             record: rec.take(),
         };
-        sum += tracer.trace(&ray, 0, RayKind::Camera);
+        let c = tracer.trace(&ray, 0, RayKind::Camera);
+        px.sum += c;
+        let lum = f64::from(c.luminance());
+        px.moment1 += lum;
+        px.moment2 += lum * lum;
+        px.n += 1;
         counts.add(&tracer.counts);
         rec = tracer.record;
     }
     if let (Some(out), Some(r)) = (record, rec) {
         *out = r;
     }
-    sum * (1.0 / n as f32)
+    px
 }
 
 /// Renders `scene` through `camera`. `progress` is called with the number of rows done
@@ -118,24 +124,68 @@ pub fn raytrace(
     opts: &RaytraceOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Raytraced {
+    let whole = Share::whole(rays_per_pixel(opts));
+    let (sums, counts) = raytrace_share(scene, camera, opts, &whole, progress);
+    with_bloom(sums.map(PixelSum::mean), counts, opts)
+}
+
+/// Adds bloom to a Whitted image when `opts` turns it on.
+#[must_use]
+pub fn with_bloom(image: RgbImage, counts: RayCounts, opts: &RaytraceOptions) -> Raytraced {
+    if !opts.settings.features.bloom {
+        return Raytraced {
+            image,
+            bloom_layer: None,
+            counts,
+        };
+    }
+    let layer = opts.bloom.layer(&image);
+    let mut sum = image;
+    for (p, l) in sum.pixels_mut().iter_mut().zip(layer.pixels()) {
+        *p += *l;
+    }
+    Raytraced {
+        image: sum,
+        bloom_layer: Some(layer),
+        counts,
+    }
+}
+
+/// Renders the pixels of `share`'s tiles (tiles counted on the written image, row 0 at the
+/// top), before bloom: each pixel's sums over its rays, and the rays cast. The other pixels
+/// hold no samples; the share's sample range is not used (every pixel takes all its rays).
+#[must_use]
+pub fn raytrace_share(
+    scene: &WhittedScene,
+    camera: &prism_scene::OrbitCamera,
+    opts: &RaytraceOptions,
+    share: &Share,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (Image<PixelSum>, RayCounts) {
     let view = OrbitView::new(camera, opts.width, opts.height);
     let frame = Frame { scene, view, opts };
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
-    let mut image = Image::new(opts.width, opts.height, Rgb::BLACK);
-    image
-        .pixels_mut()
+    let mut sums = Image::new(opts.width, opts.height, PixelSum::default());
+    sums.pixels_mut()
         .par_chunks_mut(opts.width as usize)
         .enumerate()
         .for_each(|(row, line)| {
+            let row = row as u32;
             let mut counts = RayCounts::default();
             let mut dirs = Vec::new();
-            if rays_per_pixel(opts) == 1 {
-                view.corner_directions(opts.height - 1 - row as u32, &mut dirs);
-            }
-            for (x, p) in line.iter_mut().enumerate() {
-                let d = dirs.get(x).copied();
-                *p = pixel(&frame, x as u32, row as u32, d, &mut counts, None);
+            let mine = |x: u32| share.has_tile(tile_of(x, row, opts.width));
+            if (0..opts.width).any(mine) {
+                if rays_per_pixel(opts) == 1 {
+                    view.corner_directions(opts.height - 1 - row, &mut dirs);
+                }
+                for (x, p) in line.iter_mut().enumerate() {
+                    let x = x as u32;
+                    if mine(x) {
+                        let d = dirs.get(x as usize).copied();
+                        *p = pixel(&frame, x, row, d, &mut counts, None);
+                    }
+                }
             }
             totals
                 .lock()
@@ -145,24 +195,7 @@ pub fn raytrace(
             progress(d);
         });
     let counts = totals.into_inner().expect("no panics under the lock");
-    if opts.settings.features.bloom {
-        let layer = opts.bloom.layer(&image);
-        let mut sum = image;
-        for (p, l) in sum.pixels_mut().iter_mut().zip(layer.pixels()) {
-            *p += *l;
-        }
-        Raytraced {
-            image: sum,
-            bloom_layer: Some(layer),
-            counts,
-        }
-    } else {
-        Raytraced {
-            image,
-            bloom_layer: None,
-            counts,
-        }
-    }
+    (sums, counts)
 }
 
 /// One pixel's ray tree, for visual debugging.
@@ -197,7 +230,7 @@ pub fn trace_pixel(
     let mut rays = Vec::new();
     let mut counts = RayCounts::default();
     let frame = Frame { scene, view, opts };
-    let color = pixel(&frame, x, row, None, &mut counts, Some(&mut rays));
+    let color = pixel(&frame, x, row, None, &mut counts, Some(&mut rays)).mean();
     PixelTrace {
         pixel: (x, row),
         color,

@@ -388,6 +388,38 @@ impl Scene {
         }
     }
 
+    /// A 64-bit fingerprint of everything that changes pixels: geometry, materials (with
+    /// their texels), lights and camera, but not the warnings. Equal scenes give equal
+    /// fingerprints on every machine; it is the FNV-1a hash of the fields' `Debug` forms,
+    /// which print every float exactly.
+    #[must_use]
+    pub fn fingerprint(&self) -> u64 {
+        struct Fnv(u64);
+        impl std::fmt::Write for Fnv {
+            fn write_str(&mut self, s: &str) -> std::fmt::Result {
+                for &b in s.as_bytes() {
+                    self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+                }
+                Ok(())
+            }
+        }
+        let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+        // Writing to the hasher cannot fail.
+        let _ = std::fmt::Write::write_fmt(
+            &mut h,
+            format_args!(
+                "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+                self.meshes,
+                self.spheres,
+                self.materials,
+                self.material_names,
+                self.lights,
+                self.camera
+            ),
+        );
+        h.0
+    }
+
     /// The name of material `i`: the file's, else `material i`.
     #[must_use]
     pub fn material_name(&self, i: usize) -> String {

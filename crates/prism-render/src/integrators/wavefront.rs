@@ -100,21 +100,23 @@ struct Buffers {
     blocked: Vec<bool>,
 }
 
-/// Radiance and sample counts of the pixels `(x, y)` of one tile, in order.
+/// The sums of the pixels `(x, y)` of one tile, in order, over sample indices `samples`.
 pub(crate) fn tile(
     scene: &RenderScene,
     camera: &Perspective,
     opts: &RenderOptions,
     pixels: &[(u32, u32)],
-) -> Vec<(Rgb, u32)> {
+    samples: &std::ops::Range<u32>,
+) -> Vec<PixelSum> {
     let mut sums = vec![PixelSum::default(); pixels.len()];
     let mut active: Vec<usize> = (0..pixels.len()).collect();
     let mut radiance = vec![Rgb::BLACK; pixels.len()];
     let mut buffers = Buffers::default();
     // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
     let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
-    let mut n = 0u32;
-    active.retain(|&k| sums[k].wants_more(opts));
+    let most = samples.len() as u32;
+    let mut n = samples.start;
+    active.retain(|&k| sums[k].wants_more(most));
     while !active.is_empty() {
         sample_pass(
             scene,
@@ -130,10 +132,10 @@ pub(crate) fn tile(
         n += 1;
         active.retain(|&k| {
             sums[k].add(radiance[k], opts);
-            sums[k].wants_more(opts)
+            sums[k].wants_more(most)
         });
     }
-    sums.iter().map(PixelSum::result).collect()
+    sums
 }
 
 /// Traces sample `n` of each pixel of `active` to its end, writing its radiance.

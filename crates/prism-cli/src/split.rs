@@ -1,0 +1,227 @@
+//! Split renders: the `--tile I/N` argument, writing a part file, and `prism merge`, which
+//! checks a set of parts and assembles the picture the single render would have written.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Result;
+use clap::Args;
+use prism_image::{Bloom, Image};
+use prism_math::Rgb;
+use prism_render::{merge, Part, PixelSum};
+
+use crate::output::{image_output, ImageFormat};
+use crate::UserError;
+
+/// The colour merged pictures give pixels that no part held (with `--allow-missing`).
+const HOLE: Rgb = Rgb {
+    r: 1.0,
+    g: 0.0,
+    b: 1.0,
+};
+
+/// Parses `I/N` (0 <= I < N): share I of N.
+pub fn parse_tile(s: &str) -> std::result::Result<(u32, u32), String> {
+    let parsed = s
+        .split_once('/')
+        .and_then(|(i, n)| Some((i.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((i, n)) if n >= 1 && i < n => Ok((i, n)),
+        _ => Err(format!(
+            "expected I/N, share I (counted from 0) of N, with 0 <= I < N; found `{s}`"
+        )),
+    }
+}
+
+/// Checks that a part is written to an OpenEXR file and that no picture-only output is
+/// asked for with it; `flags` names the picture outputs given.
+pub fn check_part_output(output: &Path, flags: &[&str]) -> Result<()> {
+    if crate::output::extension(output) != "exr" {
+        return Err(UserError(format!(
+            "--output {}: a split render writes a part file, an OpenEXR file (.exr); merge \
+             the parts with `prism merge` for the picture",
+            output.display()
+        ))
+        .into());
+    }
+    if let Some(flag) = flags.first() {
+        return Err(UserError(format!(
+            "{flag}: a split render writes only its part file; give {flag} to `prism merge`"
+        ))
+        .into());
+    }
+    crate::output::check_folder(output, "--output")?;
+    Ok(())
+}
+
+/// Writes `part` to `output` atomically and prints the summary line when not quiet on a
+/// terminal.
+pub fn write_part(part: &Part, output: &Path, quiet: bool, started: Instant) -> Result<()> {
+    part.write(output)?;
+    if !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
+        eprintln!(
+            "prism: part {}/{} (samples {}..{}), {:.2} M samples in {:.1} s -> {}",
+            part.share.part,
+            part.share.parts,
+            part.share.samples.start,
+            part.share.samples.end,
+            samples as f64 / 1e6,
+            started.elapsed().as_secs_f64(),
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// Arguments of `prism merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Part files written by `prism render --tile I/N` / `--samples-from A --samples-to B`
+    /// or `prism raytrace --tile I/N`, in any order.
+    #[arg(required = true, value_name = "PART.exr")]
+    parts: Vec<PathBuf>,
+    /// The picture: .png or .jpg (encoded as the command that made the parts encodes), or
+    /// .exr (linear). The folder must exist.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write the linear picture to this OpenEXR file.
+    #[arg(long, value_name = "FILE")]
+    exr: Option<PathBuf>,
+    /// Write the sample-count heat map (blue: few, red: the most) to this .png or .jpg.
+    #[arg(long, value_name = "FILE")]
+    heatmap: Option<PathBuf>,
+    /// Merge even if some tiles or sample ranges are in no part: those pixels are painted
+    /// magenta (a missing sample range only lowers its pixels' sample counts), and each
+    /// missing share is listed.
+    #[arg(long)]
+    allow_missing: bool,
+    /// No summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// Runs `prism merge`.
+pub fn run(a: &MergeArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let format = image_output(
+        &a.output,
+        "--output",
+        &[ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr],
+    )?;
+    if let Some(exr) = &a.exr {
+        image_output(exr, "--exr", &[ImageFormat::Exr])?;
+    }
+    let heatmap_format = a
+        .heatmap
+        .as_deref()
+        .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
+        .transpose()?;
+    let mut parts = Vec::with_capacity(a.parts.len());
+    for path in &a.parts {
+        let part = Part::read(path).map_err(|e| UserError(e.to_string()))?;
+        parts.push((path.clone(), part));
+    }
+    let merged = merge(&parts, a.allow_missing).map_err(|e| UserError(e.to_string()))?;
+    drop(parts);
+    for hole in &merged.holes {
+        eprintln!("prism: warning: missing {hole}");
+    }
+    let setting = |k: &str| {
+        merged
+            .identity
+            .iter()
+            .find(|(n, _)| n == k)
+            .map(|(_, v)| v.as_str())
+    };
+    let mut image: Image<Rgb> = merged.sums.map(PixelSum::mean);
+    if let Some(bloom) = setting("bloom").and_then(parse_bloom) {
+        let layer = bloom.layer(&image);
+        for (p, l) in image.pixels_mut().iter_mut().zip(layer.pixels()) {
+            *p += *l;
+        }
+    }
+    let holes = merged.sums.pixels().iter().filter(|p| p.n == 0).count();
+    for (p, s) in image.pixels_mut().iter_mut().zip(merged.sums.pixels()) {
+        if s.n == 0 {
+            *p = HOLE;
+        }
+    }
+    let truncated = setting("encoding") == Some("truncated");
+    match format {
+        ImageFormat::Exr => prism_image::write_exr(&a.output, &image)?,
+        _ if truncated => {
+            crate::output::write_rgb8(&a.output, format, &image.to_rgb8_truncated())?;
+        }
+        _ => crate::output::write_rgb8(&a.output, format, &image.linear_to_srgb8())?,
+    }
+    let mut written = vec![a.output.display().to_string()];
+    if let Some(exr) = &a.exr {
+        prism_image::write_exr(exr, &image)?;
+        written.push(exr.display().to_string());
+    }
+    if let (Some(path), Some(f)) = (&a.heatmap, heatmap_format) {
+        let samples = merged.sums.map(|p| p.n);
+        crate::output::write_rgb8(path, f, &prism_image::heatmap(&samples))?;
+        written.push(path.display().to_string());
+    }
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        let (w, h) = (merged.sums.width(), merged.sums.height());
+        eprintln!(
+            "prism: merged {} parts, {w}x{h}{} in {:.2} s -> {}",
+            a.parts.len(),
+            if holes > 0 {
+                format!(", {holes} pixels missing (magenta)")
+            } else {
+                String::new()
+            },
+            t0.elapsed().as_secs_f64(),
+            written.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// The bloom a Whitted part records: `THRESHOLD PASSES`, or `off`.
+fn parse_bloom(v: &str) -> Option<Bloom> {
+    let (t, p) = v.split_once(' ')?;
+    Some(Bloom {
+        threshold: t.parse().ok()?,
+        passes: p.parse().ok()?,
+    })
+}
+
+/// The bloom setting a Whitted part records (see `parse_bloom`).
+pub fn bloom_setting(bloom: Option<&Bloom>) -> String {
+    match bloom {
+        Some(b) => format!("{} {}", b.threshold, b.passes),
+        None => "off".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Property: every I/N with 0 <= I < N parses; out-of-range and malformed shares do not.
+    #[test]
+    fn tiles_parse_only_in_range() {
+        assert_eq!(parse_tile("0/1"), Ok((0, 1)));
+        assert_eq!(parse_tile("6/7"), Ok((6, 7)));
+        for bad in ["7/7", "1/0", "-1/3", "a/b", "3", "1/2/3", ""] {
+            assert!(parse_tile(bad).is_err(), "{bad}");
+        }
+    }
+
+    /// Oracle: the bloom setting written is the one read back.
+    #[test]
+    fn bloom_setting_round_trips() {
+        let b = Bloom {
+            threshold: 0.75,
+            passes: 3,
+        };
+        let back = parse_bloom(&bloom_setting(Some(&b))).unwrap();
+        assert_eq!((back.threshold, back.passes), (0.75, 3));
+        assert!(parse_bloom(&bloom_setting(None)).is_none());
+    }
+}
