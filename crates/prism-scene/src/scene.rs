@@ -459,3 +459,23 @@ impl Scene {
         (lo.x <= hi.x).then_some((lo, hi))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// Property: the fingerprint is the same for equal scenes, whatever their warnings, and
+    /// changes when one coordinate moves by one ulp or a light's colour changes.
+    #[test]
+    fn fingerprint_tells_scenes_apart() {
+        let a = crate::cornell_box();
+        let mut b = a.clone();
+        b.warnings.push("read past something".into());
+        assert_eq!(a.fingerprint(), b.fingerprint());
+        let mut c = a.clone();
+        let p = &mut c.meshes[0].positions[0];
+        p.x = f32::from_bits(p.x.to_bits() + 1);
+        assert_ne!(a.fingerprint(), c.fingerprint());
+        let mut d = a.clone();
+        d.camera.eye.z += 1.0;
+        assert_ne!(a.fingerprint(), d.fingerprint());
+    }
+}

@@ -1,0 +1,350 @@
+//! Split renders end to end: `prism render --tile` / `--samples-from --samples-to` and
+//! `prism raytrace --tile` parts merged by `prism merge` against the single-process render
+//! (the oracle), and every way a set of parts can be wrong refused with exit 2 and no output.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn prism() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_prism"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("prism-split-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn ok(o: Output) -> Output {
+    assert!(
+        o.status.success(),
+        "exit {:?}: {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn run(cmd: &str, args: &[&str], extra: &[&str], out: &Path) -> Output {
+    prism()
+        .arg(cmd)
+        .args(args)
+        .args(extra)
+        .arg("-o")
+        .arg(out)
+        .arg("-q")
+        .output()
+        .unwrap()
+}
+
+fn merge(parts: &[PathBuf], out: &Path, extra: &[&str]) -> Output {
+    prism()
+        .arg("merge")
+        .args(parts)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+fn lambertian() -> String {
+    prism_testkit::shared_asset("pathtracer/dae/sky/CBspheres_lambertian.dae")
+        .display()
+        .to_string()
+}
+
+/// 100x70 pixels: 4x3 tiles, the last column and row of tiles cut short.
+const SMALL: [&str; 3] = ["-r", "100", "70"];
+
+/// Oracle: the single render. Tile splits into N = 1, 2, 3 and 7 shares (7 does not divide
+/// the 12 tiles) merge, given in any order, to its PNG and EXR byte for byte, with fixed
+/// and adaptive sampling.
+#[test]
+fn tile_splits_merge_to_the_single_render_byte_for_byte() {
+    let dir = scratch("tiles");
+    let scene = lambertian();
+    for adaptive in [&[][..], &["--adaptive", "0.05", "--batch", "4"][..]] {
+        let mut args = vec!["render", scene.as_str(), "-s", "8", "--seed", "3"];
+        args.extend(SMALL);
+        args.extend(adaptive);
+        let whole_png = dir.join("whole.png");
+        let whole_exr = dir.join("whole.exr");
+        ok(run(
+            args[0],
+            &args[1..],
+            &["--exr", whole_exr.to_str().unwrap()],
+            &whole_png,
+        ));
+        for n in [1u32, 2, 3, 7] {
+            let mut parts = Vec::new();
+            for i in (0..n).rev() {
+                let p = dir.join(format!("part-{i}-of-{n}.exr"));
+                let tile = format!("{i}/{n}");
+                ok(run(args[0], &args[1..], &["--tile", &tile], &p));
+                parts.push(p);
+            }
+            let (png, exr) = (dir.join("merged.png"), dir.join("merged.exr"));
+            ok(merge(&parts, &png, &["--exr", exr.to_str().unwrap()]));
+            assert!(
+                std::fs::read(&png).unwrap() == std::fs::read(&whole_png).unwrap(),
+                "{n} tile shares, {adaptive:?}: the PNG differs"
+            );
+            assert!(
+                std::fs::read(&exr).unwrap() == std::fs::read(&whole_exr).unwrap(),
+                "{n} tile shares, {adaptive:?}: the EXR differs"
+            );
+        }
+    }
+}
+
+/// Oracle: the single render. Sample-range splits into N = 1, 2, 3 and 7 ranges (of 13
+/// samples, so ranges differ in length), alone and crossed with a 3-way tile split, merge
+/// to its radiance up to float summation order: every channel within 1e-5 relative, and
+/// at most 0.1% of the 8-bit PNG's bytes off by one.
+#[test]
+fn sample_splits_merge_to_the_single_render() {
+    let dir = scratch("samples");
+    let scene = lambertian();
+    let mut args = vec!["render", scene.as_str(), "-s", "13", "--seed", "5"];
+    args.extend(SMALL);
+    let whole_png = dir.join("whole.png");
+    let whole_exr = dir.join("whole.exr");
+    ok(run(
+        args[0],
+        &args[1..],
+        &["--exr", whole_exr.to_str().unwrap()],
+        &whole_png,
+    ));
+    let whole = prism_image::read_exr(&whole_exr).unwrap();
+    let whole_bytes = std::fs::read(&whole_png).unwrap();
+    for (n, tiles) in [(1u32, 1u32), (2, 1), (3, 1), (7, 1), (2, 3)] {
+        let mut parts = Vec::new();
+        for t in 0..tiles {
+            for k in 0..n {
+                let (a, b) = (13 * k / n, 13 * (k + 1) / n);
+                let p = dir.join(format!("s{a}-{b}-t{t}.exr"));
+                let (from, to, tile) = (a.to_string(), b.to_string(), format!("{t}/{tiles}"));
+                let extra = [
+                    "--samples-from",
+                    &from,
+                    "--samples-to",
+                    &to,
+                    "--tile",
+                    &tile,
+                ];
+                ok(run(args[0], &args[1..], &extra, &p));
+                parts.push(p);
+            }
+        }
+        let (png, exr) = (dir.join("merged.png"), dir.join("merged.exr"));
+        ok(merge(&parts, &png, &["--exr", exr.to_str().unwrap()]));
+        let merged = prism_image::read_exr(&exr).unwrap();
+        for (a, b) in merged.pixels().iter().zip(whole.pixels()) {
+            for (x, y) in a.to_array().into_iter().zip(b.to_array()) {
+                assert!(
+                    (x - y).abs() <= 1e-5 * y.abs().max(1e-3),
+                    "{n} ranges: {x} against {y}"
+                );
+            }
+        }
+        let bytes = std::fs::read(&png).unwrap();
+        let merged8 = prism_image::decode_png(&bytes, "merged").unwrap();
+        let whole8 = prism_image::decode_png(&whole_bytes, "whole").unwrap();
+        let off = merged8
+            .pixels()
+            .iter()
+            .zip(whole8.pixels())
+            .flat_map(|(p, q)| p.iter().zip(q.iter()))
+            .filter(|(p, q)| p != q)
+            .inspect(|(p, q)| assert!(p.abs_diff(**q) <= 1))
+            .count();
+        assert!(off * 1000 <= 100 * 70 * 3, "{n} ranges: {off} bytes differ");
+        if n == 1 {
+            assert_eq!(bytes, whole_bytes, "one range is the single render");
+        }
+    }
+}
+
+/// Oracle: the single Whitted render, bloom included (merge adds it after assembling, as
+/// bloom spreads light across tiles): tile splits into 1, 2, 3 and 7 shares give its bytes.
+#[test]
+fn whitted_tile_splits_merge_to_the_single_render() {
+    let dir = scratch("whitted");
+    let args = [
+        "cornell-box",
+        "-r",
+        "90",
+        "70",
+        "--enable",
+        "bloom,multi-rays",
+        "--spp",
+        "2",
+        "--bloom-threshold",
+        "0.4",
+    ];
+    let whole = dir.join("whole.png");
+    ok(run("raytrace", &args, &[], &whole));
+    for n in [1u32, 2, 3, 7] {
+        let parts: Vec<PathBuf> = (0..n)
+            .map(|i| {
+                let p = dir.join(format!("w{i}.exr"));
+                ok(run("raytrace", &args, &["--tile", &format!("{i}/{n}")], &p));
+                p
+            })
+            .collect();
+        let out = dir.join("merged.png");
+        ok(merge(&parts, &out, &[]));
+        assert!(
+            std::fs::read(&out).unwrap() == std::fs::read(&whole).unwrap(),
+            "{n} Whitted tile shares differ from the single render"
+        );
+    }
+}
+
+/// Each bad set of parts: exit 2, a message naming the culprit, and the output left as it
+/// was (absent here, or its old bytes).
+#[test]
+fn bad_part_sets_exit_2_and_write_nothing() {
+    let dir = scratch("bad");
+    let scene = lambertian();
+    let part = |name: &str, extra: &[&str]| {
+        let p = dir.join(name);
+        let mut args = vec!["render", scene.as_str(), "-s", "4"];
+        args.extend(SMALL);
+        ok(run(args[0], &args[1..], extra, &p));
+        p
+    };
+    let a = part("a.exr", &["--tile", "0/2"]);
+    let b = part("b.exr", &["--tile", "1/2"]);
+    let seed = part("seed.exr", &["--tile", "1/2", "--seed", "9"]);
+    let cornell = {
+        let p = dir.join("cornell.exr");
+        ok(run(
+            "render",
+            &["-s", "4", "-r", "100", "70", "--tile", "1/2"],
+            &[],
+            &p,
+        ));
+        p
+    };
+    let three = part("three.exr", &["--tile", "1/3"]);
+    let low = part("low.exr", &["--tile", "1/2", "--samples-to", "2"]);
+    let high = part("high.exr", &["--tile", "1/2", "--samples-from", "1"]);
+    let plain = dir.join("plain.exr");
+    ok(run(
+        "render",
+        &["-s", "1", "-r", "100", "70", "--integrator", "normals"],
+        &[],
+        &plain,
+    ));
+    let bytes = std::fs::read(&b).unwrap();
+    let truncated = dir.join("truncated.exr");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let flipped = dir.join("flipped.exr");
+    let mut f = bytes.clone();
+    let at = f.len() - 40;
+    f[at] ^= 0x55;
+    std::fs::write(&flipped, &f).unwrap();
+    let relabelled = dir.join("relabelled.exr");
+    let text = b"prism.part\0string\0";
+    let at = bytes.windows(text.len()).position(|w| w == text).unwrap() + text.len() + 4;
+    let mut r = bytes.clone();
+    assert_eq!(&r[at..at + 3], b"1/2");
+    r[at] = b'0';
+    std::fs::write(&relabelled, &r).unwrap();
+    let cases: Vec<(Vec<&PathBuf>, &str)> = vec![
+        (vec![&a], "missing part: tiles 1/2, samples 0..4"),
+        (vec![&a, &b, &b], "b.exr repeats tiles 1/2, samples 0..4 of"),
+        (
+            vec![&a, &low, &high],
+            "high.exr repeats tiles 1/2, samples 1..2 of",
+        ),
+        (vec![&a, &low], "missing part: tiles 1/2, samples 2..4"),
+        (vec![&a, &seed], "seed.exr: seed is 9, but"),
+        (vec![&a, &cornell], "cornell.exr: scene is"),
+        (
+            vec![&a, &three],
+            "three.exr: the tile share count is 3, but",
+        ),
+        (
+            vec![&a, &plain],
+            "plain.exr: not a prism part file: it has no attribute prism.",
+        ),
+        (vec![&a, &truncated], "truncated.exr"),
+        (vec![&a, &flipped], "flipped.exr"),
+        (vec![&a, &relabelled], "relabelled.exr: corrupt: pixel"),
+    ];
+    let out = dir.join("out.png");
+    for (parts, message) in &cases {
+        let parts: Vec<PathBuf> = parts.iter().map(|p| (*p).clone()).collect();
+        let o = merge(&parts, &out, &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{parts:?}: {err}");
+        assert!(
+            err.contains(message),
+            "{parts:?}: expected `{message}` in {err}"
+        );
+        assert!(!out.exists(), "{parts:?} wrote an output");
+    }
+    // An old output survives a refused merge.
+    std::fs::write(&out, b"old").unwrap();
+    assert_eq!(merge(&[a.clone()], &out, &[]).status.code(), Some(2));
+    assert_eq!(std::fs::read(&out).unwrap(), b"old");
+    // --allow-missing paints the holes magenta and says which shares are missing.
+    let o = ok(merge(&[a.clone()], &out, &["--allow-missing"]));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing tiles 1/2, samples 0..4"));
+    let img = prism_image::read_png(&out).unwrap();
+    assert_eq!(img.get(40, 0), [255, 0, 255, 255], "tile 1 is a hole");
+    assert_ne!(img.get(0, 0), [255, 0, 255, 255], "tile 0 is rendered");
+}
+
+/// Split flags that cannot work are refused before rendering, with exit 2.
+#[test]
+fn impossible_splits_are_refused() {
+    let dir = scratch("refused");
+    let scene = lambertian();
+    let cases: [(&[&str], &str, &str); 6] = [
+        (
+            &["--samples-to", "2", "--adaptive", "0.1"],
+            "p.exr",
+            "adaptive sampling decides per pixel",
+        ),
+        (&["--tile", "0/2"], "p.png", "a part file, an OpenEXR file"),
+        (&["--tile", "2/2"], "p.exr", "expected I/N"),
+        (
+            &["--samples-from", "3", "--samples-to", "3"],
+            "p.exr",
+            "expected 0 <= FROM < TO",
+        ),
+        (
+            &["--samples-to", "9"],
+            "p.exr",
+            "expected 0 <= FROM < TO <= --spp (4)",
+        ),
+        (
+            &["--tile", "0/2", "--exr", "x.exr"],
+            "p.exr",
+            "--exr: a split render",
+        ),
+    ];
+    for (extra, out, message) in cases {
+        let out = dir.join(out);
+        let o = run("render", &[scene.as_str(), "-s", "4"], extra, &out);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(
+            err.contains(message),
+            "{extra:?}: expected `{message}` in {err}"
+        );
+        assert!(!out.exists());
+    }
+    let o = run(
+        "raytrace",
+        &["--tile", "0/2", "--debug-pixel", "1,1"],
+        &[],
+        &dir.join("w.exr"),
+    );
+    assert_eq!(o.status.code(), Some(2));
+}

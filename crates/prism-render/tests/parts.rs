@@ -1,0 +1,186 @@
+//! Split renders in the library: shares partition the tiles, part files read back what was
+//! written, part data that contradicts its share is refused, and merging equals the whole
+//! render whatever the order of the parts.
+
+use std::path::PathBuf;
+
+use prism_image::ExrSamples;
+use prism_render::{
+    merge, render_share, tile_of, tiles, Part, PartError, RenderOptions, RenderScene, Share,
+};
+
+fn options() -> RenderOptions {
+    RenderOptions {
+        width: 75,
+        height: 40,
+        spp: 5,
+        seed: 11,
+        ..RenderOptions::default()
+    }
+}
+
+fn identity(opts: &RenderOptions) -> Vec<(String, String)> {
+    [
+        ("kind", "render".to_string()),
+        ("width", opts.width.to_string()),
+        ("height", opts.height.to_string()),
+        ("spp", opts.spp.to_string()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
+}
+
+/// Property: for every tile count and share count, each tile is in exactly one share, the
+/// shares' tile counts differ by at most one, and `tile_of` finds each pixel's tile.
+#[test]
+fn shares_partition_the_tiles_evenly() {
+    for (w, h) in [(1, 1), (31, 33), (100, 70), (512, 384)] {
+        let all = tiles(w, h);
+        for (k, &(x0, y0)) in all.iter().enumerate() {
+            assert_eq!(tile_of(x0, y0, w), k);
+            assert_eq!(tile_of((x0 + 31).min(w - 1), (y0 + 31).min(h - 1), w), k);
+        }
+        for n in 1..=9u32 {
+            let counts: Vec<usize> = (0..n)
+                .map(|part| {
+                    let s = Share {
+                        part,
+                        parts: n,
+                        samples: 0..1,
+                    };
+                    (0..all.len()).filter(|&k| s.has_tile(k)).count()
+                })
+                .collect();
+            assert_eq!(counts.iter().sum::<usize>(), all.len());
+            let (lo, hi) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
+            assert!(hi - lo <= 1, "{w}x{h} in {n}: {counts:?}");
+        }
+    }
+}
+
+/// Oracle: the whole render's sums. Three tile shares, each split in two sample ranges,
+/// written to part files and read back, merge (in any order) to the whole render's sample
+/// counts, and to its radiance sums within float summation order.
+#[test]
+fn parts_round_trip_and_merge_to_the_whole_render() {
+    let scene = RenderScene::new(&prism_scene::cornell_box());
+    let opts = options();
+    let whole = render_share(&scene, &opts, &Share::whole(opts.spp), &|_| {});
+    let dir = std::env::temp_dir().join(format!("prism-parts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut parts = Vec::new();
+    for part in 0..3 {
+        for samples in [0..2, 2..5] {
+            let share = Share {
+                part,
+                parts: 3,
+                samples,
+            };
+            let sums = render_share(&scene, &opts, &share, &|_| {});
+            let p = Part::new(identity(&opts), share, sums);
+            let file = dir.join(format!("p{part}-{}.exr", p.share.samples.start));
+            p.write(&file).unwrap();
+            let back = Part::read(&file).unwrap();
+            assert_eq!((&back.identity, &back.share), (&p.identity, &p.share));
+            for (a, b) in back.sums.pixels().iter().zip(p.sums.pixels()) {
+                assert_eq!((a.sum, a.n), (b.sum, b.n));
+                assert_eq!(a.moment1, f64::from(b.moment1 as f32));
+            }
+            parts.push((file, back));
+        }
+    }
+    let forward = merge(&parts, false).unwrap();
+    parts.reverse();
+    let backward = merge(&parts, false).unwrap();
+    assert!(forward.holes.is_empty());
+    for ((f, b), w) in forward
+        .sums
+        .pixels()
+        .iter()
+        .zip(backward.sums.pixels())
+        .zip(whole.pixels())
+    {
+        assert_eq!((f.sum, f.n), (b.sum, b.n), "the order of the parts matters");
+        assert_eq!(f.n, w.n);
+        for (x, y) in f.sum.to_array().into_iter().zip(w.sum.to_array()) {
+            assert!((x - y).abs() <= 1e-5 * y.abs().max(1e-3), "{x} against {y}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A part whose pixel data contradicts its share is refused, naming the pixel: data in a
+/// tile outside the share, a pixel of the share with no samples, more samples than its
+/// range holds, a sum that is not finite.
+#[test]
+fn part_data_must_fit_the_share() {
+    let scene = RenderScene::new(&prism_scene::cornell_box());
+    let opts = options();
+    let share = Share {
+        part: 1,
+        parts: 2,
+        samples: 1..3,
+    };
+    let sums = render_share(&scene, &opts, &share, &|_| {});
+    let good = Part::new(identity(&opts), share, sums).to_exr();
+    let file = PathBuf::from("p.exr");
+    assert!(Part::from_exr(&good, &file).is_ok());
+    let set = |name: &str, x: usize, value: f32| {
+        let mut l = good.clone();
+        for (n, c) in &mut l.channels {
+            match c {
+                ExrSamples::Float(v) if n == name => v[x] = value,
+                ExrSamples::Uint(v) if n == name => v[x] = value as u32,
+                _ => {}
+            }
+        }
+        Part::from_exr(&l, &file)
+    };
+    // Pixel 0 is in tile 0 (share 0); pixel 40 in tile 1 (share 1).
+    let cases = [
+        (
+            "sum.G",
+            0,
+            0.5,
+            "pixel (0, 0) holds data, but its tile is not in share 1/2",
+        ),
+        (
+            "samples",
+            40,
+            0.0,
+            "pixel (40, 0) holds 0 samples; its share takes 1 to 2",
+        ),
+        ("samples", 40, 3.0, "pixel (40, 0) holds 3 samples"),
+        (
+            "sum.R",
+            40,
+            f32::NAN,
+            "pixel (40, 0) holds a sum that is not finite",
+        ),
+    ];
+    for (channel, x, value, message) in cases {
+        match set(channel, x, value) {
+            Err(e @ PartError::Corrupt { .. }) => {
+                assert!(e.to_string().contains(message), "{e}");
+            }
+            other => panic!("{channel}[{x}] = {value}: {other:?}"),
+        }
+    }
+    let mut l = good.clone();
+    l.attributes.retain(|(k, _)| k != "prism.spp");
+    assert!(matches!(
+        Part::from_exr(&l, &file),
+        Err(PartError::NotAPart { .. })
+    ));
+    let mut l = good;
+    for (k, v) in &mut l.attributes {
+        if k == "prism.samples" {
+            *v = "1..9".into();
+        }
+    }
+    assert!(matches!(
+        Part::from_exr(&l, &file),
+        Err(PartError::BadAttribute { .. })
+    ));
+}
