@@ -290,10 +290,10 @@ fn bad_part_sets_exit_2_and_write_nothing() {
     }
     // An old output survives a refused merge.
     std::fs::write(&out, b"old").unwrap();
-    assert_eq!(merge(&[a.clone()], &out, &[]).status.code(), Some(2));
+    assert_eq!(merge(std::slice::from_ref(&a), &out, &[]).status.code(), Some(2));
     assert_eq!(std::fs::read(&out).unwrap(), b"old");
     // --allow-missing paints the holes magenta and says which shares are missing.
-    let o = ok(merge(&[a.clone()], &out, &["--allow-missing"]));
+    let o = ok(merge(std::slice::from_ref(&a), &out, &["--allow-missing"]));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing tiles 1/2, samples 0..4"));
     let img = prism_image::read_png(&out).unwrap();
     assert_eq!(img.get(40, 0), [255, 0, 255, 255], "tile 1 is a hole");
