@@ -477,11 +477,32 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             })
             .sum();
         let bar = crate::progress::samples_bar(pixels * share.samples.len() as u64, a.quiet);
+        let t2 = Instant::now();
         let sums = pool
             .install(|| render_share(&prepared, &options, &share, &|done| bar.set_position(done)));
+        let render_time = t2.elapsed();
         bar.finish_and_clear();
-        let part = Part::new(identity(&scene, &options), share, sums);
-        return crate::split::write_part(&part, &a.output, a.quiet, t0);
+        let t3 = Instant::now();
+        let fingerprint = Instant::now();
+        let identity = identity(&scene, &options);
+        let fingerprint = fingerprint.elapsed();
+        let part = Part::new(identity, share, sums);
+        crate::split::write_part(&part, &a.output, a.quiet, t0)?;
+        if a.stats {
+            let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+            let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
+            eprintln!("read: {:.1} ms", ms(read));
+            eprintln!("build: {:.1} ms", ms(build));
+            eprintln!("render: {:.1} ms", ms(render_time));
+            eprintln!("fingerprint: {:.1} ms", ms(fingerprint));
+            eprintln!("write: {:.1} ms", ms(t3.elapsed()));
+            eprintln!("samples: {samples}");
+            eprintln!(
+                "samples/s: {:.0}",
+                samples as f64 / render_time.as_secs_f64()
+            );
+        }
+        return Ok(());
     }
     let bar = crate::progress::samples_bar(u64::from(w) * u64::from(h) * u64::from(a.spp), a.quiet);
     let t2 = Instant::now();

@@ -8,7 +8,7 @@ use anyhow::Result;
 use clap::Args;
 use prism_image::{Bloom, Image};
 use prism_math::Rgb;
-use prism_render::{merge, Part, PixelSum};
+use prism_render::{merge, Part, PartFile, PixelSum};
 
 use crate::output::{image_output, ImageFormat};
 use crate::UserError;
@@ -62,10 +62,10 @@ pub fn write_part(part: &Part, output: &Path, quiet: bool, started: Instant) -> 
         let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
         eprintln!(
             "prism: part {}/{} (samples {}..{}), {:.2} M samples in {:.1} s -> {}",
-            part.share.part,
-            part.share.parts,
-            part.share.samples.start,
-            part.share.samples.end,
+            part.header.share.part,
+            part.header.share.parts,
+            part.header.share.samples.start,
+            part.header.share.samples.end,
             samples as f64 / 1e6,
             started.elapsed().as_secs_f64(),
             output.display()
@@ -119,8 +119,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         .transpose()?;
     let mut parts = Vec::with_capacity(a.parts.len());
     for path in &a.parts {
-        let part = Part::read(path).map_err(|e| UserError(e.to_string()))?;
-        parts.push((path.clone(), part));
+        parts.push(PartFile::open(path).map_err(|e| UserError(e.to_string()))?);
     }
     let merged = merge(&parts, a.allow_missing).map_err(|e| UserError(e.to_string()))?;
     drop(parts);

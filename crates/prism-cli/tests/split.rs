@@ -244,16 +244,18 @@ fn bad_part_sets_exit_2_and_write_nothing() {
     std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
     let flipped = dir.join("flipped.exr");
     let mut f = bytes.clone();
-    let at = f.len() - 40;
-    f[at] ^= 0x55;
+    let at = f.len() / 2;
+    f[at..at + 16].fill(0xff);
     std::fs::write(&flipped, &f).unwrap();
-    let relabelled = dir.join("relabelled.exr");
-    let text = b"prism.part\0string\0";
-    let at = bytes.windows(text.len()).position(|w| w == text).unwrap() + text.len() + 4;
-    let mut r = bytes.clone();
-    assert_eq!(&r[at..at + 3], b"1/2");
-    r[at] = b'0';
-    std::fs::write(&relabelled, &r).unwrap();
+    // A sample count the share cannot hold, in an otherwise valid file.
+    let tampered = dir.join("tampered.exr");
+    let mut layers = prism_image::decode_exr_layers(&bytes, "b").unwrap();
+    for (name, c) in &mut layers.channels {
+        if let (true, prism_image::ExrSamples::Uint(v)) = (name == "samples", c) {
+            v[32] = 9;
+        }
+    }
+    std::fs::write(&tampered, prism_image::encode_exr_layers(&layers)).unwrap();
     let cases: Vec<(Vec<&PathBuf>, &str)> = vec![
         (vec![&a], "missing part: tiles 1/2, samples 0..4"),
         (vec![&a, &b, &b], "b.exr repeats tiles 1/2, samples 0..4 of"),
@@ -274,7 +276,10 @@ fn bad_part_sets_exit_2_and_write_nothing() {
         ),
         (vec![&a, &truncated], "truncated.exr"),
         (vec![&a, &flipped], "flipped.exr"),
-        (vec![&a, &relabelled], "relabelled.exr: corrupt: pixel"),
+        (
+            vec![&a, &tampered],
+            "tampered.exr: corrupt: pixel (32, 0) holds 9 samples; its share takes 1 to 4",
+        ),
     ];
     let out = dir.join("out.png");
     for (parts, message) in &cases {
@@ -290,7 +295,10 @@ fn bad_part_sets_exit_2_and_write_nothing() {
     }
     // An old output survives a refused merge.
     std::fs::write(&out, b"old").unwrap();
-    assert_eq!(merge(std::slice::from_ref(&a), &out, &[]).status.code(), Some(2));
+    assert_eq!(
+        merge(std::slice::from_ref(&a), &out, &[]).status.code(),
+        Some(2)
+    );
     assert_eq!(std::fs::read(&out).unwrap(), b"old");
     // --allow-missing paints the holes magenta and says which shares are missing.
     let o = ok(merge(std::slice::from_ref(&a), &out, &["--allow-missing"]));

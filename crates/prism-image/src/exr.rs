@@ -96,7 +96,7 @@ fn zip(raw: &[u8]) -> Vec<u8> {
     for i in (1..t.len()).rev() {
         t[i] = t[i].wrapping_sub(t[i - 1]).wrapping_add(128);
     }
-    miniz_oxide::deflate::compress_to_vec_zlib(&t, 4)
+    miniz_oxide::deflate::compress_to_vec_zlib(&t, 1)
 }
 
 /// The one encoder: channels sorted by name, then the standard attributes and the string
@@ -301,17 +301,20 @@ fn unzip(block: &[u8], expected: usize, what: &str) -> Result<Vec<u8>, ImageErro
         return Err(decode_err(what, "a ZIP block inflates to the wrong size"));
     }
     let mut t = t;
-    for i in 1..t.len() {
-        t[i] = t[i - 1].wrapping_add(t[i]).wrapping_sub(128);
+    let mut prev = 128u8;
+    for v in &mut t {
+        // The first byte is stored as is: 128 + v - 128.
+        *v = prev.wrapping_add(*v).wrapping_sub(128);
+        prev = *v;
     }
-    let half = t.len().div_ceil(2);
+    let (even, odd) = t.split_at(t.len().div_ceil(2));
     let mut out = vec![0u8; t.len()];
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = if i % 2 == 0 {
-            t[i / 2]
-        } else {
-            t[half + i / 2]
-        };
+    for ((pair, e), o) in out.chunks_exact_mut(2).zip(even).zip(odd) {
+        pair[0] = *e;
+        pair[1] = *o;
+    }
+    if even.len() > odd.len() {
+        out[t.len() - 1] = even[even.len() - 1];
     }
     Ok(out)
 }
@@ -342,6 +345,20 @@ pub fn decode_exr(data: &[u8], what: &str) -> Result<RgbImage, ImageError> {
 /// # Errors
 /// As [`decode_exr`].
 pub fn decode_exr_layers(data: &[u8], what: &str) -> Result<ExrLayers, ImageError> {
+    decode(data, what, true)
+}
+
+/// Decodes an OpenEXR file's header only: its size, its channels' names and types (each
+/// holding no samples) and its string attributes.
+///
+/// # Errors
+/// As [`decode_exr`], for the header.
+pub fn decode_exr_header(data: &[u8], what: &str) -> Result<ExrLayers, ImageError> {
+    decode(data, what, false)
+}
+
+/// The one decoder: the header, then the pixels if `pixels`.
+fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError> {
     let mut b = Bytes { data, at: 0, what };
     if b.take(4)? != [0x76, 0x2f, 0x31, 0x01] {
         return Err(decode_err(what, "expected the OpenEXR signature"));
@@ -448,6 +465,23 @@ pub fn decode_exr_layers(data: &[u8], what: &str) -> Result<ExrLayers, ImageErro
         };
         layout.push((*ty, line_bytes));
         line_bytes += size * w;
+    }
+    if !pixels {
+        return Ok(ExrLayers {
+            width: w as u32,
+            height: h as u32,
+            channels: channels
+                .into_iter()
+                .map(|(n, ty)| {
+                    let empty = match ty {
+                        0 => ExrSamples::Uint(Vec::new()),
+                        _ => ExrSamples::Float(Vec::new()),
+                    };
+                    (n, empty)
+                })
+                .collect(),
+            attributes,
+        });
     }
     // zlib expands at most about 1032 to 1: a file too small for its pixels is refused
     // before they are allocated.
@@ -619,6 +653,12 @@ mod tests {
         sorted.channels.sort_by(|a, b| a.0.cmp(&b.0));
         assert_eq!(back, sorted);
         assert_eq!(back.attribute("prism.tile"), Some("2/7"));
+        let head = decode_exr_header(&bytes, "mem").unwrap();
+        assert_eq!((head.width, head.height), (w, h));
+        assert_eq!(head.attributes, back.attributes);
+        let names: Vec<&str> = head.channels.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["B", "G", "R", "samples"]);
+        assert!(matches!(head.channel("samples"), Some(ExrSamples::Uint(v)) if v.is_empty()));
         assert!(bytes.len() < 4 * 6 * n, "constant channels compress");
         let rgb = decode_exr(&bytes, "mem").unwrap();
         assert_eq!(rgb.get(3, 5), Rgb::new(38.0 * 0.37, 1.5, -38.0));

@@ -21,8 +21,8 @@ pub use cubemap::{cube_face, CubeMap, CUBE_FACES};
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{
-    decode_exr, decode_exr_layers, encode_exr, encode_exr_layers, read_exr, read_exr_layers,
-    write_exr, write_exr_layers, ExrLayers, ExrSamples,
+    decode_exr, decode_exr_header, decode_exr_layers, encode_exr, encode_exr_layers, read_exr,
+    read_exr_layers, write_exr, write_exr_layers, ExrLayers, ExrSamples,
 };
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};

@@ -38,7 +38,7 @@ pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;
 pub use lights::{LightSample, MeshLight, RenderLight};
 pub use overlay::{palette, Overlay};
-pub use parts::{merge, Merged, Part, PartError};
+pub use parts::{merge, merge_order, Merged, Part, PartError, PartFile, PartHeader};
 pub use raytrace::{
     raytrace, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions, Raytraced,
 };

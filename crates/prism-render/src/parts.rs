@@ -91,40 +91,17 @@ pub enum PartError {
     NoParts,
 }
 
-/// One share of a render: its identity (every setting that changes pixels, by name), the
-/// share, and each pixel's sums (pixels outside the share hold none).
+/// What a part is a share of: the render's identity (every setting that changes pixels, by
+/// name) and the share.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Part {
+pub struct PartHeader {
     /// Settings by name (`kind`, `width`, `height`, `spp`, `scene`, ...), sorted by name.
     pub identity: Vec<(String, String)>,
     /// The tiles and samples this part holds.
     pub share: Share,
-    /// Each pixel's sums.
-    pub sums: Image<PixelSum>,
 }
 
-impl Part {
-    /// A part of a render whose settings are `identity`; it must hold `kind`, `width`,
-    /// `height` and `spp`.
-    ///
-    /// # Panics
-    /// If a required identity key is missing.
-    #[must_use]
-    pub fn new(mut identity: Vec<(String, String)>, share: Share, sums: Image<PixelSum>) -> Part {
-        identity.sort();
-        for k in REQUIRED {
-            assert!(
-                identity.iter().any(|(n, _)| n == k),
-                "a part's identity needs {k}"
-            );
-        }
-        Part {
-            identity,
-            share,
-            sums,
-        }
-    }
-
+impl PartHeader {
     /// The identity setting `key`.
     #[must_use]
     pub fn setting(&self, key: &str) -> Option<&str> {
@@ -134,74 +111,13 @@ impl Part {
             .map(|(_, v)| v.as_str())
     }
 
-    /// The part as OpenEXR channels and attributes: `R`, `G`, `B` the mean radiance (what
-    /// other tools show), `sum.R`, `sum.G`, `sum.B` the radiance sums, `Y.sum` and
-    /// `Y.sumsq` the luminance moments (rounded to 32-bit floats), `samples` the sample count;
-    /// attributes `prism.<key>` for the identity, `prism.part` (`I/N`) and `prism.samples`
-    /// (`A..B`).
-    #[must_use]
-    pub fn to_exr(&self) -> ExrLayers {
-        let p = self.sums.pixels();
-        let float = |f: &dyn Fn(&PixelSum) -> f32| ExrSamples::Float(p.iter().map(f).collect());
-        let mut attributes: Vec<(String, String)> = self
-            .identity
-            .iter()
-            .map(|(k, v)| (format!("{PREFIX}{k}"), v.clone()))
-            .collect();
-        attributes.push((
-            PART.into(),
-            format!("{}/{}", self.share.part, self.share.parts),
-        ));
-        attributes.push((
-            SAMPLES.into(),
-            format!("{}..{}", self.share.samples.start, self.share.samples.end),
-        ));
-        ExrLayers {
-            width: self.sums.width(),
-            height: self.sums.height(),
-            channels: vec![
-                ("R".into(), float(&|s| s.mean().r)),
-                ("G".into(), float(&|s| s.mean().g)),
-                ("B".into(), float(&|s| s.mean().b)),
-                ("sum.R".into(), float(&|s| s.sum.r)),
-                ("sum.G".into(), float(&|s| s.sum.g)),
-                ("sum.B".into(), float(&|s| s.sum.b)),
-                ("Y.sum".into(), float(&|s| s.moment1 as f32)),
-                ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
-                (
-                    "samples".into(),
-                    ExrSamples::Uint(p.iter().map(|s| s.n).collect()),
-                ),
-            ],
-            attributes,
-        }
-    }
-
-    /// Writes the part (see [`Part::to_exr`]) atomically: a re-run part replaces the old
-    /// file whole or not at all.
-    ///
-    /// # Errors
-    /// [`PartError::Image`] if the file cannot be written.
-    pub fn write(&self, path: &Path) -> Result<(), PartError> {
-        Ok(prism_image::write_exr_layers(path, &self.to_exr())?)
-    }
-
-    /// Reads a part file, checking its attributes and that every pixel's data fits its share
-    /// (see [`Part::from_exr`]).
-    ///
-    /// # Errors
-    /// [`PartError::Image`] if it cannot be read or decoded, else as [`Part::from_exr`].
-    pub fn read(path: &Path) -> Result<Part, PartError> {
-        Part::from_exr(&prism_image::read_exr_layers(path)?, path)
-    }
-
-    /// The part held in OpenEXR channels and attributes; `file` names it in errors.
+    /// The header held in an OpenEXR file's attributes (the channels need hold no samples);
+    /// `file` names it in errors.
     ///
     /// # Errors
     /// [`PartError::NotAPart`] without the attributes and channels of a part,
-    /// [`PartError::BadAttribute`] for a malformed one, [`PartError::Corrupt`] for a pixel
-    /// whose sample count or sums contradict the share.
-    pub fn from_exr(layers: &ExrLayers, file: &Path) -> Result<Part, PartError> {
+    /// [`PartError::BadAttribute`] for a malformed attribute.
+    pub fn from_exr(layers: &ExrLayers, file: &Path) -> Result<PartHeader, PartError> {
         let not_a_part = |what: &str| PartError::NotAPart {
             file: file.to_path_buf(),
             what: what.to_string(),
@@ -252,20 +168,135 @@ impl Part {
             .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
             .filter(|r| r.start < r.end && r.end <= spp)
             .ok_or_else(|| bad(SAMPLES, samples_text, "A..B with 0 <= A < B <= prism.spp"))?;
-        let float = |name: &str| match layers.channel(name) {
-            Some(ExrSamples::Float(v)) => Ok(v),
-            _ => Err(not_a_part(&format!("float channel {name}"))),
-        };
-        let (r, g, b) = (float("sum.R")?, float("sum.G")?, float("sum.B")?);
-        let (m1, m2) = (float("Y.sum")?, float("Y.sumsq")?);
-        let Some(ExrSamples::Uint(n)) = layers.channel("samples") else {
+        for name in ["sum.R", "sum.G", "sum.B", "Y.sum", "Y.sumsq"] {
+            if !matches!(layers.channel(name), Some(ExrSamples::Float(_))) {
+                return Err(not_a_part(&format!("float channel {name}")));
+            }
+        }
+        if !matches!(layers.channel("samples"), Some(ExrSamples::Uint(_))) {
             return Err(not_a_part("uint channel samples"));
+        }
+        Ok(PartHeader {
+            identity,
+            share: Share {
+                part,
+                parts,
+                samples,
+            },
+        })
+    }
+}
+
+/// One share of a render: its header and each pixel's sums (pixels outside the share hold
+/// none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Part {
+    /// The render and the share.
+    pub header: PartHeader,
+    /// Each pixel's sums.
+    pub sums: Image<PixelSum>,
+}
+
+impl Part {
+    /// A part of a render whose settings are `identity`; it must hold `kind`, `width`,
+    /// `height` and `spp`.
+    ///
+    /// # Panics
+    /// If a required identity key is missing.
+    #[must_use]
+    pub fn new(mut identity: Vec<(String, String)>, share: Share, sums: Image<PixelSum>) -> Part {
+        identity.sort();
+        for k in REQUIRED {
+            assert!(
+                identity.iter().any(|(n, _)| n == k),
+                "a part's identity needs {k}"
+            );
+        }
+        Part {
+            header: PartHeader { identity, share },
+            sums,
+        }
+    }
+
+    /// The part as OpenEXR channels and attributes: `R`, `G`, `B` the mean radiance (what
+    /// other tools show), `sum.R`, `sum.G`, `sum.B` the radiance sums, `Y.sum` and
+    /// `Y.sumsq` the luminance moments (rounded to 32-bit floats), `samples` the sample count;
+    /// attributes `prism.<key>` for the identity, `prism.part` (`I/N`) and `prism.samples`
+    /// (`A..B`).
+    #[must_use]
+    pub fn to_exr(&self) -> ExrLayers {
+        let p = self.sums.pixels();
+        let float = |f: &dyn Fn(&PixelSum) -> f32| ExrSamples::Float(p.iter().map(f).collect());
+        let h = &self.header;
+        let mut attributes: Vec<(String, String)> = h
+            .identity
+            .iter()
+            .map(|(k, v)| (format!("{PREFIX}{k}"), v.clone()))
+            .collect();
+        attributes.push((PART.into(), format!("{}/{}", h.share.part, h.share.parts)));
+        attributes.push((
+            SAMPLES.into(),
+            format!("{}..{}", h.share.samples.start, h.share.samples.end),
+        ));
+        ExrLayers {
+            width: self.sums.width(),
+            height: self.sums.height(),
+            channels: vec![
+                ("R".into(), float(&|s| s.mean().r)),
+                ("G".into(), float(&|s| s.mean().g)),
+                ("B".into(), float(&|s| s.mean().b)),
+                ("sum.R".into(), float(&|s| s.sum.r)),
+                ("sum.G".into(), float(&|s| s.sum.g)),
+                ("sum.B".into(), float(&|s| s.sum.b)),
+                ("Y.sum".into(), float(&|s| s.moment1 as f32)),
+                ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
+                (
+                    "samples".into(),
+                    ExrSamples::Uint(p.iter().map(|s| s.n).collect()),
+                ),
+            ],
+            attributes,
+        }
+    }
+
+    /// Writes the part (see [`Part::to_exr`]) atomically: a re-run part replaces the old
+    /// file whole or not at all.
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if the file cannot be written.
+    pub fn write(&self, path: &Path) -> Result<(), PartError> {
+        Ok(prism_image::write_exr_layers(path, &self.to_exr())?)
+    }
+
+    /// Reads a part file, checking its attributes and that every pixel's data fits its share
+    /// (see [`Part::from_exr`]).
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if it cannot be read or decoded, else as [`Part::from_exr`].
+    pub fn read(path: &Path) -> Result<Part, PartError> {
+        Part::from_exr(&prism_image::read_exr_layers(path)?, path)
+    }
+
+    /// The part held in OpenEXR channels and attributes; `file` names it in errors.
+    ///
+    /// # Errors
+    /// [`PartError::NotAPart`] without the attributes and channels of a part,
+    /// [`PartError::BadAttribute`] for a malformed one, [`PartError::Corrupt`] for a pixel
+    /// whose sample count or sums contradict the share.
+    pub fn from_exr(layers: &ExrLayers, file: &Path) -> Result<Part, PartError> {
+        let header = PartHeader::from_exr(layers, file)?;
+        let float = |name: &str| match layers.channel(name) {
+            Some(ExrSamples::Float(v)) => v,
+            _ => unreachable!("the header check found float channel {name}"),
         };
-        let share = Share {
-            part,
-            parts,
-            samples,
+        let (r, g, b) = (float("sum.R"), float("sum.G"), float("sum.B"));
+        let (m1, m2) = (float("Y.sum"), float("Y.sumsq"));
+        let Some(ExrSamples::Uint(n)) = layers.channel("samples") else {
+            unreachable!("the header check found uint channel samples")
         };
+        let (width, height) = (layers.width, layers.height);
+        let share = &header.share;
+        let (part, parts) = (share.part, share.parts);
         let most = share.samples.len() as u32;
         let mut sums = Image::new(width, height, PixelSum::default());
         for y in 0..height {
@@ -302,11 +333,48 @@ impl Part {
                 sums.set(x, y, s);
             }
         }
-        Ok(Part {
-            identity,
-            share,
-            sums,
+        Ok(Part { header, sums })
+    }
+}
+
+/// A part file opened for merging: its header read and checked, its pixels decoded only
+/// when merged, one part at a time.
+#[derive(Clone, Debug)]
+pub struct PartFile {
+    /// The file.
+    pub path: PathBuf,
+    /// What it is a share of.
+    pub header: PartHeader,
+    bytes: Vec<u8>,
+}
+
+impl PartFile {
+    /// Reads a part file and checks its header.
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if it cannot be read or is not an OpenEXR file prism reads, else
+    /// as [`PartHeader::from_exr`].
+    pub fn open(path: &Path) -> Result<PartFile, PartError> {
+        let bytes = std::fs::read(path).map_err(|source| ImageError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let layers = prism_image::decode_exr_header(&bytes, &path.display().to_string())?;
+        Ok(PartFile {
+            path: path.to_path_buf(),
+            header: PartHeader::from_exr(&layers, path)?,
+            bytes,
         })
+    }
+
+    /// Decodes the part's pixels and checks them against its share.
+    ///
+    /// # Errors
+    /// As [`Part::from_exr`], or [`PartError::Image`] if the pixels do not decode.
+    pub fn load(&self) -> Result<Part, PartError> {
+        let what = self.path.display().to_string();
+        let layers = prism_image::decode_exr_layers(&self.bytes, &what)?;
+        Part::from_exr(&layers, &self.path)
     }
 }
 
@@ -321,26 +389,25 @@ pub struct Merged {
     pub holes: Vec<String>,
 }
 
-/// Checks that `parts` (each with the file it came from) are shares of one render, every
-/// tile and sample exactly once, and adds them up. Each pixel adds its parts in the order of
-/// their first sample, whatever the order given, so a tile split gives exactly the sums of
-/// the whole render. With `allow_missing`, missing shares are listed in
-/// [`Merged::holes`] instead of refused.
+/// The order in which `headers` are added (by share, then first sample), after checking
+/// that they are shares of one render and cover every tile and sample at most once; the
+/// shares no part holds are listed in the second value.
 ///
 /// # Errors
 /// [`PartError::NoParts`] for an empty set, [`PartError::Mismatch`] for parts of
-/// different renders or splits, [`PartError::Doubled`] for work held twice,
-/// [`PartError::Missing`] for work held nowhere.
-pub fn merge(parts: &[(PathBuf, Part)], allow_missing: bool) -> Result<Merged, PartError> {
-    let Some((first_file, first)) = parts.first() else {
+/// different renders or splits, [`PartError::Doubled`] for work held twice.
+pub fn merge_order(
+    headers: &[(&Path, &PartHeader)],
+) -> Result<(Vec<usize>, Vec<String>), PartError> {
+    let Some(&(first_file, first)) = headers.first() else {
         return Err(PartError::NoParts);
     };
-    for (file, p) in &parts[1..] {
+    for &(file, p) in &headers[1..] {
         let mismatch = |key: &str, found: String, expected: String| PartError::Mismatch {
-            file: file.clone(),
+            file: file.to_path_buf(),
             key: key.to_string(),
             found,
-            first: first_file.clone(),
+            first: first_file.to_path_buf(),
             expected,
         };
         let keys: std::collections::BTreeSet<&str> = first
@@ -369,20 +436,21 @@ pub fn merge(parts: &[(PathBuf, Part)], allow_missing: bool) -> Result<Merged, P
         .and_then(|v| v.parse().ok())
         .unwrap_or(0);
     let count = first.share.parts;
-    let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by_key(|&i| (parts[i].1.share.part, parts[i].1.share.samples.start));
+    let mut order: Vec<usize> = (0..headers.len()).collect();
+    order.sort_by_key(|&i| (headers[i].1.share.part, headers[i].1.share.samples.start));
     let mut holes = Vec::new();
     let describe = |part: u32, a: u32, b: u32| format!("tiles {part}/{count}, samples {a}..{b}");
+    let mut at = 0;
     for share in 0..count {
         let mut next = 0u32;
         let mut last: Option<usize> = None;
-        for &i in order.iter().filter(|&&i| parts[i].1.share.part == share) {
-            let r = &parts[i].1.share.samples;
+        while let Some(&i) = order.get(at).filter(|&&i| headers[i].1.share.part == share) {
+            let r = &headers[i].1.share.samples;
             if r.start < next {
                 let j = last.expect("an earlier part set `next`");
                 return Err(PartError::Doubled {
-                    first: parts[j].0.clone(),
-                    second: parts[i].0.clone(),
+                    first: headers[j].0.to_path_buf(),
+                    second: headers[i].0.to_path_buf(),
                     what: describe(share, r.start, next.min(r.end)),
                 });
             }
@@ -391,27 +459,53 @@ pub fn merge(parts: &[(PathBuf, Part)], allow_missing: bool) -> Result<Merged, P
             }
             next = r.end;
             last = Some(i);
+            at += 1;
         }
         if next < spp {
             holes.push(describe(share, next, spp));
         }
     }
+    Ok((order, holes))
+}
+
+/// Checks that `files` are shares of one render, every tile and sample exactly once, and
+/// adds them up, decoding one part at a time. Each pixel adds its parts in the order of
+/// their first sample, whatever the order given, so a tile split gives exactly the sums of
+/// the whole render. With `allow_missing`, missing shares are listed in [`Merged::holes`]
+/// instead of refused.
+///
+/// # Errors
+/// As [`merge_order`], [`PartError::Missing`] for work held nowhere, and as
+/// [`PartFile::load`] for a part whose pixels are corrupt.
+pub fn merge(files: &[PartFile], allow_missing: bool) -> Result<Merged, PartError> {
+    let headers: Vec<(&Path, &PartHeader)> = files
+        .iter()
+        .map(|f| (f.path.as_path(), &f.header))
+        .collect();
+    let (order, holes) = merge_order(&headers)?;
     if !holes.is_empty() && !allow_missing {
         return Err(PartError::Missing { holes });
     }
-    let (w, h) = (first.sums.width(), first.sums.height());
+    let first = &files[0].header;
+    let setting = |k: &str| first.setting(k).and_then(|v| v.parse::<u32>().ok());
+    let (w, h) = (
+        setting("width").unwrap_or(0),
+        setting("height").unwrap_or(0),
+    );
     let mut sums = Image::new(w, h, PixelSum::default());
-    for (k, &(x0, y0)) in tiles(w, h).iter().enumerate() {
-        let share = (k % count as usize) as u32;
-        for &i in order.iter().filter(|&&i| parts[i].1.share.part == share) {
-            let part = &parts[i].1.sums;
+    let all = tiles(w, h);
+    for i in order {
+        let part = files[i].load()?;
+        let share = &part.header.share;
+        for (_, &(x0, y0)) in all.iter().enumerate().filter(|&(k, _)| share.has_tile(k)) {
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..(x0 + TILE).min(w) {
+                    let add = part.sums.get(x, y);
                     let mut acc = sums.get(x, y);
                     if acc.n == 0 {
-                        acc = part.get(x, y);
+                        acc = add;
                     } else {
-                        acc.merge(&part.get(x, y));
+                        acc.merge(&add);
                     }
                     sums.set(x, y, acc);
                 }
