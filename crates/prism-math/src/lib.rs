@@ -1,10 +1,11 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
-//! boxes and frames, 4x4 transforms named destination-from-source, sixteen-lane numbers for
+//! boxes and frames, exact (order-independent) sums of floats, 4x4 transforms named destination-from-source, sixteen-lane numbers for
 //! SIMD kernels, warps with their densities, deterministic random numbers, and line numbers
 //! of byte offsets for the readers' error messages.
 #![warn(missing_docs)]
 
 mod color;
+mod exact;
 mod geometry;
 pub mod lanes;
 mod random;
@@ -13,6 +14,7 @@ mod transform;
 pub mod warp;
 
 pub use color::Rgb;
+pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
 pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};

@@ -5,7 +5,7 @@
 use std::ops::Range;
 
 use prism_image::Image;
-use prism_math::{Ray, Rgb};
+use prism_math::{ExactSum, Ray, Rgb};
 use rayon::prelude::*;
 
 use crate::camera::Perspective;
@@ -187,12 +187,14 @@ pub fn render_share(
     sums
 }
 
-/// A pixel's running sums: its radiance, and its illuminance's first two moments for
+/// A pixel's running sums: its radiance, exactly (so that samples split into ranges and
+/// summed in any order give the same bits), and its illuminance's first two moments for
 /// adaptive sampling.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelSum {
-    /// The sum of the radiance samples (a non-finite sample counts as black).
-    pub sum: Rgb,
+    /// The sums of the radiance samples' red, green and blue (a non-finite sample, or one of
+    /// [`ExactSum::LIMIT`] or more, counts as black).
+    pub sum: [ExactSum; 3],
     /// The sum of the samples' luminances.
     pub moment1: f64,
     /// The sum of the samples' squared luminances.
@@ -203,15 +205,26 @@ pub struct PixelSum {
 }
 
 impl PixelSum {
-    /// Adds a sample (a non-finite one counts as black), then checks convergence every
-    /// `batch` samples when sampling is adaptive.
-    pub(crate) fn add(&mut self, l: Rgb, opts: &RenderOptions) {
-        let l = if l.is_finite() { l } else { Rgb::BLACK };
-        self.sum += l;
+    /// Adds a sample (a non-finite or too large one counts as black).
+    pub(crate) fn accumulate(&mut self, l: Rgb) {
+        let fixed = |c: f32| ExactSum::fixed(c);
+        let (l, f) = match (fixed(l.r), fixed(l.g), fixed(l.b)) {
+            (Some(r), Some(g), Some(b)) => (l, [r, g, b]),
+            _ => (Rgb::BLACK, [0; 3]),
+        };
+        for (s, v) in self.sum.iter_mut().zip(f) {
+            s.0 += v;
+        }
         let i = f64::from(l.luminance());
         self.moment1 += i;
         self.moment2 += i * i;
         self.n += 1;
+    }
+
+    /// Adds a sample (as [`PixelSum::accumulate`]), then checks convergence every `batch`
+    /// samples when sampling is adaptive.
+    pub(crate) fn add(&mut self, l: Rgb, opts: &RenderOptions) {
+        self.accumulate(l);
         let n = self.n;
         if let Some(tol) = opts.adaptive {
             if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
@@ -232,7 +245,9 @@ impl PixelSum {
 
     /// Adds the sums of another share of this pixel's samples.
     pub fn merge(&mut self, other: &PixelSum) {
-        self.sum += other.sum;
+        for (s, o) in self.sum.iter_mut().zip(other.sum) {
+            *s += o;
+        }
         self.moment1 += other.moment1;
         self.moment2 += other.moment2;
         self.n += other.n;
@@ -241,10 +256,8 @@ impl PixelSum {
     /// The mean radiance (black without samples).
     #[must_use]
     pub fn mean(&self) -> Rgb {
-        if self.n == 0 {
-            return Rgb::BLACK;
-        }
-        self.sum * (1.0 / self.n as f32)
+        let [r, g, b] = self.sum.map(|s| s.mean(self.n));
+        Rgb::new(r, g, b)
     }
 }
 

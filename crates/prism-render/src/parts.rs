@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use prism_image::{ExrLayers, ExrSamples, Image, ImageError};
-use prism_math::Rgb;
+use prism_math::ExactSum;
 
 use crate::film::{tile_of, tiles, PixelSum, Share, TILE};
 
@@ -17,6 +17,12 @@ const PART: &str = "prism.part";
 const SAMPLES: &str = "prism.samples";
 /// Identity keys every part has: what it renders, its size and its samples per pixel.
 const REQUIRED: [&str; 4] = ["kind", "width", "height", "spp"];
+
+/// The channels of the exact radiance sums: for R, G and B, four 32-bit words each, least
+/// significant first.
+fn sum_channels() -> [[String; 4]; 3] {
+    ["R", "G", "B"].map(|c| [0, 1, 2, 3].map(|w| format!("sum.{c}.w{w}")))
+}
 
 /// What can be wrong with a part file or a set of them.
 #[derive(Debug, thiserror::Error)]
@@ -168,13 +174,20 @@ impl PartHeader {
             .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
             .filter(|r| r.start < r.end && r.end <= spp)
             .ok_or_else(|| bad(SAMPLES, samples_text, "A..B with 0 <= A < B <= prism.spp"))?;
-        for name in ["sum.R", "sum.G", "sum.B", "Y.sum", "Y.sumsq"] {
+        for name in ["Y.sum", "Y.sumsq"] {
             if !matches!(layers.channel(name), Some(ExrSamples::Float(_))) {
                 return Err(not_a_part(&format!("float channel {name}")));
             }
         }
-        if !matches!(layers.channel("samples"), Some(ExrSamples::Uint(_))) {
-            return Err(not_a_part("uint channel samples"));
+        for name in sum_channels()
+            .iter()
+            .flatten()
+            .map(String::as_str)
+            .chain(["samples"])
+        {
+            if !matches!(layers.channel(name), Some(ExrSamples::Uint(_))) {
+                return Err(not_a_part(&format!("uint channel {name}")));
+            }
         }
         Ok(PartHeader {
             identity,
@@ -219,8 +232,9 @@ impl Part {
     }
 
     /// The part as OpenEXR channels and attributes: `R`, `G`, `B` the mean radiance (what
-    /// other tools show), `sum.R`, `sum.G`, `sum.B` the radiance sums, `Y.sum` and
-    /// `Y.sumsq` the luminance moments (rounded to 32-bit floats), `samples` the sample count;
+    /// other tools show), `sum.R.w0` to `sum.R.w3` (and for G and B) the exact radiance
+    /// sums' 32-bit words, least significant first, `Y.sum` and `Y.sumsq` the luminance
+    /// moments (rounded to 32-bit floats), `samples` the sample count;
     /// attributes `prism.<key>` for the identity, `prism.part` (`I/N`) and `prism.samples`
     /// (`A..B`).
     #[must_use]
@@ -238,16 +252,13 @@ impl Part {
             SAMPLES.into(),
             format!("{}..{}", h.share.samples.start, h.share.samples.end),
         ));
-        ExrLayers {
+        let mut layers = ExrLayers {
             width: self.sums.width(),
             height: self.sums.height(),
             channels: vec![
                 ("R".into(), float(&|s| s.mean().r)),
                 ("G".into(), float(&|s| s.mean().g)),
                 ("B".into(), float(&|s| s.mean().b)),
-                ("sum.R".into(), float(&|s| s.sum.r)),
-                ("sum.G".into(), float(&|s| s.sum.g)),
-                ("sum.B".into(), float(&|s| s.sum.b)),
                 ("Y.sum".into(), float(&|s| s.moment1 as f32)),
                 ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
                 (
@@ -256,7 +267,14 @@ impl Part {
                 ),
             ],
             attributes,
+        };
+        for (c, names) in sum_channels().into_iter().enumerate() {
+            for (w, name) in names.into_iter().enumerate() {
+                let words = p.iter().map(|s| s.sum[c].words()[w]).collect();
+                layers.channels.push((name, ExrSamples::Uint(words)));
+            }
         }
+        layers
     }
 
     /// Writes the part (see [`Part::to_exr`]) atomically: a re-run part replaces the old
@@ -289,11 +307,13 @@ impl Part {
             Some(ExrSamples::Float(v)) => v,
             _ => unreachable!("the header check found float channel {name}"),
         };
-        let (r, g, b) = (float("sum.R"), float("sum.G"), float("sum.B"));
         let (m1, m2) = (float("Y.sum"), float("Y.sumsq"));
-        let Some(ExrSamples::Uint(n)) = layers.channel("samples") else {
-            unreachable!("the header check found uint channel samples")
+        let uint = |name: &str| match layers.channel(name) {
+            Some(ExrSamples::Uint(v)) => v,
+            _ => unreachable!("the header check found uint channel {name}"),
         };
+        let n = uint("samples");
+        let words = sum_channels().map(|names| names.map(|name| uint(&name)));
         let (width, height) = (layers.width, layers.height);
         let share = &header.share;
         let (part, parts) = (share.part, share.parts);
@@ -303,7 +323,7 @@ impl Part {
             for x in 0..width {
                 let i = (y * width + x) as usize;
                 let s = PixelSum {
-                    sum: Rgb::new(r[i], g[i], b[i]),
+                    sum: words.map(|w| ExactSum::from_words([w[0][i], w[1][i], w[2][i], w[3][i]])),
                     moment1: f64::from(m1[i]),
                     moment2: f64::from(m2[i]),
                     n: n[i],
@@ -327,8 +347,8 @@ impl Part {
                         "holds data, but its tile is not in share {part}/{parts}"
                     )));
                 }
-                if !(s.sum.is_finite() && s.moment1.is_finite() && s.moment2.is_finite()) {
-                    return Err(corrupt("holds a sum that is not finite".into()));
+                if !(s.moment1.is_finite() && s.moment2.is_finite()) {
+                    return Err(corrupt("holds a moment that is not finite".into()));
                 }
                 sums.set(x, y, s);
             }

@@ -100,12 +100,7 @@ fn pixel(
             counts: RayCounts::default(),
             record: rec.take(),
         };
-        let c = tracer.trace(&ray, 0, RayKind::Camera);
-        px.sum += c;
-        let lum = f64::from(c.luminance());
-        px.moment1 += lum;
-        px.moment2 += lum * lum;
-        px.n += 1;
+        px.accumulate(tracer.trace(&ray, 0, RayKind::Camera));
         counts.add(&tracer.counts);
         rec = tracer.record;
     }
