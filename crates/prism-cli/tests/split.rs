@@ -60,7 +60,7 @@ const SMALL: [&str; 3] = ["-r", "100", "70"];
 
 /// Oracle: the single render. Tile splits into N = 1, 2, 3 and 7 shares (7 does not divide
 /// the 12 tiles) merge, given in any order, to its PNG and EXR byte for byte, with fixed
-/// and adaptive sampling.
+/// and adaptive sampling (and to its sample-count heat map).
 #[test]
 fn tile_splits_merge_to_the_single_render_byte_for_byte() {
     let dir = scratch("tiles");
@@ -71,12 +71,12 @@ fn tile_splits_merge_to_the_single_render_byte_for_byte() {
         args.extend(adaptive);
         let whole_png = dir.join("whole.png");
         let whole_exr = dir.join("whole.exr");
-        ok(run(
-            args[0],
-            &args[1..],
-            &["--exr", whole_exr.to_str().unwrap()],
-            &whole_png,
-        ));
+        let whole_map = dir.join("whole-map.png");
+        let mut pictures = vec!["--exr", whole_exr.to_str().unwrap()];
+        if !adaptive.is_empty() {
+            pictures.extend(["--heatmap", whole_map.to_str().unwrap()]);
+        }
+        ok(run(args[0], &args[1..], &pictures, &whole_png));
         for n in [1u32, 2, 3, 7] {
             let mut parts = Vec::new();
             for i in (0..n).rev() {
@@ -86,11 +86,19 @@ fn tile_splits_merge_to_the_single_render_byte_for_byte() {
                 parts.push(p);
             }
             let (png, exr) = (dir.join("merged.png"), dir.join("merged.exr"));
-            ok(merge(&parts, &png, &["--exr", exr.to_str().unwrap()]));
+            let map = dir.join("merged-map.png");
+            let (e, m) = (exr.to_str().unwrap(), map.to_str().unwrap());
+            ok(merge(&parts, &png, &["--exr", e, "--heatmap", m]));
             assert!(
                 std::fs::read(&png).unwrap() == std::fs::read(&whole_png).unwrap(),
                 "{n} tile shares, {adaptive:?}: the PNG differs"
             );
+            if !adaptive.is_empty() {
+                assert!(
+                    std::fs::read(&map).unwrap() == std::fs::read(&whole_map).unwrap(),
+                    "{n} tile shares: the heat map differs"
+                );
+            }
             assert!(
                 std::fs::read(&exr).unwrap() == std::fs::read(&whole_exr).unwrap(),
                 "{n} tile shares, {adaptive:?}: the EXR differs"
