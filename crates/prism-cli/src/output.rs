@@ -43,6 +43,28 @@ pub fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// Checks a rendered picture's outputs before any work: the picture (`--output`: .png, .jpg
+/// or .exr), the linear copy (`--exr`) and the sample-count heat map (`--heatmap`: .png or
+/// .jpg); returns the picture's and the heat map's formats.
+pub fn picture_outputs(
+    output: &Path,
+    exr: Option<&Path>,
+    heatmap: Option<&Path>,
+) -> Result<(ImageFormat, Option<ImageFormat>)> {
+    let format = image_output(
+        output,
+        "--output",
+        &[ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr],
+    )?;
+    if let Some(exr) = exr {
+        image_output(exr, "--exr", &[ImageFormat::Exr])?;
+    }
+    let heatmap = heatmap
+        .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
+        .transpose()?;
+    Ok((format, heatmap))
+}
+
 /// The image format `path` names, if it is one of `allowed`; the folder must exist and
 /// take new files. `flag` names the option in the message.
 pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<ImageFormat> {

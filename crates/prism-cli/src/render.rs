@@ -319,15 +319,9 @@ const MAX_SIDE: u32 = 16384;
 
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
-    use crate::output::{image_output, ImageFormat};
-    let format = image_output(
-        &a.output,
-        "--output",
-        &[ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr],
-    )?;
-    if let Some(exr) = &a.exr {
-        image_output(exr, "--exr", &[ImageFormat::Exr])?;
-    }
+    use crate::output::ImageFormat;
+    let (format, heatmap_format) =
+        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref())?;
     if let Some(map) = &a.envmap {
         if crate::output::extension(map) != "exr" {
             return Err(UserError(format!(
@@ -337,11 +331,6 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .into());
         }
     }
-    let heatmap_format = a
-        .heatmap
-        .as_deref()
-        .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
-        .transpose()?;
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
     let share = share(a, adaptive)?;

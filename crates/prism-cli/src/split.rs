@@ -10,7 +10,7 @@ use prism_image::{Bloom, Image};
 use prism_math::Rgb;
 use prism_render::{merge, Part, PartFile, PixelSum};
 
-use crate::output::{image_output, ImageFormat};
+use crate::output::ImageFormat;
 use crate::UserError;
 
 /// The colour merged pictures give pixels that no part held (with `--allow-missing`).
@@ -104,19 +104,8 @@ pub struct MergeArgs {
 /// Runs `prism merge`.
 pub fn run(a: &MergeArgs) -> Result<()> {
     let t0 = Instant::now();
-    let format = image_output(
-        &a.output,
-        "--output",
-        &[ImageFormat::Png, ImageFormat::Jpeg, ImageFormat::Exr],
-    )?;
-    if let Some(exr) = &a.exr {
-        image_output(exr, "--exr", &[ImageFormat::Exr])?;
-    }
-    let heatmap_format = a
-        .heatmap
-        .as_deref()
-        .map(|p| image_output(p, "--heatmap", &[ImageFormat::Png, ImageFormat::Jpeg]))
-        .transpose()?;
+    let (format, heatmap_format) =
+        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref())?;
     let mut parts = Vec::with_capacity(a.parts.len());
     for path in &a.parts {
         parts.push(PartFile::open(path).map_err(|e| UserError(e.to_string()))?);

@@ -216,9 +216,13 @@ pub fn encode_exr_layers(layers: &ExrLayers) -> Vec<u8> {
 /// # Errors
 /// [`ImageError::Io`] if the file cannot be written; the destination is then untouched.
 pub fn write_exr_layers(path: &Path, layers: &ExrLayers) -> Result<(), ImageError> {
-    let bytes = encode_exr_layers(layers);
+    write_bytes(path, &encode_exr_layers(layers))
+}
+
+/// Writes encoded bytes to `path` atomically.
+fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
     write_atomic(path, |w| {
-        w.write_all(&bytes).map_err(|source| ImageError::Io {
+        w.write_all(bytes).map_err(|source| ImageError::Io {
             path: path.to_path_buf(),
             source,
         })
@@ -230,13 +234,7 @@ pub fn write_exr_layers(path: &Path, layers: &ExrLayers) -> Result<(), ImageErro
 /// # Errors
 /// [`ImageError::Io`] if the file cannot be written; the destination is then untouched.
 pub fn write_exr(path: &Path, image: &RgbImage) -> Result<(), ImageError> {
-    let bytes = encode_exr(image);
-    write_atomic(path, |w| {
-        w.write_all(&bytes).map_err(|source| ImageError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    })
+    write_bytes(path, &encode_exr(image))
 }
 
 /// A half-precision float's value.
