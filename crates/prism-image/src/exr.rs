@@ -44,14 +44,6 @@ impl ExrSamples {
             ExrSamples::Uint(_) => 0,
         }
     }
-
-    /// The 4-byte little-endian sample `i`.
-    fn bytes(&self, i: usize) -> [u8; 4] {
-        match self {
-            ExrSamples::Float(v) => v[i].to_le_bytes(),
-            ExrSamples::Uint(v) => v[i].to_le_bytes(),
-        }
-    }
 }
 
 /// An OpenEXR image with any named channels and string attributes, such as the part files of
@@ -157,8 +149,14 @@ fn encode(layers: &ExrLayers, compress: bool) -> Vec<u8> {
             let mut raw = Vec::with_capacity(4 * channels.len() * w * lines);
             for y in first..(first + lines).min(h) {
                 for (_, c) in &channels {
-                    for x in 0..w {
-                        raw.extend_from_slice(&c.bytes(y * w + x));
+                    let row = y * w..(y + 1) * w;
+                    match c {
+                        ExrSamples::Float(v) => {
+                            raw.extend(v[row].iter().flat_map(|s| s.to_le_bytes()));
+                        }
+                        ExrSamples::Uint(v) => {
+                            raw.extend(v[row].iter().flat_map(|s| s.to_le_bytes()));
+                        }
                     }
                 }
             }

@@ -64,7 +64,11 @@ impl ExactSum {
     /// The sum as a float, rounded to nearest.
     #[must_use]
     pub fn value(self) -> f64 {
-        self.0 as f64 / SCALE
+        // Both conversions round to nearest; the 64-bit one is one instruction.
+        match i64::try_from(self.0) {
+            Ok(v) => v as f64 / SCALE,
+            Err(_) => self.0 as f64 / SCALE,
+        }
     }
 
     /// The sum divided by `n`, rounded to a float (0 for `n` = 0).

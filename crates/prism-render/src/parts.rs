@@ -241,6 +241,8 @@ impl Part {
     pub fn to_exr(&self) -> ExrLayers {
         let p = self.sums.pixels();
         let float = |f: &dyn Fn(&PixelSum) -> f32| ExrSamples::Float(p.iter().map(f).collect());
+        let means: Vec<[f32; 3]> = p.iter().map(|s| s.mean().to_array()).collect();
+        let mean = |c: usize| ExrSamples::Float(means.iter().map(|m| m[c]).collect());
         let h = &self.header;
         let mut attributes: Vec<(String, String)> = h
             .identity
@@ -256,9 +258,9 @@ impl Part {
             width: self.sums.width(),
             height: self.sums.height(),
             channels: vec![
-                ("R".into(), float(&|s| s.mean().r)),
-                ("G".into(), float(&|s| s.mean().g)),
-                ("B".into(), float(&|s| s.mean().b)),
+                ("R".into(), mean(0)),
+                ("G".into(), mean(1)),
+                ("B".into(), mean(2)),
                 ("Y.sum".into(), float(&|s| s.moment1 as f32)),
                 ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
                 (
