@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use prism_image::{ExrLayers, ExrSamples, Image, ImageError};
 use prism_math::ExactSum;
 
-use crate::film::{tile_of, tiles, PixelSum, Share, TILE};
+use crate::film::{tile_of, PixelSum, Share};
 
 /// Attribute-name prefix of a part's identity and share.
 const PREFIX: &str = "prism.";
@@ -305,58 +305,72 @@ impl Part {
     /// whose sample count or sums contradict the share.
     pub fn from_exr(layers: &ExrLayers, file: &Path) -> Result<Part, PartError> {
         let header = PartHeader::from_exr(layers, file)?;
-        let float = |name: &str| match layers.channel(name) {
-            Some(ExrSamples::Float(v)) => v,
-            _ => unreachable!("the header check found float channel {name}"),
-        };
-        let (m1, m2) = (float("Y.sum"), float("Y.sumsq"));
-        let uint = |name: &str| match layers.channel(name) {
-            Some(ExrSamples::Uint(v)) => v,
-            _ => unreachable!("the header check found uint channel {name}"),
-        };
-        let n = uint("samples");
-        let words = sum_channels().map(|names| names.map(|name| uint(&name)));
-        let (width, height) = (layers.width, layers.height);
-        let share = &header.share;
-        let (part, parts) = (share.part, share.parts);
-        let most = share.samples.len() as u32;
-        let mut sums = Image::new(width, height, PixelSum::default());
-        for y in 0..height {
-            for x in 0..width {
-                let i = (y * width + x) as usize;
-                let s = PixelSum {
-                    sum: words.map(|w| ExactSum::from_words([w[0][i], w[1][i], w[2][i], w[3][i]])),
-                    moment1: f64::from(m1[i]),
-                    moment2: f64::from(m2[i]),
-                    n: n[i],
-                    ..PixelSum::default()
-                };
-                let corrupt = |why: String| PartError::Corrupt {
-                    file: file.to_path_buf(),
-                    x,
-                    y,
-                    why,
-                };
-                let mine = share.has_tile(tile_of(x, y, width));
-                if mine && !(1..=most).contains(&s.n) {
-                    return Err(corrupt(format!(
-                        "holds {} samples; its share takes 1 to {most}",
-                        s.n
-                    )));
-                }
-                if !mine && s != PixelSum::default() {
-                    return Err(corrupt(format!(
-                        "holds data, but its tile is not in share {part}/{parts}"
-                    )));
-                }
-                if !(s.moment1.is_finite() && s.moment2.is_finite()) {
-                    return Err(corrupt("holds a moment that is not finite".into()));
-                }
-                sums.set(x, y, s);
-            }
-        }
+        let mut sums = Image::new(layers.width, layers.height, PixelSum::default());
+        each_pixel(layers, &header, file, |x, y, s| sums.set(x, y, s))?;
         Ok(Part { header, sums })
     }
+}
+
+/// Checks every pixel held in `layers` against `header`'s share, then hands each pixel of the
+/// share to `f` as `(x, y, sums)`, row by row. `header` must be the one read from `layers`.
+fn each_pixel(
+    layers: &ExrLayers,
+    header: &PartHeader,
+    file: &Path,
+    mut f: impl FnMut(u32, u32, PixelSum),
+) -> Result<(), PartError> {
+    let float = |name: &str| match layers.channel(name) {
+        Some(ExrSamples::Float(v)) => v,
+        _ => unreachable!("the header check found float channel {name}"),
+    };
+    let (m1, m2) = (float("Y.sum"), float("Y.sumsq"));
+    let uint = |name: &str| match layers.channel(name) {
+        Some(ExrSamples::Uint(v)) => v,
+        _ => unreachable!("the header check found uint channel {name}"),
+    };
+    let n = uint("samples");
+    let words = sum_channels().map(|names| names.map(|name| uint(&name)));
+    let (width, height) = (layers.width, layers.height);
+    let share = &header.share;
+    let (part, parts) = (share.part, share.parts);
+    let most = share.samples.len() as u32;
+    for y in 0..height {
+        for x in 0..width {
+            let i = (y * width + x) as usize;
+            let s = PixelSum {
+                sum: words.map(|w| ExactSum::from_words([w[0][i], w[1][i], w[2][i], w[3][i]])),
+                moment1: f64::from(m1[i]),
+                moment2: f64::from(m2[i]),
+                n: n[i],
+                ..PixelSum::default()
+            };
+            let corrupt = |why: String| PartError::Corrupt {
+                file: file.to_path_buf(),
+                x,
+                y,
+                why,
+            };
+            let mine = share.has_tile(tile_of(x, y, width));
+            if mine && !(1..=most).contains(&s.n) {
+                return Err(corrupt(format!(
+                    "holds {} samples; its share takes 1 to {most}",
+                    s.n
+                )));
+            }
+            if !mine && s != PixelSum::default() {
+                return Err(corrupt(format!(
+                    "holds data, but its tile is not in share {part}/{parts}"
+                )));
+            }
+            if !(s.moment1.is_finite() && s.moment2.is_finite()) {
+                return Err(corrupt("holds a moment that is not finite".into()));
+            }
+            if mine {
+                f(x, y, s);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A part file opened for merging: its header read and checked, its pixels decoded only
@@ -394,9 +408,13 @@ impl PartFile {
     /// # Errors
     /// As [`Part::from_exr`], or [`PartError::Image`] if the pixels do not decode.
     pub fn load(&self) -> Result<Part, PartError> {
+        Part::from_exr(&self.layers()?, &self.path)
+    }
+
+    /// The decoded channels.
+    fn layers(&self) -> Result<ExrLayers, PartError> {
         let what = self.path.display().to_string();
-        let layers = prism_image::decode_exr_layers(&self.bytes, &what)?;
-        Part::from_exr(&layers, &self.path)
+        Ok(prism_image::decode_exr_layers(&self.bytes, &what)?)
     }
 }
 
@@ -515,24 +533,18 @@ pub fn merge(files: &[PartFile], allow_missing: bool) -> Result<Merged, PartErro
         setting("height").unwrap_or(0),
     );
     let mut sums = Image::new(w, h, PixelSum::default());
-    let all = tiles(w, h);
     for i in order {
-        let part = files[i].load()?;
-        let share = &part.header.share;
-        for (_, &(x0, y0)) in all.iter().enumerate().filter(|&(k, _)| share.has_tile(k)) {
-            for y in y0..(y0 + TILE).min(h) {
-                for x in x0..(x0 + TILE).min(w) {
-                    let add = part.sums.get(x, y);
-                    let mut acc = sums.get(x, y);
-                    if acc.n == 0 {
-                        acc = add;
-                    } else {
-                        acc.merge(&add);
-                    }
-                    sums.set(x, y, acc);
-                }
+        let file = &files[i];
+        let layers = file.layers()?;
+        // Straight from the channels into the sums: no second image per part.
+        each_pixel(&layers, &file.header, &file.path, |x, y, add| {
+            let acc = &mut sums.pixels_mut()[(y * w + x) as usize];
+            if acc.n == 0 {
+                *acc = add;
+            } else {
+                acc.merge(&add);
             }
-        }
+        })?;
     }
     Ok(Merged {
         identity: first.identity.clone(),
