@@ -9,7 +9,9 @@
 #   usage: cluster/check.sh PRISM_BINARY PYTHON_WITH_RAY_AND_PYYAML
 set -euo pipefail
 prism=$(realpath "$1")
-python=$(command -v "$2")
+python=$(command -v "${2:-python3}")
+# An absolute path that keeps a virtual environment's own interpreter (no symlinks resolved).
+[[ $python == /* ]] || python="$(cd "$(dirname "$python")" && pwd)/$(basename "$python")"
 here=$(cd "$(dirname "$0")" && pwd)
 shared=$(cd "$here/../../shared/assets" && pwd)
 work=$(mktemp -d)

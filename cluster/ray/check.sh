@@ -5,7 +5,9 @@
 #   usage: cluster/ray/check.sh PRISM_BINARY [PYTHON]
 set -euo pipefail
 prism=$(realpath "$1")
-python=${2:-python3}
+python=$(command -v "${2:-python3}")
+# An absolute path that keeps a virtual environment's own interpreter (no symlinks resolved).
+[[ $python == /* ]] || python="$(cd "$(dirname "$python")" && pwd)/$(basename "$python")"
 here=$(cd "$(dirname "$0")" && pwd)
 shared=$(cd "$here/../../../shared/assets" && pwd)
 work=$(mktemp -d)
