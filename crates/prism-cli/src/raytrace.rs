@@ -348,6 +348,9 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         ))
         .into());
     }
+    if let Some((_, parts)) = a.tile {
+        crate::split::check_tile_count(parts, w, h)?;
+    }
     if a.debug_pixel.as_ref().is_some_and(|p| p.len() != 2) {
         return Err(UserError("--debug-pixel: expected X,Y (two whole numbers)".into()).into());
     }

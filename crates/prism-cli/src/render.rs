@@ -341,6 +341,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
+    if let Some(s) = &share {
+        crate::split::check_tile_count(s.parts, w, h)?;
+    }
     if a.spp == 0 || a.spp > 1 << 20 {
         return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 20, a.spp)).into());
     }

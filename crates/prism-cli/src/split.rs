@@ -33,6 +33,19 @@ pub fn parse_tile(s: &str) -> std::result::Result<(u32, u32), String> {
     }
 }
 
+/// Checks that a `width x height` image has at least `parts` tiles to share out.
+pub fn check_tile_count(parts: u32, width: u32, height: u32) -> Result<()> {
+    let tiles = prism_render::tile_count(width, height);
+    if parts as usize > tiles {
+        return Err(UserError(format!(
+            "--tile I/{parts}: a {width}x{height} image has only {tiles} tiles of 32x32 to share \
+             out; use at most {tiles} shares"
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 /// Checks that a part is written to an OpenEXR file and that no picture-only output is
 /// asked for with it; `flags` names the picture outputs given.
 pub fn check_part_output(output: &Path, flags: &[&str]) -> Result<()> {

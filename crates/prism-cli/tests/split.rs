@@ -302,7 +302,7 @@ fn bad_part_sets_exit_2_and_write_nothing() {
 fn impossible_splits_are_refused() {
     let dir = scratch("refused");
     let scene = lambertian();
-    let cases: [(&[&str], &str, &str); 6] = [
+    let cases: [(&[&str], &str, &str); 7] = [
         (
             &["--samples-to", "2", "--adaptive", "0.1"],
             "p.exr",
@@ -324,6 +324,11 @@ fn impossible_splits_are_refused() {
             &["--tile", "0/2", "--exr", "x.exr"],
             "p.exr",
             "--exr: a split render",
+        ),
+        (
+            &["--tile", "0/4294967295", "-r", "64", "64"],
+            "p.exr",
+            "a 64x64 image has only 4 tiles of 32x32",
         ),
     ];
     for (extra, out, message) in cases {

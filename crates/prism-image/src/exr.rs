@@ -462,6 +462,14 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
         layout.push((*ty, line_bytes));
         line_bytes += size * w;
     }
+    // zlib expands at most about 1032 to 1: a file too small for its pixels is refused
+    // before they are allocated (by this reader or by a caller that read only the header).
+    if (data.len() as u64).saturating_mul(1032) < (h as u64).saturating_mul(line_bytes as u64) {
+        return Err(decode_err(
+            what,
+            format!("{w}x{h} pixels cannot fit in {} bytes", data.len()),
+        ));
+    }
     if !pixels {
         return Ok(ExrLayers {
             width: w as u32,
@@ -478,14 +486,6 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
                 .collect(),
             attributes,
         });
-    }
-    // zlib expands at most about 1032 to 1: a file too small for its pixels is refused
-    // before they are allocated.
-    if (data.len() as u64).saturating_mul(1032) < (h as u64).saturating_mul(line_bytes as u64) {
-        return Err(decode_err(
-            what,
-            format!("{w}x{h} pixels cannot fit in {} bytes", data.len()),
-        ));
     }
     let blocks = h.div_ceil(lines_per_block);
     let mut offsets = Vec::with_capacity(blocks);

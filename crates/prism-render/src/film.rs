@@ -83,6 +83,12 @@ pub fn tiles(width: u32, height: u32) -> Vec<(u32, u32)> {
         .collect()
 }
 
+/// How many tiles a `width x height` film has.
+#[must_use]
+pub fn tile_count(width: u32, height: u32) -> usize {
+    width.div_ceil(TILE) as usize * height.div_ceil(TILE) as usize
+}
+
 /// The row-major index of the tile holding pixel `(x, y)` of a film `width` pixels wide.
 #[must_use]
 pub fn tile_of(x: u32, y: u32, width: u32) -> usize {

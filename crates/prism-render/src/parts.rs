@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use prism_image::{ExrLayers, ExrSamples, Image, ImageError};
 use prism_math::ExactSum;
 
-use crate::film::{tile_of, PixelSum, Share};
+use crate::film::{tile_count, tile_of, PixelSum, Share};
 
 /// Attribute-name prefix of a part's identity and share.
 const PREFIX: &str = "prism.";
@@ -168,6 +168,13 @@ impl PartHeader {
             .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
             .filter(|&(i, n)| n >= 1 && i < n)
             .ok_or_else(|| bad(PART, part_text, "I/N with 0 <= I < N"))?;
+        if parts as usize > tile_count(width, height) {
+            return Err(bad(
+                PART,
+                part_text,
+                "I/N with N at most the image's number of 32x32 tiles",
+            ));
+        }
         let samples_text = attribute(SAMPLES)?;
         let samples = samples_text
             .split_once("..")
