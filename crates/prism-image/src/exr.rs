@@ -444,6 +444,11 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
         }
         None => return Err(decode_err(what, "expected a compression attribute")),
     };
+    // A file without channels holds no pixels: its data window alone would let a few bytes
+    // ask for an image of any size.
+    if channels.is_empty() {
+        return Err(decode_err(what, "expected at least one channel"));
+    }
     // Channels are stored in name order; each has 2 (half) or 4 (uint, float) bytes a sample.
     channels.sort();
     let mut layout = Vec::new();
@@ -488,7 +493,8 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
         });
     }
     let blocks = h.div_ceil(lines_per_block);
-    let mut offsets = Vec::with_capacity(blocks);
+    // Each offset takes 8 bytes of the file: a short file cannot ask for a long table.
+    let mut offsets = Vec::with_capacity(blocks.min(data.len() / 8));
     for _ in 0..blocks {
         offsets.push(b.u64()?);
     }
@@ -658,6 +664,25 @@ mod tests {
         assert!(bytes.len() < 4 * 6 * n, "constant channels compress");
         let rgb = decode_exr(&bytes, "mem").unwrap();
         assert_eq!(rgb.get(3, 5), Rgb::new(38.0 * 0.37, 1.5, -38.0));
+    }
+
+    /// A file with no channels is refused (its data window alone could ask for any size),
+    /// by the header reader too.
+    #[test]
+    fn files_without_channels_are_refused() {
+        let empty = ExrLayers {
+            width: 16384,
+            height: 3,
+            channels: Vec::new(),
+            attributes: Vec::new(),
+        };
+        let bytes = encode_exr_layers(&empty);
+        for e in [
+            decode_exr(&bytes, "mem").unwrap_err(),
+            decode_exr_header(&bytes, "mem").unwrap_err(),
+        ] {
+            assert_eq!(e.to_string(), "mem: expected at least one channel");
+        }
     }
 
     /// Oracle: what the writer wrote reads back exactly.
