@@ -11,6 +11,7 @@ mod render;
 mod shade;
 mod split;
 mod svg;
+mod view;
 
 use std::process::ExitCode;
 
@@ -42,6 +43,8 @@ enum Command {
     Cloth(cloth::ClothArgs),
     /// Check the part files of a split render and assemble its picture.
     Merge(split::MergeArgs),
+    /// Open an SVG drawing in an interactive window drawn on the CPU (X11 or Xvfb).
+    View(view::ViewArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
 }
@@ -94,6 +97,7 @@ fn main() -> ExitCode {
         Command::Shade(a) => shade::run(&a),
         Command::Cloth(a) => cloth::run(&a),
         Command::Merge(a) => split::run(&a),
+        Command::View(a) => view::run(&a),
         Command::Demo(a) => demo::run(&a),
     };
     match result {

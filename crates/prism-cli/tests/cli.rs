@@ -1719,3 +1719,35 @@ fn cloth_runs_and_errors() {
         stderr(&o)
     );
 }
+
+/// `prism view` refuses before opening anything: a file whose extension names no mode, a
+/// missing file, and no display (exit 2 with a message naming what to do).
+#[test]
+fn view_refuses_without_a_display_or_a_mode() {
+    let dir = scratch("view");
+    let svg = dir.join("t.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="4" height="4"/>"#,
+    )
+    .unwrap();
+    let txt = dir.join("t.txt");
+    std::fs::write(&txt, "x").unwrap();
+    let view = |file: &Path| {
+        prism()
+            .arg("view")
+            .arg(file)
+            .env_remove("DISPLAY")
+            .output()
+            .unwrap()
+    };
+    let o = view(&svg);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("prism view needs an X11 display, and DISPLAY is not set"));
+    let o = view(&txt);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("cannot tell what to view from the extension `.txt`"));
+    let o = view(&dir.join("missing.svg"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("missing.svg"));
+}

@@ -1,0 +1,253 @@
+//! `prism view`: the window around prism-view's [`Viewer`]: winit for the window and its
+//! events, softbuffer for CPU-drawn pixels, X11 loaded at run time (so it runs over SSH with
+//! X forwarding and under Xvfb, and needs no GPU).
+
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::rc::Rc;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use prism_raster::{read_svg, Dialect};
+use prism_view::{Input, Key, SvgMode, Viewer};
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::{Key as WinitKey, ModifiersState, NamedKey};
+use winit::window::{Window, WindowId};
+
+use crate::UserError;
+
+/// What the file is viewed as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// An SVG drawing through the rasterizer (the course viewer's controls).
+    Svg,
+}
+
+/// Arguments of `prism view`.
+#[derive(Args, Debug)]
+#[command(after_help = "Controls (also on screen with H):
+  all modes  H help overlay, Esc quit
+  svg        - = fewer/more samples per pixel (1, 4, 9, 16), P pixel sampling
+             (nearest/bilinear), L level sampling (level 0/nearest/trilinear), drag to
+             pan, wheel to zoom about the cursor, R reset the view, S save a screenshot
+             PNG (FILE-screenshot-N.png in the current folder)")]
+pub struct ViewArgs {
+    /// The file to open; its extension chooses the mode (.svg: svg).
+    file: PathBuf,
+    /// The mode, instead of the one the extension chooses.
+    #[arg(long, value_enum)]
+    mode: Option<ModeArg>,
+    /// Read SVG as the CS184 course dialect (its elements, quirks and view).
+    #[arg(long)]
+    compat: bool,
+    /// Window size: WIDTH HEIGHT.
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [960, 640])]
+    resolution: Vec<u32>,
+}
+
+/// The mode for `a.file`.
+fn open(a: &ViewArgs) -> Result<Viewer> {
+    let mode = match a.mode {
+        Some(m) => m,
+        None => match crate::output::extension(&a.file).as_str() {
+            "svg" => ModeArg::Svg,
+            other => {
+                return Err(UserError(format!(
+                    "{}: cannot tell what to view from the extension `.{other}`; prism view \
+                     opens .svg files (--mode svg)",
+                    a.file.display()
+                ))
+                .into())
+            }
+        },
+    };
+    let (w, h) = (a.resolution[0], a.resolution[1]);
+    if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
+        || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
+    {
+        return Err(UserError(format!(
+            "--resolution: expected 1 to {} pixels a side, found {w} x {h}",
+            prism_raster::MAX_DIMENSION
+        ))
+        .into());
+    }
+    match mode {
+        ModeArg::Svg => {
+            let dialect = if a.compat {
+                Dialect::Cs184
+            } else {
+                Dialect::Svg
+            };
+            let doc = read_svg(&a.file, dialect).map_err(|e| UserError(e.to_string()))?;
+            for w in &doc.warnings {
+                eprintln!("warning: {w}");
+            }
+            let here = std::env::current_dir()?;
+            let mode = SvgMode::new(doc, &a.file, dialect, &here);
+            Ok(Viewer::new(Box::new(mode), w, h))
+        }
+    }
+}
+
+/// Runs `prism view`.
+pub fn run(a: &ViewArgs) -> Result<()> {
+    let viewer = open(a)?;
+    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
+        return Err(UserError(
+            "prism view needs an X11 display, and DISPLAY is not set (over SSH, connect with \
+             ssh -X; headless, start Xvfb :99 and set DISPLAY=:99)"
+                .into(),
+        )
+        .into());
+    }
+    let event_loop = EventLoop::new()
+        .map_err(|e| UserError(format!("prism view: cannot reach the display: {e}")))?;
+    let mut app = App {
+        viewer,
+        size: (a.resolution[0], a.resolution[1]),
+        window: None,
+        surface: None,
+        modifiers: ModifiersState::empty(),
+        error: None,
+    };
+    event_loop.run_app(&mut app)?;
+    match app.error {
+        Some(e) => Err(UserError(format!("prism view: {e}")).into()),
+        None => Ok(()),
+    }
+}
+
+/// The window, its pixel surface and the viewer.
+struct App {
+    viewer: Viewer,
+    size: (u32, u32),
+    window: Option<Rc<Window>>,
+    surface: Option<softbuffer::Surface<Rc<Window>, Rc<Window>>>,
+    modifiers: ModifiersState,
+    error: Option<String>,
+}
+
+impl App {
+    fn send(&mut self, input: Input, event_loop: &ActiveEventLoop) {
+        if self.viewer.input(input) {
+            if let Some(w) = &self.window {
+                w.request_redraw();
+            }
+        }
+        if self.viewer.quit() {
+            event_loop.exit();
+        }
+    }
+
+    fn redraw(&mut self) -> Result<(), String> {
+        let frame = self.viewer.frame().image;
+        let (w, h) = (frame.width(), frame.height());
+        let Some(surface) = self.surface.as_mut() else {
+            return Ok(());
+        };
+        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
+            return Ok(());
+        };
+        surface.resize(nw, nh).map_err(|e| e.to_string())?;
+        let mut buffer = surface.buffer_mut().map_err(|e| e.to_string())?;
+        for (out, p) in buffer.iter_mut().zip(frame.pixels()) {
+            *out = u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]);
+        }
+        buffer.present().map_err(|e| e.to_string())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title(self.viewer.title())
+            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+        let made = event_loop
+            .create_window(attributes)
+            .map_err(|e| e.to_string())
+            .and_then(|w| {
+                let w = Rc::new(w);
+                let context = softbuffer::Context::new(w.clone()).map_err(|e| e.to_string())?;
+                let surface =
+                    softbuffer::Surface::new(&context, w.clone()).map_err(|e| e.to_string())?;
+                Ok((w, surface))
+            });
+        match made {
+            Ok((w, surface)) => {
+                w.request_redraw();
+                self.window = Some(w);
+                self.surface = Some(surface);
+            }
+            Err(e) => {
+                self.error = Some(format!("cannot open a window: {e}"));
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => self.send(
+                Input::Resize {
+                    width: size.width,
+                    height: size.height,
+                },
+                event_loop,
+            ),
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.redraw() {
+                    self.error = Some(format!("cannot draw: {e}"));
+                    event_loop.exit();
+                } else if self.viewer.busy() {
+                    if let Some(w) = &self.window {
+                        w.request_redraw();
+                    }
+                }
+            }
+            WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                let key = match &event.logical_key {
+                    WinitKey::Named(NamedKey::Escape) => Some(Key::Escape),
+                    WinitKey::Named(NamedKey::ArrowLeft) => Some(Key::Left),
+                    WinitKey::Named(NamedKey::ArrowRight) => Some(Key::Right),
+                    WinitKey::Named(NamedKey::ArrowUp) => Some(Key::Up),
+                    WinitKey::Named(NamedKey::ArrowDown) => Some(Key::Down),
+                    WinitKey::Character(s) => {
+                        s.chars().next().map(|c| Key::Char(c.to_ascii_lowercase()))
+                    }
+                    _ => None,
+                };
+                if let Some(key) = key {
+                    let ctrl = self.modifiers.control_key();
+                    self.send(Input::Key { key, ctrl }, event_loop);
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => self.send(
+                Input::Cursor {
+                    x: position.x,
+                    y: position.y,
+                },
+                event_loop,
+            ),
+            WindowEvent::MouseInput {
+                state,
+                button: MouseButton::Left,
+                ..
+            } => self.send(Input::Button(state == ElementState::Pressed), event_loop),
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.send(Input::Wheel(lines), event_loop);
+            }
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Drives `prism view` in a real window under Xvfb with xdotool and checks what each input
+# does to the picture (ImageMagick counts colours and differing pixels):
+#   - the window opens within 1 s;
+#   - `=` (to 16 samples per pixel) smooths a triangle's edges: grey levels appear;
+#   - dragging pans the picture; H shows the help overlay; S saves a screenshot PNG;
+#   - Esc closes the window with exit code 0;
+#   - without a display, prism view exits 2 with a clear message.
+# Needs: apt-get install -y xvfb xdotool x11-utils imagemagick libxkbcommon-x11-0
+#   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
+set -euo pipefail
+prism=$(realpath "${1:-target/release/prism}")
+work=$(mktemp -d)
+display=:$((90 + RANDOM % 9))
+Xvfb "$display" -screen 0 1024x768x24 >/dev/null 2>&1 &
+xvfb=$!
+trap 'kill $xvfb 2>/dev/null; rm -rf "$work"' EXIT
+export DISPLAY=$display
+for _ in $(seq 50); do xdpyinfo >/dev/null 2>&1 && break; sleep 0.1; done
+cd "$work"
+cat >tri.svg <<'SVG'
+<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
+  <polygon points="10,10 90,30 30,90" fill="black"/>
+</svg>
+SVG
+shot() { sleep 0.4; import -window "$wid" "$1"; }
+colours() { convert "$1" -crop 400x280+0+0 +repage -format %k info:; }
+differ() { compare -metric AE "$1" "$2" null: 2>&1 || true; }
+
+start=$(date +%s.%N)
+"$prism" view tri.svg -r 400 300 &
+pid=$!
+wid=$(xdotool search --sync --name "prism view" | head -1)
+opened=$(echo "$(date +%s.%N) - $start" | bc)
+echo "view: window open after $opened s"
+(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+xdotool windowfocus --sync "$wid"
+shot one.png
+xdotool key equal equal equal
+shot sixteen.png
+c1=$(colours one.png)
+c16=$(colours sixteen.png)
+edges=$(differ one.png sixteen.png)
+echo "view: colours in the picture at 1 spp: $c1, at 16 spp: $c16; $edges pixels changed"
+# One sample: only black and white. Sixteen: grey levels along the edges.
+((c1 <= 2 && c16 >= 5 && edges > 200)) || { echo "view: = did not smooth the edges"; exit 1; }
+
+xdotool mousemove --window "$wid" 200 140 mousedown 1 mousemove --window "$wid" 260 140 mouseup 1
+shot panned.png
+moved=$(differ sixteen.png panned.png)
+echo "view: dragging 60 pixels changed $moved pixels"
+((moved > 500)) || { echo "view: dragging did not pan"; exit 1; }
+
+xdotool key h
+shot help.png
+helped=$(differ panned.png help.png)
+echo "view: the help overlay changed $helped pixels"
+((helped > 2000)) || { echo "view: H did not show the help"; exit 1; }
+
+xdotool key s
+sleep 0.4
+[ -f tri-screenshot-1.png ] || { echo "view: S saved no screenshot"; exit 1; }
+echo "view: S saved tri-screenshot-1.png"
+
+xdotool key Escape
+for _ in $(seq 20); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+if kill -0 "$pid" 2>/dev/null; then echo "view: Esc did not close the window"; exit 1; fi
+wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
+echo "view: Esc closed the window (exit 0)"
+
+set +e
+out=$(env -u DISPLAY "$prism" view tri.svg 2>&1)
+code=$?
+set -e
+[ "$code" = 2 ] || { echo "view: without a display, exit $code: $out"; exit 1; }
+echo "view: without a display, exit 2: $out"
+echo "view: all checks passed"
