@@ -9,7 +9,7 @@ use std::rc::Rc;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_raster::{read_svg, Dialect};
-use prism_view::{Input, Key, SvgMode, Viewer};
+use prism_view::{Input, Key, PathMode, SvgMode, Viewer};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -23,6 +23,8 @@ use crate::UserError;
 pub enum ModeArg {
     /// An SVG drawing through the rasterizer (the course viewer's controls).
     Svg,
+    /// A lit COLLADA scene, path-traced progressively.
+    Path,
 }
 
 /// Arguments of `prism view`.
@@ -32,9 +34,12 @@ pub enum ModeArg {
   svg        - = fewer/more samples per pixel (1, 4, 9, 16), P pixel sampling
              (nearest/bilinear), L level sampling (level 0/nearest/trilinear), drag to
              pan, wheel to zoom about the cursor, R reset the view, S save a screenshot
-             PNG (FILE-screenshot-N.png in the current folder)")]
+             PNG (FILE-screenshot-N.png in the current folder)
+  path       one sample per pixel a frame (the picture after n passes is prism render
+             -s n); drag orbits the camera, the wheel moves it closer, 1-9 only the m-th
+             bounce, 0 every bounce, A the noise heat map, R reset the camera")]
 pub struct ViewArgs {
-    /// The file to open; its extension chooses the mode (.svg: svg).
+    /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path).
     file: PathBuf,
     /// The mode, instead of the one the extension chooses.
     #[arg(long, value_enum)]
@@ -42,9 +47,12 @@ pub struct ViewArgs {
     /// Read SVG as the CS184 course dialect (its elements, quirks and view).
     #[arg(long)]
     compat: bool,
-    /// Window size: WIDTH HEIGHT.
-    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [960, 640])]
-    resolution: Vec<u32>,
+    /// Window size: WIDTH HEIGHT (default 960 640, and 512 384 for path tracing).
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
+    resolution: Option<Vec<u32>>,
+    /// Seed of the path tracer's random numbers.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
 }
 
 /// The mode for `a.file`.
@@ -53,17 +61,22 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         Some(m) => m,
         None => match crate::output::extension(&a.file).as_str() {
             "svg" => ModeArg::Svg,
+            "dae" => ModeArg::Path,
             other => {
                 return Err(UserError(format!(
                     "{}: cannot tell what to view from the extension `.{other}`; prism view \
-                     opens .svg files (--mode svg)",
+                     opens .svg drawings and lit .dae scenes (--mode svg or path)",
                     a.file.display()
                 ))
                 .into())
             }
         },
     };
-    let (w, h) = (a.resolution[0], a.resolution[1]);
+    let (w, h) = match (&a.resolution, mode) {
+        (Some(r), _) => (r[0], r[1]),
+        (None, ModeArg::Svg) => (960, 640),
+        (None, ModeArg::Path) => (512, 384),
+    };
     if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
         || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
     {
@@ -88,6 +101,23 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             let mode = SvgMode::new(doc, &a.file, dialect, &here);
             Ok(Viewer::new(Box::new(mode), w, h))
         }
+        ModeArg::Path => {
+            let scene = prism_scene::load(&a.file, &prism_scene::SceneOptions::default())
+                .map_err(|e| UserError(e.to_string()))?;
+            for w in &scene.warnings {
+                eprintln!("warning: {w}");
+            }
+            if !scene.is_lit() {
+                return Err(UserError(format!(
+                    "{}: the scene has no light, so path tracing shows black; prism view \
+                     opens lit scenes",
+                    a.file.display()
+                ))
+                .into());
+            }
+            let mode = PathMode::new(&scene, &a.file, a.seed);
+            Ok(Viewer::new(Box::new(mode), w, h))
+        }
     }
 }
 
@@ -106,7 +136,6 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         .map_err(|e| UserError(format!("prism view: cannot reach the display: {e}")))?;
     let mut app = App {
         viewer,
-        size: (a.resolution[0], a.resolution[1]),
         window: None,
         surface: None,
         modifiers: ModifiersState::empty(),
@@ -122,7 +151,6 @@ pub fn run(a: &ViewArgs) -> Result<()> {
 /// The window, its pixel surface and the viewer.
 struct App {
     viewer: Viewer,
-    size: (u32, u32),
     window: Option<Rc<Window>>,
     surface: Option<softbuffer::Surface<Rc<Window>, Rc<Window>>>,
     modifiers: ModifiersState,
@@ -166,7 +194,10 @@ impl ApplicationHandler for App {
         }
         let attributes = Window::default_attributes()
             .with_title(self.viewer.title())
-            .with_inner_size(winit::dpi::PhysicalSize::new(self.size.0, self.size.1));
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                self.viewer.size().0,
+                self.viewer.size().1,
+            ));
         let made = event_loop
             .create_window(attributes)
             .map_err(|e| e.to_string())

@@ -82,6 +82,12 @@ impl Viewer {
         self.mode.as_ref()
     }
 
+    /// The window size.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
     /// The window title.
     #[must_use]
     pub fn title(&self) -> String {

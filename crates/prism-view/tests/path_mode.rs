@@ -1,0 +1,89 @@
+//! The path-tracing mode driven headlessly: its progressive picture against the batch
+//! renderer, and what orbiting, bounce keys and the heat map do to its state.
+
+use std::path::Path;
+
+use prism_render::{render, RenderOptions, RenderScene};
+use prism_view::{Input, Key, Mode, PathMode, Viewer};
+
+fn key(c: char) -> Input {
+    Input::Key {
+        key: Key::Char(c),
+        ctrl: false,
+    }
+}
+
+/// Oracle: `prism render -s 4` of the same scene and seed. Four progressive passes add up,
+/// exactly, to its image.
+#[test]
+fn progressive_passes_are_the_batch_render() {
+    let scene = prism_scene::cornell_box();
+    let mut mode = PathMode::new(&scene, Path::new("cornell"), 7);
+    for _ in 0..3 {
+        mode.draw(64, 48);
+    }
+    let picture = mode.draw(64, 48);
+    assert_eq!(mode.passes(), 4);
+    let opts = RenderOptions {
+        width: 64,
+        height: 48,
+        spp: 4,
+        seed: 7,
+        ..RenderOptions::default()
+    };
+    let batch = render(&RenderScene::new(&scene), &opts, &|_| {});
+    assert_eq!(picture, batch.image.linear_to_srgb8());
+}
+
+/// Dragging orbits the camera about its target (same distance, new eye) and restarts; the
+/// wheel moves it closer; `2` keeps the second bounce, `0` all; `A` shows the noise map
+/// without restarting; `R` puts the camera back.
+#[test]
+fn orbit_bounces_heat_map_and_reset() {
+    let scene = prism_scene::cornell_box();
+    let base = scene.camera;
+    let mut v = Viewer::new(Box::new(PathMode::new(&scene, Path::new("c"), 0)), 48, 32);
+    v.picture();
+    v.picture();
+    assert!(v.mode().status().starts_with("2 spp"));
+    assert!(v.busy());
+    v.input(Input::Cursor { x: 10.0, y: 10.0 });
+    v.input(Input::Button(true));
+    assert!(v.input(Input::Cursor { x: 20.0, y: 12.0 }));
+    v.input(Input::Button(false));
+    v.picture();
+    assert!(
+        v.mode().status().starts_with("1 spp"),
+        "{}",
+        v.mode().status()
+    );
+    v.input(key('2'));
+    v.picture();
+    assert!(v.mode().status().contains("bounce 2 only"));
+    v.input(key('0'));
+    v.picture();
+    assert!(v.mode().status().contains("all bounces"));
+    let plain = v.picture().clone();
+    v.input(key('a'));
+    let map = v.picture().clone();
+    assert!(v.mode().status().contains("noise map"));
+    assert!(
+        v.mode().status().starts_with("3 spp"),
+        "the map does not restart"
+    );
+    assert_ne!(plain, map);
+
+    let mut mode = PathMode::new(&scene, Path::new("c"), 0);
+    mode.input(&Input::Cursor { x: 0.0, y: 0.0 }, (48, 32));
+    mode.input(&Input::Button(true), (48, 32));
+    mode.input(&Input::Cursor { x: 12.0, y: 0.0 }, (48, 32));
+    let turned = mode.camera();
+    let d0 = (base.eye - base.target).length();
+    let d1 = (turned.eye - turned.target).length();
+    assert!((d0 - d1).abs() < 1e-4 * d0);
+    assert!((turned.eye - base.eye).length() > 1e-3 * d0);
+    mode.input(&Input::Wheel(3.0), (48, 32));
+    assert!((mode.camera().eye - base.target).length() < d0);
+    mode.input(&key('r'), (48, 32));
+    assert_eq!(mode.camera(), base);
+}
