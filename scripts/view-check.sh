@@ -5,11 +5,15 @@
 #   - `=` (to 16 samples per pixel) smooths a triangle's edges: grey levels appear;
 #   - dragging pans the picture; H shows the help overlay; S saves a screenshot PNG;
 #   - Esc closes the window with exit code 0;
+#   - a lit COLLADA scene opens within 1 s and refines by itself; dragging orbits the camera
+#     (most pixels change); `2` shows the second bounce only;
 #   - without a display, prism view exits 2 with a clear message.
 # Needs: apt-get install -y xvfb xdotool x11-utils imagemagick libxkbcommon-x11-0
 #   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
+# Run from the repository, with ../shared beside it (the scene comes from there).
 set -euo pipefail
 prism=$(realpath "${1:-target/release/prism}")
+scene=$(realpath ../shared/assets/pathtracer/dae/sky/CBspheres_lambertian.dae)
 work=$(mktemp -d)
 display=:$((90 + RANDOM % 9))
 Xvfb "$display" -screen 0 1024x768x24 >/dev/null 2>&1 &
@@ -67,6 +71,33 @@ for _ in $(seq 20); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
 if kill -0 "$pid" 2>/dev/null; then echo "view: Esc did not close the window"; exit 1; fi
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 echo "view: Esc closed the window (exit 0)"
+
+start=$(date +%s.%N)
+"$prism" view "$scene" -r 256 192 &
+pid=$!
+wid=$(xdotool search --sync --name "prism view" | head -1)
+opened=$(echo "$(date +%s.%N) - $start" | bc)
+echo "view: path-traced scene open after $opened s"
+(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+xdotool windowfocus --sync "$wid"
+shot early.png
+sleep 1
+shot later.png
+refined=$(differ early.png later.png)
+echo "view: one second of passes changed $refined pixels"
+((refined > 1000)) || { echo "view: the picture does not refine"; exit 1; }
+xdotool mousemove --window "$wid" 128 96 mousedown 1 mousemove --window "$wid" 170 96 mouseup 1
+shot orbited.png
+orbit=$(differ later.png orbited.png)
+echo "view: orbiting changed $orbit pixels"
+((orbit > 8000)) || { echo "view: dragging did not orbit"; exit 1; }
+xdotool key 2
+shot bounce.png
+bounce=$(differ orbited.png bounce.png)
+echo "view: the second bounce alone changed $bounce pixels"
+((bounce > 8000)) || { echo "view: 2 did not show the second bounce"; exit 1; }
+xdotool key Escape
+wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
 set +e
 out=$(env -u DISPLAY "$prism" view tri.svg 2>&1)
