@@ -682,8 +682,8 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
                 view: &prism_shade::View,
                 shader: &Shader|
      -> Result<prism_image::RgbImage> {
-        let mut mesh = crate::cloth::cloth_mesh(c);
-        mesh.append(&crate::cloth::obstacles(&c.scene));
+        let mut mesh = prism_cloth::cloth_mesh(c);
+        mesh.append(&prism_cloth::obstacles(&c.scene));
         prism_shade::shade(
             &mesh,
             view,
@@ -704,7 +704,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
     let mut panels = Vec::new();
     for n in names {
         let start = run(n, &[], 0)?;
-        let view = crate::cloth::course_view(&start, w, h);
+        let view = prism_cloth::course_view(&start, w, h);
         let c = run(n, &[], frames)?;
         panels.push(draw(&c, &view, &Shader::Phong)?);
     }
@@ -725,7 +725,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         for v in values {
             let set = vec![format!("{key}={v}")];
             let start = run("pinned2", &set, 0)?;
-            let view = crate::cloth::course_view(&start, w, h);
+            let view = prism_cloth::course_view(&start, w, h);
             panels.push(draw(&run("pinned2", &set, frames)?, &view, &Shader::Phong)?);
         }
         save(file, &panels, 3)?;
@@ -765,7 +765,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         Shader::Mirror(cube),
     ];
     let start = run("sphere", &[], 0)?;
-    let view = crate::cloth::course_view(&start, w, h);
+    let view = prism_cloth::course_view(&start, w, h);
     let c = run("sphere", &[], frames)?;
     let panels: Vec<_> = shaders
         .iter()

@@ -43,7 +43,8 @@ enum Command {
     Cloth(cloth::ClothArgs),
     /// Check the part files of a split render and assemble its picture.
     Merge(split::MergeArgs),
-    /// Open an SVG drawing in an interactive window drawn on the CPU (X11 or Xvfb).
+    /// Open an SVG drawing, a lit COLLADA scene (path-traced) or a cloth scene in an
+    /// interactive window drawn on the CPU (X11 or Xvfb).
     View(view::ViewArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),

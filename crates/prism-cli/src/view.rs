@@ -9,7 +9,7 @@ use std::rc::Rc;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_raster::{read_svg, Dialect};
-use prism_view::{Input, Key, PathMode, SvgMode, Viewer};
+use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -25,6 +25,8 @@ pub enum ModeArg {
     Svg,
     /// A lit COLLADA scene, path-traced progressively.
     Path,
+    /// A ClothSim scene JSON, simulated and shaded as the course app plays it.
+    Cloth,
 }
 
 /// Arguments of `prism view`.
@@ -37,9 +39,12 @@ pub enum ModeArg {
              PNG (FILE-screenshot-N.png in the current folder)
   path       one sample per pixel a frame (the picture after n passes is prism render
              -s n); drag orbits the camera, the wheel moves it closer, 1-9 only the m-th
-             bounce, 0 every bounce, A the noise heat map, R reset the camera")]
+             bounce, 0 every bounce, A the noise heat map, R reset the camera
+  cloth      P play/pause, N one frame, R back to the start, C next shader (phong,
+             diffuse, normal, wireframe), drag to orbit, wheel to move closer")]
 pub struct ViewArgs {
-    /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path).
+    /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path;
+    /// .json: cloth).
     file: PathBuf,
     /// The mode, instead of the one the extension chooses.
     #[arg(long, value_enum)]
@@ -47,12 +52,16 @@ pub struct ViewArgs {
     /// Read SVG as the CS184 course dialect (its elements, quirks and view).
     #[arg(long)]
     compat: bool,
-    /// Window size: WIDTH HEIGHT (default 960 640, and 512 384 for path tracing).
+    /// Window size: WIDTH HEIGHT (default 960 640; 512 384 for path tracing; 1024 800, the
+    /// course app's, for cloth).
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
     resolution: Option<Vec<u32>>,
     /// Seed of the path tracer's random numbers.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Cloth: override a scene value, as `prism cloth --set` (`--set ks=500`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
 }
 
 /// The mode for `a.file`.
@@ -62,10 +71,12 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         None => match crate::output::extension(&a.file).as_str() {
             "svg" => ModeArg::Svg,
             "dae" => ModeArg::Path,
+            "json" => ModeArg::Cloth,
             other => {
                 return Err(UserError(format!(
                     "{}: cannot tell what to view from the extension `.{other}`; prism view \
-                     opens .svg drawings and lit .dae scenes (--mode svg or path)",
+                     opens .svg drawings, lit .dae scenes and cloth .json scenes (--mode svg, path or \
+                     cloth)",
                     a.file.display()
                 ))
                 .into())
@@ -76,6 +87,7 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         (Some(r), _) => (r[0], r[1]),
         (None, ModeArg::Svg) => (960, 640),
         (None, ModeArg::Path) => (512, 384),
+        (None, ModeArg::Cloth) => (1024, 800),
     };
     if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
         || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
@@ -117,6 +129,11 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             }
             let mode = PathMode::new(&scene, &a.file, a.seed);
             Ok(Viewer::new(Box::new(mode), w, h))
+        }
+        ModeArg::Cloth => {
+            let scene =
+                prism_cloth::read_scene(&a.file, &a.set).map_err(|e| UserError(e.to_string()))?;
+            Ok(Viewer::new(Box::new(ClothMode::new(scene, &a.file)), w, h))
         }
     }
 }

@@ -5,14 +5,17 @@
 //! - `sim`: [`Cloth`], the mass-spring simulation stepped exactly as the course's algorithm
 //!   (`FORMATS.md` §4), in f64.
 //! - `random`: [`GlibcRand`], the C library's `rand()` that jitters the vertical cloth.
+//! - `draw`: the cloth and its obstacles as prism-shade meshes, and the course app's camera.
 #![warn(missing_docs)]
 
+mod draw;
 mod error;
 mod json;
 mod random;
 mod scene;
 mod sim;
 
+pub use draw::{cloth_mesh, course_view, obstacles};
 pub use error::ClothError;
 pub use json::{parse_json, Json, JsonValue, MAX_JSON_DEPTH};
 pub use random::{GlibcRand, RAND_MAX};

@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use prism_image::{heat_colour, Image, Rgb8Image};
-use prism_math::Vec3;
 use prism_render::{render_share, PixelSum, RenderOptions, RenderScene, Share};
 
 use crate::input::{Input, Key};
+use crate::orbit::Orbit;
 use crate::viewer::{Mode, Response};
 
 /// Passes after which the picture is left as it is.
@@ -22,16 +22,13 @@ pub struct PathMode {
     path: PathBuf,
     scene: RenderScene,
     base: prism_scene::Camera,
-    /// Orbit about the camera's target: yaw and pitch added (radians) and distance scale.
-    orbit: (f32, f32, f32),
+    orbit: Orbit,
     only_bounce: Option<u32>,
     heatmap: bool,
     seed: u64,
     sums: Option<Image<PixelSum>>,
     passes: u32,
     rate: f64,
-    cursor: (f64, f64),
-    drag: Option<(f64, f64)>,
 }
 
 impl PathMode {
@@ -42,15 +39,13 @@ impl PathMode {
             path: path.to_path_buf(),
             scene: RenderScene::new(scene),
             base: scene.camera,
-            orbit: (0.0, 0.0, 1.0),
+            orbit: Orbit::default(),
             only_bounce: None,
             heatmap: false,
             seed,
             sums: None,
             passes: 0,
             rate: 0.0,
-            cursor: (0.0, 0.0),
-            drag: None,
         }
     }
 
@@ -64,22 +59,8 @@ impl PathMode {
     #[must_use]
     pub fn camera(&self) -> prism_scene::Camera {
         let c = self.base;
-        if self.orbit == (0.0, 0.0, 1.0) {
-            return c;
-        }
-        let d = c.eye - c.target;
-        let r = d.length() * self.orbit.2;
-        let yaw = d.x.atan2(d.z) + self.orbit.0;
-        let limit = 89f32.to_radians();
-        let pitch = ((d.y / d.length().max(1e-12)).clamp(-1.0, 1.0).asin() + self.orbit.1)
-            .clamp(-limit, limit);
-        let dir = Vec3::new(
-            pitch.cos() * yaw.sin(),
-            pitch.sin(),
-            pitch.cos() * yaw.cos(),
-        );
         prism_scene::Camera {
-            eye: c.target + dir * r,
+            eye: self.orbit.eye(c.eye, c.target),
             ..c
         }
     }
@@ -142,29 +123,24 @@ impl Mode for PathMode {
                     Response::Redraw
                 }
                 Key::Char('r') => {
-                    self.orbit = (0.0, 0.0, 1.0);
+                    self.orbit.reset();
                     self.restart()
                 }
                 _ => Response::Ignored,
             },
             Input::Cursor { x, y } => {
-                self.cursor = (x, y);
-                let Some((px, py)) = self.drag else {
-                    return Response::Ignored;
-                };
-                // Half a turn across the window's width.
-                let per_pixel = std::f32::consts::PI / size.0.max(1) as f32;
-                self.orbit.0 -= (x - px) as f32 * per_pixel;
-                self.orbit.1 += (y - py) as f32 * per_pixel;
-                self.drag = Some((x, y));
-                self.restart()
+                if self.orbit.cursor(x, y, size.0) {
+                    self.restart()
+                } else {
+                    Response::Ignored
+                }
             }
             Input::Button(down) => {
-                self.drag = down.then_some(self.cursor);
+                self.orbit.button(down);
                 Response::Ignored
             }
             Input::Wheel(lines) => {
-                self.orbit.2 = (self.orbit.2 * 0.9f32.powf(lines as f32)).clamp(0.05, 20.0);
+                self.orbit.wheel(lines);
                 self.restart()
             }
             Input::Resize { .. } => self.restart(),
