@@ -7,6 +7,8 @@
 #   - Esc closes the window with exit code 0;
 #   - a lit COLLADA scene opens within 1 s and refines by itself; dragging orbits the camera
 #     (most pixels change); `2` shows the second bounce only;
+#   - a cloth scene opens within 1 s and plays by itself; `P` pauses it (the picture holds
+#     still); `C` changes the shader;
 #   - without a display, prism view exits 2 with a clear message.
 # Needs: apt-get install -y xvfb xdotool x11-utils imagemagick libxkbcommon-x11-0
 #   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
@@ -14,6 +16,7 @@
 set -euo pipefail
 prism=$(realpath "${1:-target/release/prism}")
 scene=$(realpath ../shared/assets/pathtracer/dae/sky/CBspheres_lambertian.dae)
+cloth=$(realpath ../shared/assets/clothsim/scene/pinned2.json)
 work=$(mktemp -d)
 display=:$((90 + RANDOM % 9))
 Xvfb "$display" -screen 0 1024x768x24 >/dev/null 2>&1 &
@@ -96,6 +99,35 @@ shot bounce.png
 bounce=$(differ orbited.png bounce.png)
 echo "view: the second bounce alone changed $bounce pixels"
 ((bounce > 8000)) || { echo "view: 2 did not show the second bounce"; exit 1; }
+xdotool key Escape
+wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
+
+start=$(date +%s.%N)
+"$prism" view "$cloth" -r 320 240 &
+pid=$!
+wid=$(xdotool search --sync --name "prism view" | head -1)
+opened=$(echo "$(date +%s.%N) - $start" | bc)
+echo "view: cloth scene open after $opened s"
+(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+xdotool windowfocus --sync "$wid"
+shot c1.png
+shot c2.png
+played=$(differ c1.png c2.png)
+echo "view: the cloth playing changed $played pixels"
+((played > 500)) || { echo "view: the cloth does not play"; exit 1; }
+xdotool key p
+shot p1.png
+shot p2.png
+# Only the status line's timing may change while paused.
+held=$(compare -metric AE <(convert p1.png -crop 320x220+0+0 +repage png:-) \
+    <(convert p2.png -crop 320x220+0+0 +repage png:-) null: 2>&1 || true)
+echo "view: paused, $held pixels changed"
+((held == 0)) || { echo "view: P did not pause"; exit 1; }
+xdotool key c
+shot shader.png
+shaded=$(differ p2.png shader.png)
+echo "view: the next shader changed $shaded pixels"
+((shaded > 1000)) || { echo "view: C did not change the shader"; exit 1; }
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
