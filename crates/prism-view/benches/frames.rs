@@ -1,0 +1,75 @@
+//! Frame times of `prism view`'s modes, headless (the window adds one copy of the pixels):
+//! a course SVG at 1024x1024 and 16 samples per pixel, one progressive pass of the Cornell
+//! box at 512x384, and a 50x50 cloth simulated and shaded at 1024x800. Median and spread of
+//! 15 frames each, after 3 to warm up.
+
+use std::time::Instant;
+
+use prism_raster::{read_svg, Dialect};
+use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer};
+
+fn measure(name: &str, viewer: &mut Viewer, next: &mut dyn FnMut(&mut Viewer)) {
+    let mut times = Vec::new();
+    for i in 0..18 {
+        next(viewer);
+        let t = Instant::now();
+        let frame = viewer.frame();
+        std::hint::black_box(&frame);
+        if i >= 3 {
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "{name}: median {:.1} ms a frame ({:.0} frames/s), fastest {:.1}, slowest {:.1}",
+        times[times.len() / 2],
+        1e3 / times[times.len() / 2],
+        times[0],
+        times[times.len() - 1]
+    );
+}
+
+fn main() {
+    let assets = prism_testkit::shared_assets();
+    let svg = assets.join("rasterizer/svg/illustration/05_lion.svg");
+    let doc = read_svg(&svg, Dialect::Cs184).expect("the course's lion");
+    let here = std::env::temp_dir();
+    let mut v = Viewer::new(
+        Box::new(SvgMode::new(doc, &svg, Dialect::Cs184, &here)),
+        1024,
+        1024,
+    );
+    for _ in 0..3 {
+        v.input(Input::Key {
+            key: Key::Char('='),
+            ctrl: false,
+        });
+    }
+    assert!(v.mode().status().starts_with("16 spp"));
+    // Each frame pans by one pixel, so that every frame is drawn anew.
+    let mut x = 500.0;
+    v.input(Input::Cursor { x, y: 500.0 });
+    v.input(Input::Button(true));
+    measure("svg 05_lion.svg, 1024x1024, 16 spp", &mut v, &mut |v| {
+        x += 1.0;
+        v.input(Input::Cursor { x, y: 500.0 });
+    });
+
+    let dae = assets.join("pathtracer/dae/sky/CBspheres_lambertian.dae");
+    let scene = prism_scene::load(&dae, &prism_scene::SceneOptions::default()).expect("scene");
+    let mut v = Viewer::new(Box::new(PathMode::new(&scene, &dae, 0)), 512, 384);
+    measure(
+        "path CBspheres_lambertian.dae, 512x384, one pass",
+        &mut v,
+        &mut |_| {},
+    );
+
+    let json = assets.join("clothsim/scene/pinned2.json");
+    let cloth = prism_cloth::read_scene(&json, &[]).expect("cloth");
+    let mut v = Viewer::new(Box::new(ClothMode::new(cloth, &json)), 1024, 800);
+    measure(
+        "cloth pinned2.json (50x50), 1024x800, one frame simulated and shaded",
+        &mut v,
+        &mut |_| {},
+    );
+}
