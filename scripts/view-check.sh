@@ -9,6 +9,8 @@
 #     (most pixels change); `2` shows the second bounce only;
 #   - a cloth scene opens within 1 s and plays by itself; `P` pauses it (the picture holds
 #     still); `C` changes the shader;
+#   - the Whitted ray tracer opens within 1 s; a click on a pixel draws its rays; `X` clears
+#     them (the picture is as before);
 #   - without a display, prism view exits 2 with a clear message.
 # Needs: apt-get install -y xvfb xdotool x11-utils imagemagick libxkbcommon-x11-0
 #   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
@@ -128,6 +130,29 @@ shot shader.png
 shaded=$(differ p2.png shader.png)
 echo "view: the next shader changed $shaded pixels"
 ((shaded > 1000)) || { echo "view: C did not change the shader"; exit 1; }
+xdotool key Escape
+wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
+
+start=$(date +%s.%N)
+"$prism" view cornell-box -r 300 300 &
+pid=$!
+wid=$(xdotool search --sync --name "prism view" | head -1)
+opened=$(echo "$(date +%s.%N) - $start" | bc)
+echo "view: Whitted scene open after $opened s"
+(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+xdotool windowfocus --sync "$wid"
+shot w1.png
+xdotool mousemove --window "$wid" 140 170 click 1
+shot w2.png
+rays=$(differ w1.png w2.png)
+echo "view: clicking a pixel changed $rays pixels (its rays over the dimmed picture)"
+((rays > 5000)) || { echo "view: a click drew no rays"; exit 1; }
+xdotool key x
+shot w3.png
+back=$(compare -metric AE <(convert w1.png -crop 300x280+0+0 +repage png:-) \
+    <(convert w3.png -crop 300x280+0+0 +repage png:-) null: 2>&1 || true)
+echo "view: after X, $back pixels differ from the first picture"
+((back == 0)) || { echo "view: X did not clear the rays"; exit 1; }
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 

@@ -9,8 +9,8 @@ use clap::Args;
 use prism_image::Bloom;
 use prism_math::Rgb;
 use prism_render::{
-    palette, raytrace, raytrace_share, trace_pixel, OrbitView, Overlay, Part, RayKind,
-    RaytraceOptions, Share, WhittedScene, WhittedSettings,
+    raytrace, raytrace_share, trace_pixel, OrbitView, Overlay, Part, RaytraceOptions, Share,
+    WhittedScene, WhittedSettings,
 };
 use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
 
@@ -175,31 +175,41 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
 }
 
 /// What the command loads: the scene, its cameras, the config if any.
-struct Loaded {
-    scene: prism_scene::Scene,
-    cameras: Vec<OrbitCamera>,
-    features: Features,
-    window: Option<[u32; 2]>,
+pub struct Loaded {
+    /// The scene.
+    pub scene: prism_scene::Scene,
+    /// The config's cameras (one default camera without a config).
+    pub cameras: Vec<OrbitCamera>,
+    /// The features that start on.
+    pub features: Features,
+    /// The config's window size.
+    pub window: Option<[u32; 2]>,
 }
 
 fn load(a: &RaytraceArgs) -> Result<Loaded> {
+    load_scene(&a.scene, a.data.as_ref())
+}
+
+/// Loads a Delft scene: a preset name, an OBJ scene (lit by a point light at (-1, 1, -1)) or
+/// a TOML render config; preset OBJ files come from `data`, else the staged folder, else
+/// the copies built in.
+pub fn load_scene(name: &str, data: Option<&PathBuf>) -> Result<Loaded> {
     let user = |e: prism_scene::SceneError| anyhow::Error::from(UserError(e.to_string()));
     let mut dirs = Vec::new();
-    if let Some(d) = &a.data {
+    if let Some(d) = data {
         if !d.is_dir() {
             return Err(UserError(format!("--data {}: expected a folder", d.display())).into());
         }
         dirs.push(d.clone());
     }
     dirs.push(staged_data());
-    let lower = a.scene.to_ascii_lowercase();
+    let lower = name.to_ascii_lowercase();
     if lower.ends_with(".toml") {
-        let cfg: RenderConfig =
-            prism_scene::read_render_config(Path::new(&a.scene)).map_err(user)?;
+        let cfg: RenderConfig = prism_scene::read_render_config(Path::new(&name)).map_err(user)?;
         for w in &cfg.warnings {
             eprintln!("prism: warning: {w}");
         }
-        if a.data.is_some() && cfg.data_path.is_some() {
+        if data.is_some() && cfg.data_path.is_some() {
             eprintln!("prism: warning: --data has no effect: the config's data_path is used");
         }
         let scene = cfg.load_scene(&dirs).map_err(user)?;
@@ -219,18 +229,18 @@ fn load(a: &RaytraceArgs) -> Result<Loaded> {
         });
     }
     let scene = if lower.ends_with(".obj") {
-        let mut s = prism_scene::read_obj_scene(Path::new(&a.scene), false).map_err(user)?;
+        let mut s = prism_scene::read_obj_scene(Path::new(&name), false).map_err(user)?;
         s.lights = vec![prism_scene::Light::Point {
             position: prism_math::Vec3::new(-1.0, 1.0, -1.0),
             intensity: Rgb::WHITE,
         }];
         s
     } else {
-        let preset = Preset::from_name(&a.scene).ok_or_else(|| {
+        let preset = Preset::from_name(name).ok_or_else(|| {
             let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
             UserError(format!(
                 "{}: expected a preset ({}), an .obj scene or a .toml config",
-                a.scene,
+                name,
                 names.join(", ")
             ))
         })?;
@@ -496,24 +506,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         if a.bvh_level.is_some() || a.bvh_leaf.is_some() {
             let view = OrbitView::new(camera, w, h);
             let mut ov = Overlay::new(shown, view, &scene);
-            let bvh = scene.bvh().expect("checked above");
-            if let Some(level) = a.bvh_level {
-                for (i, b) in bvh.level_boxes(level).iter().enumerate() {
-                    ov.aabb(b, palette(i));
-                }
-            }
-            if let Some(k) = a.bvh_leaf {
-                let leaf = &bvh.leaf_views()[k];
-                ov.aabb(&leaf.bounds, Rgb::new(1.0, 1.0, 0.0));
-                for &p in &leaf.prims {
-                    if (p as usize) < scene.triangle_count() {
-                        let t = scene.triangle(p as usize);
-                        for e in 0..3 {
-                            ov.segment(t[e], t[(e + 1) % 3], Rgb::new(1.0, 0.0, 1.0), false);
-                        }
-                    }
-                }
-            }
+            ov.bvh(&scene, a.bvh_level, a.bvh_leaf);
             shown = ov.image;
         }
         match format {
@@ -554,15 +547,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             // The picture is dimmed so that the rays stand out.
             let dim = base.map(|p| *p * 0.5);
             let mut ov = Overlay::new(dim, view, &scene);
-            for r in &tr.rays {
-                let on_top = matches!(r.kind, RayKind::Normal | RayKind::InterpolatedNormal);
-                ov.segment(r.origin, r.end, r.color, !on_top);
-            }
-            for r in &tr.rays {
-                if let Some(p) = r.blocked_at {
-                    ov.marker(p, Rgb::new(1.0, 0.0, 0.0));
-                }
-            }
+            ov.ray_tree(&tr.rays);
             let png = sibling(&path, ".debug.png");
             crate::output::write_rgb8(&png, ImageFormat::Png, &ov.image.to_rgb8_truncated())?;
             written.push(png.display().to_string());

@@ -9,7 +9,7 @@ use std::rc::Rc;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_raster::{read_svg, Dialect};
-use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer};
+use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer, WhittedMode};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -27,6 +27,9 @@ pub enum ModeArg {
     Path,
     /// A ClothSim scene JSON, simulated and shaded as the course app plays it.
     Cloth,
+    /// A Delft scene (a preset name, an OBJ scene or a TOML config) through the Whitted ray
+    /// tracer, with its ray trees and BVH views.
+    Whitted,
 }
 
 /// Arguments of `prism view`.
@@ -41,10 +44,14 @@ pub enum ModeArg {
              -s n); drag orbits the camera, the wheel moves it closer, 1-9 only the m-th
              bounce, 0 every bounce, A the noise heat map, R reset the camera
   cloth      P play/pause, N one frame, R back to the start, C next shader (phong,
-             diffuse, normal, wireframe), drag to orbit, wheel to move closer")]
+             diffuse, normal, wireframe), drag to orbit, wheel to move closer
+  whitted    click a pixel to trace its rays (kept while the camera orbits), X clear them,
+             drag to orbit, wheel to move closer, 1-9 0 M toggle shading, recursive,
+             hard shadow, soft shadow, normal interpolation, texture, bilinear, bvh, bloom,
+             transparency, multi-rays; [ ] BVH level, , . BVH leaf, R reset the camera")]
 pub struct ViewArgs {
     /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path;
-    /// .json: cloth).
+    /// .json: cloth; .obj, .toml or a Delft preset name such as cornell-box: whitted).
     file: PathBuf,
     /// The mode, instead of the one the extension chooses.
     #[arg(long, value_enum)]
@@ -53,7 +60,7 @@ pub struct ViewArgs {
     #[arg(long)]
     compat: bool,
     /// Window size: WIDTH HEIGHT (default 960 640; 512 384 for path tracing; 1024 800, the
-    /// course app's, for cloth).
+    /// course app's, for cloth; the config's window or 800 800 for whitted).
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
     resolution: Option<Vec<u32>>,
     /// Seed of the path tracer's random numbers.
@@ -72,11 +79,15 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             "svg" => ModeArg::Svg,
             "dae" => ModeArg::Path,
             "json" => ModeArg::Cloth,
+            "obj" | "toml" => ModeArg::Whitted,
+            "" if prism_scene::Preset::from_name(&a.file.to_string_lossy()).is_some() => {
+                ModeArg::Whitted
+            }
             other => {
                 return Err(UserError(format!(
                     "{}: cannot tell what to view from the extension `.{other}`; prism view \
-                     opens .svg drawings, lit .dae scenes and cloth .json scenes (--mode svg, path or \
-                     cloth)",
+                     opens .svg drawings, lit .dae scenes, cloth .json scenes and Delft .obj, .toml \
+                     or preset scenes (--mode svg, path, cloth or whitted)",
                     a.file.display()
                 ))
                 .into())
@@ -88,6 +99,7 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         (None, ModeArg::Svg) => (960, 640),
         (None, ModeArg::Path) => (512, 384),
         (None, ModeArg::Cloth) => (1024, 800),
+        (None, ModeArg::Whitted) => (800, 800),
     };
     if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
         || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
@@ -128,6 +140,17 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
                 .into());
             }
             let mode = PathMode::new(&scene, &a.file, a.seed);
+            Ok(Viewer::new(Box::new(mode), w, h))
+        }
+        ModeArg::Whitted => {
+            let loaded = crate::raytrace::load_scene(&a.file.to_string_lossy(), None)?;
+            let (w, h) = match (&a.resolution, loaded.window) {
+                (None, Some([cw, ch])) => (cw, ch),
+                _ => (w, h),
+            };
+            let camera = loaded.cameras.first().copied().unwrap_or_default();
+            let name = a.file.display().to_string();
+            let mode = WhittedMode::new(loaded.scene, &name, camera, loaded.features);
             Ok(Viewer::new(Box::new(mode), w, h))
         }
         ModeArg::Cloth => {

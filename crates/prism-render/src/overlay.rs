@@ -1,11 +1,12 @@
 //! [`Overlay`], 3D segments drawn over a rendered image through its [`OrbitView`]: depth
 //! tested against the scene as that view sees it (ray segments), or drawn on top (BVH
-//! boxes), plus point markers.
+//! boxes), plus point markers; a pixel's ray tree and a BVH's levels and leaves.
 
 use prism_image::RgbImage;
 use prism_math::{Aabb, Ray, Rgb, Vec3};
 
 use crate::camera::OrbitView;
+use crate::integrators::whitted::{DebugRay, RayKind};
 use crate::whitted_scene::WhittedScene;
 
 /// An image being drawn over, with the depth of the scene at each pixel.
@@ -105,6 +106,45 @@ impl Overlay {
             for bit in [1u32, 2, 4] {
                 if i & bit == 0 {
                     self.segment(corner(i), corner(i | bit), color, false);
+                }
+            }
+        }
+    }
+
+    /// Draws a pixel's ray tree as `prism raytrace --debug-pixel` does: each ray in its
+    /// colour, depth-tested except normals (drawn on top), and a red marker where a shadow
+    /// ray was blocked.
+    pub fn ray_tree(&mut self, rays: &[DebugRay]) {
+        for r in rays {
+            let on_top = matches!(r.kind, RayKind::Normal | RayKind::InterpolatedNormal);
+            self.segment(r.origin, r.end, r.color, !on_top);
+        }
+        for r in rays {
+            if let Some(p) = r.blocked_at {
+                self.marker(p, Rgb::new(1.0, 0.0, 0.0));
+            }
+        }
+    }
+
+    /// Draws `scene`'s BVH: the boxes of `level` in palette colours, and leaf `leaf` (its box
+    /// in yellow, its triangles in magenta); a level or leaf the BVH lacks draws nothing.
+    pub fn bvh(&mut self, scene: &WhittedScene, level: Option<usize>, leaf: Option<usize>) {
+        let Some(bvh) = scene.bvh() else {
+            return;
+        };
+        if let Some(level) = level {
+            for (i, b) in bvh.level_boxes(level).iter().enumerate() {
+                self.aabb(b, palette(i));
+            }
+        }
+        if let Some(view) = leaf.and_then(|k| bvh.leaf_views().into_iter().nth(k)) {
+            self.aabb(&view.bounds, Rgb::new(1.0, 1.0, 0.0));
+            for &p in &view.prims {
+                if (p as usize) < scene.triangle_count() {
+                    let t = scene.triangle(p as usize);
+                    for e in 0..3 {
+                        self.segment(t[e], t[(e + 1) % 3], Rgb::new(1.0, 0.0, 1.0), false);
+                    }
                 }
             }
         }

@@ -1,7 +1,7 @@
 //! The logic of `prism view` without a window: a [`Viewer`] takes [`Input`] events (keys,
 //! cursor, buttons, wheel, resizes) and produces frames, so that every control is tested
 //! headlessly and the window around it stays a thin shell. Each kind of file has its mode
-//! (`svg`: the course rasterizer's viewer; `path`: progressive path tracing; `cloth`: the simulation played and shaded); the help overlay and status line are drawn with
+//! (`svg`: the course rasterizer's viewer; `path`: progressive path tracing; `cloth`: the simulation played and shaded; `whitted`: the Delft ray tracer with its ray trees and BVH views); the help overlay and status line are drawn with
 //! an 8x8 bitmap font (`text`).
 #![warn(missing_docs)]
 
@@ -12,6 +12,7 @@ mod path;
 mod svg;
 mod text;
 mod viewer;
+mod whitted;
 
 pub use cloth::ClothMode;
 pub use input::{Input, Key};
@@ -20,3 +21,4 @@ pub use path::{PathMode, MAX_PASSES};
 pub use svg::SvgMode;
 pub use text::{draw_text, text_width, GLYPH};
 pub use viewer::{Frame, Mode, Response, Viewer};
+pub use whitted::WhittedMode;

@@ -1,0 +1,285 @@
+//! [`WhittedMode`]: the Delft ray tracer with its visual debugging in the window: feature
+//! switches as keys, a click on a pixel traces its ray tree (coloured as `prism raytrace
+//! --debug-pixel` colours it) and keeps it in the scene while the camera orbits, and the BVH
+//! shown level by level and leaf by leaf.
+
+use prism_image::{Bloom, Rgb8Image, RgbImage};
+use prism_render::{
+    raytrace, trace_pixel, OrbitView, Overlay, PixelTrace, RaytraceOptions, WhittedScene,
+    WhittedSettings,
+};
+use prism_scene::{Features, OrbitCamera, Scene};
+
+use crate::input::{Input, Key};
+use crate::viewer::{Mode, Response};
+
+/// The feature switches: key, name, and the flag.
+const SWITCHES: [(char, &str); 11] = [
+    ('1', "shading"),
+    ('2', "recursive"),
+    ('3', "hard-shadow"),
+    ('4', "soft-shadow"),
+    ('5', "normal-interp"),
+    ('6', "texture"),
+    ('7', "bilinear"),
+    ('8', "bvh"),
+    ('9', "bloom"),
+    ('0', "transparency"),
+    ('m', "multi-rays"),
+];
+
+fn flag<'a>(f: &'a mut Features, name: &str) -> &'a mut bool {
+    match name {
+        "shading" => &mut f.shading,
+        "recursive" => &mut f.recursive,
+        "hard-shadow" => &mut f.hard_shadow,
+        "soft-shadow" => &mut f.soft_shadow,
+        "normal-interp" => &mut f.normal_interp,
+        "texture" => &mut f.texture_mapping,
+        "bilinear" => &mut f.bilinear,
+        "bvh" => &mut f.accel_structure,
+        "bloom" => &mut f.bloom,
+        "transparency" => &mut f.transparency,
+        _ => &mut f.multiple_rays_per_pixel,
+    }
+}
+
+/// A Whitted scene in the viewer.
+pub struct WhittedMode {
+    name: String,
+    source: Scene,
+    scene: WhittedScene,
+    start: OrbitCamera,
+    camera: OrbitCamera,
+    features: Features,
+    base: Option<RgbImage>,
+    trace: Option<PixelTrace>,
+    level: Option<usize>,
+    leaf: Option<usize>,
+    cursor: (f64, f64),
+    press: Option<(f64, f64)>,
+    last: (f64, f64),
+}
+
+impl WhittedMode {
+    /// A viewer of `scene` (named `name`) through `camera`, with `features` on.
+    #[must_use]
+    pub fn new(scene: Scene, name: &str, camera: OrbitCamera, features: Features) -> WhittedMode {
+        WhittedMode {
+            name: name.to_string(),
+            scene: WhittedScene::new(&scene, features.accel_structure),
+            source: scene,
+            start: camera,
+            camera,
+            features,
+            base: None,
+            trace: None,
+            level: None,
+            leaf: None,
+            cursor: (0.0, 0.0),
+            press: None,
+            last: (0.0, 0.0),
+        }
+    }
+
+    /// The ray tree of the pixel clicked last.
+    #[must_use]
+    pub fn trace(&self) -> Option<&PixelTrace> {
+        self.trace.as_ref()
+    }
+
+    /// The camera now.
+    #[must_use]
+    pub fn camera(&self) -> OrbitCamera {
+        self.camera
+    }
+
+    fn options(&self, width: u32, height: u32) -> RaytraceOptions {
+        RaytraceOptions {
+            width,
+            height,
+            settings: WhittedSettings {
+                features: self.features,
+                light_samples: 16,
+                max_depth: 3,
+            },
+            spp: 16,
+            bloom: Bloom::default(),
+            seed: 0,
+        }
+    }
+
+    fn changed(&mut self) -> Response {
+        self.base = None;
+        Response::Redraw
+    }
+}
+
+impl Mode for WhittedMode {
+    fn name(&self) -> &'static str {
+        "whitted"
+    }
+
+    fn title(&self) -> String {
+        format!("prism view: {} (Whitted ray tracer)", self.name)
+    }
+
+    fn help(&self) -> Vec<(&'static str, &'static str)> {
+        vec![
+            ("click", "trace the pixel's rays and keep them in the scene"),
+            ("X", "clear the rays"),
+            ("drag", "orbit the camera"),
+            ("wheel", "move the camera closer or farther"),
+            (
+                "1-9 0 M",
+                "shading, recursive, hard/soft shadow, normal interp,",
+            ),
+            (
+                "",
+                "texture, bilinear, bvh, bloom, transparency, multi-rays",
+            ),
+            ("[ ]", "BVH level down / up (below 0: none)"),
+            (", .", "BVH leaf back / forward (below 0: none)"),
+            ("R", "reset the camera"),
+        ]
+    }
+
+    fn input(&mut self, input: &Input, size: (u32, u32)) -> Response {
+        match *input {
+            Input::Key { key, ctrl: false } => match key {
+                Key::Char(c) if SWITCHES.iter().any(|s| s.0 == c) => {
+                    let name = SWITCHES.iter().find(|s| s.0 == c).expect("found").1;
+                    let on = flag(&mut self.features, name);
+                    *on = !*on;
+                    let state = if *on { "on" } else { "off" };
+                    if name == "bvh" {
+                        self.scene = WhittedScene::new(&self.source, self.features.accel_structure);
+                        self.level = None;
+                        self.leaf = None;
+                    }
+                    self.changed();
+                    Response::Message(format!("{name} {state}"))
+                }
+                Key::Char('x') => {
+                    self.trace = None;
+                    Response::Redraw
+                }
+                Key::Char('r') => {
+                    self.camera = self.start;
+                    self.changed()
+                }
+                Key::Char(c @ ('[' | ']' | ',' | '.')) => {
+                    let Some(bvh) = self.scene.bvh() else {
+                        return Response::Message("the BVH is off (8 turns it on)".into());
+                    };
+                    let (slot, count) = match c {
+                        '[' | ']' => (&mut self.level, bvh.levels()),
+                        _ => (&mut self.leaf, bvh.leaf_views().len()),
+                    };
+                    *slot = match (c, *slot) {
+                        (']' | '.', None) if count > 0 => Some(0),
+                        (']' | '.', Some(k)) => Some((k + 1).min(count.saturating_sub(1))),
+                        ('[' | ',', Some(0)) | ('[' | ',', None) => None,
+                        ('[' | ',', Some(k)) => Some(k - 1),
+                        (_, s) => s,
+                    };
+                    Response::Redraw
+                }
+                _ => Response::Ignored,
+            },
+            Input::Cursor { x, y } => {
+                self.cursor = (x, y);
+                if self.press.is_none() {
+                    return Response::Ignored;
+                }
+                let per_pixel = 180.0 / size.0.max(1) as f32;
+                let (dx, dy) = ((x - self.last.0) as f32, (y - self.last.1) as f32);
+                self.last = (x, y);
+                self.camera.rotation.y -= dx * per_pixel;
+                self.camera.rotation.x =
+                    (self.camera.rotation.x + dy * per_pixel).clamp(-89.0, 89.0);
+                self.changed()
+            }
+            Input::Button(true) => {
+                self.press = Some(self.cursor);
+                self.last = self.cursor;
+                Response::Ignored
+            }
+            Input::Button(false) => {
+                let Some((px, py)) = self.press.take() else {
+                    return Response::Ignored;
+                };
+                let (x, y) = self.cursor;
+                if (x - px).abs() > 2.0 || (y - py).abs() > 2.0 {
+                    return Response::Ignored;
+                }
+                // A click: the pixel under the cursor, traced from the camera as it is now.
+                let (cx, cy) = (x.floor(), y.floor());
+                if cx < 0.0 || cy < 0.0 || cx >= f64::from(size.0) || cy >= f64::from(size.1) {
+                    return Response::Ignored;
+                }
+                let opts = self.options(size.0, size.1);
+                let t = trace_pixel(&self.scene, &self.camera, &opts, cx as u32, cy as u32);
+                let n = t.rays.len();
+                self.trace = Some(t);
+                Response::Message(format!("pixel ({cx}, {cy}): {n} rays"))
+            }
+            Input::Wheel(lines) => {
+                self.camera.distance =
+                    (self.camera.distance * 0.9f32.powf(lines as f32)).clamp(1e-3, 1e6);
+                self.changed()
+            }
+            Input::Resize { .. } => self.changed(),
+            Input::Key { .. } => Response::Ignored,
+        }
+    }
+
+    fn draw(&mut self, width: u32, height: u32) -> Rgb8Image {
+        let stale = self
+            .base
+            .as_ref()
+            .is_none_or(|b| (b.width(), b.height()) != (width, height));
+        if stale {
+            let opts = self.options(width, height);
+            self.base = Some(raytrace(&self.scene, &self.camera, &opts, &|_| {}).image);
+        }
+        let base = self.base.as_ref().expect("drawn above");
+        if self.trace.is_none() && self.level.is_none() && self.leaf.is_none() {
+            return base.to_rgb8_truncated();
+        }
+        // The picture is dimmed under rays so that they stand out.
+        let under = if self.trace.is_some() {
+            base.map(|p| *p * 0.5)
+        } else {
+            base.clone()
+        };
+        let mut ov = Overlay::new(
+            under,
+            OrbitView::new(&self.camera, width, height),
+            &self.scene,
+        );
+        if let Some(t) = &self.trace {
+            ov.ray_tree(&t.rays);
+        }
+        ov.bvh(&self.scene, self.level, self.leaf);
+        ov.image.to_rgb8_truncated()
+    }
+
+    fn status(&self) -> String {
+        let on: Vec<&str> = SWITCHES
+            .iter()
+            .filter(|(_, name)| {
+                let mut f = self.features;
+                *flag(&mut f, name)
+            })
+            .map(|(_, name)| *name)
+            .collect();
+        let show = |v: Option<usize>| v.map_or("-".to_string(), |k| k.to_string());
+        format!(
+            "{} | BVH level {} leaf {}",
+            on.join(" "),
+            show(self.level),
+            show(self.leaf)
+        )
+    }
+}
