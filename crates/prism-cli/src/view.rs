@@ -9,7 +9,7 @@ use std::rc::Rc;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_raster::{read_svg, Dialect};
-use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer, WhittedMode};
+use prism_view::{ClothMode, Input, Key, MeshMode, PathMode, SvgMode, Viewer, WhittedMode};
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
@@ -30,6 +30,8 @@ pub enum ModeArg {
     /// A Delft scene (a preset name, an OBJ scene or a TOML config) through the Whitted ray
     /// tracer, with its ray trees and BVH views.
     Whitted,
+    /// A mesh (OBJ, PLY, COLLADA) to edit as MeshEdit does.
+    Mesh,
 }
 
 /// Arguments of `prism view`.
@@ -48,10 +50,15 @@ pub enum ModeArg {
   whitted    click a pixel to trace its rays (kept while the camera orbits), X clear them,
              drag to orbit, wheel to move closer, 1-9 0 M toggle shading, recursive,
              hard shadow, soft shadow, normal interpolation, texture, bilinear, bvh, bloom,
-             transparency, multi-rays; [ ] BVH level, , . BVH leaf, R reset the camera")]
+             transparency, multi-rays; [ ] BVH level, , . BVH leaf, R reset the camera
+  mesh       hover highlights the vertex, edge or face under the cursor; F flip, S split,
+             C collapse the highlighted edge, U Loop subdivision, N smooth/flat normals,
+             W wireframe, Ctrl+Z undo, Ctrl+S save as NAME-edited.obj; drag orbits, wheel
+             zooms, arrows pan, R resets the view")]
 pub struct ViewArgs {
     /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path;
-    /// .json: cloth; .obj, .toml or a Delft preset name such as cornell-box: whitted).
+    /// .json: cloth; .obj, .toml or a Delft preset name such as cornell-box: whitted; .ply or
+    /// .dae without a light: mesh).
     file: PathBuf,
     /// The mode, instead of the one the extension chooses.
     #[arg(long, value_enum)]
@@ -77,7 +84,17 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         Some(m) => m,
         None => match crate::output::extension(&a.file).as_str() {
             "svg" => ModeArg::Svg,
-            "dae" => ModeArg::Path,
+            "dae" => {
+                let lit = prism_scene::load(&a.file, &prism_scene::SceneOptions::default())
+                    .map(|s| s.is_lit())
+                    .unwrap_or(true);
+                if lit {
+                    ModeArg::Path
+                } else {
+                    ModeArg::Mesh
+                }
+            }
+            "ply" => ModeArg::Mesh,
             "json" => ModeArg::Cloth,
             "obj" | "toml" => ModeArg::Whitted,
             "" if prism_scene::Preset::from_name(&a.file.to_string_lossy()).is_some() => {
@@ -87,7 +104,7 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
                 return Err(UserError(format!(
                     "{}: cannot tell what to view from the extension `.{other}`; prism view \
                      opens .svg drawings, lit .dae scenes, cloth .json scenes and Delft .obj, .toml \
-                     or preset scenes (--mode svg, path, cloth or whitted)",
+                     or preset scenes, and .ply meshes (--mode svg, path, cloth, whitted or mesh)",
                     a.file.display()
                 ))
                 .into())
@@ -100,6 +117,7 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
         (None, ModeArg::Path) => (512, 384),
         (None, ModeArg::Cloth) => (1024, 800),
         (None, ModeArg::Whitted) => (800, 800),
+        (None, ModeArg::Mesh) => (960, 720),
     };
     if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
         || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
@@ -152,6 +170,16 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             let name = a.file.display().to_string();
             let mode = WhittedMode::new(loaded.scene, &name, camera, loaded.features);
             Ok(Viewer::new(Box::new(mode), w, h))
+        }
+        ModeArg::Mesh => {
+            let (poly, warnings) =
+                prism_scene::read_mesh(&a.file).map_err(|e| UserError(e.to_string()))?;
+            for w in &warnings {
+                eprintln!("warning: {w}");
+            }
+            let mesh = prism_mesh::HalfedgeMesh::from_polymesh(&poly)
+                .map_err(|e| UserError(format!("{}: {e}", a.file.display())))?;
+            Ok(Viewer::new(Box::new(MeshMode::new(mesh, &a.file)), w, h))
         }
         ModeArg::Cloth => {
             let scene =

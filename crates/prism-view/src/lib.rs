@@ -1,12 +1,13 @@
 //! The logic of `prism view` without a window: a [`Viewer`] takes [`Input`] events (keys,
 //! cursor, buttons, wheel, resizes) and produces frames, so that every control is tested
 //! headlessly and the window around it stays a thin shell. Each kind of file has its mode
-//! (`svg`: the course rasterizer's viewer; `path`: progressive path tracing; `cloth`: the simulation played and shaded; `whitted`: the Delft ray tracer with its ray trees and BVH views); the help overlay and status line are drawn with
+//! (`svg`: the course rasterizer's viewer; `mesh`: MeshEdit's edits on a halfedge mesh; `path`: progressive path tracing; `cloth`: the simulation played and shaded; `whitted`: the Delft ray tracer with its ray trees and BVH views); the help overlay and status line are drawn with
 //! an 8x8 bitmap font (`text`).
 #![warn(missing_docs)]
 
 mod cloth;
 mod input;
+mod mesh;
 mod orbit;
 mod path;
 mod svg;
@@ -16,6 +17,7 @@ mod whitted;
 
 pub use cloth::ClothMode;
 pub use input::{Input, Key};
+pub use mesh::{Hover, MeshMode};
 pub use orbit::Orbit;
 pub use path::{PathMode, MAX_PASSES};
 pub use svg::SvgMode;
