@@ -1,12 +1,13 @@
 //! Frame times of `prism view`'s modes, headless (the window adds one copy of the pixels):
 //! a course SVG at 1024x1024 and 16 samples per pixel, one progressive pass of the Cornell
-//! box at 512x384, and a 50x50 cloth simulated and shaded at 1024x800. Median and spread of
-//! 15 frames each, after 3 to warm up.
+//! box at 512x384, a 50x50 cloth simulated and shaded at 1024x800, and a mesh of over 100k
+//! triangles (the course's teapot, Loop-subdivided three times) orbited at 960x720. Median
+//! and spread of 15 frames each, after 3 to warm up.
 
 use std::time::Instant;
 
 use prism_raster::{read_svg, Dialect};
-use prism_view::{ClothMode, Input, Key, PathMode, SvgMode, Viewer};
+use prism_view::{ClothMode, Input, Key, MeshMode, PathMode, SvgMode, Viewer};
 
 fn measure(name: &str, viewer: &mut Viewer, next: &mut dyn FnMut(&mut Viewer)) {
     let mut times = Vec::new();
@@ -71,5 +72,27 @@ fn main() {
         "cloth pinned2.json (50x50), 1024x800, one frame simulated and shaded",
         &mut v,
         &mut |_| {},
+    );
+
+    let dae = assets.join("meshedit/dae/teapot.dae");
+    let (poly, _) = prism_scene::read_mesh(&dae).expect("teapot");
+    let mut mesh = prism_mesh::HalfedgeMesh::from_polymesh(&poly).expect("manifold");
+    while mesh.face_count() < 100_000 {
+        let next =
+            prism_mesh::loop_subdivide(&mesh, prism_mesh::LoopWeights::Warren).expect("subdivides");
+        mesh = prism_mesh::HalfedgeMesh::from_polymesh(&next).expect("manifold");
+    }
+    let faces = mesh.face_count();
+    let mut v = Viewer::new(Box::new(MeshMode::new(mesh, &dae)), 960, 720);
+    let mut x = 100.0;
+    v.input(Input::Cursor { x, y: 100.0 });
+    v.input(Input::Button(true));
+    measure(
+        &format!("mesh teapot.dae subdivided ({faces} triangles), 960x720, orbiting"),
+        &mut v,
+        &mut |v| {
+            x += 2.0;
+            v.input(Input::Cursor { x, y: 100.0 });
+        },
     );
 }
