@@ -11,6 +11,8 @@
 #     still); `C` changes the shader;
 #   - the Whitted ray tracer opens within 1 s; a click on a pixel draws its rays; `X` clears
 #     them (the picture is as before);
+#   - a mesh (`--mode mesh` on a COLLADA file) opens within 1 s; hovering highlights an
+#     element; `F` flips the edge under the cursor (the wireframe changes); Ctrl+Z undoes it;
 #   - without a display, prism view exits 2 with a clear message.
 # Needs: apt-get install -y xvfb xdotool x11-utils imagemagick libxkbcommon-x11-0
 #   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
@@ -19,6 +21,7 @@ set -euo pipefail
 prism=$(realpath "${1:-target/release/prism}")
 scene=$(realpath ../shared/assets/pathtracer/dae/sky/CBspheres_lambertian.dae)
 cloth=$(realpath ../shared/assets/clothsim/scene/pinned2.json)
+teapot=$(realpath ../shared/assets/meshedit/dae/teapot.dae)
 work=$(mktemp -d)
 display=:$((90 + RANDOM % 9))
 Xvfb "$display" -screen 0 1024x768x24 >/dev/null 2>&1 &
@@ -153,6 +156,44 @@ back=$(compare -metric AE <(convert w1.png -crop 300x280+0+0 +repage png:-) \
     <(convert w3.png -crop 300x280+0+0 +repage png:-) null: 2>&1 || true)
 echo "view: after X, $back pixels differ from the first picture"
 ((back == 0)) || { echo "view: X did not clear the rays"; exit 1; }
+xdotool key Escape
+wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
+
+start=$(date +%s.%N)
+"$prism" view "$teapot" --mode mesh -r 480 360 &
+pid=$!
+wid=$(xdotool search --sync --name "prism view" | head -1)
+opened=$(echo "$(date +%s.%N) - $start" | bc)
+echo "view: mesh open after $opened s"
+(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+xdotool windowfocus --sync "$wid"
+shot m0.png
+area() { compare -metric AE <(convert "$1" -crop 480x340+0+0 +repage png:-) \
+    <(convert "$2" -crop 480x340+0+0 +repage png:-) null: 2>&1 || true; }
+xdotool mousemove --window "$wid" 236 170
+shot m1.png
+lit=$(area m0.png m1.png)
+echo "view: hovering highlighted $lit pixels"
+((lit > 20)) || { echo "view: hovering highlighted nothing"; exit 1; }
+# F flips only an edge: move along the teapot until the element under the cursor is one.
+flipped=0
+for x in $(seq 200 6 290); do
+    xdotool mousemove --window "$wid" "$x" 170
+    shot before-f.png
+    xdotool key f
+    shot after-f.png
+    flipped=$(area before-f.png after-f.png)
+    ((flipped > 20)) && break
+done
+echo "view: F changed $flipped pixels of the picture"
+((flipped > 20)) || { echo "view: F flipped no edge"; exit 1; }
+xdotool key ctrl+z
+xdotool mousemove --window "$wid" 10 10
+shot m3.png
+undone=$(compare -metric AE <(convert m0.png -crop 480x340+0+0 +repage png:-) \
+    <(convert m3.png -crop 480x340+0+0 +repage png:-) null: 2>&1 || true)
+echo "view: after Ctrl+Z, $undone pixels differ from the first picture"
+((undone == 0)) || { echo "view: Ctrl+Z did not undo"; exit 1; }
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
