@@ -1,8 +1,8 @@
 //! Frame times of `prism view`'s modes, headless (the window adds one copy of the pixels):
 //! a course SVG at 1024x1024 and 16 samples per pixel, one progressive pass of the Cornell
 //! box at 512x384, a 50x50 cloth simulated and shaded at 1024x800, and a mesh of over 100k
-//! triangles (the course's teapot, Loop-subdivided three times) orbited at 960x720. Median
-//! and spread of 15 frames each, after 3 to warm up.
+//! triangles (the course's beetle, Loop-subdivided twice) orbited at 960x720, with and
+//! without its wireframe. Median and spread of 15 frames each, after 3 to warm up.
 
 use std::time::Instant;
 
@@ -74,8 +74,8 @@ fn main() {
         &mut |_| {},
     );
 
-    let dae = assets.join("meshedit/dae/teapot.dae");
-    let (poly, _) = prism_scene::read_mesh(&dae).expect("teapot");
+    let dae = assets.join("meshedit/dae/beetle.dae");
+    let (poly, _) = prism_scene::read_mesh(&dae).expect("beetle");
     let mut mesh = prism_mesh::HalfedgeMesh::from_polymesh(&poly).expect("manifold");
     while mesh.face_count() < 100_000 {
         let next =
@@ -87,12 +87,20 @@ fn main() {
     let mut x = 100.0;
     v.input(Input::Cursor { x, y: 100.0 });
     v.input(Input::Button(true));
-    measure(
-        &format!("mesh teapot.dae subdivided ({faces} triangles), 960x720, orbiting"),
-        &mut v,
-        &mut |v| {
-            x += 2.0;
-            v.input(Input::Cursor { x, y: 100.0 });
-        },
-    );
+    for wireframe in ["wireframe", "no wireframe"] {
+        measure(
+            &format!(
+                "mesh beetle.dae subdivided ({faces} triangles), 960x720, orbiting, {wireframe}"
+            ),
+            &mut v,
+            &mut |v| {
+                x += 2.0;
+                v.input(Input::Cursor { x, y: 100.0 });
+            },
+        );
+        v.input(Input::Key {
+            key: Key::Char('w'),
+            ctrl: false,
+        });
+    }
 }
