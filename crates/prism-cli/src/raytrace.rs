@@ -121,25 +121,13 @@ const DEFAULT_SIDE: u32 = 800;
 
 /// Sets feature `name` in `f`.
 fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()> {
-    let slot = match name.trim() {
-        "shading" => &mut f.shading,
-        "recursive" => &mut f.recursive,
-        "hard-shadow" => &mut f.hard_shadow,
-        "soft-shadow" => &mut f.soft_shadow,
-        "normal-interp" => &mut f.normal_interp,
-        "texture" => &mut f.texture_mapping,
-        "bilinear" => &mut f.bilinear,
-        "bvh" => &mut f.accel_structure,
-        "bloom" => &mut f.bloom,
-        "transparency" => &mut f.transparency,
-        "multi-rays" => &mut f.multiple_rays_per_pixel,
-        other => {
-            return Err(UserError(format!(
-                "{flag} {other}: expected one of shading, recursive, hard-shadow, soft-shadow, \
-                 normal-interp, texture, bilinear, bvh, bloom, transparency, multi-rays"
-            ))
-            .into())
-        }
+    let Some(slot) = f.switch(name.trim()) else {
+        return Err(UserError(format!(
+            "{flag} {}: expected one of {}",
+            name.trim(),
+            Features::NAMES.join(", ")
+        ))
+        .into());
     };
     *slot = on;
     Ok(())

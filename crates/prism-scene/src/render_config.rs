@@ -50,6 +50,39 @@ pub struct Features {
 }
 
 impl Features {
+    /// The switches' names, as `--enable` and the viewer's status line spell them.
+    pub const NAMES: [&'static str; 11] = [
+        "shading",
+        "recursive",
+        "hard-shadow",
+        "soft-shadow",
+        "normal-interp",
+        "texture",
+        "bilinear",
+        "bvh",
+        "bloom",
+        "transparency",
+        "multi-rays",
+    ];
+
+    /// The switch called `name` (one of [`Features::NAMES`]).
+    pub fn switch(&mut self, name: &str) -> Option<&mut bool> {
+        Some(match name {
+            "shading" => &mut self.shading,
+            "recursive" => &mut self.recursive,
+            "hard-shadow" => &mut self.hard_shadow,
+            "soft-shadow" => &mut self.soft_shadow,
+            "normal-interp" => &mut self.normal_interp,
+            "texture" => &mut self.texture_mapping,
+            "bilinear" => &mut self.bilinear,
+            "bvh" => &mut self.accel_structure,
+            "bloom" => &mut self.bloom,
+            "transparency" => &mut self.transparency,
+            "multi-rays" => &mut self.multiple_rays_per_pixel,
+            _ => return None,
+        })
+    }
+
     /// prism's switches when no config sets them: everything on but bloom, transparency
     /// and multiple rays per pixel.
     #[must_use]

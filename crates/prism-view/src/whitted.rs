@@ -13,36 +13,8 @@ use prism_scene::{Features, OrbitCamera, Scene};
 use crate::input::{Input, Key};
 use crate::viewer::{Mode, Response};
 
-/// The feature switches: key, name, and the flag.
-const SWITCHES: [(char, &str); 11] = [
-    ('1', "shading"),
-    ('2', "recursive"),
-    ('3', "hard-shadow"),
-    ('4', "soft-shadow"),
-    ('5', "normal-interp"),
-    ('6', "texture"),
-    ('7', "bilinear"),
-    ('8', "bvh"),
-    ('9', "bloom"),
-    ('0', "transparency"),
-    ('m', "multi-rays"),
-];
-
-fn flag<'a>(f: &'a mut Features, name: &str) -> &'a mut bool {
-    match name {
-        "shading" => &mut f.shading,
-        "recursive" => &mut f.recursive,
-        "hard-shadow" => &mut f.hard_shadow,
-        "soft-shadow" => &mut f.soft_shadow,
-        "normal-interp" => &mut f.normal_interp,
-        "texture" => &mut f.texture_mapping,
-        "bilinear" => &mut f.bilinear,
-        "bvh" => &mut f.accel_structure,
-        "bloom" => &mut f.bloom,
-        "transparency" => &mut f.transparency,
-        _ => &mut f.multiple_rays_per_pixel,
-    }
-}
+/// The keys of the feature switches, in the order of [`Features::NAMES`].
+const KEYS: [char; 11] = ['1', '2', '3', '4', '5', '6', '7', '8', '9', '0', 'm'];
 
 /// A Whitted scene in the viewer.
 pub struct WhittedMode {
@@ -147,9 +119,10 @@ impl Mode for WhittedMode {
     fn input(&mut self, input: &Input, size: (u32, u32)) -> Response {
         match *input {
             Input::Key { key, ctrl: false } => match key {
-                Key::Char(c) if SWITCHES.iter().any(|s| s.0 == c) => {
-                    let name = SWITCHES.iter().find(|s| s.0 == c).expect("found").1;
-                    let on = flag(&mut self.features, name);
+                Key::Char(c) if KEYS.contains(&c) => {
+                    let i = KEYS.iter().position(|&k| k == c).expect("found");
+                    let name = Features::NAMES[i];
+                    let on = self.features.switch(name).expect("a switch's name");
                     *on = !*on;
                     let state = if *on { "on" } else { "off" };
                     if name == "bvh" {
@@ -266,13 +239,10 @@ impl Mode for WhittedMode {
     }
 
     fn status(&self) -> String {
-        let on: Vec<&str> = SWITCHES
-            .iter()
-            .filter(|(_, name)| {
-                let mut f = self.features;
-                *flag(&mut f, name)
-            })
-            .map(|(_, name)| *name)
+        let mut f = self.features;
+        let on: Vec<&str> = Features::NAMES
+            .into_iter()
+            .filter(|name| f.switch(name).is_some_and(|on| *on))
             .collect();
         let show = |v: Option<usize>| v.map_or("-".to_string(), |k| k.to_string());
         format!(
