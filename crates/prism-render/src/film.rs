@@ -152,7 +152,26 @@ pub fn render_share(
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Image<PixelSum> {
+    render_share_except(scene, opts, share, None, progress)
+}
+
+/// [`render_share`] leaving out the pixels `skip` marks (row by row, `width x height`
+/// entries): they hold no samples. A progressive renderer uses it to stop converged pixels.
+///
+/// # Panics
+/// If `skip` does not have one entry per pixel.
+pub fn render_share_except(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    share: &Share,
+    skip: Option<&[bool]>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Image<PixelSum> {
     let (w, h) = (opts.width, opts.height);
+    if let Some(s) = skip {
+        assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
+    }
+    let skipped = |x: u32, y: u32| skip.is_some_and(|s| s[(y * w + x) as usize]);
     let camera = Perspective::new(&scene.camera, w, h);
     let tiles: Vec<(u32, u32)> = tiles(w, h)
         .into_iter()
@@ -161,11 +180,14 @@ pub fn render_share(
         .map(|(_, t)| t)
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
-    let results: Vec<Vec<PixelSum>> = tiles
+    // Each tile's pixels rendered and their sums.
+    type Rendered = (Vec<(u32, u32)>, Vec<PixelSum>);
+    let results: Vec<Rendered> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
                 .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+                .filter(|&(x, y)| !skipped(x, y))
                 .collect();
             let out = if opts.integrator == Integrator::Path {
                 wavefront::tile(scene, &camera, opts, &pixels, &share.samples)
@@ -177,17 +199,13 @@ pub fn render_share(
             };
             let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
             progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
-            out
+            (pixels, out)
         })
         .collect();
     let mut sums = Image::new(w, h, PixelSum::default());
-    for (&(x0, y0), tile) in tiles.iter().zip(&results) {
-        let mut k = 0;
-        for y in y0..(y0 + TILE).min(h) {
-            for x in x0..(x0 + TILE).min(w) {
-                sums.set(x, y, tile[k]);
-                k += 1;
-            }
+    for (pixels, out) in &results {
+        for (&(x, y), s) in pixels.iter().zip(out) {
+            sums.set(x, y, *s);
         }
     }
     sums
@@ -234,14 +252,24 @@ impl PixelSum {
         let n = self.n;
         if let Some(tol) = opts.adaptive {
             if n.is_multiple_of(opts.batch.max(1)) && n > 1 {
-                let mean = self.moment1 / f64::from(n);
-                let var = ((self.moment2 - self.moment1 * self.moment1 / f64::from(n))
-                    / f64::from(n - 1))
-                .max(0.0);
-                let interval = 1.96 * (var / f64::from(n)).sqrt();
-                self.converged = interval <= f64::from(tol) * mean;
+                self.converged = self.within(tol);
             }
         }
+    }
+
+    /// The course's adaptive-sampling test: the 95% confidence interval of the pixel's
+    /// illuminance, `1.96 sigma / sqrt(n)`, is at most `tol` times its mean (false with
+    /// fewer than two samples).
+    #[must_use]
+    pub fn within(&self, tol: f32) -> bool {
+        if self.n < 2 {
+            return false;
+        }
+        let n = f64::from(self.n);
+        let mean = self.moment1 / n;
+        let var = ((self.moment2 - self.moment1 * self.moment1 / n) / (n - 1.0)).max(0.0);
+        let interval = 1.96 * (var / n).sqrt();
+        interval <= f64::from(tol) * mean
     }
 
     /// True while the pixel takes more of its `most` samples.

@@ -1,14 +1,16 @@
 //! [`PathMode`]: a COLLADA scene path-traced progressively, one sample per pixel a frame, the
 //! passes added with the film's exact pixel sums (so the picture after n passes is the
 //! `prism render -s n` image); dragging orbits the camera and the wheel moves it closer, each
-//! restarting the passes; `1`-`9` keep only the m-th bounce, `0` all of them; `A` shows the
-//! noise heat map (where adaptive sampling would keep sampling).
+//! restarting the passes; `1`-`9` keep only the m-th bounce, `0` all of them; `A` turns on
+//! adaptive sampling (a pixel stops once converged, by the course's rule checked every 32
+//! samples) and shows its heat map of samples per pixel, `M` switches between the heat map
+//! and the picture.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use prism_image::{heat_colour, Image, Rgb8Image};
-use prism_render::{render_share, PixelSum, RenderOptions, RenderScene, Share};
+use prism_image::{heatmap, Image, Rgb8Image};
+use prism_render::{render_share_except, PixelSum, RenderOptions, RenderScene, Share};
 
 use crate::input::{Input, Key};
 use crate::orbit::Orbit;
@@ -16,6 +18,10 @@ use crate::viewer::{Mode, Response};
 
 /// Passes after which the picture is left as it is.
 pub const MAX_PASSES: u32 = 4096;
+/// Adaptive sampling's tolerance and the samples between its checks (`prism render`'s
+/// defaults: `--adaptive 0.05 --batch 32`).
+const TOLERANCE: f32 = 0.05;
+const BATCH: u32 = 32;
 
 /// A path-traced scene in the viewer.
 pub struct PathMode {
@@ -24,7 +30,10 @@ pub struct PathMode {
     base: prism_scene::Camera,
     orbit: Orbit,
     only_bounce: Option<u32>,
+    adaptive: bool,
     heatmap: bool,
+    /// Pixels adaptive sampling has stopped.
+    done: Vec<bool>,
     seed: u64,
     sums: Option<Image<PixelSum>>,
     passes: u32,
@@ -41,7 +50,9 @@ impl PathMode {
             base: scene.camera,
             orbit: Orbit::default(),
             only_bounce: None,
+            adaptive: false,
             heatmap: false,
+            done: Vec::new(),
             seed,
             sums: None,
             passes: 0,
@@ -53,6 +64,12 @@ impl PathMode {
     #[must_use]
     pub fn passes(&self) -> u32 {
         self.passes
+    }
+
+    /// Each pixel's sums so far.
+    #[must_use]
+    pub fn sums(&self) -> Option<&Image<PixelSum>> {
+        self.sums.as_ref()
     }
 
     /// The camera after the orbit: the base camera's eye turned about its target.
@@ -119,6 +136,11 @@ impl Mode for PathMode {
                     self.restart()
                 }
                 Key::Char('a') => {
+                    self.adaptive = !self.adaptive;
+                    self.heatmap = self.adaptive;
+                    self.restart()
+                }
+                Key::Char('m') => {
                     self.heatmap = !self.heatmap;
                     Response::Redraw
                 }
@@ -157,6 +179,9 @@ impl Mode for PathMode {
             self.sums = Some(Image::new(width, height, PixelSum::default()));
             self.passes = 0;
         }
+        if self.passes == 0 {
+            self.done = vec![false; width as usize * height as usize];
+        }
         if self.passes < MAX_PASSES {
             self.scene.camera = self.camera();
             let opts = self.options(width, height);
@@ -166,18 +191,25 @@ impl Mode for PathMode {
                 samples: self.passes..self.passes + 1,
             };
             let t = Instant::now();
-            let pass = render_share(&self.scene, &opts, &share, &|_| {});
+            let skip = self.adaptive.then_some(self.done.as_slice());
+            let pass = render_share_except(&self.scene, &opts, &share, skip, &|_| {});
             let secs = t.elapsed().as_secs_f64();
-            self.rate = f64::from(width) * f64::from(height) / secs.max(1e-9);
+            let taken: u64 = pass.pixels().iter().map(|p| u64::from(p.n)).sum();
+            self.rate = taken as f64 / secs.max(1e-9);
             let sums = self.sums.as_mut().expect("made above");
             for (acc, add) in sums.pixels_mut().iter_mut().zip(pass.pixels()) {
                 acc.merge(add);
             }
             self.passes += 1;
+            if self.adaptive && self.passes.is_multiple_of(BATCH) {
+                for (d, s) in self.done.iter_mut().zip(sums.pixels()) {
+                    *d = *d || s.within(TOLERANCE);
+                }
+            }
         }
         let sums = self.sums.as_ref().expect("made above");
         if self.heatmap {
-            sums.map(|s| heat_colour(noise(s)))
+            heatmap(&sums.map(|s| s.n))
         } else {
             sums.map(PixelSum::mean).linear_to_srgb8()
         }
@@ -187,31 +219,24 @@ impl Mode for PathMode {
         let bounces = self
             .only_bounce
             .map_or("all bounces".to_string(), |m| format!("bounce {m} only"));
+        let stopped = self.done.iter().filter(|&&d| d).count();
+        let adaptive = if self.adaptive {
+            format!(
+                " | adaptive: {:.1}% of pixels done",
+                100.0 * stopped as f64 / self.done.len().max(1) as f64
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{} spp | {:.2} M samples/s | {bounces}{}",
+            "{} spp | {:.2} M samples/s | {bounces}{adaptive}{}",
             self.passes,
             self.rate / 1e6,
-            if self.heatmap { " | noise map" } else { "" }
+            if self.heatmap { " | heat map" } else { "" }
         )
     }
 
     fn busy(&self) -> bool {
-        self.passes < MAX_PASSES
+        self.passes < MAX_PASSES && !(self.adaptive && self.done.iter().all(|&d| d))
     }
-}
-
-/// The 95% confidence half-width of a pixel's illuminance relative to its mean, as adaptive
-/// sampling judges it, scaled so that 1 is a tolerance of 5% or worse.
-fn noise(s: &PixelSum) -> f32 {
-    if s.n < 2 {
-        return 1.0;
-    }
-    let n = f64::from(s.n);
-    let mean = s.moment1 / n;
-    let var = ((s.moment2 - s.moment1 * s.moment1 / n) / (n - 1.0)).max(0.0);
-    let interval = 1.96 * (var / n).sqrt();
-    if mean <= 0.0 {
-        return if interval > 0.0 { 1.0 } else { 0.0 };
-    }
-    ((interval / mean) / 0.05) as f32
 }

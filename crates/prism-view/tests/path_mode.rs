@@ -35,9 +35,39 @@ fn progressive_passes_are_the_batch_render() {
     assert_eq!(picture, batch.image.linear_to_srgb8());
 }
 
+/// Oracle: `prism render --adaptive 0.05 --batch 32 -s 64`. With `A`, 64 progressive passes
+/// stop the same pixels after 32 samples and give the same sums, sample counts and picture.
+#[test]
+fn adaptive_passes_are_the_adaptive_render() {
+    let scene = prism_scene::cornell_box();
+    let mut mode = PathMode::new(&scene, Path::new("cornell"), 3);
+    mode.input(&key('a'), (40, 30));
+    mode.input(&key('m'), (40, 30));
+    let mut picture = mode.draw(40, 30);
+    for _ in 1..64 {
+        picture = mode.draw(40, 30);
+    }
+    let opts = RenderOptions {
+        width: 40,
+        height: 30,
+        spp: 64,
+        seed: 3,
+        adaptive: Some(0.05),
+        batch: 32,
+        ..RenderOptions::default()
+    };
+    let batch = render(&RenderScene::new(&scene), &opts, &|_| {});
+    let counts = mode.sums().unwrap().map(|s| s.n);
+    assert_eq!(counts, batch.samples);
+    assert!(counts.pixels().contains(&32), "some pixels stopped early");
+    assert!(counts.pixels().contains(&64));
+    assert_eq!(picture, batch.image.linear_to_srgb8());
+    assert!(!mode.busy() || mode.passes() < 4096);
+}
+
 /// Dragging orbits the camera about its target (same distance, new eye) and restarts; the
-/// wheel moves it closer; `2` keeps the second bounce, `0` all; `A` shows the noise map
-/// without restarting; `R` puts the camera back.
+/// wheel moves it closer; `2` keeps the second bounce, `0` all; `A` turns adaptive sampling
+/// on and shows its heat map (restarting), `M` the picture again; `R` puts the camera back.
 #[test]
 fn orbit_bounces_heat_map_and_reset() {
     let scene = prism_scene::cornell_box();
@@ -66,12 +96,15 @@ fn orbit_bounces_heat_map_and_reset() {
     let plain = v.picture().clone();
     v.input(key('a'));
     let map = v.picture().clone();
-    assert!(v.mode().status().contains("noise map"));
+    assert!(v.mode().status().contains("adaptive"));
+    assert!(v.mode().status().contains("heat map"));
     assert!(
-        v.mode().status().starts_with("3 spp"),
-        "the map does not restart"
+        v.mode().status().starts_with("1 spp"),
+        "adaptive sampling restarts"
     );
     assert_ne!(plain, map);
+    v.input(key('m'));
+    assert!(!v.mode().status().contains("heat map"));
 
     let mut mode = PathMode::new(&scene, Path::new("c"), 0);
     mode.input(&Input::Cursor { x: 0.0, y: 0.0 }, (48, 32));
