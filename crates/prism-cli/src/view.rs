@@ -44,7 +44,8 @@ pub enum ModeArg {
              PNG (FILE-screenshot-N.png in the current folder)
   path       one sample per pixel a frame (the picture after n passes is prism render
              -s n); drag orbits the camera, the wheel moves it closer, 1-9 only the m-th
-             bounce, 0 every bounce, A the noise heat map, R reset the camera
+             bounce, 0 every bounce, A adaptive sampling and its heat map (M: heat map or
+             picture), R reset the camera
   cloth      P play/pause, N one frame, R back to the start, C next shader (phong,
              diffuse, normal, wireframe), drag to orbit, wheel to move closer
   whitted    click a pixel to trace its rays (kept while the camera orbits), X clear them,

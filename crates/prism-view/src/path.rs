@@ -118,8 +118,9 @@ impl Mode for PathMode {
             ("0", "every bounce (restarts)"),
             (
                 "A",
-                "noise heat map: red where adaptive sampling would go on",
+                "adaptive sampling on / off, shown as its heat map (restarts)",
             ),
+            ("M", "heat map of samples per pixel / picture"),
             ("R", "reset the camera (restarts)"),
         ]
     }
