@@ -38,15 +38,24 @@ SVG
 shot() { sleep 0.4; import -window "$wid" "$1"; }
 colours() { convert "$1" -crop 400x280+0+0 +repage -format %k info:; }
 differ() { compare -metric AE "$1" "$2" null: 2>&1 || true; }
+# Starts `prism view` with the arguments after the label, checks that its window is there
+# within 1 s, and focuses it; sets pid and wid.
+open_window() {
+    local label=$1
+    shift
+    local start
+    start=$(date +%s.%N)
+    "$prism" view "$@" &
+    pid=$!
+    wid=$(xdotool search --sync --name "prism view" | head -1)
+    local opened
+    opened=$(echo "$(date +%s.%N) - $start" | bc)
+    echo "view: $label open after $opened s"
+    (($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
+    xdotool windowfocus --sync "$wid"
+}
 
-start=$(date +%s.%N)
-"$prism" view tri.svg -r 400 300 &
-pid=$!
-wid=$(xdotool search --sync --name "prism view" | head -1)
-opened=$(echo "$(date +%s.%N) - $start" | bc)
-echo "view: window open after $opened s"
-(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
-xdotool windowfocus --sync "$wid"
+open_window "window" tri.svg -r 400 300
 shot one.png
 xdotool key equal equal equal
 shot sixteen.png
@@ -80,14 +89,7 @@ if kill -0 "$pid" 2>/dev/null; then echo "view: Esc did not close the window"; e
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 echo "view: Esc closed the window (exit 0)"
 
-start=$(date +%s.%N)
-"$prism" view "$scene" -r 256 192 &
-pid=$!
-wid=$(xdotool search --sync --name "prism view" | head -1)
-opened=$(echo "$(date +%s.%N) - $start" | bc)
-echo "view: path-traced scene open after $opened s"
-(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
-xdotool windowfocus --sync "$wid"
+open_window "path-traced scene" "$scene" -r 256 192
 shot early.png
 sleep 1
 shot later.png
@@ -107,14 +109,7 @@ echo "view: the second bounce alone changed $bounce pixels"
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
-start=$(date +%s.%N)
-"$prism" view "$cloth" -r 320 240 &
-pid=$!
-wid=$(xdotool search --sync --name "prism view" | head -1)
-opened=$(echo "$(date +%s.%N) - $start" | bc)
-echo "view: cloth scene open after $opened s"
-(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
-xdotool windowfocus --sync "$wid"
+open_window "cloth scene" "$cloth" -r 320 240
 shot c1.png
 shot c2.png
 played=$(differ c1.png c2.png)
@@ -136,14 +131,7 @@ echo "view: the next shader changed $shaded pixels"
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
-start=$(date +%s.%N)
-"$prism" view cornell-box -r 300 300 &
-pid=$!
-wid=$(xdotool search --sync --name "prism view" | head -1)
-opened=$(echo "$(date +%s.%N) - $start" | bc)
-echo "view: Whitted scene open after $opened s"
-(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
-xdotool windowfocus --sync "$wid"
+open_window "Whitted scene" cornell-box -r 300 300
 shot w1.png
 xdotool mousemove --window "$wid" 140 170 click 1
 shot w2.png
@@ -159,14 +147,7 @@ echo "view: after X, $back pixels differ from the first picture"
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
-start=$(date +%s.%N)
-"$prism" view "$teapot" --mode mesh -r 480 360 &
-pid=$!
-wid=$(xdotool search --sync --name "prism view" | head -1)
-opened=$(echo "$(date +%s.%N) - $start" | bc)
-echo "view: mesh open after $opened s"
-(($(echo "$opened < 1.0" | bc))) || { echo "view: took more than 1 s to open"; exit 1; }
-xdotool windowfocus --sync "$wid"
+open_window "mesh" "$teapot" --mode mesh -r 480 360
 shot m0.png
 area() { compare -metric AE <(convert "$1" -crop 480x340+0+0 +repage png:-) \
     <(convert "$2" -crop 480x340+0+0 +repage png:-) null: 2>&1 || true; }
