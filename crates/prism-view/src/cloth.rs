@@ -138,20 +138,12 @@ impl Mode for ClothMode {
                 }
                 _ => Response::Ignored,
             },
-            Input::Cursor { x, y } => {
-                if self.orbit.cursor(x, y, size.0) {
+            Input::Cursor { .. } | Input::Button(_) | Input::Wheel(_) => {
+                if self.orbit.input(input, size.0) == Some(true) {
                     Response::Redraw
                 } else {
                     Response::Ignored
                 }
-            }
-            Input::Button(down) => {
-                self.orbit.button(down);
-                Response::Ignored
-            }
-            Input::Wheel(lines) => {
-                self.orbit.wheel(lines);
-                Response::Redraw
             }
             Input::Resize { .. } => Response::Redraw,
             Input::Key { .. } => Response::Ignored,

@@ -332,7 +332,7 @@ impl Mode for MeshMode {
             },
             Input::Cursor { x, y } => {
                 self.cursor = (x, y);
-                if self.orbit.cursor(x, y, size.0) {
+                if self.orbit.input(input, size.0) == Some(true) {
                     return Response::Redraw;
                 }
                 let hover = self.pick(x, y, size);
@@ -343,13 +343,12 @@ impl Mode for MeshMode {
                     Response::Redraw
                 }
             }
-            Input::Button(down) => {
-                self.orbit.button(down);
-                Response::Ignored
-            }
-            Input::Wheel(lines) => {
-                self.orbit.wheel(lines);
-                Response::Redraw
+            Input::Button(_) | Input::Wheel(_) => {
+                if self.orbit.input(input, size.0) == Some(true) {
+                    Response::Redraw
+                } else {
+                    Response::Ignored
+                }
             }
             Input::Resize { .. } => Response::Redraw,
         }

@@ -3,6 +3,8 @@
 
 use prism_math::Vec3;
 
+use crate::input::Input;
+
 /// Turns about a target: yaw and pitch added to a camera's own (radians), and a scale of its
 /// distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,6 +65,24 @@ impl Orbit {
     /// The wheel turned `lines`: each line away from the user brings the camera 10% closer.
     pub fn wheel(&mut self, lines: f64) {
         self.scale = (self.scale * 0.9f32.powf(lines as f32)).clamp(0.05, 20.0);
+    }
+
+    /// Takes the mouse's inputs (cursor, left button, wheel) in a window `width` pixels
+    /// wide: `Some(true)` if the orbit moved, `Some(false)` if not, `None` for any other
+    /// input.
+    pub fn input(&mut self, input: &Input, width: u32) -> Option<bool> {
+        match *input {
+            Input::Cursor { x, y } => Some(self.cursor(x, y, width)),
+            Input::Button(down) => {
+                self.button(down);
+                Some(false)
+            }
+            Input::Wheel(lines) => {
+                self.wheel(lines);
+                Some(true)
+            }
+            Input::Key { .. } | Input::Resize { .. } => None,
+        }
     }
 
     /// The eye of a camera at `eye` looking at `target` (Y up), after the orbit; exactly

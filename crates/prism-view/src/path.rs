@@ -151,20 +151,12 @@ impl Mode for PathMode {
                 }
                 _ => Response::Ignored,
             },
-            Input::Cursor { x, y } => {
-                if self.orbit.cursor(x, y, size.0) {
+            Input::Cursor { .. } | Input::Button(_) | Input::Wheel(_) => {
+                if self.orbit.input(input, size.0) == Some(true) {
                     self.restart()
                 } else {
                     Response::Ignored
                 }
-            }
-            Input::Button(down) => {
-                self.orbit.button(down);
-                Response::Ignored
-            }
-            Input::Wheel(lines) => {
-                self.orbit.wheel(lines);
-                self.restart()
             }
             Input::Resize { .. } => self.restart(),
             Input::Key { .. } => Response::Ignored,
