@@ -3,6 +3,7 @@
 
 use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
+use rayon::prelude::*;
 
 use crate::node8::{self, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
@@ -117,6 +118,48 @@ enum BuildNode {
     },
 }
 
+/// What the build learns of a subtree on its way back up, so that no pass over the binary
+/// tree is needed for the statistics.
+#[derive(Clone, Copy, Default)]
+struct Summary {
+    leaves: usize,
+    /// Deepest leaf, counted from the root of the whole tree.
+    depth: usize,
+    max_leaf: usize,
+    /// Sum over the subtree's nodes of surface area times cost (in primitive tests).
+    sah: f64,
+}
+
+impl Summary {
+    fn leaf(bounds: &Aabb, count: usize, depth: usize) -> Summary {
+        Summary {
+            leaves: 1,
+            depth,
+            max_leaf: count,
+            sah: f64::from(bounds.surface_area()) * count as f64,
+        }
+    }
+
+    /// An interior node over subtrees `a` and `b`.
+    fn interior(bounds: &Aabb, traversal_cost: f32, a: Summary, b: Summary) -> Summary {
+        Summary {
+            leaves: a.leaves + b.leaves,
+            depth: a.depth.max(b.depth),
+            max_leaf: a.max_leaf.max(b.max_leaf),
+            sah: f64::from(bounds.surface_area() * traversal_cost) + (a.sah + b.sah),
+        }
+    }
+}
+
+/// A leaf placed by the collapse, whose triangles are packed afterwards (in parallel): its
+/// range in the build order and its first pack.
+struct LeafJob {
+    start: usize,
+    count: usize,
+    pack_start: usize,
+    packs: usize,
+}
+
 /// A primitive while building: its box and number. The build moves these, not indices, so
 /// each pass over a node reads memory in order.
 #[derive(Clone, Copy)]
@@ -196,17 +239,23 @@ impl Bvh {
     #[must_use]
     pub fn build(triangles: &[[Vec3; 3]], spheres: &[Sphere], opts: &BuildOptions) -> Bvh {
         let nt = triangles.len();
-        let mut prims = Vec::with_capacity(nt + spheres.len());
-        for (i, t) in triangles.iter().enumerate() {
+        let tri_ref = |(i, t): (usize, &[Vec3; 3])| {
             let b = Aabb::point(t[0]).extend(t[1]).extend(t[2]);
             let area2 = (t[1] - t[0]).cross(t[2] - t[0]).length_squared();
-            if area2 > 0.0 && b.min.is_finite() && b.max.is_finite() {
-                prims.push(PrimRef {
-                    bounds: B3::from_aabb(b),
-                    id: i as u32,
-                });
-            }
-        }
+            (area2 > 0.0 && b.min.is_finite() && b.max.is_finite()).then(|| PrimRef {
+                bounds: B3::from_aabb(b),
+                id: i as u32,
+            })
+        };
+        let mut prims: Vec<PrimRef> = if nt > opts.parallel_threshold {
+            triangles
+                .par_iter()
+                .enumerate()
+                .filter_map(tri_ref)
+                .collect()
+        } else {
+            triangles.iter().enumerate().filter_map(tri_ref).collect()
+        };
         for (i, s) in spheres.iter().enumerate() {
             let b = s.bounds();
             if s.radius > 0.0 && b.min.is_finite() && b.max.is_finite() {
@@ -230,11 +279,7 @@ impl Bvh {
                 max_leaf: max_leaf.clamp(1, MAX_LEAF_REF),
                 ..*opts
             };
-            let (mut b3, mut cb) = (B3::EMPTY, B3::EMPTY);
-            for p in &prims {
-                b3 = b3.union(p.bounds);
-                cb = cb.grow(p.centroid2());
-            }
+            let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
             Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
         };
         let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
@@ -243,25 +288,31 @@ impl Bvh {
             triangle_count: nt as u32,
             ..Bvh::default()
         };
-        if let Some(root) = root {
-            let root_area = root_bounds(&root).surface_area().max(f32::MIN_POSITIVE);
-            bvh.statistics(&root, 0, root_area, opts.traversal_cost);
-            bvh.packs.reserve_exact(pack_count(&root));
+        if let Some((root, summary)) = root {
+            let bounds = root_bounds(&root);
+            let root_area = bounds.surface_area().max(f32::MIN_POSITIVE);
+            bvh.stats.leaves = summary.leaves;
+            bvh.stats.depth = summary.depth;
+            bvh.stats.max_leaf_size = summary.max_leaf;
+            bvh.stats.sah_cost = (summary.sah / f64::from(root_area)) as f32;
             // About one 8-wide node per seven leaves.
             bvh.nodes.reserve(bvh.stats.leaves / 7 + 1);
-            bvh.bounds = root_bounds(&root);
+            bvh.bounds = bounds;
+            let mut jobs = Vec::with_capacity(summary.leaves);
             match &root {
                 BuildNode::Leaf { .. } => {
                     // A lone leaf still sits under a node.
                     let mut n = Node8::empty();
-                    let r = bvh.make_leaf(&root, triangles, &ids);
-                    n.set(0, root_bounds(&root), r);
+                    let r = bvh.plan_leaf(&root, &ids, &mut jobs);
+                    n.set(0, bounds, r);
                     bvh.nodes.push(n);
                 }
                 BuildNode::Interior { .. } => {
-                    bvh.collapse(&root, triangles, &ids);
+                    bvh.collapse(&root, &ids, &mut jobs);
                 }
             }
+            bvh.pack_leaves(&jobs, triangles, &ids, opts.parallel_threshold);
+            free(root, 0);
         }
         bvh.stats.primitives = ids.len();
         bvh.stats.nodes = bvh.nodes.len();
@@ -273,27 +324,10 @@ impl Bvh {
         bvh
     }
 
-    /// Leaf count, depth and SAH cost of the binary tree the 8-wide one is collapsed from.
-    fn statistics(&mut self, n: &BuildNode, depth: usize, root_area: f32, trav: f32) {
-        match n {
-            BuildNode::Leaf { bounds, count, .. } => {
-                self.stats.leaves += 1;
-                self.stats.depth = self.stats.depth.max(depth);
-                self.stats.max_leaf_size = self.stats.max_leaf_size.max(*count);
-                self.stats.sah_cost += bounds.surface_area() / root_area * *count as f32;
-            }
-            BuildNode::Interior { bounds, children } => {
-                self.stats.sah_cost += bounds.surface_area() / root_area * trav;
-                self.statistics(&children[0], depth + 1, root_area, trav);
-                self.statistics(&children[1], depth + 1, root_area, trav);
-            }
-        }
-    }
-
     /// Flattens an interior binary node and its subtree into 8-wide nodes: each takes up to
     /// eight descendants, opening the interior child of largest area first. Returns the
     /// node's index.
-    fn collapse(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]], order: &[u32]) -> u32 {
+    fn collapse(&mut self, n: &BuildNode, order: &[u32], jobs: &mut Vec<LeafJob>) -> u32 {
         let mut kids: [&BuildNode; 8] = [n; 8];
         let mut area = [0f32; 8];
         let mut len = 1;
@@ -333,36 +367,39 @@ impl Bvh {
         self.nodes.push(Node8::empty());
         for (slot, &k) in kids[..len].iter().enumerate() {
             let r = match k {
-                BuildNode::Leaf { .. } => self.make_leaf(k, triangles, order),
-                BuildNode::Interior { .. } => self.collapse(k, triangles, order),
+                BuildNode::Leaf { .. } => self.plan_leaf(k, order, jobs),
+                BuildNode::Interior { .. } => self.collapse(k, order, jobs),
             };
             self.nodes[index].set(slot, root_bounds(k), r);
         }
         index as u32
     }
 
-    /// Stores a leaf's triangles in packs of four and its spheres; returns its reference.
-    fn make_leaf(&mut self, n: &BuildNode, triangles: &[[Vec3; 3]], order: &[u32]) -> u32 {
+    /// Places a leaf: its packs of four triangles (filled by [`Bvh::pack_leaves`]) and its
+    /// spheres. Returns its reference.
+    fn plan_leaf(&mut self, n: &BuildNode, order: &[u32], jobs: &mut Vec<LeafJob>) -> u32 {
         let BuildNode::Leaf { start, count, .. } = *n else {
             unreachable!("only leaves are stored as leaves")
         };
         let nt = self.triangle_count;
         let prims = &order[start..start + count];
-        let mut tris = [([Vec3::ZERO; 3], 0u32); MAX_LEAF_REF];
-        let mut nt_leaf = 0;
-        for &p in prims.iter().filter(|&&p| p < nt) {
-            tris[nt_leaf] = (triangles[p as usize], p);
-            nt_leaf += 1;
-        }
+        let nt_leaf = prims.iter().filter(|&&p| p < nt).count();
+        let pack_start = jobs.last().map_or(0, |j| j.pack_start + j.packs);
         let rec = LeafRec {
-            pack_start: self.packs.len() as u32,
+            pack_start: pack_start as u32,
             sphere_start: self.leaf_spheres.len() as u32,
             packs: nt_leaf.div_ceil(4) as u16,
             spheres: (count - nt_leaf) as u16,
         };
-        self.packs.extend(tris[..nt_leaf].chunks(4).map(Tri4::new));
+        jobs.push(LeafJob {
+            start,
+            count,
+            pack_start,
+            packs: usize::from(rec.packs),
+        });
         assert!(
-            self.packs.len() <= LOW_BITS as usize && self.leaves.len() < LOW_BITS as usize,
+            pack_start + usize::from(rec.packs) <= LOW_BITS as usize
+                && self.leaves.len() < LOW_BITS as usize,
             "BVH over 2^30 triangles"
         );
         if rec.spheres == 0 && rec.packs < 8 {
@@ -372,6 +409,51 @@ impl Bvh {
             .extend(prims.iter().copied().filter(|&p| p >= nt));
         self.leaves.push(rec);
         LEAF | (self.leaves.len() - 1) as u32
+    }
+
+    /// Fills the triangle packs of the leaves the collapse placed, in parallel for large
+    /// hierarchies (each leaf writes only its own packs, so the result is the same).
+    fn pack_leaves(
+        &mut self,
+        jobs: &[LeafJob],
+        triangles: &[[Vec3; 3]],
+        order: &[u32],
+        parallel_threshold: usize,
+    ) {
+        let total = jobs.last().map_or(0, |j| j.pack_start + j.packs);
+        self.packs = vec![Tri4::new(&[]); total];
+        let nt = self.triangle_count;
+        let fill = |job: &LeafJob, out: &mut [Tri4]| {
+            let mut tris = [([Vec3::ZERO; 3], 0u32); MAX_LEAF_REF];
+            let mut n = 0;
+            for &p in order[job.start..job.start + job.count]
+                .iter()
+                .filter(|&&p| p < nt)
+            {
+                tris[n] = (triangles[p as usize], p);
+                n += 1;
+            }
+            for (pack, four) in out.iter_mut().zip(tris[..n].chunks(4)) {
+                *pack = Tri4::new(four);
+            }
+        };
+        let mut rest = self.packs.as_mut_slice();
+        let mut outs = Vec::with_capacity(jobs.len());
+        for job in jobs {
+            let (out, tail) = std::mem::take(&mut rest).split_at_mut(job.packs);
+            outs.push(out);
+            rest = tail;
+        }
+        if order.len() > parallel_threshold {
+            jobs.par_iter()
+                .zip(outs)
+                .with_min_len(256)
+                .for_each(|(job, out)| fill(job, out));
+        } else {
+            for (job, out) in jobs.iter().zip(outs) {
+                fill(job, out);
+            }
+        }
     }
 
     /// Build statistics.
@@ -840,17 +922,71 @@ impl<T: Copy> Stack<T> {
     }
 }
 
-/// Packs of four the leaves under `n` need at most (spheres counted as triangles).
-fn pack_count(n: &BuildNode) -> usize {
-    match n {
-        BuildNode::Leaf { count, .. } => count.div_ceil(4),
-        BuildNode::Interior { children, .. } => pack_count(&children[0]) + pack_count(&children[1]),
-    }
-}
-
 fn root_bounds(n: &BuildNode) -> Aabb {
     match n {
         BuildNode::Leaf { bounds, .. } | BuildNode::Interior { bounds, .. } => *bounds,
+    }
+}
+
+/// The union of the boxes of `prims` and the bounds of their doubled centroids (min and max
+/// are exact, so the parallel reduction gives the same boxes as a sequential one).
+fn bounds_of(prims: &[PrimRef], parallel_threshold: usize) -> (B3, B3) {
+    let add = |(b, c): (B3, B3), p: &PrimRef| (b.union(p.bounds), c.grow(p.centroid2()));
+    if prims.len() > parallel_threshold {
+        prims
+            .par_chunks(parallel_threshold)
+            .map(|c| c.iter().fold((B3::EMPTY, B3::EMPTY), add))
+            .reduce(
+                || (B3::EMPTY, B3::EMPTY),
+                |(a, b), (c, d)| (a.union(c), b.union(d)),
+            )
+    } else {
+        prims.iter().fold((B3::EMPTY, B3::EMPTY), add)
+    }
+}
+
+/// Frees a binary tree, the top levels' halves in parallel.
+fn free(n: BuildNode, depth: usize) {
+    if let BuildNode::Interior { children, .. } = n {
+        let [a, b] = *children;
+        if depth < 4 {
+            rayon::join(|| free(a, depth + 1), || free(b, depth + 1));
+        }
+    }
+}
+
+/// Per-axis bin counts and boxes of a set of primitives.
+#[derive(Clone, Copy)]
+struct Bins {
+    counts: [[u32; BINS]; 3],
+    boxes: [[B3; BINS]; 3],
+}
+
+impl Bins {
+    const EMPTY: Bins = Bins {
+        counts: [[0; BINS]; 3],
+        boxes: [[B3::EMPTY; BINS]; 3],
+    };
+
+    #[inline(always)]
+    fn add(&mut self, bin: [usize; 3], b: B3) {
+        for (axis, &k) in bin.iter().enumerate() {
+            let k = k % BINS;
+            self.counts[axis][k] += 1;
+            self.boxes[axis][k] = self.boxes[axis][k].union(b);
+        }
+    }
+
+    /// The bins of both sets (counts add exactly and boxes unite exactly, so the order of
+    /// merging does not matter).
+    fn merge(mut self, o: &Bins) -> Bins {
+        for axis in 0..3 {
+            for k in 0..BINS {
+                self.counts[axis][k] += o.counts[axis][k];
+                self.boxes[axis][k] = self.boxes[axis][k].union(o.boxes[axis][k]);
+            }
+        }
+        self
     }
 }
 
@@ -863,13 +999,18 @@ fn build_node(
     opts: &BuildOptions,
     b3: B3,
     cb: B3,
-) -> BuildNode {
+) -> (BuildNode, Summary) {
     let bounds = b3.to_aabb();
     let n = prims.len();
-    let leaf = || BuildNode::Leaf {
-        bounds,
-        start: offset,
-        count: n,
+    let leaf = || {
+        (
+            BuildNode::Leaf {
+                bounds,
+                start: offset,
+                count: n,
+            },
+            Summary::leaf(&bounds, n, depth),
+        )
     };
     if n == 1 {
         return leaf();
@@ -883,16 +1024,25 @@ fn build_node(
         Vec3A::ZERO,
     );
     let bin_of = |p: &PrimRef| bins((p.centroid2() - cb.min) * scale);
-    let mut counts = [[0u32; BINS]; 3];
-    let mut boxes = [[B3::EMPTY; BINS]; 3];
-    for p in prims.iter() {
-        let bin = bin_of(p);
-        for axis in 0..3 {
-            let k = bin[axis];
-            counts[axis][k] += 1;
-            boxes[axis][k] = boxes[axis][k].union(p.bounds);
+    let bin_all = |bins: &mut Bins, ps: &[PrimRef]| {
+        for p in ps {
+            bins.add(bin_of(p), p.bounds);
         }
+    };
+    let mut bins = Bins::EMPTY;
+    if n > 4 * opts.parallel_threshold {
+        bins = prims
+            .par_chunks(opts.parallel_threshold)
+            .map(|ps| {
+                let mut b = Bins::EMPTY;
+                bin_all(&mut b, ps);
+                b
+            })
+            .reduce(|| Bins::EMPTY, |a, b| a.merge(&b));
+    } else {
+        bin_all(&mut bins, prims);
     }
+    let Bins { counts, boxes } = &bins;
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, split bin)
     for axis in 0..3 {
         if extent[axis] <= 0.0 {
@@ -970,7 +1120,7 @@ fn build_node(
     }
     let (l, r) = prims.split_at_mut(mid);
     let [(lb, lc), (rb, rc)] = sides;
-    let (a, b) = if n > opts.parallel_threshold {
+    let ((a, sa), (b, sb)) = if n > opts.parallel_threshold {
         rayon::join(
             || build_node(l, offset, depth + 1, opts, lb, lc),
             || build_node(r, offset + mid, depth + 1, opts, rb, rc),
@@ -981,10 +1131,13 @@ fn build_node(
             build_node(r, offset + mid, depth + 1, opts, rb, rc),
         )
     };
-    BuildNode::Interior {
-        bounds,
-        children: Box::new([a, b]),
-    }
+    (
+        BuildNode::Interior {
+            bounds,
+            children: Box::new([a, b]),
+        },
+        Summary::interior(&bounds, opts.traversal_cost, sa, sb),
+    )
 }
 
 /// The bins (`0..BINS`) of scaled centroid offsets on the three axes: the integer parts,

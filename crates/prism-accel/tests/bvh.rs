@@ -178,6 +178,8 @@ fn build_is_deterministic_and_stats_add_up() {
     let a = one.install(|| Bvh::build(&tris, &[], &opts));
     let b = Bvh::build(&tris, &[], &opts);
     assert_eq!(a.stats(), b.stats());
+    // The whole layout: nodes, packs and leaves, byte for byte in their debug form.
+    assert_eq!(format!("{a:?}"), format!("{b:?}"));
     let s = a.stats();
     // An 8-wide tree: every node holds at most eight children.
     assert!(s.nodes < s.leaves && 7 * s.nodes + 1 >= s.leaves);
