@@ -1097,17 +1097,21 @@ fn build_node(
     let mut mid = 0;
     let mut sides = [(B3::EMPTY, B3::EMPTY); 2];
     if let Some((axis, split)) = split {
+        // The four boxes stay in registers: one branch per primitive, no indexed stores.
+        let [(mut lb, mut lc), (mut rb, mut rc)] = sides;
         for j in 0..n {
             let p = prims[j];
-            let left = usize::from(bin_of(&p)[axis] < split);
-            let side = &mut sides[1 - left];
-            side.0 = side.0.union(p.bounds);
-            side.1 = side.1.grow(p.centroid2());
-            if left == 1 {
+            if bin_of(&p)[axis] < split {
+                lb = lb.union(p.bounds);
+                lc = lc.grow(p.centroid2());
                 prims.swap(mid, j);
                 mid += 1;
+            } else {
+                rb = rb.union(p.bounds);
+                rc = rc.grow(p.centroid2());
             }
         }
+        sides = [(lb, lc), (rb, rc)];
     }
     if mid == 0 || mid == n {
         mid = n / 2;
