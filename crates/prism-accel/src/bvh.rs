@@ -5,6 +5,7 @@ use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
 use rayon::prelude::*;
 
+use crate::flat::{Flat, FLAT_MAX, WIDTH};
 use crate::node8::{self, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
 use crate::tri4::Tri4;
@@ -104,6 +105,8 @@ pub struct Bvh {
     triangle_count: u32,
     bounds: Aabb,
     stats: BvhStats,
+    /// For small hierarchies, the primitives in one list, for the batched queries.
+    flat: Option<Flat>,
 }
 
 enum BuildNode {
@@ -314,13 +317,33 @@ impl Bvh {
             bvh.pack_leaves(&jobs, triangles, &ids, opts.parallel_threshold);
             free(root, 0);
         }
+        if (1..=FLAT_MAX).contains(&ids.len()) {
+            let mut flat = Flat {
+                first_sphere: nt as u32,
+                ..Flat::default()
+            };
+            let mut sorted = ids.clone();
+            sorted.sort_unstable();
+            for &p in &sorted {
+                if p < nt as u32 {
+                    flat.triangles.push((triangles[p as usize], p));
+                } else {
+                    flat.spheres.push((spheres[p as usize - nt], p));
+                }
+            }
+            bvh.flat = Some(flat);
+        }
         bvh.stats.primitives = ids.len();
         bvh.stats.nodes = bvh.nodes.len();
         bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node8>()
             + bvh.packs.len() * std::mem::size_of::<Tri4>()
             + bvh.leaves.len() * std::mem::size_of::<LeafRec>()
             + bvh.leaf_spheres.len() * 4
-            + bvh.spheres.len() * std::mem::size_of::<Sphere>();
+            + bvh.spheres.len() * std::mem::size_of::<Sphere>()
+            + bvh.flat.as_ref().map_or(0, |f| {
+                f.triangles.len() * std::mem::size_of::<([Vec3; 3], u32)>()
+                    + f.spheres.len() * std::mem::size_of::<(Sphere, u32)>()
+            });
         bvh
     }
 
@@ -712,6 +735,21 @@ impl Bvh {
         }
         #[cfg(target_arch = "x86_64")]
         {
+            if let (Some(flat), true) = (&self.flat, std::arch::is_x86_feature_detected!("avx512f"))
+            {
+                for (rays, hits) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
+                    // SAFETY: the processor has AVX-512F.
+                    let lanes = unsafe { flat.closest(rays, tmin, tmax) };
+                    for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+                        *hit = if lanes.defer & (1 << lane) != 0 {
+                            self.intersect(ray, tmin, tmax)
+                        } else {
+                            lanes.hits[lane]
+                        };
+                    }
+                }
+                return;
+            }
             if std::arch::is_x86_feature_detected!("avx512vl") {
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.intersect_batch_avx512(rays, tmin, tmax, hits) };
@@ -782,6 +820,22 @@ impl Bvh {
         }
         #[cfg(target_arch = "x86_64")]
         {
+            if let (Some(flat), true) = (&self.flat, std::arch::is_x86_feature_detected!("avx512f"))
+            {
+                let groups = rays.chunks(WIDTH).zip(tmax.chunks(WIDTH));
+                for ((rays, ends), blocked) in groups.zip(blocked.chunks_mut(WIDTH)) {
+                    // SAFETY: the processor has AVX-512F.
+                    let lanes = unsafe { flat.occluded(rays, tmin, ends) };
+                    for (lane, b) in blocked.iter_mut().enumerate() {
+                        *b = if lanes.defer & (1 << lane) != 0 {
+                            self.occluded(&rays[lane], tmin, ends[lane])
+                        } else {
+                            lanes.blocked & (1 << lane) != 0
+                        };
+                    }
+                }
+                return;
+            }
             if std::arch::is_x86_feature_detected!("avx512vl") {
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.occluded_batch_avx512(rays, tmin, tmax, blocked) };

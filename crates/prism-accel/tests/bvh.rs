@@ -111,6 +111,57 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Oracle: the one-ray calls, on hierarchies small enough for the batched queries to test
+    /// every primitive on lanes. The scenes hold a quad split on its diagonal, whose edge the
+    /// rays through grid points meet exactly (edge functions of zero), and a triangle twice
+    /// (two hits at one distance): every hit and occlusion is the one-ray call's, bit for bit.
+    #[test]
+    fn small_scene_batches_equal_single_rays(
+        tris in prop::collection::vec(
+            (v3(), v3(), v3()).prop_map(|(a, b, c)| [a, a + 0.5 * b, a + 0.5 * c]),
+            0..14,
+        ),
+        spheres in prop::collection::vec(
+            (v3(), 0.05f32..3.0).prop_map(|(c, r)| Sphere { center: c, radius: r }),
+            0..5,
+        ),
+        rays in prop::collection::vec((v3(), v3(), 0.5f32..20.0, 0u8..4), 1..90),
+    ) {
+        let mut tris = tris;
+        let quad = [Vec3::new(-2.0, -2.0, 0.0), Vec3::new(2.0, -2.0, 0.0), Vec3::new(2.0, 2.0, 0.0)];
+        tris.push(quad);
+        tris.push([quad[0], quad[2], Vec3::new(-2.0, 2.0, 0.0)]);
+        tris.push(quad);
+        let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+        let (rays, ends): (Vec<Ray>, Vec<f32>) = rays
+            .into_iter()
+            .map(|(o, d, t, kind)| {
+                let ray = match kind {
+                    // Through a grid point of the quad's diagonal.
+                    0 => Ray::new(o.round(), Vec3::new(0.0, 0.0, 0.0) - o.round()),
+                    // Axis-aligned, from a grid point.
+                    1 => Ray::new(o.round(), [Vec3::X, -Vec3::Y, Vec3::Z][(t as usize) % 3]),
+                    _ => Ray::new(o, d),
+                };
+                (ray, t)
+            })
+            .unzip();
+        let mut hits = vec![None; rays.len()];
+        bvh.intersect_batch(&rays, 1e-3, 15.0, &mut hits);
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
+        for (i, ray) in rays.iter().enumerate() {
+            let one = bvh.intersect(ray, 1e-3, 15.0);
+            prop_assert_eq!(hits[i].map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())),
+                one.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())));
+            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
+        }
+    }
+}
+
 /// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at
 /// its vertices and edge midpoints (where tests that are not watertight leak), always hit.
 #[test]

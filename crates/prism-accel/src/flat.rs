@@ -1,0 +1,370 @@
+//! [`Flat`], the primitives of a small hierarchy in one list, and its batched queries:
+//! sixteen rays at once against every primitive with AVX-512, with no branch that depends on
+//! a ray. Each lane computes the one-ray tests' operations in their order, so it finds the
+//! hit the hierarchy finds. A lane that meets an edge function of exactly zero (which the
+//! one-ray test settles in double precision) or two primitives at the same nearest distance
+//! (where the hierarchy's visiting order decides) is left to the hierarchy.
+
+use prism_math::{Ray, Vec3};
+
+use crate::bvh::Hit;
+use crate::shapes::Sphere;
+
+/// Hierarchies over at most this many primitives also keep them in a [`Flat`] list. Their
+/// one-ray traversals spend their time in mispredicted branches and serial latency rather
+/// than work, and testing every primitive on sixteen lanes costs less.
+pub(crate) const FLAT_MAX: usize = 24;
+
+/// Lanes of one query.
+pub(crate) const WIDTH: usize = 16;
+
+/// The primitives of a small hierarchy (those it holds: degenerate ones are left out), with
+/// their primitive numbers.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Flat {
+    pub(crate) triangles: Vec<([Vec3; 3], u32)>,
+    pub(crate) spheres: Vec<(Sphere, u32)>,
+    /// Primitive numbers from this one on are spheres.
+    pub(crate) first_sphere: u32,
+}
+
+/// What a group of up to sixteen rays learnt, lane by lane.
+pub(crate) struct Lanes {
+    /// The nearest hit (closest-hit queries).
+    pub(crate) hits: [Option<Hit>; WIDTH],
+    /// Lanes that met something (occlusion queries).
+    pub(crate) blocked: u16,
+    /// Lanes whose answer must come from the hierarchy.
+    pub(crate) defer: u16,
+}
+
+impl Flat {
+    /// The closest hits of `rays` (at most sixteen) with `tmin < t < tmax`.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) unsafe fn closest(&self, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+        // SAFETY: the caller guarantees AVX-512F.
+        unsafe { avx512::closest(self, rays, tmin, tmax) }
+    }
+
+    /// Whether anything lies along each of `rays` (at most sixteen) with `tmin < t <
+    /// tmax[i]`.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) unsafe fn occluded(&self, rays: &[Ray], tmin: f32, tmax: &[f32]) -> Lanes {
+        // SAFETY: the caller guarantees AVX-512F.
+        unsafe { avx512::occluded(self, rays, tmin, tmax) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use super::{Flat, Lanes, WIDTH};
+    use crate::bvh::Hit;
+    use crate::shapes::Sphere;
+    use prism_math::{Ray, Vec3};
+
+    /// The rays of a group on lanes, prepared as the one-ray tests prepare them.
+    struct Group {
+        origin: [__m512; 3],
+        dir: [__m512; 3],
+        shear: [__m512; 3],
+        /// `is[k][a]`: lanes whose sheared axis `k` is source axis `a` (0 or 1; the other
+        /// lanes take axis 2).
+        is: [[__mmask16; 2]; 3],
+    }
+
+    /// Lanes `i < rays.len()` take `rays[i]`; the others repeat the first ray. The shear and
+    /// the axis permutation are `RayPre::new`'s, computed on lanes with the same operations.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn group(rays: &[Ray]) -> Group {
+        let mut padded = [rays[0]; WIDTH];
+        let n = rays.len().min(WIDTH);
+        padded[..n].copy_from_slice(&rays[..n]);
+        const _: () = assert!(std::mem::size_of::<Ray>() == 24);
+        let base = padded.as_ptr().cast::<f32>();
+        let index = _mm512_mullo_epi32(
+            _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+            _mm512_set1_epi32(6),
+        );
+        let (o, d) = (
+            std::mem::offset_of!(Ray, origin) / 4,
+            std::mem::offset_of!(Ray, dir) / 4,
+        );
+        // SAFETY: `Ray` is six floats (two `Vec3`, three floats each, at the offsets taken
+        // above), so lane i reads floats 6i to 6i + 5: the ray of `padded` it takes.
+        let field = |k: usize| unsafe { _mm512_i32gather_ps::<4>(index, base.add(k)) };
+        let origin = [field(o), field(o + 1), field(o + 2)];
+        let dir = [field(d), field(d + 1), field(d + 2)];
+        let abs = dir.map(|d| _mm512_abs_ps(d));
+        let ge = |a: __m512, b: __m512| _mm512_cmp_ps_mask::<_CMP_GE_OQ>(a, b);
+        // The dominant axis kz (ties to the lower axis), and whether the ray runs down it.
+        let kz0 = ge(abs[0], abs[1]) & ge(abs[0], abs[2]);
+        let kz1 = !kz0 & ge(abs[1], abs[2]);
+        let kz2 = !kz0 & !kz1;
+        let dz = _mm512_mask_blend_ps(kz0, _mm512_mask_blend_ps(kz1, dir[2], dir[1]), dir[0]);
+        let down = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(dz, _mm512_setzero_ps());
+        let up = !down;
+        // The permutations of `PERMS`, by (kz, down): kx and ky per lane.
+        let (p0, p1, p2) = (kz0 & up, kz0 & down, kz1 & up);
+        let (p3, p4, p5) = (kz1 & down, kz2 & up, kz2 & down);
+        let is = [[p3 | p4, p0 | p5], [p2 | p5, p1 | p4], [kz0, kz1]];
+        let mut g = Group {
+            origin,
+            dir,
+            shear: [_mm512_setzero_ps(); 3],
+            is,
+        };
+        let inv_z = _mm512_div_ps(_mm512_set1_ps(1.0), dz);
+        g.shear = [
+            _mm512_mul_ps(pick(&g, 0, &dir), inv_z),
+            _mm512_mul_ps(pick(&g, 1, &dir), inv_z),
+            inv_z,
+        ];
+        g
+    }
+
+    /// Per lane, the component of `v` on the lane's sheared axis `k`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn pick(g: &Group, k: usize, v: &[__m512; 3]) -> __m512 {
+        _mm512_mask_blend_ps(
+            g.is[k][0],
+            _mm512_mask_blend_ps(g.is[k][1], v[2], v[1]),
+            v[0],
+        )
+    }
+
+    /// One triangle's hit on every lane, as a pack of the hierarchy tests it:
+    /// `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit with `tmin < t < tmax`, `zero`
+    /// those with an edge function of exactly zero.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn triangle(
+        g: &Group,
+        tri: &[Vec3; 3],
+        tmin: __m512,
+        tmax: __m512,
+    ) -> (__m512, __m512, __m512, __m512, __mmask16, __mmask16) {
+        let rel = |i: usize| {
+            let r = [
+                _mm512_sub_ps(_mm512_set1_ps(tri[i].x), g.origin[0]),
+                _mm512_sub_ps(_mm512_set1_ps(tri[i].y), g.origin[1]),
+                _mm512_sub_ps(_mm512_set1_ps(tri[i].z), g.origin[2]),
+            ];
+            (pick(g, 0, &r), pick(g, 1, &r), pick(g, 2, &r))
+        };
+        let (ax, ay, az) = rel(0);
+        let (bx, by, bz) = rel(1);
+        let (cx, cy, cz) = rel(2);
+        let [sx, sy, sz] = g.shear;
+        let shear = |p: __m512, s: __m512, z: __m512| _mm512_sub_ps(p, _mm512_mul_ps(s, z));
+        let (ax, ay) = (shear(ax, sx, az), shear(ay, sy, az));
+        let (bx, by) = (shear(bx, sx, bz), shear(by, sy, bz));
+        let (cx, cy) = (shear(cx, sx, cz), shear(cy, sy, cz));
+        let edge = |a: __m512, b: __m512, c: __m512, d: __m512| {
+            _mm512_sub_ps(_mm512_mul_ps(a, b), _mm512_mul_ps(c, d))
+        };
+        let u = edge(cx, by, cy, bx);
+        let v = edge(ax, cy, ay, cx);
+        let w = edge(bx, ay, by, ax);
+        let zero = _mm512_setzero_ps();
+        let eq0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(x, zero);
+        let lt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(x, zero);
+        let gt0 = |x: __m512| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(x, zero);
+        let zeros = eq0(u) | eq0(v) | eq0(w);
+        let neg = lt0(u) | lt0(v) | lt0(w);
+        let pos = gt0(u) | gt0(v) | gt0(w);
+        let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
+        let sum = _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(u, az), _mm512_mul_ps(v, bz)),
+            _mm512_mul_ps(w, cz),
+        );
+        let t = _mm512_mul_ps(
+            _mm512_mul_ps(sz, sum),
+            _mm512_div_ps(_mm512_set1_ps(1.0), det),
+        );
+        let hit = !(neg & pos)
+            & _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(det, zero)
+            & _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, tmin)
+            & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, tmax);
+        (t, v, w, det, hit, zeros)
+    }
+
+    /// One sphere's hit on every lane, as `intersect_sphere` finds it: `(t, hit)`, the
+    /// nearest root with `tmin < t < tmax`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn sphere(g: &Group, s: &Sphere, tmin: __m512, tmax: __m512) -> (__m512, __mmask16) {
+        let o = [
+            _mm512_sub_ps(g.origin[0], _mm512_set1_ps(s.center.x)),
+            _mm512_sub_ps(g.origin[1], _mm512_set1_ps(s.center.y)),
+            _mm512_sub_ps(g.origin[2], _mm512_set1_ps(s.center.z)),
+        ];
+        let d = g.dir;
+        let dot = |a: &[__m512; 3], b: &[__m512; 3]| {
+            _mm512_add_ps(
+                _mm512_add_ps(_mm512_mul_ps(a[0], b[0]), _mm512_mul_ps(a[1], b[1])),
+                _mm512_mul_ps(a[2], b[2]),
+            )
+        };
+        let r = _mm512_set1_ps(s.radius);
+        let a = dot(&d, &d);
+        let b = _mm512_mul_ps(_mm512_set1_ps(2.0), dot(&o, &d));
+        let c = _mm512_sub_ps(dot(&o, &o), _mm512_set1_ps(s.radius * s.radius));
+        let k = _mm512_div_ps(b, _mm512_mul_ps(_mm512_set1_ps(2.0), a));
+        let l = [0, 1, 2].map(|i| _mm512_sub_ps(o[i], _mm512_mul_ps(k, d[i])));
+        let l = _mm512_sqrt_ps(dot(&l, &l));
+        let disc = _mm512_mul_ps(
+            _mm512_mul_ps(_mm512_mul_ps(_mm512_set1_ps(4.0), a), _mm512_add_ps(r, l)),
+            _mm512_sub_ps(r, l),
+        );
+        let zero = _mm512_setzero_ps();
+        let miss = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(disc, zero);
+        let root = _mm512_sqrt_ps(disc);
+        let b_neg = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(b, zero);
+        let q = _mm512_mul_ps(
+            _mm512_set1_ps(-0.5),
+            _mm512_mask_blend_ps(b_neg, _mm512_add_ps(b, root), _mm512_sub_ps(b, root)),
+        );
+        let t0 = _mm512_div_ps(q, a);
+        let t1 = _mm512_div_ps(c, q);
+        let swap = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t0, t1);
+        let near = _mm512_mask_blend_ps(swap, t0, t1);
+        let far = _mm512_mask_blend_ps(swap, t1, t0);
+        let inside = |t: __m512| {
+            _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, tmin) & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, tmax)
+        };
+        let (in_near, in_far) = (inside(near), inside(far));
+        (
+            _mm512_mask_blend_ps(in_near, far, near),
+            !miss & (in_near | in_far),
+        )
+    }
+
+    /// The running nearest hit of a group's lanes.
+    struct Nearest {
+        t: __m512,
+        v: __m512,
+        w: __m512,
+        det: __m512,
+        prim: __m512i,
+        found: __mmask16,
+        /// Lanes where a primitive met the nearest distance found so far exactly.
+        tie: __mmask16,
+    }
+
+    impl Nearest {
+        /// Takes a primitive's hits (`hit` lanes at `t`) where they are nearer.
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn update(&mut self, t: __m512, v: __m512, w: __m512, det: __m512, prim: u32, hit: u16) {
+            let nearer = hit & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, self.t);
+            let equal = hit & _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(t, self.t);
+            self.tie = (self.tie & !nearer) | equal;
+            self.t = _mm512_mask_blend_ps(nearer, self.t, t);
+            self.v = _mm512_mask_blend_ps(nearer, self.v, v);
+            self.w = _mm512_mask_blend_ps(nearer, self.w, w);
+            self.det = _mm512_mask_blend_ps(nearer, self.det, det);
+            self.prim = _mm512_mask_blend_epi32(nearer, self.prim, _mm512_set1_epi32(prim as i32));
+            self.found |= nearer;
+        }
+    }
+
+    /// [`Flat::closest`].
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn closest(flat: &Flat, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+        let g = group(rays);
+        let (lo, hi) = (_mm512_set1_ps(tmin), _mm512_set1_ps(tmax));
+        let zero = _mm512_setzero_ps();
+        let mut near = Nearest {
+            t: hi,
+            v: zero,
+            w: zero,
+            det: zero,
+            prim: _mm512_set1_epi32(-1),
+            found: 0,
+            tie: 0,
+        };
+        let mut defer = 0u16;
+        for (tri, prim) in &flat.triangles {
+            let (t, v, w, det, hit, zeros) = triangle(&g, tri, lo, hi);
+            defer |= zeros;
+            near.update(t, v, w, det, *prim, hit);
+        }
+        for (s, prim) in &flat.spheres {
+            let (t, hit) = sphere(&g, s, lo, hi);
+            near.update(t, zero, zero, zero, *prim, hit);
+        }
+        let mut t = [0f32; WIDTH];
+        let mut v = [0f32; WIDTH];
+        let mut w = [0f32; WIDTH];
+        let mut det = [0f32; WIDTH];
+        let mut prim = [0u32; WIDTH];
+        // SAFETY: each store writes sixteen lanes into an array of sixteen.
+        unsafe {
+            _mm512_storeu_ps(t.as_mut_ptr(), near.t);
+            _mm512_storeu_ps(v.as_mut_ptr(), near.v);
+            _mm512_storeu_ps(w.as_mut_ptr(), near.w);
+            _mm512_storeu_ps(det.as_mut_ptr(), near.det);
+            _mm512_storeu_si512(prim.as_mut_ptr().cast(), near.prim);
+        }
+        let defer = defer | near.tie;
+        let mut hits = [None; WIDTH];
+        for lane in 0..rays.len().min(WIDTH) {
+            if near.found & (1 << lane) == 0 || defer & (1 << lane) != 0 {
+                continue;
+            }
+            let (b1, b2) = if prim[lane] >= flat.first_sphere {
+                (0.0, 0.0)
+            } else {
+                let inv = 1.0 / det[lane];
+                (v[lane] * inv, w[lane] * inv)
+            };
+            hits[lane] = Some(Hit {
+                t: t[lane],
+                prim: prim[lane],
+                b1,
+                b2,
+            });
+        }
+        Lanes {
+            hits,
+            blocked: 0,
+            defer,
+        }
+    }
+
+    /// [`Flat::occluded`].
+    #[target_feature(enable = "avx512f")]
+    pub(super) fn occluded(flat: &Flat, rays: &[Ray], tmin: f32, tmax: &[f32]) -> Lanes {
+        let g = group(rays);
+        let mut ends = [tmax[0]; WIDTH];
+        ends[..tmax.len().min(WIDTH)].copy_from_slice(&tmax[..tmax.len().min(WIDTH)]);
+        let lo = _mm512_set1_ps(tmin);
+        // SAFETY: sixteen floats are read from an array of sixteen.
+        let hi = unsafe { _mm512_loadu_ps(ends.as_ptr()) };
+        let (mut blocked, mut defer) = (0u16, 0u16);
+        for (tri, _) in &flat.triangles {
+            let (.., hit, zeros) = triangle(&g, tri, lo, hi);
+            blocked |= hit;
+            defer |= zeros;
+        }
+        for (s, _) in &flat.spheres {
+            blocked |= sphere(&g, s, lo, hi).1;
+        }
+        // A lane blocked by another primitive is blocked whatever the deferred test says.
+        Lanes {
+            hits: [None; WIDTH],
+            blocked,
+            defer: defer & !blocked,
+        }
+    }
+}
