@@ -283,7 +283,30 @@ impl Bvh {
                 ..*opts
             };
             let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
-            Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
+            let big = take_big(&mut prims, b3);
+            if big == 0 {
+                Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
+            } else {
+                // The large primitives under one child of the root (leaves of two, which the
+                // collapse lifts into the root), the others under the other.
+                let (l, r) = prims.split_at_mut(big);
+                let (lb, lc) = bounds_of(l, opts.parallel_threshold);
+                let (rb, rc) = bounds_of(r, opts.parallel_threshold);
+                let small_leaves = BuildOptions {
+                    max_leaf: 2,
+                    ..opts
+                };
+                let (a, sa) = build_node(l, 0, 1, &small_leaves, lb, lc);
+                let (b, sb) = build_node(r, big, 1, &opts, rb, rc);
+                let bounds = b3.to_aabb();
+                Some((
+                    BuildNode::Interior {
+                        bounds,
+                        children: Box::new([a, b]),
+                    },
+                    Summary::interior(&bounds, opts.traversal_cost, sa, sb),
+                ))
+            }
         };
         let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
         let mut bvh = Bvh {
@@ -317,22 +340,7 @@ impl Bvh {
             bvh.pack_leaves(&jobs, triangles, &ids, opts.parallel_threshold);
             free(root, 0);
         }
-        if (1..=FLAT_MAX).contains(&ids.len()) {
-            let mut flat = Flat {
-                first_sphere: nt as u32,
-                ..Flat::default()
-            };
-            let mut sorted = ids.clone();
-            sorted.sort_unstable();
-            for &p in &sorted {
-                if p < nt as u32 {
-                    flat.triangles.push((triangles[p as usize], p));
-                } else {
-                    flat.spheres.push((spheres[p as usize - nt], p));
-                }
-            }
-            bvh.flat = Some(flat);
-        }
+        bvh.flat = bvh.root_list(triangles, spheres);
         bvh.stats.primitives = ids.len();
         bvh.stats.nodes = bvh.nodes.len();
         bvh.stats.bytes = bvh.nodes.len() * std::mem::size_of::<Node8>()
@@ -485,6 +493,39 @@ impl Bvh {
         }
     }
 
+    /// The primitives of the root's leaves in one list, with the boxes of the root's other
+    /// children, if the root has between one and [`FLAT_MAX`] of them.
+    fn root_list(&self, triangles: &[[Vec3; 3]], spheres: &[Sphere]) -> Option<Flat> {
+        let root = self.nodes.first()?;
+        let nt = self.triangle_count;
+        let mut flat = Flat {
+            first_sphere: nt,
+            ..Flat::default()
+        };
+        let mut prims = Vec::new();
+        for slot in (0..8).filter(|&k| root.slot_used(k)) {
+            let child = root.child[slot];
+            if Bvh::is_leaf_ref(child) {
+                prims.extend(self.leaf_prims(child));
+                flat.skip |= 1 << slot;
+            } else {
+                flat.inner.push(root.child_box(slot));
+            }
+        }
+        if !(1..=FLAT_MAX).contains(&prims.len()) {
+            return None;
+        }
+        prims.sort_unstable();
+        for p in prims {
+            if p < nt {
+                flat.triangles.push((triangles[p as usize], p));
+            } else {
+                flat.spheres.push((spheres[(p - nt) as usize], p));
+            }
+        }
+        Some(flat)
+    }
+
     /// Build statistics.
     #[must_use]
     pub fn stats(&self) -> BvhStats {
@@ -635,29 +676,40 @@ impl Bvh {
     /// The closest hit with `tmin < t < tmax`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.intersect_below(ray, tmin, tmax, 0)
+    }
+
+    /// [`Bvh::intersect`] leaving out the root's children in the slots of `skip`.
+    fn intersect_below(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the processor has AVX.
-            return unsafe { self.intersect_avx(ray, tmin, tmax) };
+            return unsafe { self.intersect_avx(ray, tmin, tmax, skip) };
         }
-        self.intersect_with::<false>(ray, tmin, tmax)
+        self.intersect_with::<false>(ray, tmin, tmax, skip)
     }
 
-    /// [`Bvh::intersect`] compiled for AVX.
+    /// [`Bvh::intersect_below`] compiled for AVX.
     ///
     /// # Safety
     /// The processor must support AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax)
+    unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
+        self.intersect_with::<true>(ray, tmin, tmax, skip)
     }
 
     #[inline(always)]
-    fn intersect_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+    fn intersect_with<const AVX: bool>(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        skip: u32,
+    ) -> Option<Hit> {
         let r = RayPre::new(ray);
         let slab = SlabRay::new(&r);
         let mut best: Option<Hit> = None;
@@ -673,6 +725,9 @@ impl Bvh {
             } else {
                 let n = &self.nodes[node_ref as usize];
                 let (near, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
+                if node_ref == 0 {
+                    mask &= !skip;
+                }
                 if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -741,10 +796,23 @@ impl Bvh {
                     // SAFETY: the processor has AVX-512F.
                     let lanes = unsafe { flat.closest(rays, tmin, tmax) };
                     for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-                        *hit = if lanes.defer & (1 << lane) != 0 {
+                        let bit = 1 << lane;
+                        let near = lanes.hits[lane];
+                        *hit = if lanes.defer & bit != 0 {
                             self.intersect(ray, tmin, tmax)
+                        } else if lanes.need & bit != 0 {
+                            // The rest of the tree, for a hit no farther than the list's.
+                            let end = near.map_or(tmax, |h| h.t.next_up());
+                            match self.intersect_below(ray, tmin, end, flat.skip) {
+                                // Two primitives at one distance: the tree's order decides.
+                                Some(h) if near.is_some_and(|n| n.t == h.t) => {
+                                    self.intersect(ray, tmin, tmax)
+                                }
+                                Some(h) => Some(h),
+                                None => near,
+                            }
                         } else {
-                            lanes.hits[lane]
+                            near
                         };
                     }
                 }
@@ -770,7 +838,7 @@ impl Bvh {
     #[inline(always)]
     fn intersect_batch_with(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
         for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<true>(ray, tmin, tmax);
+            *hit = self.intersect_with::<true>(ray, tmin, tmax, 0);
         }
     }
 
@@ -827,10 +895,15 @@ impl Bvh {
                     // SAFETY: the processor has AVX-512F.
                     let lanes = unsafe { flat.occluded(rays, tmin, ends) };
                     for (lane, b) in blocked.iter_mut().enumerate() {
-                        *b = if lanes.defer & (1 << lane) != 0 {
+                        let bit = 1 << lane;
+                        *b = if lanes.blocked & bit != 0 {
+                            true
+                        } else if lanes.defer & bit != 0 {
                             self.occluded(&rays[lane], tmin, ends[lane])
+                        } else if lanes.need & bit != 0 {
+                            self.occluded_below(&rays[lane], tmin, ends[lane], flat.skip)
                         } else {
-                            lanes.blocked & (1 << lane) != 0
+                            false
                         };
                     }
                 }
@@ -856,7 +929,7 @@ impl Bvh {
     #[inline(always)]
     fn occluded_batch_with(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t);
+            *b = self.occluded_with::<true>(ray, tmin, t, 0);
         }
     }
 
@@ -895,29 +968,34 @@ impl Bvh {
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+        self.occluded_below(ray, tmin, tmax, 0)
+    }
+
+    /// [`Bvh::occluded`] leaving out the root's children in the slots of `skip`.
+    fn occluded_below(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the processor has AVX.
-            return unsafe { self.occluded_avx(ray, tmin, tmax) };
+            return unsafe { self.occluded_avx(ray, tmin, tmax, skip) };
         }
-        self.occluded_with::<false>(ray, tmin, tmax)
+        self.occluded_with::<false>(ray, tmin, tmax, skip)
     }
 
-    /// [`Bvh::occluded`] compiled for AVX.
+    /// [`Bvh::occluded_below`] compiled for AVX.
     ///
     /// # Safety
     /// The processor must support AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax)
+    unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
+        self.occluded_with::<true>(ray, tmin, tmax, skip)
     }
 
     #[inline(always)]
-    fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+    fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
         let r = RayPre::new(ray);
         let slab = SlabRay::new(&r);
         let mut stack = Stack::<u32>::new();
@@ -932,6 +1010,9 @@ impl Bvh {
             } else {
                 let n = &self.nodes[node_ref as usize];
                 let (_, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
+                if node_ref == 0 {
+                    mask &= !skip;
+                }
                 if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -986,6 +1067,47 @@ fn root_bounds(n: &BuildNode) -> Aabb {
     match n {
         BuildNode::Leaf { bounds, .. } | BuildNode::Interior { bounds, .. } => *bounds,
     }
+}
+
+/// Primitives whose box has at least this fraction of the scene's surface area are large.
+const BIG_AREA: f32 = 1.0 / 16.0;
+/// At most this many large primitives are set apart.
+const BIG_MAX: usize = 12;
+
+/// Sets apart the large primitives of a scene with more than [`FLAT_MAX`] (walls and floors
+/// of a room, among small ones): moves up to [`BIG_MAX`] of them (largest first) to the
+/// front of `prims`, in primitive order, and returns how many (none if there are no small
+/// ones to keep apart from). `b3` bounds the scene.
+fn take_big(prims: &mut [PrimRef], b3: B3) -> usize {
+    if prims.len() <= FLAT_MAX {
+        return 0;
+    }
+    let least = b3.area() * BIG_AREA;
+    let mut big: Vec<(f32, u32)> = prims
+        .iter()
+        .filter(|p| p.bounds.area() >= least)
+        .map(|p| (p.bounds.area(), p.id))
+        .collect();
+    if big.is_empty() || big.len() == prims.len() {
+        return 0;
+    }
+    big.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    big.truncate(BIG_MAX);
+    let mut ids: Vec<u32> = big.iter().map(|b| b.1).collect();
+    ids.sort_unstable();
+    // A stable partition: the large ones first, each side in its old order.
+    let (mut front, mut back): (Vec<PrimRef>, Vec<PrimRef>) = (Vec::new(), Vec::new());
+    for p in prims.iter() {
+        if ids.binary_search(&p.id).is_ok() {
+            front.push(*p);
+        } else {
+            back.push(*p);
+        }
+    }
+    let n = front.len();
+    prims[..n].copy_from_slice(&front);
+    prims[n..].copy_from_slice(&back);
+    n
 }
 
 /// The union of the boxes of `prims` and the bounds of their doubled centroids (min and max
@@ -1279,11 +1401,14 @@ mod tests {
                 };
                 let ray = Ray::new(o.floor(), d);
                 // SAFETY: AVX was detected above.
-                let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
-                assert_eq!(avx, bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY));
+                let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY, 0) };
+                assert_eq!(
+                    avx,
+                    bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, 0)
+                );
                 // SAFETY: as above.
-                let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
-                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0));
+                let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0, 0) };
+                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, 0));
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");

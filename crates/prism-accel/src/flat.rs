@@ -1,31 +1,37 @@
-//! [`Flat`], the primitives of a small hierarchy in one list, and its batched queries:
-//! sixteen rays at once against every primitive with AVX-512, with no branch that depends on
-//! a ray. Each lane computes the one-ray tests' operations in their order, so it finds the
-//! hit the hierarchy finds. A lane that meets an edge function of exactly zero (which the
-//! one-ray test settles in double precision) or two primitives at the same nearest distance
-//! (where the hierarchy's visiting order decides) is left to the hierarchy.
+//! [`Flat`], the primitives of the root's leaves in one list, and the batched queries on it:
+//! sixteen rays at once against each primitive with AVX-512, with no branch that depends on
+//! a ray, then the same rays against the boxes of the root's other children, to find the
+//! rays that must still traverse those. In a small scene that is every primitive; in a
+//! Cornell box, the walls. Each lane computes the one-ray tests' operations in their order,
+//! so it finds the hit the hierarchy finds. A lane that meets an edge function of exactly
+//! zero (which the one-ray test settles in double precision) or two primitives at the same
+//! nearest distance (where the hierarchy's visiting order decides) is left to the hierarchy.
 
-use prism_math::{Ray, Vec3};
+use prism_math::{Aabb, Ray, Vec3};
 
 use crate::bvh::Hit;
 use crate::shapes::Sphere;
 
-/// Hierarchies over at most this many primitives also keep them in a [`Flat`] list. Their
-/// one-ray traversals spend their time in mispredicted branches and serial latency rather
-/// than work, and testing every primitive on sixteen lanes costs less.
+/// Roots whose leaves hold at most this many primitives also keep them in a [`Flat`] list.
+/// One-ray traversals of a few large primitives spend their time in mispredicted branches
+/// and serial latency rather than work; testing each on sixteen lanes costs less.
 pub(crate) const FLAT_MAX: usize = 24;
 
 /// Lanes of one query.
 pub(crate) const WIDTH: usize = 16;
 
-/// The primitives of a small hierarchy (those it holds: degenerate ones are left out), with
-/// their primitive numbers.
+/// The primitives of the root's leaves, with their primitive numbers, and the root's other
+/// children.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Flat {
     pub(crate) triangles: Vec<([Vec3; 3], u32)>,
     pub(crate) spheres: Vec<(Sphere, u32)>,
     /// Primitive numbers from this one on are spheres.
     pub(crate) first_sphere: u32,
+    /// The boxes of the root's children that are not leaves.
+    pub(crate) inner: Vec<Aabb>,
+    /// The root's slots whose leaves are in the list.
+    pub(crate) skip: u32,
 }
 
 /// What a group of up to sixteen rays learnt, lane by lane.
@@ -36,6 +42,9 @@ pub(crate) struct Lanes {
     pub(crate) blocked: u16,
     /// Lanes whose answer must come from the hierarchy.
     pub(crate) defer: u16,
+    /// Lanes that enter one of the root's other children before their nearest hit (or
+    /// their end): they must traverse the rest of the hierarchy too.
+    pub(crate) need: u16,
 }
 
 impl Flat {
@@ -67,8 +76,9 @@ mod avx512 {
 
     use super::{Flat, Lanes, WIDTH};
     use crate::bvh::Hit;
+    use crate::node8::FAR_WIDEN;
     use crate::shapes::Sphere;
-    use prism_math::{Ray, Vec3};
+    use prism_math::{Aabb, Ray, Vec3};
 
     /// The rays of a group on lanes, prepared as the one-ray tests prepare them.
     struct Group {
@@ -249,6 +259,57 @@ mod avx512 {
         )
     }
 
+    /// Lanes entering `b` with an entry in `[tmin, tmax]`: the slab test of the tree's nodes
+    /// (`node8`), on lanes.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn enters(g: &Group, inv: &[__m512; 3], b: &Aabb, tmin: __m512, tmax: __m512) -> __mmask16 {
+        let mut near = tmin;
+        let mut far = _mm512_set1_ps(f32::INFINITY);
+        for (a, &inv) in inv.iter().enumerate() {
+            // Lanes whose direction is negative on this axis meet the upper plane first.
+            let neg = _mm512_cmplt_epi32_mask(_mm512_castps_si512(inv), _mm512_setzero_si512());
+            let (lo, hi) = (_mm512_set1_ps(b.min[a]), _mm512_set1_ps(b.max[a]));
+            let t = |plane: __m512| _mm512_mul_ps(_mm512_sub_ps(plane, g.origin[a]), inv);
+            // The slab value first: a NaN (a ray in the slab's plane) drops out.
+            near = _mm512_max_ps(t(_mm512_mask_blend_ps(neg, lo, hi)), near);
+            far = _mm512_min_ps(t(_mm512_mask_blend_ps(neg, hi, lo)), far);
+        }
+        let far = _mm512_min_ps(_mm512_mul_ps(far, _mm512_set1_ps(FAR_WIDEN)), tmax);
+        _mm512_cmp_ps_mask::<_CMP_LE_OQ>(near, far)
+    }
+
+    /// `t` moved up by 1/1024 of its size: past a distance by far more than the slab
+    /// test's rounding, so that the gate below never drops a child the tree would enter.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn widen(t: __m512) -> __m512 {
+        _mm512_add_ps(
+            t,
+            _mm512_mul_ps(_mm512_abs_ps(t), _mm512_set1_ps(1.0 / 1024.0)),
+        )
+    }
+
+    /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn need(flat: &Flat, g: &Group, tmin: __m512, tmax: __m512) -> __mmask16 {
+        if flat.inner.is_empty() {
+            return 0;
+        }
+        let one = _mm512_set1_ps(1.0);
+        let inv = [
+            _mm512_div_ps(one, g.dir[0]),
+            _mm512_div_ps(one, g.dir[1]),
+            _mm512_div_ps(one, g.dir[2]),
+        ];
+        let mut need = 0;
+        for b in &flat.inner {
+            need |= enters(g, &inv, b, tmin, tmax);
+        }
+        need
+    }
+
     /// The running nearest hit of a group's lanes.
     struct Nearest {
         t: __m512,
@@ -317,6 +378,9 @@ mod avx512 {
             _mm512_storeu_si512(prim.as_mut_ptr().cast(), near.prim);
         }
         let defer = defer | near.tie;
+        // Past a hit the list found, a margin far wider than the slab test's rounding.
+        let reach = _mm512_mask_blend_ps(near.found, hi, widen(near.t));
+        let need = need(flat, &g, lo, reach) & !defer;
         let mut hits = [None; WIDTH];
         for lane in 0..rays.len().min(WIDTH) {
             if near.found & (1 << lane) == 0 || defer & (1 << lane) != 0 {
@@ -339,6 +403,7 @@ mod avx512 {
             hits,
             blocked: 0,
             defer,
+            need,
         }
     }
 
@@ -361,10 +426,13 @@ mod avx512 {
             blocked |= sphere(&g, s, lo, hi).1;
         }
         // A lane blocked by another primitive is blocked whatever the deferred test says.
+        let defer = defer & !blocked;
+        let reach = widen(hi);
         Lanes {
             hits: [None; WIDTH],
             blocked,
-            defer: defer & !blocked,
+            defer,
+            need: need(flat, &g, lo, reach) & !blocked & !defer,
         }
     }
 }

@@ -8,13 +8,18 @@
 //!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD: AVX
 //!   when the processor has it (detected at run time), else two SSE halves, with identical
 //!   results. Leaf triangles are stored in packs of four, also tested at once. The layout is
-//!   a pure function of the input, whatever the thread count.
+//!   a pure function of the input, whatever the thread count. In scenes of more than 24
+//!   primitives, up to 12 large ones (a box of at least 1/16 of the scene's surface area: a
+//!   room's walls and floor) are built apart under one child of the root, so that the
+//!   collapse lifts their leaves into the root.
 //! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
 //!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays.
 //! - [`Bvh::intersect_batch`] and [`Bvh::occluded_batch`] answer many rays in one call. On
-//!   hierarchies of a few primitives (a Cornell box with two spheres) and processors with
-//!   AVX-512, they test sixteen rays at once against every primitive, with the one-ray
-//!   tests' operations on each lane, and so return the same hits.
+//!   processors with AVX-512, when the root's leaves hold at most 24 primitives (a Cornell
+//!   box's walls, or all of a small scene), they test sixteen rays at once against those
+//!   primitives, with the one-ray tests' operations on each lane, and against the boxes of
+//!   the root's other children; only rays that enter one of those before their nearest hit
+//!   traverse the rest. They return the one-ray calls' hits, bit for bit.
 //! - [`Bvh::levels`], [`Bvh::level_boxes`] and [`Bvh::leaf_views`] show the 8-wide tree
 //!   level by level and leaf by leaf, for drawing and checking it.
 #![warn(missing_docs)]

@@ -88,7 +88,7 @@ impl SlabRay {
 
 /// Rounding in the slab test may shrink the interval by a few ulps; widening the far end by
 /// this factor keeps hits on box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
-const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
+pub(crate) const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
 
 /// Entry distances of the ray into the eight child boxes, and which it enters (with an entry
 /// in `[tmin, tmax]`), by 4-wide SSE halves.

@@ -162,6 +162,67 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Oracle: the one-ray calls, in a room: ten large triangles (its walls, which the build
+    /// lifts into the root and the batched queries test on lanes) around a cluster of small
+    /// ones and spheres (which rays that reach them still traverse). Rays start inside, some
+    /// at grid points and axis-aligned (edges met exactly); every hit and occlusion is the
+    /// one-ray call's, bit for bit.
+    #[test]
+    fn room_batches_equal_single_rays(
+        small in prop::collection::vec(
+            (v3(), v3(), v3()).prop_map(|(a, b, c)| {
+                let a = a * 0.2;
+                [a, a + 0.05 * b, a + 0.05 * c]
+            }),
+            30..200,
+        ),
+        spheres in prop::collection::vec(
+            (v3(), 0.05f32..0.5).prop_map(|(c, r)| Sphere { center: c * 0.2, radius: r }),
+            0..4,
+        ),
+        rays in prop::collection::vec((v3(), v3(), 0.5f32..30.0, 0u8..4), 1..120),
+    ) {
+        let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 10.0;
+        let quad = |a: Vec3, b: Vec3, cc: Vec3, d: Vec3| [[a, b, cc], [a, cc, d]];
+        let mut tris: Vec<[Vec3; 3]> = [
+            quad(c(-1., -1., -1.), c(1., -1., -1.), c(1., -1., 1.), c(-1., -1., 1.)),
+            quad(c(-1., 1., -1.), c(-1., 1., 1.), c(1., 1., 1.), c(1., 1., -1.)),
+            quad(c(-1., -1., -1.), c(-1., 1., -1.), c(1., 1., -1.), c(1., -1., -1.)),
+            quad(c(-1., -1., -1.), c(-1., -1., 1.), c(-1., 1., 1.), c(-1., 1., -1.)),
+            quad(c(1., -1., -1.), c(1., 1., -1.), c(1., 1., 1.), c(1., -1., 1.)),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        tris.extend(small);
+        let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+        let (rays, ends): (Vec<Ray>, Vec<f32>) = rays
+            .into_iter()
+            .map(|(o, d, t, kind)| {
+                let ray = match kind {
+                    0 => Ray::new(o.round() * 0.5, d),
+                    1 => Ray::new(o.round() * 0.5, [Vec3::X, -Vec3::Y, Vec3::Z][(t as usize) % 3]),
+                    _ => Ray::new(o * 0.9, d),
+                };
+                (ray, t)
+            })
+            .unzip();
+        let mut hits = vec![None; rays.len()];
+        bvh.intersect_batch(&rays, 1e-3, f32::INFINITY, &mut hits);
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
+        for (i, ray) in rays.iter().enumerate() {
+            let one = bvh.intersect(ray, 1e-3, f32::INFINITY);
+            prop_assert_eq!(hits[i].map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())),
+                one.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())));
+            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
+        }
+    }
+}
+
 /// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at
 /// its vertices and edge midpoints (where tests that are not watertight leak), always hit.
 #[test]
