@@ -2,7 +2,7 @@
 //! collapse into 8-wide nodes, statistics, and closest-hit and occlusion traversal.
 
 use prism_math::glam::Vec3A;
-use prism_math::{Aabb, Ray, Vec3};
+use prism_math::{prefetch, Aabb, Ray, Vec3};
 use rayon::prelude::*;
 
 use crate::flat::{Flat, FLAT_MAX, WIDTH};
@@ -1129,18 +1129,6 @@ fn bounds_of(prims: &[PrimRef], parallel_threshold: usize) -> (B3, B3) {
 
 /// How far ahead, in primitives, leaf packing prefetches triangles.
 const PACK_AHEAD: usize = 16;
-
-/// Starts loading the cache line at `p` (a hint: it never faults, whatever the address).
-#[inline(always)]
-fn prefetch<T>(p: *const T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching is only a hint; it never faults, whatever the address.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p.cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
 
 /// Frees a binary tree, the top levels' halves in parallel.
 fn free(n: BuildNode, depth: usize) {

@@ -1,9 +1,10 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
 //! boxes and frames, exact (order-independent) sums of floats, 4x4 transforms named destination-from-source, sixteen-lane numbers for
 //! SIMD kernels, warps with their densities, deterministic random numbers, and line numbers
-//! of byte offsets for the readers' error messages.
+//! of byte offsets for the readers' error messages, and a cache prefetch hint.
 #![warn(missing_docs)]
 
+mod cache;
 mod color;
 mod exact;
 mod geometry;
@@ -13,6 +14,7 @@ mod text;
 mod transform;
 pub mod warp;
 
+pub use cache::prefetch;
 pub use color::Rgb;
 pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
