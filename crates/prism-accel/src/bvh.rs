@@ -676,32 +676,29 @@ impl Bvh {
     /// The closest hit with `tmin < t < tmax`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_below(ray, tmin, tmax, 0)
-    }
-
-    /// [`Bvh::intersect`] leaving out the root's children in the slots of `skip`.
-    fn intersect_below(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the processor has AVX.
-            return unsafe { self.intersect_avx(ray, tmin, tmax, skip) };
+            return unsafe { self.intersect_avx(ray, tmin, tmax) };
         }
-        self.intersect_with::<false>(ray, tmin, tmax, skip)
+        self.intersect_with::<false>(ray, tmin, tmax, 0)
     }
 
-    /// [`Bvh::intersect_below`] compiled for AVX.
+    /// [`Bvh::intersect`] compiled for AVX.
     ///
     /// # Safety
     /// The processor must support AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax, skip)
+    unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.intersect_with::<true>(ray, tmin, tmax, 0)
     }
 
+    /// The closest hit with `tmin < t < tmax`, leaving out the root's children in the slots
+    /// of `skip`.
     #[inline(always)]
     fn intersect_with<const AVX: bool>(
         &self,
@@ -790,35 +787,11 @@ impl Bvh {
         }
         #[cfg(target_arch = "x86_64")]
         {
-            if let (Some(flat), true) = (&self.flat, std::arch::is_x86_feature_detected!("avx512f"))
-            {
-                for (rays, hits) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
-                    // SAFETY: the processor has AVX-512F.
-                    let lanes = unsafe { flat.closest(rays, tmin, tmax) };
-                    for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-                        let bit = 1 << lane;
-                        let near = lanes.hits[lane];
-                        *hit = if lanes.defer & bit != 0 {
-                            self.intersect(ray, tmin, tmax)
-                        } else if lanes.need & bit != 0 {
-                            // The rest of the tree, for a hit no farther than the list's.
-                            let end = near.map_or(tmax, |h| h.t.next_up());
-                            match self.intersect_below(ray, tmin, end, flat.skip) {
-                                // Two primitives at one distance: the tree's order decides.
-                                Some(h) if near.is_some_and(|n| n.t == h.t) => {
-                                    self.intersect(ray, tmin, tmax)
-                                }
-                                Some(h) => Some(h),
-                                None => near,
-                            }
-                        } else {
-                            near
-                        };
-                    }
-                }
-                return;
-            }
             if std::arch::is_x86_feature_detected!("avx512vl") {
+                if let Some(flat) = &self.flat {
+                    // SAFETY: the processor has AVX-512VL, hence AVX-512F.
+                    return unsafe { self.intersect_batch_flat(flat, rays, tmin, tmax, hits) };
+                }
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.intersect_batch_avx512(rays, tmin, tmax, hits) };
             }
@@ -839,6 +812,81 @@ impl Bvh {
     fn intersect_batch_with(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
         for (ray, hit) in rays.iter().zip(hits) {
             *hit = self.intersect_with::<true>(ray, tmin, tmax, 0);
+        }
+    }
+
+    /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): sixteen rays at a time
+    /// against the list on lanes, then the rest of the tree for the rays that enter it.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F and AVX-512VL.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn intersect_batch_flat(
+        &self,
+        flat: &Flat,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        for (rays, hits) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
+            // SAFETY: the processor has AVX-512F.
+            let lanes = unsafe { flat.closest(rays, tmin, tmax) };
+            for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+                let bit = 1 << lane;
+                let near = lanes.hits[lane];
+                *hit = if lanes.defer & bit != 0 {
+                    self.intersect_with::<true>(ray, tmin, tmax, 0)
+                } else if lanes.need & bit != 0 {
+                    // The rest of the tree, for a hit no farther than the list's.
+                    let end = near.map_or(tmax, |h| h.t.next_up());
+                    match self.intersect_with::<true>(ray, tmin, end, flat.skip) {
+                        // Two primitives at one distance: the tree's order decides.
+                        Some(h) if near.is_some_and(|n| n.t == h.t) => {
+                            self.intersect_with::<true>(ray, tmin, tmax, 0)
+                        }
+                        Some(h) => Some(h),
+                        None => near,
+                    }
+                } else {
+                    near
+                };
+            }
+        }
+    }
+
+    /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_flat`].
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F and AVX-512VL.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn occluded_batch_flat(
+        &self,
+        flat: &Flat,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
+        let groups = rays.chunks(WIDTH).zip(tmax.chunks(WIDTH));
+        for ((rays, ends), blocked) in groups.zip(blocked.chunks_mut(WIDTH)) {
+            // SAFETY: the processor has AVX-512F.
+            let lanes = unsafe { flat.occluded(rays, tmin, ends) };
+            for (lane, b) in blocked.iter_mut().enumerate() {
+                let bit = 1 << lane;
+                let (ray, end) = (&rays[lane], ends[lane]);
+                *b = if lanes.blocked & bit != 0 {
+                    true
+                } else if lanes.defer & bit != 0 {
+                    self.occluded_with::<true>(ray, tmin, end, 0)
+                } else if lanes.need & bit != 0 {
+                    self.occluded_with::<true>(ray, tmin, end, flat.skip)
+                } else {
+                    false
+                };
+            }
         }
     }
 
@@ -888,28 +936,11 @@ impl Bvh {
         }
         #[cfg(target_arch = "x86_64")]
         {
-            if let (Some(flat), true) = (&self.flat, std::arch::is_x86_feature_detected!("avx512f"))
-            {
-                let groups = rays.chunks(WIDTH).zip(tmax.chunks(WIDTH));
-                for ((rays, ends), blocked) in groups.zip(blocked.chunks_mut(WIDTH)) {
-                    // SAFETY: the processor has AVX-512F.
-                    let lanes = unsafe { flat.occluded(rays, tmin, ends) };
-                    for (lane, b) in blocked.iter_mut().enumerate() {
-                        let bit = 1 << lane;
-                        *b = if lanes.blocked & bit != 0 {
-                            true
-                        } else if lanes.defer & bit != 0 {
-                            self.occluded(&rays[lane], tmin, ends[lane])
-                        } else if lanes.need & bit != 0 {
-                            self.occluded_below(&rays[lane], tmin, ends[lane], flat.skip)
-                        } else {
-                            false
-                        };
-                    }
-                }
-                return;
-            }
             if std::arch::is_x86_feature_detected!("avx512vl") {
+                if let Some(flat) = &self.flat {
+                    // SAFETY: the processor has AVX-512VL, hence AVX-512F.
+                    return unsafe { self.occluded_batch_flat(flat, rays, tmin, tmax, blocked) };
+                }
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.occluded_batch_avx512(rays, tmin, tmax, blocked) };
             }
@@ -968,32 +999,29 @@ impl Bvh {
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_below(ray, tmin, tmax, 0)
-    }
-
-    /// [`Bvh::occluded`] leaving out the root's children in the slots of `skip`.
-    fn occluded_below(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the processor has AVX.
-            return unsafe { self.occluded_avx(ray, tmin, tmax, skip) };
+            return unsafe { self.occluded_avx(ray, tmin, tmax) };
         }
-        self.occluded_with::<false>(ray, tmin, tmax, skip)
+        self.occluded_with::<false>(ray, tmin, tmax, 0)
     }
 
-    /// [`Bvh::occluded_below`] compiled for AVX.
+    /// [`Bvh::occluded`] compiled for AVX.
     ///
     /// # Safety
     /// The processor must support AVX.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax, skip)
+    unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+        self.occluded_with::<true>(ray, tmin, tmax, 0)
     }
 
+    /// True if anything lies along the ray with `tmin < t < tmax`, leaving out the root's
+    /// children in the slots of `skip`.
     #[inline(always)]
     fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
         let r = RayPre::new(ray);
@@ -1389,13 +1417,13 @@ mod tests {
                 };
                 let ray = Ray::new(o.floor(), d);
                 // SAFETY: AVX was detected above.
-                let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY, 0) };
+                let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
                 assert_eq!(
                     avx,
                     bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, 0)
                 );
                 // SAFETY: as above.
-                let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0, 0) };
+                let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
                 assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, 0));
                 hits += usize::from(avx.is_some());
             }
