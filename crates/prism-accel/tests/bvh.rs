@@ -1,4 +1,5 @@
-//! The BVH against brute force (proptest), and watertightness on a closed mesh.
+//! The BVH against brute force (proptest), its batched queries against its one-ray calls,
+//! and watertightness on a closed mesh.
 
 use prism_accel::{intersect_sphere, intersect_triangle, BuildOptions, Bvh, Hit, RayPre, Sphere};
 use prism_math::{Pcg32, Ray, Vec3};
@@ -52,6 +53,21 @@ fn scene() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Vec<Sphere>)> {
     )
 }
 
+/// Oracle: the one-ray calls. The batched queries' answers for `rays` (closest hits with
+/// `1e-3 < t < tmax`, occlusion below each of `ends`) are theirs, bit for bit.
+fn check_batches(bvh: &Bvh, rays: &[Ray], ends: &[f32], tmax: f32) -> Result<(), TestCaseError> {
+    let mut hits = vec![None; rays.len()];
+    bvh.intersect_batch(rays, 1e-3, tmax, &mut hits);
+    let mut blocked = vec![false; rays.len()];
+    bvh.occluded_batch(rays, 1e-3, ends, &mut blocked);
+    let bits = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()));
+    for (i, ray) in rays.iter().enumerate() {
+        prop_assert_eq!(bits(hits[i]), bits(bvh.intersect(ray, 1e-3, tmax)));
+        prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -100,14 +116,7 @@ proptest! {
         let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
         let (rays, ends): (Vec<Ray>, Vec<f32>) =
             rays.into_iter().map(|(o, d, t)| (Ray::new(o, d), t)).unzip();
-        let mut hits = vec![None; rays.len()];
-        bvh.intersect_batch(&rays, 1e-3, 15.0, &mut hits);
-        let mut blocked = vec![false; rays.len()];
-        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
-        for (i, ray) in rays.iter().enumerate() {
-            prop_assert_eq!(hits[i], bvh.intersect(ray, 1e-3, 15.0));
-            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
-        }
+        check_batches(&bvh, &rays, &ends, 15.0)?;
     }
 }
 
@@ -149,16 +158,7 @@ proptest! {
                 (ray, t)
             })
             .unzip();
-        let mut hits = vec![None; rays.len()];
-        bvh.intersect_batch(&rays, 1e-3, 15.0, &mut hits);
-        let mut blocked = vec![false; rays.len()];
-        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
-        for (i, ray) in rays.iter().enumerate() {
-            let one = bvh.intersect(ray, 1e-3, 15.0);
-            prop_assert_eq!(hits[i].map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())),
-                one.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())));
-            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
-        }
+        check_batches(&bvh, &rays, &ends, 15.0)?;
     }
 }
 
@@ -210,16 +210,7 @@ proptest! {
                 (ray, t)
             })
             .unzip();
-        let mut hits = vec![None; rays.len()];
-        bvh.intersect_batch(&rays, 1e-3, f32::INFINITY, &mut hits);
-        let mut blocked = vec![false; rays.len()];
-        bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
-        for (i, ray) in rays.iter().enumerate() {
-            let one = bvh.intersect(ray, 1e-3, f32::INFINITY);
-            prop_assert_eq!(hits[i].map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())),
-                one.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits())));
-            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
-        }
+        check_batches(&bvh, &rays, &ends, f32::INFINITY)?;
     }
 }
 
