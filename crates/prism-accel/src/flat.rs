@@ -279,14 +279,18 @@ mod avx512 {
         _mm512_cmp_ps_mask::<_CMP_LE_OQ>(near, far)
     }
 
-    /// `t` moved up by 1/1024 of its size: past a distance by far more than the slab
-    /// test's rounding, so that the gate below never drops a child the tree would enter.
+    /// `t` moved up by 1/1024 of its size and by the smallest normal float: past a distance
+    /// by far more than the slab test's rounding (subnormal distances included), so that the
+    /// gate below never drops a child the tree would enter.
     #[inline]
     #[target_feature(enable = "avx512f")]
     fn widen(t: __m512) -> __m512 {
         _mm512_add_ps(
-            t,
-            _mm512_mul_ps(_mm512_abs_ps(t), _mm512_set1_ps(1.0 / 1024.0)),
+            _mm512_add_ps(
+                t,
+                _mm512_mul_ps(_mm512_abs_ps(t), _mm512_set1_ps(1.0 / 1024.0)),
+            ),
+            _mm512_set1_ps(f32::MIN_POSITIVE),
         )
     }
 
