@@ -37,7 +37,15 @@ cat >tri.svg <<'SVG'
 SVG
 shot() { sleep 0.4; import -window "$wid" "$1"; }
 colours() { convert "$1" -crop 400x280+0+0 +repage -format %k info:; }
-differ() { compare -metric AE "$1" "$2" null: 2>&1 || true; }
+# Pixels that differ between two screenshots, in the region WxH+X+Y if one is given.
+differ() {
+    if (($# > 2)); then
+        compare -metric AE <(convert "$1" -crop "$3" +repage png:-) \
+            <(convert "$2" -crop "$3" +repage png:-) null: 2>&1 || true
+    else
+        compare -metric AE "$1" "$2" null: 2>&1 || true
+    fi
+}
 # Starts `prism view` with the arguments after the label, checks that its window is there
 # within 1 s, and focuses it; sets pid and wid.
 open_window() {
@@ -119,8 +127,7 @@ xdotool key p
 shot p1.png
 shot p2.png
 # Only the status line's timing may change while paused.
-held=$(compare -metric AE <(convert p1.png -crop 320x220+0+0 +repage png:-) \
-    <(convert p2.png -crop 320x220+0+0 +repage png:-) null: 2>&1 || true)
+held=$(differ p1.png p2.png 320x220+0+0)
 echo "view: paused, $held pixels changed"
 ((held == 0)) || { echo "view: P did not pause"; exit 1; }
 xdotool key c
@@ -140,8 +147,7 @@ echo "view: clicking a pixel changed $rays pixels (its rays over the dimmed pict
 ((rays > 5000)) || { echo "view: a click drew no rays"; exit 1; }
 xdotool key x
 shot w3.png
-back=$(compare -metric AE <(convert w1.png -crop 300x280+0+0 +repage png:-) \
-    <(convert w3.png -crop 300x280+0+0 +repage png:-) null: 2>&1 || true)
+back=$(differ w1.png w3.png 300x280+0+0)
 echo "view: after X, $back pixels differ from the first picture"
 ((back == 0)) || { echo "view: X did not clear the rays"; exit 1; }
 xdotool key Escape
@@ -149,8 +155,8 @@ wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
 open_window "mesh" "$teapot" --mode mesh -r 480 360
 shot m0.png
-area() { compare -metric AE <(convert "$1" -crop 480x340+0+0 +repage png:-) \
-    <(convert "$2" -crop 480x340+0+0 +repage png:-) null: 2>&1 || true; }
+# The picture above the status line.
+area() { differ "$1" "$2" 480x340+0+0; }
 xdotool mousemove --window "$wid" 236 170
 shot m1.png
 lit=$(area m0.png m1.png)
@@ -171,8 +177,7 @@ echo "view: F changed $flipped pixels of the picture"
 xdotool key ctrl+z
 xdotool mousemove --window "$wid" 10 10
 shot m3.png
-undone=$(compare -metric AE <(convert m0.png -crop 480x340+0+0 +repage png:-) \
-    <(convert m3.png -crop 480x340+0+0 +repage png:-) null: 2>&1 || true)
+undone=$(area m0.png m3.png)
 echo "view: after Ctrl+Z, $undone pixels differ from the first picture"
 ((undone == 0)) || { echo "view: Ctrl+Z did not undo"; exit 1; }
 xdotool key Escape
