@@ -14,8 +14,13 @@ use crate::lights::{MeshLight, RenderLight};
 /// What a BVH primitive is.
 #[derive(Clone, Copy, Debug)]
 enum Prim {
-    /// Triangle `tri` of mesh `mesh`.
-    Mesh { mesh: u32, tri: u32 },
+    /// Triangle `tri` of mesh `mesh`, with its vertex indices (kept here so that a hit
+    /// reads its vertices without first reading the mesh's triangle list).
+    Mesh {
+        mesh: u32,
+        tri: u32,
+        corners: [u32; 3],
+    },
     /// Half of area light `light`.
     LightQuad { light: u32 },
     /// Sphere `index`.
@@ -24,7 +29,6 @@ enum Prim {
 
 struct MeshRec {
     positions: Vec<Vec3>,
-    triangles: Vec<[u32; 3]>,
     shading: Shading,
     material: usize,
     /// The light it is, if it emits.
@@ -64,6 +68,7 @@ impl RenderScene {
                 prims.push(Prim::Mesh {
                     mesh: mi as u32,
                     tri: ti as u32,
+                    corners: *t,
                 });
             }
         }
@@ -179,7 +184,6 @@ impl RenderScene {
                 .zip(mesh_light)
                 .map(|(m, light)| MeshRec {
                     positions: m.positions.clone(),
-                    triangles: m.triangles.clone(),
                     shading: m.shading.clone(),
                     material: m.material,
                     light,
@@ -279,9 +283,9 @@ impl RenderScene {
     fn interaction(&self, ray: &Ray, hit: prism_accel::Hit) -> Interaction {
         let b0 = 1.0 - hit.b1 - hit.b2;
         match self.prims[hit.prim as usize] {
-            Prim::Mesh { mesh, tri } => {
+            Prim::Mesh { mesh, tri, corners } => {
                 let m = &self.meshes[mesh as usize];
-                let t = m.triangles[tri as usize];
+                let t = corners;
                 let [a, b, c] = t.map(|i| m.positions[i as usize]);
                 let p = b0 * a + hit.b1 * b + hit.b2 * c;
                 let ng = (b - a).cross(c - a).normalize();
