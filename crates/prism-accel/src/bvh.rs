@@ -2,10 +2,10 @@
 //! collapse into 8-wide nodes, statistics, and closest-hit and occlusion traversal.
 
 use prism_math::glam::Vec3A;
-use prism_math::{prefetch, Aabb, Ray, Vec3};
+use prism_math::{prefetch, Aabb, Isa, Ray, Vec3};
 use rayon::prelude::*;
 
-use crate::flat::{Flat, FLAT_MAX, WIDTH};
+use crate::flat::{Flat, Lanes, FLAT_MAX, WIDTH, WIDTH8};
 use crate::node8::{self, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
 use crate::tri4::Tri4;
@@ -680,7 +680,7 @@ impl Bvh {
             return None;
         }
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
+        if Isa::avx() {
             // SAFETY: the processor has AVX.
             return unsafe { self.intersect_avx(ray, tmin, tmax) };
         }
@@ -780,14 +780,31 @@ impl Bvh {
     /// # Panics
     /// If `hits` is not as long as `rays`.
     pub fn intersect_batch(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
+        self.intersect_batch_on(Isa::get(), rays, tmin, tmax, hits);
+    }
+
+    /// [`Bvh::intersect_batch`] on the code paths of instruction set `isa` (or of the
+    /// processor, if it has less): the same hits on every level.
+    ///
+    /// # Panics
+    /// If `hits` is not as long as `rays`.
+    pub fn intersect_batch_on(
+        &self,
+        isa: Isa,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
         assert_eq!(rays.len(), hits.len());
         if self.nodes.is_empty() {
             hits.fill(None);
             return;
         }
+        let isa = isa.min(Isa::get());
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512vl") {
+            if isa >= Isa::Avx512 {
                 if let Some(flat) = &self.flat {
                     // SAFETY: the processor has AVX-512VL, hence AVX-512F.
                     return unsafe { self.intersect_batch_flat(flat, rays, tmin, tmax, hits) };
@@ -795,12 +812,17 @@ impl Bvh {
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.intersect_batch_avx512(rays, tmin, tmax, hits) };
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if isa >= Isa::Avx2 {
+                if let Some(flat) = &self.flat {
+                    // SAFETY: the processor has AVX2.
+                    return unsafe { self.intersect_batch_flat8(flat, rays, tmin, tmax, hits) };
+                }
                 // SAFETY: the processor has AVX2.
                 return unsafe { self.intersect_batch_avx2(rays, tmin, tmax, hits) };
             }
         }
-        // Older processors: ray by ray, each call choosing AVX or SSE.
+        // Older processors: ray by ray.
+        let _ = isa;
         for (ray, hit) in rays.iter().zip(hits) {
             *hit = self.intersect(ray, tmin, tmax);
         }
@@ -815,24 +837,21 @@ impl Bvh {
         }
     }
 
-    /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): sixteen rays at a time
-    /// against the list on lanes, then the rest of the tree for the rays that enter it.
-    ///
-    /// # Safety
-    /// The processor must support AVX-512F and AVX-512VL.
+    /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
+    /// against the list on lanes (`closest`), then the rest of the tree for the rays that
+    /// enter it. Inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512vl")]
-    unsafe fn intersect_batch_flat(
+    #[inline(always)]
+    fn intersect_batch_list(
         &self,
-        flat: &Flat,
         rays: &[Ray],
-        tmin: f32,
-        tmax: f32,
+        (tmin, tmax): (f32, f32),
         hits: &mut [Option<Hit>],
+        (flat, width): (&Flat, usize),
+        closest: impl Fn(&[Ray]) -> Lanes,
     ) {
-        for (rays, hits) in rays.chunks(WIDTH).zip(hits.chunks_mut(WIDTH)) {
-            // SAFETY: the processor has AVX-512F.
-            let lanes = unsafe { flat.closest(rays, tmin, tmax) };
+        for (rays, hits) in rays.chunks(width).zip(hits.chunks_mut(width)) {
+            let lanes = closest(rays);
             for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
                 let bit = 1 << lane;
                 let near = lanes.hits[lane];
@@ -856,24 +875,60 @@ impl Bvh {
         }
     }
 
-    /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_flat`].
+    /// [`Bvh::intersect_batch_list`] on sixteen lanes of AVX-512.
     ///
     /// # Safety
     /// The processor must support AVX-512F and AVX-512VL.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
-    unsafe fn occluded_batch_flat(
+    unsafe fn intersect_batch_flat(
         &self,
         flat: &Flat,
         rays: &[Ray],
         tmin: f32,
-        tmax: &[f32],
-        blocked: &mut [bool],
+        tmax: f32,
+        hits: &mut [Option<Hit>],
     ) {
-        let groups = rays.chunks(WIDTH).zip(tmax.chunks(WIDTH));
-        for ((rays, ends), blocked) in groups.zip(blocked.chunks_mut(WIDTH)) {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH), |r| {
             // SAFETY: the processor has AVX-512F.
-            let lanes = unsafe { flat.occluded(rays, tmin, ends) };
+            unsafe { flat.closest(r, tmin, tmax) }
+        });
+    }
+
+    /// [`Bvh::intersect_batch_list`] on eight lanes of AVX2.
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn intersect_batch_flat8(
+        &self,
+        flat: &Flat,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH8), |r| {
+            // SAFETY: the processor has AVX2.
+            unsafe { flat.closest8(r, tmin, tmax) }
+        });
+    }
+
+    /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_list`].
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn occluded_batch_list(
+        &self,
+        rays: &[Ray],
+        (tmin, tmax): (f32, &[f32]),
+        blocked: &mut [bool],
+        (flat, width): (&Flat, usize),
+        occluded: impl Fn(&[Ray], &[f32]) -> Lanes,
+    ) {
+        let groups = rays.chunks(width).zip(tmax.chunks(width));
+        for ((rays, ends), blocked) in groups.zip(blocked.chunks_mut(width)) {
+            let lanes = occluded(rays, ends);
             for (lane, b) in blocked.iter_mut().enumerate() {
                 let bit = 1 << lane;
                 let (ray, end) = (&rays[lane], ends[lane]);
@@ -888,6 +943,46 @@ impl Bvh {
                 };
             }
         }
+    }
+
+    /// [`Bvh::occluded_batch_list`] on sixteen lanes of AVX-512.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F and AVX-512VL.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    unsafe fn occluded_batch_flat(
+        &self,
+        flat: &Flat,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, WIDTH), |r, e| {
+            // SAFETY: the processor has AVX-512F.
+            unsafe { flat.occluded(r, tmin, e) }
+        });
+    }
+
+    /// [`Bvh::occluded_batch_list`] on eight lanes of AVX2.
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn occluded_batch_flat8(
+        &self,
+        flat: &Flat,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, WIDTH8), |r, e| {
+            // SAFETY: the processor has AVX2.
+            unsafe { flat.occluded8(r, tmin, e) }
+        });
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX-512VL: the same 256-bit operations, with
@@ -929,14 +1024,31 @@ impl Bvh {
     /// # Panics
     /// If the slices differ in length.
     pub fn occluded_batch(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
+        self.occluded_batch_on(Isa::get(), rays, tmin, tmax, blocked);
+    }
+
+    /// [`Bvh::occluded_batch`] on the code paths of instruction set `isa` (or of the
+    /// processor, if it has less): the same answers on every level.
+    ///
+    /// # Panics
+    /// If the slices differ in length.
+    pub fn occluded_batch_on(
+        &self,
+        isa: Isa,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
         assert!(rays.len() == tmax.len() && rays.len() == blocked.len());
         if self.nodes.is_empty() {
             blocked.fill(false);
             return;
         }
+        let isa = isa.min(Isa::get());
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512vl") {
+            if isa >= Isa::Avx512 {
                 if let Some(flat) = &self.flat {
                     // SAFETY: the processor has AVX-512VL, hence AVX-512F.
                     return unsafe { self.occluded_batch_flat(flat, rays, tmin, tmax, blocked) };
@@ -944,12 +1056,17 @@ impl Bvh {
                 // SAFETY: the processor has AVX-512VL.
                 return unsafe { self.occluded_batch_avx512(rays, tmin, tmax, blocked) };
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if isa >= Isa::Avx2 {
+                if let Some(flat) = &self.flat {
+                    // SAFETY: the processor has AVX2.
+                    return unsafe { self.occluded_batch_flat8(flat, rays, tmin, tmax, blocked) };
+                }
                 // SAFETY: the processor has AVX2.
                 return unsafe { self.occluded_batch_avx2(rays, tmin, tmax, blocked) };
             }
         }
-        // Older processors: ray by ray, each call choosing AVX or SSE.
+        // Older processors: ray by ray.
+        let _ = isa;
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
             *b = self.occluded(ray, tmin, t);
         }
@@ -1003,7 +1120,7 @@ impl Bvh {
             return false;
         }
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
+        if Isa::avx() {
             // SAFETY: the processor has AVX.
             return unsafe { self.occluded_avx(ray, tmin, tmax) };
         }

@@ -2,7 +2,7 @@
 //! and watertightness on a closed mesh.
 
 use prism_accel::{intersect_sphere, intersect_triangle, BuildOptions, Bvh, Hit, RayPre, Sphere};
-use prism_math::{Pcg32, Ray, Vec3};
+use prism_math::{Isa, Pcg32, Ray, Vec3};
 use proptest::prelude::*;
 
 fn brute_force(tris: &[[Vec3; 3]], spheres: &[Sphere], ray: &Ray, tmax: f32) -> Option<Hit> {
@@ -54,16 +54,26 @@ fn scene() -> impl Strategy<Value = (Vec<[Vec3; 3]>, Vec<Sphere>)> {
 }
 
 /// Oracle: the one-ray calls. The batched queries' answers for `rays` (closest hits with
-/// `1e-3 < t < tmax`, occlusion below each of `ends`) are theirs, bit for bit.
+/// `1e-3 < t < tmax`, occlusion below each of `ends`) are theirs, bit for bit, on the code
+/// paths of every instruction set the processor has (sixteen lanes with AVX-512, eight with
+/// AVX2, one ray at a time below).
 fn check_batches(bvh: &Bvh, rays: &[Ray], ends: &[f32], tmax: f32) -> Result<(), TestCaseError> {
-    let mut hits = vec![None; rays.len()];
-    bvh.intersect_batch(rays, 1e-3, tmax, &mut hits);
-    let mut blocked = vec![false; rays.len()];
-    bvh.occluded_batch(rays, 1e-3, ends, &mut blocked);
     let bits = |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()));
-    for (i, ray) in rays.iter().enumerate() {
-        prop_assert_eq!(bits(hits[i]), bits(bvh.intersect(ray, 1e-3, tmax)));
-        prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]));
+    for isa in [Isa::Sse, Isa::Avx2, Isa::Avx512] {
+        let mut hits = vec![None; rays.len()];
+        bvh.intersect_batch_on(isa, rays, 1e-3, tmax, &mut hits);
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_batch_on(isa, rays, 1e-3, ends, &mut blocked);
+        for (i, ray) in rays.iter().enumerate() {
+            prop_assert_eq!(
+                bits(hits[i]),
+                bits(bvh.intersect(ray, 1e-3, tmax)),
+                "{:?}, ray {}",
+                isa,
+                i
+            );
+            prop_assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]), "{:?}", isa);
+        }
     }
     Ok(())
 }

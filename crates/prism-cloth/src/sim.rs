@@ -233,7 +233,7 @@ impl SpringLaw {
     /// of length zero.
     fn forces(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
+        if prism_math::Isa::avx() {
             // SAFETY: the processor has AVX.
             return unsafe { self.forces_avx(positions, springs, out) };
         }

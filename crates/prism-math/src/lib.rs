@@ -1,13 +1,15 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
 //! boxes and frames, exact (order-independent) sums of floats, 4x4 transforms named destination-from-source, sixteen-lane numbers for
 //! SIMD kernels, warps with their densities, deterministic random numbers, and line numbers
-//! of byte offsets for the readers' error messages, and a cache prefetch hint.
+//! of byte offsets for the readers' error messages, a cache prefetch hint, and the
+//! instruction sets the kernels may use.
 #![warn(missing_docs)]
 
 mod cache;
 mod color;
 mod exact;
 mod geometry;
+mod isa;
 pub mod lanes;
 mod random;
 mod text;
@@ -20,6 +22,7 @@ pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
 pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};
+pub use isa::Isa;
 pub use random::{hash_words, mix64, unit_f32, Pcg32};
 pub use text::LineIndex;
 pub use transform::Transform;

@@ -375,11 +375,11 @@ impl Frame<'_> {
     fn band<T>(&self, band: u32, out: &mut [T], buf: &mut Band, store: &impl Fn(Rgb) -> T) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512f") {
+            if prism_math::Isa::avx512() {
                 // SAFETY: the processor has AVX-512F.
                 return unsafe { self.band_avx512(band, out, buf, store) };
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if prism_math::Isa::avx2() {
                 // SAFETY: the processor has AVX2.
                 return unsafe { self.band_avx2(band, out, buf, store) };
             }

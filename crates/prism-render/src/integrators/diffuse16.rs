@@ -370,13 +370,11 @@ pub(super) fn step_dispatch(
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512dq")
-        {
+        if prism_math::Isa::avx512() {
             // SAFETY: the processor has AVX-512F and AVX-512DQ.
             return unsafe { step_avx512(opts, lights, paths, surfs, group, out) };
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if prism_math::Isa::avx2() {
             // SAFETY: the processor has AVX2.
             return unsafe { step_avx2(opts, lights, paths, surfs, group, out) };
         }
