@@ -126,6 +126,28 @@ impl Bsdf {
         }
     }
 
+    /// [`Bsdf::eval`] and [`Bsdf::pdf`] together, the terms they share computed once (the
+    /// same values, bit for bit).
+    #[must_use]
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if wo.z * wi.z <= 0.0 {
+            return (Rgb::splat(0.0), 0.0);
+        }
+        let (wo, wi) = upper(wo, wi);
+        match *self {
+            Bsdf::Diffuse { albedo } => (albedo * (wi.z / PI), cosine_hemisphere_pdf(wi.z)),
+            Bsdf::Conductor { alpha, eta, k } => {
+                let h = (wo + wi).normalize();
+                let d = beckmann_d(h, alpha);
+                let g1_wo = smith_g1(wo, h, alpha);
+                let g = g1_wo * smith_g1(wi, h, alpha);
+                let f = fresnel_conductor(wi.dot(h), eta, k);
+                (f * (d * g / (4.0 * wo.z)), g1_wo * d / (4.0 * wo.z))
+            }
+            _ => (Rgb::splat(0.0), 0.0),
+        }
+    }
+
     /// The density of [`Bsdf::sample`] choosing `wi`. Zero for delta lobes.
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -184,13 +206,13 @@ impl Bsdf {
                     return None;
                 }
                 let wi = flip(wi);
-                let pdf = self.pdf(wo, wi);
+                let (f, pdf) = self.eval_pdf(wo, wi);
                 if pdf <= 0.0 {
                     return None;
                 }
                 Some(BsdfSample {
                     wi,
-                    weight: self.eval(wo, wi) * (1.0 / pdf),
+                    weight: f * (1.0 / pdf),
                     pdf,
                     delta: false,
                 })

@@ -196,3 +196,48 @@ fn visible_normal_weights_are_bounded() {
         }
     }
 }
+
+/// Oracle: `eval` and `pdf` called apart. `eval_pdf` gives both bit for bit, for every BSDF,
+/// on random pairs of directions on both sides of the surface.
+#[test]
+fn eval_pdf_equals_eval_and_pdf() {
+    let bsdfs = [
+        Bsdf::Diffuse {
+            albedo: Rgb::new(0.7, 0.5, 0.3),
+        },
+        Bsdf::Conductor {
+            alpha: 0.3,
+            eta: Rgb::new(0.2, 0.92, 1.1),
+            k: Rgb::new(3.9, 2.45, 2.14),
+        },
+        Bsdf::Conductor {
+            alpha: 0.05,
+            eta: Rgb::new(1.5, 1.5, 1.5),
+            k: Rgb::new(0.0, 0.5, 1.0),
+        },
+        Bsdf::Mirror {
+            reflectance: Rgb::WHITE,
+        },
+        Bsdf::Black,
+    ];
+    let mut rng = Pcg32::new(3, 9);
+    let mut unit = || {
+        let z = 1.0 - 2.0 * rng.next_f32();
+        let phi = 2.0 * PI * rng.next_f32();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    for b in &bsdfs {
+        for _ in 0..2000 {
+            let (wo, wi) = (unit(), unit());
+            let (f, p) = b.eval_pdf(wo, wi);
+            let e = b.eval(wo, wi);
+            assert_eq!(
+                [f.r, f.g, f.b].map(f32::to_bits),
+                [e.r, e.g, e.b].map(f32::to_bits),
+                "{b:?}"
+            );
+            assert_eq!(p.to_bits(), b.pdf(wo, wi).to_bits(), "{b:?}");
+        }
+    }
+}

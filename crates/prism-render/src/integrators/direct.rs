@@ -87,7 +87,7 @@ pub(super) fn light_term(
         return None;
     }
     let wi_l = frame.to_local(ls.wi);
-    let f = hit.bsdf.eval(wo_l, wi_l);
+    let (f, bsdf_pdf) = hit.bsdf.eval_pdf(wo_l, wi_l);
     if f.max_channel() <= 0.0 {
         return None;
     }
@@ -97,7 +97,7 @@ pub(super) fn light_term(
         f32::INFINITY
     };
     let w = if mis && !ls.delta {
-        power(count as f32, ls.pdf, hit.bsdf.pdf(wo_l, wi_l))
+        power(count as f32, ls.pdf, bsdf_pdf)
     } else {
         1.0
     };
