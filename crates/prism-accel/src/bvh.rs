@@ -518,7 +518,9 @@ impl Bvh {
         prims.sort_unstable();
         for p in prims {
             if p < nt {
-                flat.triangles.push((triangles[p as usize], p));
+                let t = triangles[p as usize];
+                flat.triangles.push((t, p));
+                flat.padded.push(t.map(|v| [v.x, v.y, v.z, 0.0]));
             } else {
                 flat.spheres.push((spheres[(p - nt) as usize], p));
             }

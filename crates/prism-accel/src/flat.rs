@@ -29,6 +29,8 @@ pub(crate) const WIDTH8: usize = 8;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Flat {
     pub(crate) triangles: Vec<([Vec3; 3], u32)>,
+    /// The triangles' vertices padded to four floats (`x, y, z, 0`), for lane permutes.
+    pub(crate) padded: Vec<[[f32; 4]; 3]>,
     pub(crate) spheres: Vec<(Sphere, u32)>,
     /// Primitive numbers from this one on are spheres.
     pub(crate) first_sphere: u32,
@@ -102,7 +104,7 @@ mod avx512 {
     use crate::bvh::Hit;
     use crate::node8::FAR_WIDEN;
     use crate::shapes::Sphere;
-    use prism_math::{Aabb, Ray, Vec3};
+    use prism_math::{Aabb, Ray};
 
     /// The rays of a group on lanes, prepared as the one-ray tests prepare them.
     struct Group {
@@ -112,6 +114,10 @@ mod avx512 {
         /// `is[k][a]`: lanes whose sheared axis `k` is source axis `a` (0 or 1; the other
         /// lanes take axis 2).
         is: [[__mmask16; 2]; 3],
+        /// Per lane, the source axis of sheared axis `k` (0, 1 or 2), and the origin's
+        /// coordinate on it.
+        axis: [__m512i; 3],
+        origin_on: [__m512; 3],
     }
 
     /// Lanes `i < rays.len()` take `rays[i]`; the others repeat the first ray. The shear and
@@ -150,17 +156,32 @@ mod avx512 {
         let (p0, p1, p2) = (kz0 & up, kz0 & down, kz1 & up);
         let (p3, p4, p5) = (kz1 & down, kz2 & up, kz2 & down);
         let is = [[p3 | p4, p0 | p5], [p2 | p5, p1 | p4], [kz0, kz1]];
+        let axis = is.map(|[a0, a1]| {
+            _mm512_mask_blend_epi32(
+                a0,
+                _mm512_mask_blend_epi32(a1, _mm512_set1_epi32(2), _mm512_set1_epi32(1)),
+                _mm512_setzero_si512(),
+            )
+        });
+        let zero = _mm512_setzero_ps();
         let mut g = Group {
             origin,
             dir,
-            shear: [_mm512_setzero_ps(); 3],
+            shear: [zero; 3],
             is,
+            axis,
+            origin_on: [zero; 3],
         };
         let inv_z = _mm512_div_ps(_mm512_set1_ps(1.0), dz);
         g.shear = [
             _mm512_mul_ps(pick(&g, 0, &dir), inv_z),
             _mm512_mul_ps(pick(&g, 1, &dir), inv_z),
             inv_z,
+        ];
+        g.origin_on = [
+            pick(&g, 0, &origin),
+            pick(&g, 1, &origin),
+            pick(&g, 2, &origin),
         ];
         g
     }
@@ -183,17 +204,17 @@ mod avx512 {
     #[target_feature(enable = "avx512f")]
     fn triangle(
         g: &Group,
-        tri: &[Vec3; 3],
+        tri: &[[f32; 4]; 3],
         tmin: __m512,
         tmax: __m512,
     ) -> (__m512, __m512, __m512, __m512, __mmask16, __mmask16) {
+        // Each lane's vertex coordinate on its sheared axis, less the origin's: `v[k] -
+        // o[k]`, the value the one-ray test takes after reordering `v - o`.
         let rel = |i: usize| {
-            let r = [
-                _mm512_sub_ps(_mm512_set1_ps(tri[i].x), g.origin[0]),
-                _mm512_sub_ps(_mm512_set1_ps(tri[i].y), g.origin[1]),
-                _mm512_sub_ps(_mm512_set1_ps(tri[i].z), g.origin[2]),
-            ];
-            (pick(g, 0, &r), pick(g, 1, &r), pick(g, 2, &r))
+            // SAFETY: a padded vertex is four floats.
+            let v = _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(tri[i].as_ptr()) });
+            let on = |k: usize| _mm512_sub_ps(_mm512_permutexvar_ps(g.axis[k], v), g.origin_on[k]);
+            (on(0), on(1), on(2))
         };
         let (ax, ay, az) = rel(0);
         let (bx, by, bz) = rel(1);
@@ -383,7 +404,7 @@ mod avx512 {
             tie: 0,
         };
         let mut defer = 0u16;
-        for (tri, prim) in &flat.triangles {
+        for (tri, (_, prim)) in flat.padded.iter().zip(&flat.triangles) {
             let (t, v, w, det, hit, zeros) = triangle(&g, tri, lo, hi);
             defer |= zeros;
             near.update(t, v, w, det, *prim, hit);
@@ -445,7 +466,7 @@ mod avx512 {
         // SAFETY: sixteen floats are read from an array of sixteen.
         let hi = unsafe { _mm512_loadu_ps(ends.as_ptr()) };
         let (mut blocked, mut defer) = (0u16, 0u16);
-        for (tri, _) in &flat.triangles {
+        for tri in &flat.padded {
             let (.., hit, zeros) = triangle(&g, tri, lo, hi);
             blocked |= hit;
             defer |= zeros;
@@ -477,7 +498,7 @@ mod avx2 {
     use crate::bvh::Hit;
     use crate::node8::FAR_WIDEN;
     use crate::shapes::Sphere;
-    use prism_math::{Aabb, Ray, Vec3};
+    use prism_math::{Aabb, Ray};
 
     /// A lane mask: every bit of a lane set where it is in, none where it is out.
     type M = __m256;
@@ -523,6 +544,10 @@ mod avx2 {
         /// `is[k][a]`: lanes whose sheared axis `k` is source axis `a` (0 or 1; the other
         /// lanes take axis 2).
         is: [[M; 2]; 3],
+        /// Per lane, the source axis of sheared axis `k` (0, 1 or 2), and the origin's
+        /// coordinate on it.
+        axis: [__m256i; 3],
+        origin_on: [__m256; 3],
     }
 
     /// Lanes `i < rays.len()` take `rays[i]`; the others repeat the first ray. The shear and
@@ -564,17 +589,30 @@ mod avx2 {
             [or(p2, p5), or(p1, p4)],
             [kz0, kz1],
         ];
+        let axis = is.map(|[a0, a1]| {
+            let two = _mm256_castsi256_ps(_mm256_set1_epi32(2));
+            let one = _mm256_castsi256_ps(_mm256_set1_epi32(1));
+            _mm256_castps_si256(blend(a0, blend(a1, two, one), _mm256_setzero_ps()))
+        });
+        let zero = _mm256_setzero_ps();
         let mut g = Group {
             origin,
             dir,
-            shear: [_mm256_setzero_ps(); 3],
+            shear: [zero; 3],
             is,
+            axis,
+            origin_on: [zero; 3],
         };
         let inv_z = _mm256_div_ps(_mm256_set1_ps(1.0), dz);
         g.shear = [
             _mm256_mul_ps(pick(&g, 0, &dir), inv_z),
             _mm256_mul_ps(pick(&g, 1, &dir), inv_z),
             inv_z,
+        ];
+        g.origin_on = [
+            pick(&g, 0, &origin),
+            pick(&g, 1, &origin),
+            pick(&g, 2, &origin),
         ];
         g
     }
@@ -593,17 +631,18 @@ mod avx2 {
     #[target_feature(enable = "avx2")]
     fn triangle(
         g: &Group,
-        tri: &[Vec3; 3],
+        tri: &[[f32; 4]; 3],
         tmin: __m256,
         tmax: __m256,
     ) -> (__m256, __m256, __m256, __m256, M, M) {
+        // Each lane's vertex coordinate on its sheared axis, less the origin's (see
+        // `avx512::triangle`).
         let rel = |i: usize| {
-            let r = [
-                _mm256_sub_ps(_mm256_set1_ps(tri[i].x), g.origin[0]),
-                _mm256_sub_ps(_mm256_set1_ps(tri[i].y), g.origin[1]),
-                _mm256_sub_ps(_mm256_set1_ps(tri[i].z), g.origin[2]),
-            ];
-            (pick(g, 0, &r), pick(g, 1, &r), pick(g, 2, &r))
+            // SAFETY: a padded vertex is four floats.
+            let v = _mm256_broadcast_ps(&unsafe { _mm_loadu_ps(tri[i].as_ptr()) });
+            let on =
+                |k: usize| _mm256_sub_ps(_mm256_permutevar8x32_ps(v, g.axis[k]), g.origin_on[k]);
+            (on(0), on(1), on(2))
         };
         let (ax, ay, az) = rel(0);
         let (bx, by, bz) = rel(1);
@@ -800,7 +839,7 @@ mod avx2 {
             tie: zero,
         };
         let mut defer = zero;
-        for (tri, prim) in &flat.triangles {
+        for (tri, (_, prim)) in flat.padded.iter().zip(&flat.triangles) {
             let (t, v, w, det, hit, zeros) = triangle(&g, tri, lo, hi);
             defer = or(defer, zeros);
             near.update(t, v, w, det, *prim, hit);
@@ -864,7 +903,7 @@ mod avx2 {
         let hi = unsafe { _mm256_loadu_ps(ends.as_ptr()) };
         let zero = _mm256_setzero_ps();
         let (mut blocked, mut defer) = (zero, zero);
-        for (tri, _) in &flat.triangles {
+        for tri in &flat.padded {
             let (.., hit, zeros) = triangle(&g, tri, lo, hi);
             blocked = or(blocked, hit);
             defer = or(defer, zeros);
