@@ -518,9 +518,7 @@ impl Bvh {
         prims.sort_unstable();
         for p in prims {
             if p < nt {
-                let t = triangles[p as usize];
-                flat.triangles.push((t, p));
-                flat.padded.push(t.map(|v| [v.x, v.y, v.z, 0.0]));
+                flat.push_triangle(triangles[p as usize], p);
             } else {
                 flat.spheres.push((spheres[(p - nt) as usize], p));
             }

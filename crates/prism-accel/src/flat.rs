@@ -18,6 +18,9 @@ use crate::shapes::Sphere;
 /// and serial latency rather than work; testing each on sixteen lanes costs less.
 pub(crate) const FLAT_MAX: usize = 24;
 
+/// The most distinct vertices a list holds.
+const MAX_VERTICES: usize = 3 * FLAT_MAX;
+
 /// Lanes of one query with AVX-512.
 pub(crate) const WIDTH: usize = 16;
 
@@ -29,8 +32,11 @@ pub(crate) const WIDTH8: usize = 8;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Flat {
     pub(crate) triangles: Vec<([Vec3; 3], u32)>,
-    /// The triangles' vertices padded to four floats (`x, y, z, 0`), for lane permutes.
-    pub(crate) padded: Vec<[[f32; 4]; 3]>,
+    /// The triangles' distinct vertices, padded to four floats (`x, y, z, 0`) for lane
+    /// permutes: a room's walls share their corners, which are then prepared once.
+    pub(crate) vertices: Vec<[f32; 4]>,
+    /// Per triangle, its vertices' indices in `vertices`.
+    pub(crate) corners: Vec<[u16; 3]>,
     pub(crate) spheres: Vec<(Sphere, u32)>,
     /// Primitive numbers from this one on are spheres.
     pub(crate) first_sphere: u32,
@@ -54,6 +60,25 @@ pub(crate) struct Lanes {
 }
 
 impl Flat {
+    /// Adds triangle `tri`, primitive `prim`, sharing the vertices already listed.
+    pub(crate) fn push_triangle(&mut self, tri: [Vec3; 3], prim: u32) {
+        let corners = tri.map(|v| {
+            let padded = [v.x, v.y, v.z, 0.0];
+            let bits = padded.map(f32::to_bits);
+            let at = self
+                .vertices
+                .iter()
+                .position(|w| w.map(f32::to_bits) == bits)
+                .unwrap_or_else(|| {
+                    self.vertices.push(padded);
+                    self.vertices.len() - 1
+                });
+            at as u16
+        });
+        self.triangles.push((tri, prim));
+        self.corners.push(corners);
+    }
+
     /// The closest hits of `rays` (at most sixteen) with `tmin < t < tmax`.
     ///
     /// # Safety
@@ -100,7 +125,7 @@ impl Flat {
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use super::{Flat, Lanes, WIDTH};
+    use super::{Flat, Lanes, MAX_VERTICES, WIDTH};
     use crate::bvh::Hit;
     use crate::node8::FAR_WIDEN;
     use crate::shapes::Sphere;
@@ -197,33 +222,39 @@ mod avx512 {
         )
     }
 
-    /// One triangle's hit on every lane, as a pack of the hierarchy tests it:
-    /// `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit with `tmin < t < tmax`, `zero`
-    /// those with an edge function of exactly zero.
+    /// A vertex as every lane's triangle test takes it: its coordinates on the lane's
+    /// sheared axes, less the origin's (`v[k] - o[k]`, the one-ray test's values after
+    /// reordering `v - o`), the first two sheared.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn vertex(g: &Group, p: &[f32; 4]) -> [__m512; 3] {
+        // SAFETY: a padded vertex is four floats.
+        let v = _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(p.as_ptr()) });
+        let on = |k: usize| _mm512_sub_ps(_mm512_permutexvar_ps(g.axis[k], v), g.origin_on[k]);
+        let (x, y, z) = (on(0), on(1), on(2));
+        let [sx, sy, _] = g.shear;
+        [
+            _mm512_sub_ps(x, _mm512_mul_ps(sx, z)),
+            _mm512_sub_ps(y, _mm512_mul_ps(sy, z)),
+            z,
+        ]
+    }
+
+    /// One triangle's hit on every lane from its prepared vertices ([`vertex`]), as a pack
+    /// of the hierarchy tests it: `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit
+    /// with `tmin < t < tmax`, `zero` those with an edge function of exactly zero.
     #[inline]
     #[target_feature(enable = "avx512f")]
     fn triangle(
         g: &Group,
-        tri: &[[f32; 4]; 3],
+        [a, b, c]: [&[__m512; 3]; 3],
         tmin: __m512,
         tmax: __m512,
     ) -> (__m512, __m512, __m512, __m512, __mmask16, __mmask16) {
-        // Each lane's vertex coordinate on its sheared axis, less the origin's: `v[k] -
-        // o[k]`, the value the one-ray test takes after reordering `v - o`.
-        let rel = |i: usize| {
-            // SAFETY: a padded vertex is four floats.
-            let v = _mm512_broadcast_f32x4(unsafe { _mm_loadu_ps(tri[i].as_ptr()) });
-            let on = |k: usize| _mm512_sub_ps(_mm512_permutexvar_ps(g.axis[k], v), g.origin_on[k]);
-            (on(0), on(1), on(2))
-        };
-        let (ax, ay, az) = rel(0);
-        let (bx, by, bz) = rel(1);
-        let (cx, cy, cz) = rel(2);
-        let [sx, sy, sz] = g.shear;
-        let shear = |p: __m512, s: __m512, z: __m512| _mm512_sub_ps(p, _mm512_mul_ps(s, z));
-        let (ax, ay) = (shear(ax, sx, az), shear(ay, sy, az));
-        let (bx, by) = (shear(bx, sx, bz), shear(by, sy, bz));
-        let (cx, cy) = (shear(cx, sx, cz), shear(cy, sy, cz));
+        let [ax, ay, az] = *a;
+        let [bx, by, bz] = *b;
+        let [cx, cy, cz] = *c;
+        let sz = g.shear[2];
         let edge = |a: __m512, b: __m512, c: __m512, d: __m512| {
             _mm512_sub_ps(_mm512_mul_ps(a, b), _mm512_mul_ps(c, d))
         };
@@ -359,6 +390,33 @@ mod avx512 {
         need
     }
 
+    /// The list's vertices prepared for a group ([`vertex`]), each once.
+    struct Prepared {
+        items: [std::mem::MaybeUninit<[__m512; 3]>; MAX_VERTICES],
+    }
+
+    impl Prepared {
+        #[inline]
+        #[target_feature(enable = "avx512f")]
+        fn new(flat: &Flat, g: &Group) -> Prepared {
+            let mut p = Prepared {
+                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
+            };
+            for (item, v) in p.items.iter_mut().zip(&flat.vertices) {
+                *item = std::mem::MaybeUninit::new(vertex(g, v));
+            }
+            p
+        }
+
+        /// The prepared vertices of a triangle.
+        #[inline(always)]
+        fn get(&self, corners: &[u16; 3]) -> [&[__m512; 3]; 3] {
+            // SAFETY: `new` wrote the first `flat.vertices.len()` items (at most
+            // `MAX_VERTICES`: three per primitive of a list), and every corner indexes one.
+            corners.map(|i| unsafe { self.items[usize::from(i)].assume_init_ref() })
+        }
+    }
+
     /// The running nearest hit of a group's lanes.
     struct Nearest {
         t: __m512,
@@ -404,8 +462,9 @@ mod avx512 {
             tie: 0,
         };
         let mut defer = 0u16;
-        for (tri, (_, prim)) in flat.padded.iter().zip(&flat.triangles) {
-            let (t, v, w, det, hit, zeros) = triangle(&g, tri, lo, hi);
+        let prepared = Prepared::new(flat, &g);
+        for (corners, (_, prim)) in flat.corners.iter().zip(&flat.triangles) {
+            let (t, v, w, det, hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             defer |= zeros;
             near.update(t, v, w, det, *prim, hit);
         }
@@ -466,8 +525,9 @@ mod avx512 {
         // SAFETY: sixteen floats are read from an array of sixteen.
         let hi = unsafe { _mm512_loadu_ps(ends.as_ptr()) };
         let (mut blocked, mut defer) = (0u16, 0u16);
-        for tri in &flat.padded {
-            let (.., hit, zeros) = triangle(&g, tri, lo, hi);
+        let prepared = Prepared::new(flat, &g);
+        for corners in &flat.corners {
+            let (.., hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             blocked |= hit;
             defer |= zeros;
         }
@@ -494,7 +554,7 @@ mod avx512 {
 mod avx2 {
     use std::arch::x86_64::*;
 
-    use super::{Flat, Lanes, WIDTH8 as WIDTH};
+    use super::{Flat, Lanes, MAX_VERTICES, WIDTH8 as WIDTH};
     use crate::bvh::Hit;
     use crate::node8::FAR_WIDEN;
     use crate::shapes::Sphere;
@@ -624,34 +684,39 @@ mod avx2 {
         blend(g.is[k][0], blend(g.is[k][1], v[2], v[1]), v[0])
     }
 
-    /// One triangle's hit on every lane, as a pack of the hierarchy tests it:
-    /// `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit with `tmin < t < tmax`, `zero`
-    /// those with an edge function of exactly zero.
+    /// A vertex as every lane's triangle test takes it: its coordinates on the lane's
+    /// sheared axes, less the origin's (`v[k] - o[k]`, the one-ray test's values after
+    /// reordering `v - o`), the first two sheared.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn vertex(g: &Group, p: &[f32; 4]) -> [__m256; 3] {
+        // SAFETY: a padded vertex is four floats.
+        let v = _mm256_broadcast_ps(&unsafe { _mm_loadu_ps(p.as_ptr()) });
+        let on = |k: usize| _mm256_sub_ps(_mm256_permutevar8x32_ps(v, g.axis[k]), g.origin_on[k]);
+        let (x, y, z) = (on(0), on(1), on(2));
+        let [sx, sy, _] = g.shear;
+        [
+            _mm256_sub_ps(x, _mm256_mul_ps(sx, z)),
+            _mm256_sub_ps(y, _mm256_mul_ps(sy, z)),
+            z,
+        ]
+    }
+
+    /// One triangle's hit on every lane from its prepared vertices ([`vertex`]), as a pack
+    /// of the hierarchy tests it: `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit
+    /// with `tmin < t < tmax`, `zero` those with an edge function of exactly zero.
     #[inline]
     #[target_feature(enable = "avx2")]
     fn triangle(
         g: &Group,
-        tri: &[[f32; 4]; 3],
+        [a, b, c]: [&[__m256; 3]; 3],
         tmin: __m256,
         tmax: __m256,
     ) -> (__m256, __m256, __m256, __m256, M, M) {
-        // Each lane's vertex coordinate on its sheared axis, less the origin's (see
-        // `avx512::triangle`).
-        let rel = |i: usize| {
-            // SAFETY: a padded vertex is four floats.
-            let v = _mm256_broadcast_ps(&unsafe { _mm_loadu_ps(tri[i].as_ptr()) });
-            let on =
-                |k: usize| _mm256_sub_ps(_mm256_permutevar8x32_ps(v, g.axis[k]), g.origin_on[k]);
-            (on(0), on(1), on(2))
-        };
-        let (ax, ay, az) = rel(0);
-        let (bx, by, bz) = rel(1);
-        let (cx, cy, cz) = rel(2);
-        let [sx, sy, sz] = g.shear;
-        let shear = |p: __m256, s: __m256, z: __m256| _mm256_sub_ps(p, _mm256_mul_ps(s, z));
-        let (ax, ay) = (shear(ax, sx, az), shear(ay, sy, az));
-        let (bx, by) = (shear(bx, sx, bz), shear(by, sy, bz));
-        let (cx, cy) = (shear(cx, sx, cz), shear(cy, sy, cz));
+        let [ax, ay, az] = *a;
+        let [bx, by, bz] = *b;
+        let [cx, cy, cz] = *c;
+        let sz = g.shear[2];
         let edge = |a: __m256, b: __m256, c: __m256, d: __m256| {
             _mm256_sub_ps(_mm256_mul_ps(a, b), _mm256_mul_ps(c, d))
         };
@@ -792,6 +857,33 @@ mod avx2 {
         bits(need)
     }
 
+    /// The list's vertices prepared for a group ([`vertex`]), each once.
+    struct Prepared {
+        items: [std::mem::MaybeUninit<[__m256; 3]>; MAX_VERTICES],
+    }
+
+    impl Prepared {
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn new(flat: &Flat, g: &Group) -> Prepared {
+            let mut p = Prepared {
+                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
+            };
+            for (item, v) in p.items.iter_mut().zip(&flat.vertices) {
+                *item = std::mem::MaybeUninit::new(vertex(g, v));
+            }
+            p
+        }
+
+        /// The prepared vertices of a triangle.
+        #[inline(always)]
+        fn get(&self, corners: &[u16; 3]) -> [&[__m256; 3]; 3] {
+            // SAFETY: `new` wrote the first `flat.vertices.len()` items (at most
+            // `MAX_VERTICES`: three per primitive of a list), and every corner indexes one.
+            corners.map(|i| unsafe { self.items[usize::from(i)].assume_init_ref() })
+        }
+    }
+
     /// The running nearest hit of a group's lanes.
     struct Nearest {
         t: __m256,
@@ -839,8 +931,9 @@ mod avx2 {
             tie: zero,
         };
         let mut defer = zero;
-        for (tri, (_, prim)) in flat.padded.iter().zip(&flat.triangles) {
-            let (t, v, w, det, hit, zeros) = triangle(&g, tri, lo, hi);
+        let prepared = Prepared::new(flat, &g);
+        for (corners, (_, prim)) in flat.corners.iter().zip(&flat.triangles) {
+            let (t, v, w, det, hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             defer = or(defer, zeros);
             near.update(t, v, w, det, *prim, hit);
         }
@@ -903,8 +996,9 @@ mod avx2 {
         let hi = unsafe { _mm256_loadu_ps(ends.as_ptr()) };
         let zero = _mm256_setzero_ps();
         let (mut blocked, mut defer) = (zero, zero);
-        for tri in &flat.padded {
-            let (.., hit, zeros) = triangle(&g, tri, lo, hi);
+        let prepared = Prepared::new(flat, &g);
+        for corners in &flat.corners {
+            let (.., hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             blocked = or(blocked, hit);
             defer = or(defer, zeros);
         }
