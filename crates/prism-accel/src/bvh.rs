@@ -848,16 +848,20 @@ impl Bvh {
         (tmin, tmax): (f32, f32),
         hits: &mut [Option<Hit>],
         (flat, width): (&Flat, usize),
-        closest: impl Fn(&[Ray]) -> Lanes,
+        closest: impl Fn(&[Ray], &mut [Option<Hit>]) -> Lanes,
     ) {
         for (rays, hits) in rays.chunks(width).zip(hits.chunks_mut(width)) {
-            let lanes = closest(rays);
-            for (lane, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-                let bit = 1 << lane;
-                let near = lanes.hits[lane];
-                *hit = if lanes.defer & bit != 0 {
+            let lanes = closest(rays, hits);
+            // The list's hits stand, but in the lanes that must consult the tree.
+            let mut rest = u32::from(lanes.defer | lanes.need) & ((1 << rays.len()) - 1);
+            while rest != 0 {
+                let lane = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let ray = &rays[lane];
+                let near = hits[lane];
+                hits[lane] = if lanes.defer & (1 << lane) != 0 {
                     self.intersect_with::<true>(ray, tmin, tmax, 0)
-                } else if lanes.need & bit != 0 {
+                } else {
                     // The rest of the tree, for a hit no farther than the list's.
                     let end = near.map_or(tmax, |h| h.t.next_up());
                     match self.intersect_with::<true>(ray, tmin, end, flat.skip) {
@@ -868,8 +872,6 @@ impl Bvh {
                         Some(h) => Some(h),
                         None => near,
                     }
-                } else {
-                    near
                 };
             }
         }
@@ -889,9 +891,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH), |r| {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH), |r, h| {
             // SAFETY: the processor has AVX-512F.
-            unsafe { flat.closest(r, tmin, tmax) }
+            unsafe { flat.closest(r, tmin, tmax, h) }
         });
     }
 
@@ -909,9 +911,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH8), |r| {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH8), |r, h| {
             // SAFETY: the processor has AVX2.
-            unsafe { flat.closest8(r, tmin, tmax) }
+            unsafe { flat.closest8(r, tmin, tmax, h) }
         });
     }
 

@@ -46,10 +46,9 @@ pub(crate) struct Flat {
     pub(crate) skip: u32,
 }
 
-/// What a group of up to sixteen rays learnt, lane by lane (the first eight with AVX2).
+/// What a group of up to sixteen rays learnt, lane by lane (the first eight with AVX2), as
+/// bit masks.
 pub(crate) struct Lanes {
-    /// The nearest hit (closest-hit queries).
-    pub(crate) hits: [Option<Hit>; WIDTH],
     /// Lanes that met something (occlusion queries).
     pub(crate) blocked: u16,
     /// Lanes whose answer must come from the hierarchy.
@@ -79,14 +78,21 @@ impl Flat {
         self.corners.push(corners);
     }
 
-    /// The closest hits of `rays` (at most sixteen) with `tmin < t < tmax`.
+    /// The closest hits of `rays` (at most sixteen) with `tmin < t < tmax`, written to
+    /// `hits` (one per ray) except in the lanes the returned `defer` names.
     ///
     /// # Safety
     /// The processor must support AVX-512F.
     #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn closest(&self, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+    pub(crate) unsafe fn closest(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) -> Lanes {
         // SAFETY: the caller guarantees AVX-512F.
-        unsafe { avx512::closest(self, rays, tmin, tmax) }
+        unsafe { avx512::closest(self, rays, (tmin, tmax), hits) }
     }
 
     /// Whether anything lies along each of `rays` (at most sixteen) with `tmin < t <
@@ -105,9 +111,15 @@ impl Flat {
     /// # Safety
     /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn closest8(&self, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+    pub(crate) unsafe fn closest8(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) -> Lanes {
         // SAFETY: the caller guarantees AVX2.
-        unsafe { avx2::closest(self, rays, tmin, tmax) }
+        unsafe { avx2::closest(self, rays, (tmin, tmax), hits) }
     }
 
     /// [`Flat::occluded`] for at most eight rays, with AVX2.
@@ -396,22 +408,28 @@ mod avx512 {
     }
 
     impl Prepared {
+        /// Room for the vertices, none prepared.
+        #[inline(always)]
+        fn new() -> Prepared {
+            Prepared {
+                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
+            }
+        }
+
+        /// Prepares the list's vertices for group `g`, in place (returning kilobytes of
+        /// vectors by value would copy them).
         #[inline]
         #[target_feature(enable = "avx512f")]
-        fn new(flat: &Flat, g: &Group) -> Prepared {
-            let mut p = Prepared {
-                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
-            };
-            for (item, v) in p.items.iter_mut().zip(&flat.vertices) {
+        fn fill(&mut self, flat: &Flat, g: &Group) {
+            for (item, v) in self.items.iter_mut().zip(&flat.vertices) {
                 *item = std::mem::MaybeUninit::new(vertex(g, v));
             }
-            p
         }
 
         /// The prepared vertices of a triangle.
         #[inline(always)]
         fn get(&self, corners: &[u16; 3]) -> [&[__m512; 3]; 3] {
-            // SAFETY: `new` wrote the first `flat.vertices.len()` items (at most
+            // SAFETY: `fill` wrote the first `flat.vertices.len()` items (at most
             // `MAX_VERTICES`: three per primitive of a list), and every corner indexes one.
             corners.map(|i| unsafe { self.items[usize::from(i)].assume_init_ref() })
         }
@@ -448,7 +466,12 @@ mod avx512 {
 
     /// [`Flat::closest`].
     #[target_feature(enable = "avx512f")]
-    pub(super) fn closest(flat: &Flat, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+    pub(super) fn closest(
+        flat: &Flat,
+        rays: &[Ray],
+        (tmin, tmax): (f32, f32),
+        out: &mut [Option<Hit>],
+    ) -> Lanes {
         let g = group(rays);
         let (lo, hi) = (_mm512_set1_ps(tmin), _mm512_set1_ps(tmax));
         let zero = _mm512_setzero_ps();
@@ -462,7 +485,8 @@ mod avx512 {
             tie: 0,
         };
         let mut defer = 0u16;
-        let prepared = Prepared::new(flat, &g);
+        let mut prepared = Prepared::new();
+        prepared.fill(flat, &g);
         for (corners, (_, prim)) in flat.corners.iter().zip(&flat.triangles) {
             let (t, v, w, det, hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             defer |= zeros;
@@ -472,43 +496,36 @@ mod avx512 {
             let (t, hit) = sphere(&g, s, lo, hi);
             near.update(t, zero, zero, zero, *prim, hit);
         }
+        // The barycentric weights `v / det` and `w / det` (the one-ray test's operations),
+        // zero for spheres.
+        let inv = _mm512_div_ps(_mm512_set1_ps(1.0), near.det);
+        let sphere =
+            _mm512_cmpge_epu32_mask(near.prim, _mm512_set1_epi32(flat.first_sphere as i32));
+        let b1 = _mm512_mask_blend_ps(sphere, _mm512_mul_ps(near.v, inv), zero);
+        let b2 = _mm512_mask_blend_ps(sphere, _mm512_mul_ps(near.w, inv), zero);
         let mut t = [0f32; WIDTH];
-        let mut v = [0f32; WIDTH];
-        let mut w = [0f32; WIDTH];
-        let mut det = [0f32; WIDTH];
+        let mut b = [[0f32; WIDTH]; 2];
         let mut prim = [0u32; WIDTH];
         // SAFETY: each store writes sixteen lanes into an array of sixteen.
         unsafe {
             _mm512_storeu_ps(t.as_mut_ptr(), near.t);
-            _mm512_storeu_ps(v.as_mut_ptr(), near.v);
-            _mm512_storeu_ps(w.as_mut_ptr(), near.w);
-            _mm512_storeu_ps(det.as_mut_ptr(), near.det);
+            _mm512_storeu_ps(b[0].as_mut_ptr(), b1);
+            _mm512_storeu_ps(b[1].as_mut_ptr(), b2);
             _mm512_storeu_si512(prim.as_mut_ptr().cast(), near.prim);
         }
         let defer = defer | near.tie;
         // Past a hit the list found, a margin far wider than the slab test's rounding.
         let reach = _mm512_mask_blend_ps(near.found, hi, widen(near.t));
         let need = need(flat, &g, lo, reach) & !defer;
-        let mut hits = [None; WIDTH];
-        for lane in 0..rays.len().min(WIDTH) {
-            if near.found & (1 << lane) == 0 || defer & (1 << lane) != 0 {
-                continue;
-            }
-            let (b1, b2) = if prim[lane] >= flat.first_sphere {
-                (0.0, 0.0)
-            } else {
-                let inv = 1.0 / det[lane];
-                (v[lane] * inv, w[lane] * inv)
-            };
-            hits[lane] = Some(Hit {
+        for (lane, hit) in out.iter_mut().enumerate().take(WIDTH) {
+            *hit = (near.found & (1 << lane) != 0).then(|| Hit {
                 t: t[lane],
                 prim: prim[lane],
-                b1,
-                b2,
+                b1: b[0][lane],
+                b2: b[1][lane],
             });
         }
         Lanes {
-            hits,
             blocked: 0,
             defer,
             need,
@@ -525,7 +542,8 @@ mod avx512 {
         // SAFETY: sixteen floats are read from an array of sixteen.
         let hi = unsafe { _mm512_loadu_ps(ends.as_ptr()) };
         let (mut blocked, mut defer) = (0u16, 0u16);
-        let prepared = Prepared::new(flat, &g);
+        let mut prepared = Prepared::new();
+        prepared.fill(flat, &g);
         for corners in &flat.corners {
             let (.., hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             blocked |= hit;
@@ -538,7 +556,6 @@ mod avx512 {
         let defer = defer & !blocked;
         let reach = widen(hi);
         Lanes {
-            hits: [None; WIDTH],
             blocked,
             defer,
             need: need(flat, &g, lo, reach) & !blocked & !defer,
@@ -863,22 +880,28 @@ mod avx2 {
     }
 
     impl Prepared {
+        /// Room for the vertices, none prepared.
+        #[inline(always)]
+        fn new() -> Prepared {
+            Prepared {
+                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
+            }
+        }
+
+        /// Prepares the list's vertices for group `g`, in place (returning kilobytes of
+        /// vectors by value would copy them).
         #[inline]
         #[target_feature(enable = "avx2")]
-        fn new(flat: &Flat, g: &Group) -> Prepared {
-            let mut p = Prepared {
-                items: [const { std::mem::MaybeUninit::uninit() }; MAX_VERTICES],
-            };
-            for (item, v) in p.items.iter_mut().zip(&flat.vertices) {
+        fn fill(&mut self, flat: &Flat, g: &Group) {
+            for (item, v) in self.items.iter_mut().zip(&flat.vertices) {
                 *item = std::mem::MaybeUninit::new(vertex(g, v));
             }
-            p
         }
 
         /// The prepared vertices of a triangle.
         #[inline(always)]
         fn get(&self, corners: &[u16; 3]) -> [&[__m256; 3]; 3] {
-            // SAFETY: `new` wrote the first `flat.vertices.len()` items (at most
+            // SAFETY: `fill` wrote the first `flat.vertices.len()` items (at most
             // `MAX_VERTICES`: three per primitive of a list), and every corner indexes one.
             corners.map(|i| unsafe { self.items[usize::from(i)].assume_init_ref() })
         }
@@ -917,7 +940,12 @@ mod avx2 {
 
     /// [`Flat::closest8`].
     #[target_feature(enable = "avx2")]
-    pub(super) fn closest(flat: &Flat, rays: &[Ray], tmin: f32, tmax: f32) -> Lanes {
+    pub(super) fn closest(
+        flat: &Flat,
+        rays: &[Ray],
+        (tmin, tmax): (f32, f32),
+        out: &mut [Option<Hit>],
+    ) -> Lanes {
         let g = group(rays);
         let (lo, hi) = (_mm256_set1_ps(tmin), _mm256_set1_ps(tmax));
         let zero = _mm256_setzero_ps();
@@ -931,7 +959,8 @@ mod avx2 {
             tie: zero,
         };
         let mut defer = zero;
-        let prepared = Prepared::new(flat, &g);
+        let mut prepared = Prepared::new();
+        prepared.fill(flat, &g);
         for (corners, (_, prim)) in flat.corners.iter().zip(&flat.triangles) {
             let (t, v, w, det, hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             defer = or(defer, zeros);
@@ -959,26 +988,24 @@ mod avx2 {
         // Past a hit the list found, a margin far wider than the slab test's rounding.
         let reach = blend(near.found, hi, widen(near.t));
         let need = need(flat, &g, lo, reach) & !defer;
-        let mut hits = [None; super::WIDTH];
-        for lane in 0..rays.len().min(WIDTH) {
-            if found & (1 << lane) == 0 || defer & (1 << lane) != 0 {
-                continue;
-            }
-            let (b1, b2) = if prim[lane] >= flat.first_sphere {
-                (0.0, 0.0)
-            } else {
-                let inv = 1.0 / det[lane];
-                (v[lane] * inv, w[lane] * inv)
-            };
-            hits[lane] = Some(Hit {
-                t: t[lane],
-                prim: prim[lane],
-                b1,
-                b2,
+        for (lane, hit) in out.iter_mut().enumerate().take(WIDTH) {
+            *hit = (found & (1 << lane) != 0).then(|| {
+                // The barycentric weights `v / det` and `w / det`, zero for spheres.
+                let (b1, b2) = if prim[lane] >= flat.first_sphere {
+                    (0.0, 0.0)
+                } else {
+                    let inv = 1.0 / det[lane];
+                    (v[lane] * inv, w[lane] * inv)
+                };
+                Hit {
+                    t: t[lane],
+                    prim: prim[lane],
+                    b1,
+                    b2,
+                }
             });
         }
         Lanes {
-            hits,
             blocked: 0,
             defer,
             need,
@@ -996,7 +1023,8 @@ mod avx2 {
         let hi = unsafe { _mm256_loadu_ps(ends.as_ptr()) };
         let zero = _mm256_setzero_ps();
         let (mut blocked, mut defer) = (zero, zero);
-        let prepared = Prepared::new(flat, &g);
+        let mut prepared = Prepared::new();
+        prepared.fill(flat, &g);
         for corners in &flat.corners {
             let (.., hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
             blocked = or(blocked, hit);
@@ -1010,7 +1038,6 @@ mod avx2 {
         let defer = defer & !blocked;
         let reach = widen(hi);
         Lanes {
-            hits: [None; super::WIDTH],
             blocked,
             defer,
             need: need(flat, &g, lo, reach) & !blocked & !defer,
