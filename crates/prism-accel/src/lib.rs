@@ -4,7 +4,8 @@
 //! - Triangles use the watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through
 //!   a shared edge or vertex of a closed mesh hits at least one of the triangles.
 //! - The BVH is built top-down with a binned surface area heuristic (16 bins on each axis,
-//!   leaves costed in packs of four triangles), in parallel above a size threshold, then
+//!   leaves costed in packs of four triangles; every subtree of at most eight primitives
+//!   one leaf), in parallel above a size threshold, then
 //!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD: AVX
 //!   when the processor has it (detected at run time), else two SSE halves, with identical
 //!   results. Leaf triangles are stored in packs of four, also tested at once. The layout is
@@ -15,9 +16,9 @@
 //! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
 //!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays.
 //! - [`Bvh::intersect_batch`] and [`Bvh::occluded_batch`] answer many rays in one call. On
-//!   processors with AVX-512, when the root's leaves hold at most 24 primitives (a Cornell
-//!   box's walls, or all of a small scene), they test sixteen rays at once against those
-//!   primitives, with the one-ray tests' operations on each lane, and against the boxes of
+//!   processors with AVX-512 (AVX2), when the root's leaves hold at most 24 primitives (a
+//!   Cornell box's walls, or all of a small scene), they test sixteen (eight) rays at once
+//!   against those primitives, with the one-ray tests' operations on each lane, and against the boxes of
 //!   the root's other children; only rays that enter one of those before their nearest hit
 //!   traverse the rest. They return the one-ray calls' hits, bit for bit.
 //! - [`Bvh::levels`], [`Bvh::level_boxes`] and [`Bvh::leaf_views`] show the 8-wide tree
@@ -29,6 +30,8 @@ mod flat;
 mod inspect;
 mod node8;
 mod shapes;
+#[cfg(target_arch = "x86_64")]
+mod simd;
 mod tri4;
 
 pub use bvh::{BuildOptions, Bvh, BvhStats, Hit};
