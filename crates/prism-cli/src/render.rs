@@ -534,6 +534,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             s.sah_cost,
             s.bytes as f64 / s.primitives.max(1) as f64
         );
+        eprintln!("simd: {}", prism_math::Isa::get().name());
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         eprintln!("read: {:.1} ms", ms(read));
         eprintln!("build: {:.1} ms", ms(build));

@@ -1759,66 +1759,45 @@ fn view_refuses_without_a_display_or_a_mode() {
 #[test]
 fn outputs_are_the_same_bytes_on_every_instruction_set() {
     let dir = scratch("isa");
-    let scene = |name: &str| prism_testkit::shared_asset(&format!("pathtracer/dae/sky/{name}"));
-    let runs: Vec<(&str, Vec<std::ffi::OsString>)> = vec![
-        (
-            "bunny.exr",
-            vec![
-                "render".into(),
-                scene("CBbunny.dae").into(),
-                "-q".into(),
-                "-s".into(),
-                "2".into(),
-                "-r".into(),
-                "96".into(),
-                "72".into(),
-                "-o".into(),
-            ],
-        ),
+    // Each argument list ends with the option that names the output.
+    let args = |words: &[&str], file: &str| -> Vec<std::ffi::OsString> {
+        words
+            .iter()
+            .map(|&w| {
+                if w == "{}" {
+                    prism_testkit::shared_asset(file).into()
+                } else {
+                    w.into()
+                }
+            })
+            .collect()
+    };
+    let render = ["render", "{}", "-q", "-s", "2", "-r", "96", "72", "-o"];
+    let runs = [
+        ("bunny.exr", args(&render, "pathtracer/dae/sky/CBbunny.dae")),
         (
             "spheres.exr",
-            vec![
-                "render".into(),
-                scene("CBspheres_lambertian.dae").into(),
-                "-q".into(),
-                "-s".into(),
-                "2".into(),
-                "-r".into(),
-                "96".into(),
-                "72".into(),
-                "-o".into(),
-            ],
+            args(&render, "pathtracer/dae/sky/CBspheres_lambertian.dae"),
         ),
         (
             "monkey.png",
-            vec![
-                "shade".into(),
-                prism_testkit::shared_asset("delft-raytracer/data/monkey.obj").into(),
-                "--shader".into(),
-                "phong".into(),
-                "-r".into(),
-                "96".into(),
-                "72".into(),
-                "-o".into(),
-            ],
+            args(
+                &["shade", "{}", "--shader", "phong", "-r", "96", "72", "-o"],
+                "delft-raytracer/data/monkey.obj",
+            ),
         ),
         (
             "cloth.obj",
-            vec![
-                "cloth".into(),
-                prism_testkit::shared_asset("clothsim/scene/pinned2.json").into(),
-                "--frames".into(),
-                "2".into(),
-                "-q".into(),
-                "--obj".into(),
-            ],
+            args(
+                &["cloth", "{}", "--frames", "2", "-q", "--obj"],
+                "clothsim/scene/pinned2.json",
+            ),
         ),
     ];
     for (out, args) in &runs {
         let mut outputs = Vec::new();
         for isa in ["avx512", "avx2", "avx", "sse"] {
             let path = dir.join(format!("{isa}-{out}"));
-            // Each argument list ends with the option that names the output.
             let o = prism()
                 .env("PRISM_ISA", isa)
                 .args(args)
@@ -1831,6 +1810,29 @@ fn outputs_are_the_same_bytes_on_every_instruction_set() {
         for (isa, bytes) in &outputs[1..] {
             assert!(bytes == &outputs[0].1, "{out}: {isa} differs from avx512");
         }
+    }
+    // The cap is in force: `--stats` names the level the kernels ran on (never above the
+    // cap, and the cap itself where the processor has it).
+    let level = |cap: &str| {
+        let o = prism()
+            .env("PRISM_ISA", cap)
+            .args(args(&render, "pathtracer/dae/sky/CBspheres_lambertian.dae"))
+            .arg(dir.join("level.exr"))
+            .arg("--stats")
+            .output()
+            .unwrap();
+        let text = stderr(&o);
+        let line = text.lines().find(|l| l.starts_with("simd: ")).unwrap_or("");
+        line.trim_start_matches("simd: ").to_string()
+    };
+    assert_eq!(level("sse"), "sse");
+    let native = level("avx512");
+    assert!(
+        ["sse", "avx", "avx2", "avx512"].contains(&native.as_str()),
+        "{native}"
+    );
+    if native == "avx512" || native == "avx2" {
+        assert_eq!(level("avx2"), "avx2");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -51,6 +51,17 @@ impl Isa {
         Isa::get() >= Isa::Avx
     }
 
+    /// The level's name, as `PRISM_ISA` takes it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Sse => "sse",
+            Isa::Avx => "avx",
+            Isa::Avx2 => "avx2",
+            Isa::Avx512 => "avx512",
+        }
+    }
+
     /// The level a name stands for (`avx512`, `avx2`, `avx`, `sse`; any case).
     #[must_use]
     pub fn parse(name: &str) -> Option<Isa> {
@@ -94,6 +105,9 @@ mod tests {
         assert_eq!(Isa::parse("avx"), Some(Isa::Avx));
         assert_eq!(Isa::parse("sse2"), Some(Isa::Sse));
         assert_eq!(Isa::parse("neon"), None);
+        for isa in [Isa::Sse, Isa::Avx, Isa::Avx2, Isa::Avx512] {
+            assert_eq!(Isa::parse(isa.name()), Some(isa));
+        }
         assert!(Isa::Sse < Isa::Avx && Isa::Avx < Isa::Avx2 && Isa::Avx2 < Isa::Avx512);
         // Whatever the cap, the level never exceeds what the processor has.
         assert!(Isa::get() <= Isa::detect());
