@@ -5,9 +5,11 @@ use prism_math::glam::Vec3A;
 use prism_math::{prefetch, Aabb, Isa, Ray, Vec3};
 use rayon::prelude::*;
 
-use crate::flat::{Flat, Lanes, FLAT_MAX, WIDTH, WIDTH8};
+use crate::flat::{Flat, Lanes, FLAT_MAX};
 use crate::node8::{self, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{Avx2, Avx512, Simd};
 use crate::tri4::Tri4;
 
 /// A leaf: `packs` triangle packs from `pack_start`, `spheres` spheres from `sphere_start`.
@@ -895,9 +897,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH), |r, h| {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, Avx512::W), |r, h| {
             // SAFETY: the processor has AVX-512F.
-            unsafe { flat.closest(r, tmin, tmax, h) }
+            unsafe { crate::flat::closest_avx512(flat, r, (tmin, tmax), h) }
         });
     }
 
@@ -915,9 +917,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, WIDTH8), |r, h| {
+        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, Avx2::W), |r, h| {
             // SAFETY: the processor has AVX2.
-            unsafe { flat.closest8(r, tmin, tmax, h) }
+            unsafe { crate::flat::closest_avx2(flat, r, (tmin, tmax), h) }
         });
     }
 
@@ -965,9 +967,9 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, WIDTH), |r, e| {
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
             // SAFETY: the processor has AVX-512F.
-            unsafe { flat.occluded(r, tmin, e) }
+            unsafe { crate::flat::occluded_avx512(flat, r, tmin, e) }
         });
     }
 
@@ -985,9 +987,9 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, WIDTH8), |r, e| {
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
             // SAFETY: the processor has AVX2.
-            unsafe { flat.occluded8(r, tmin, e) }
+            unsafe { crate::flat::occluded_avx2(flat, r, tmin, e) }
         });
     }
 

@@ -9,9 +9,8 @@
 //! zero (which the one-ray test settles in double precision) or two primitives at the same
 //! nearest distance (where the hierarchy's visiting order decides) is left to the hierarchy.
 
-use prism_math::{Aabb, Ray, Vec3};
+use prism_math::{Aabb, Vec3};
 
-use crate::bvh::Hit;
 use crate::shapes::Sphere;
 
 /// Roots whose leaves hold at most this many primitives also keep them in a [`Flat`] list.
@@ -21,12 +20,6 @@ pub(crate) const FLAT_MAX: usize = 24;
 
 /// The most distinct vertices a list holds.
 const MAX_VERTICES: usize = 3 * FLAT_MAX;
-
-/// Lanes of one query with AVX-512.
-pub(crate) const WIDTH: usize = 16;
-
-/// Lanes of one query with AVX2.
-pub(crate) const WIDTH8: usize = 8;
 
 /// The primitives of the root's leaves, with their primitive numbers, and the root's other
 /// children.
@@ -78,61 +71,10 @@ impl Flat {
         self.triangles.push((tri, prim));
         self.corners.push(corners);
     }
-
-    /// The closest hits of `rays` (at most sixteen) with `tmin < t < tmax`, written to
-    /// `hits` (one per ray) except in the lanes the returned `defer` names.
-    ///
-    /// # Safety
-    /// The processor must support AVX-512F.
-    #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn closest(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: f32,
-        hits: &mut [Option<Hit>],
-    ) -> Lanes {
-        // SAFETY: the caller guarantees AVX-512F.
-        unsafe { queries::closest_avx512(self, rays, (tmin, tmax), hits) }
-    }
-
-    /// Whether anything lies along each of `rays` (at most sixteen) with `tmin < t <
-    /// tmax[i]`.
-    ///
-    /// # Safety
-    /// The processor must support AVX-512F.
-    #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn occluded(&self, rays: &[Ray], tmin: f32, tmax: &[f32]) -> Lanes {
-        // SAFETY: the caller guarantees AVX-512F.
-        unsafe { queries::occluded_avx512(self, rays, tmin, tmax) }
-    }
-
-    /// [`Flat::closest`] for at most eight rays, with AVX2.
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn closest8(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: f32,
-        hits: &mut [Option<Hit>],
-    ) -> Lanes {
-        // SAFETY: the caller guarantees AVX2.
-        unsafe { queries::closest_avx2(self, rays, (tmin, tmax), hits) }
-    }
-
-    /// [`Flat::occluded`] for at most eight rays, with AVX2.
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    pub(crate) unsafe fn occluded8(&self, rays: &[Ray], tmin: f32, tmax: &[f32]) -> Lanes {
-        // SAFETY: the caller guarantees AVX2.
-        unsafe { queries::occluded_avx2(self, rays, tmin, tmax) }
-    }
 }
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use queries::{closest_avx2, closest_avx512, occluded_avx2, occluded_avx512};
 
 /// The queries on the lanes of one width `S`, and their entry points compiled for each.
 #[cfg(target_arch = "x86_64")]
@@ -583,12 +525,13 @@ mod queries {
         }
     }
 
-    /// [`closest`] on sixteen lanes of AVX-512.
+    /// The closest hits of `rays` (at most sixteen) with `t.0 < t < t.1`, written to `out`
+    /// (one per ray) except in the lanes the returned `defer` names.
     ///
     /// # Safety
     /// The processor must support AVX-512F.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn closest_avx512(
+    pub(crate) unsafe fn closest_avx512(
         flat: &Flat,
         rays: &[Ray],
         t: (f32, f32),
@@ -598,12 +541,13 @@ mod queries {
         unsafe { closest::<Avx512>(flat, rays, t, out) }
     }
 
-    /// [`occluded`] on sixteen lanes of AVX-512.
+    /// Whether anything lies along each of `rays` (at most sixteen) with `tmin < t <
+    /// tmax[i]`.
     ///
     /// # Safety
     /// The processor must support AVX-512F.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn occluded_avx512(
+    pub(crate) unsafe fn occluded_avx512(
         flat: &Flat,
         rays: &[Ray],
         tmin: f32,
@@ -613,12 +557,12 @@ mod queries {
         unsafe { occluded::<Avx512>(flat, rays, tmin, tmax) }
     }
 
-    /// [`closest`] on eight lanes of AVX2.
+    /// [`closest_avx512`] for at most eight rays, with AVX2.
     ///
     /// # Safety
     /// The processor must support AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn closest_avx2(
+    pub(crate) unsafe fn closest_avx2(
         flat: &Flat,
         rays: &[Ray],
         t: (f32, f32),
@@ -628,12 +572,12 @@ mod queries {
         unsafe { closest::<Avx2>(flat, rays, t, out) }
     }
 
-    /// [`occluded`] on eight lanes of AVX2.
+    /// [`occluded_avx512`] for at most eight rays, with AVX2.
     ///
     /// # Safety
     /// The processor must support AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn occluded_avx2(
+    pub(crate) unsafe fn occluded_avx2(
         flat: &Flat,
         rays: &[Ray],
         tmin: f32,
