@@ -74,13 +74,17 @@ impl Tri4 {
         }
         let neg = u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero);
         let pos = u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero);
+        // No edge function is zero here, so a lane is inside its triangle when its edge
+        // functions are all negative or all positive: exactly one of `neg` and `pos`. A NaN
+        // lane is neither. Most packs have no such lane and stop before the division.
+        let inside = neg ^ pos;
+        if !inside.any() {
+            return None;
+        }
         let det = u + v + w;
         let t = sz * (u * az + v * bz + w * cz) * (Vec4::ONE / det);
-        // NaN lanes: `t` is NaN, so its comparisons are false.
-        let hit = !(neg & pos)
-            & det.cmpne(zero)
-            & t.cmpgt(Vec4::splat(tmin))
-            & t.cmplt(Vec4::splat(tmax));
+        let hit =
+            inside & det.cmpne(zero) & t.cmpgt(Vec4::splat(tmin)) & t.cmplt(Vec4::splat(tmax));
         let mut mask = hit.bitmask();
         if mask == 0 {
             return None;
