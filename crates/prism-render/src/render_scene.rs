@@ -265,11 +265,45 @@ impl RenderScene {
         hits.resize(rays.len(), None);
         self.bvh.intersect_batch(rays, 0.0, f32::INFINITY, hits);
         out.clear();
+        // The hits land anywhere in the scene's tables: start loading a later hit's
+        // primitive record, and a nearer one's vertices, while this one is computed, so that
+        // the cache misses overlap.
+        const RECORD_AHEAD: usize = 8;
+        const VERTICES_AHEAD: usize = 4;
         out.extend(
             rays.iter()
                 .zip(hits.iter())
-                .map(|(ray, hit)| hit.map(|h| self.interaction(ray, h))),
+                .enumerate()
+                .map(|(i, (ray, hit))| {
+                    if let Some(Some(h)) = hits.get(i + RECORD_AHEAD) {
+                        prism_math::prefetch(&self.prims[h.prim as usize]);
+                    }
+                    if let Some(Some(h)) = hits.get(i + VERTICES_AHEAD) {
+                        self.prefetch_vertices(h.prim);
+                    }
+                    hit.map(|h| self.interaction(ray, h))
+                }),
         );
+    }
+
+    /// Starts loading the vertex data a hit on primitive `prim` will read.
+    #[inline(always)]
+    fn prefetch_vertices(&self, prim: u32) {
+        if let Prim::Mesh { mesh, tri, corners } = self.prims[prim as usize] {
+            let m = &self.meshes[mesh as usize];
+            for i in corners {
+                prism_math::prefetch(m.positions.as_ptr().wrapping_add(i as usize));
+            }
+            match &m.shading {
+                Shading::Smooth(n) => {
+                    for i in corners {
+                        prism_math::prefetch(n.as_ptr().wrapping_add(i as usize));
+                    }
+                }
+                Shading::Corners(n) => prism_math::prefetch(n.as_ptr().wrapping_add(tri as usize)),
+                Shading::Flat => {}
+            }
+        }
     }
 
     /// The closest surface along the ray, with its shading data.
