@@ -20,6 +20,9 @@ enum Prim {
         mesh: u32,
         tri: u32,
         corners: [u32; 3],
+        /// The unit geometric normal, `(b - a) x (c - a)` normalized, computed once here
+        /// rather than at every hit.
+        ng: Vec3,
     },
     /// Half of area light `light`.
     LightQuad { light: u32 },
@@ -64,11 +67,13 @@ impl RenderScene {
         let mut prims = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
             for (ti, t) in m.triangles.iter().enumerate() {
-                tris.push(t.map(|i| m.positions[i as usize]));
+                let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                tris.push([a, b, c]);
                 prims.push(Prim::Mesh {
                     mesh: mi as u32,
                     tri: ti as u32,
                     corners: *t,
+                    ng: (b - a).cross(c - a).normalize(),
                 });
             }
         }
@@ -289,7 +294,10 @@ impl RenderScene {
     /// Starts loading the vertex data a hit on primitive `prim` will read.
     #[inline(always)]
     fn prefetch_vertices(&self, prim: u32) {
-        if let Prim::Mesh { mesh, tri, corners } = self.prims[prim as usize] {
+        if let Prim::Mesh {
+            mesh, tri, corners, ..
+        } = self.prims[prim as usize]
+        {
             let m = &self.meshes[mesh as usize];
             for i in corners {
                 prism_math::prefetch(m.positions.as_ptr().wrapping_add(i as usize));
@@ -317,12 +325,16 @@ impl RenderScene {
     fn interaction(&self, ray: &Ray, hit: prism_accel::Hit) -> Interaction {
         let b0 = 1.0 - hit.b1 - hit.b2;
         match self.prims[hit.prim as usize] {
-            Prim::Mesh { mesh, tri, corners } => {
+            Prim::Mesh {
+                mesh,
+                tri,
+                corners,
+                ng,
+            } => {
                 let m = &self.meshes[mesh as usize];
                 let t = corners;
                 let [a, b, c] = t.map(|i| m.positions[i as usize]);
                 let p = b0 * a + hit.b1 * b + hit.b2 * c;
-                let ng = (b - a).cross(c - a).normalize();
                 let interp =
                     |n: [Vec3; 3]| (b0 * n[0] + hit.b1 * n[1] + hit.b2 * n[2]).try_normalize();
                 let ns = match &m.shading {
