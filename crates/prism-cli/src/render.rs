@@ -116,7 +116,8 @@ pub struct RenderArgs {
     /// Camera placement.
     #[arg(long, value_enum, default_value_t = CameraArg::Course)]
     camera: CameraArg,
-    /// Print BVH statistics, per-stage times (`render: 12.3 ms`) and samples/s on stderr.
+    /// Print BVH statistics, times (`render: 12.3 ms`), samples/s and the path integrator's
+    /// share of time per stage (camera rays, closest hits, hit records, ...) on stderr.
     #[arg(long)]
     stats: bool,
     /// Render only share I of N (I from 0) of the image's 32x32 tiles, dealt round-robin,
@@ -545,6 +546,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "samples/s: {:.0}",
             out.total_samples as f64 / render_time.as_secs_f64()
         );
+        if let Some(shares) = out.profile.shares() {
+            let stages: Vec<String> = shares
+                .iter()
+                .map(|(stage, share)| format!("{} {:.1}%", stage.name(), 100.0 * share))
+                .collect();
+            eprintln!("stages: {}", stages.join(", "));
+        }
     }
     Ok(())
 }

@@ -575,12 +575,32 @@ fn render_scenes_and_errors() {
         "render: ",
         "write: ",
         "samples/s: ",
+        "stages: ",
     ] {
         assert!(
             err.lines().any(|l| l.starts_with(stage)),
             "{stage} missing: {err}"
         );
     }
+    // Property: the path integrator's stages share the whole of its time.
+    let stages = err
+        .lines()
+        .find_map(|l| l.strip_prefix("stages: "))
+        .unwrap();
+    let shares: Vec<f64> = stages
+        .split(", ")
+        .map(|s| {
+            s.rsplit(' ')
+                .next()
+                .unwrap()
+                .trim_end_matches('%')
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(shares.len(), 8, "{stages}");
+    assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
+    assert!(stages.starts_with("camera rays ") && stages.contains(", shadow rays "));
     let bunny = prism_testkit::shared_assets().join("pathtracer/dae/sky/CBbunny.dae");
     let o = prism()
         .args([

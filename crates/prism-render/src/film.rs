@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::camera::Perspective;
 use crate::integrators::{radiance, wavefront, Integrator};
+use crate::profile::Profile;
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
 
@@ -70,6 +71,8 @@ pub struct Rendered {
     pub samples: Image<u32>,
     /// All samples taken.
     pub total_samples: u64,
+    /// Where the path integrator's time went (empty for the other integrators).
+    pub profile: Profile,
 }
 
 /// The side of a film tile in pixels: the unit of work of a thread and of a split render.
@@ -135,11 +138,20 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
-    let sums = render_share(scene, opts, &Share::whole(opts.spp), progress);
+    let profile = Profile::default();
+    let sums = render_tiles(
+        scene,
+        opts,
+        &Share::whole(opts.spp),
+        None,
+        progress,
+        Some(&profile),
+    );
     Rendered {
         image: sums.map(|p| p.mean()),
         samples: sums.map(|p| p.n),
         total_samples: sums.pixels().iter().map(|p| u64::from(p.n)).sum(),
+        profile,
     }
 }
 
@@ -167,6 +179,18 @@ pub fn render_share_except(
     skip: Option<&[bool]>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Image<PixelSum> {
+    render_tiles(scene, opts, share, skip, progress, None)
+}
+
+/// [`render_share_except`], adding the path integrator's time per stage to `profile`.
+fn render_tiles(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    share: &Share,
+    skip: Option<&[bool]>,
+    progress: &(dyn Fn(u64) + Sync),
+    profile: Option<&Profile>,
+) -> Image<PixelSum> {
     let (w, h) = (opts.width, opts.height);
     if let Some(s) = skip {
         assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
@@ -190,7 +214,7 @@ pub fn render_share_except(
                 .filter(|&(x, y)| !skipped(x, y))
                 .collect();
             let out = if opts.integrator == Integrator::Path {
-                wavefront::tile(scene, &camera, opts, &pixels, &share.samples)
+                wavefront::tile(scene, &camera, opts, &pixels, &share.samples, profile)
             } else {
                 pixels
                     .iter()

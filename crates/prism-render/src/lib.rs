@@ -19,6 +19,7 @@ mod interaction;
 mod lights;
 mod overlay;
 mod parts;
+mod profile;
 mod raytrace;
 mod render_scene;
 mod sampler;
@@ -40,6 +41,7 @@ pub use interaction::Interaction;
 pub use lights::{LightSample, MeshLight, RenderLight};
 pub use overlay::{palette, Overlay};
 pub use parts::{merge, merge_order, Merged, Part, PartError, PartFile, PartHeader};
+pub use profile::{Profile, Stage};
 pub use raytrace::{
     raytrace, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions, Raytraced,
 };

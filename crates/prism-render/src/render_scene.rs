@@ -257,18 +257,22 @@ impl RenderScene {
         self.bvh.occluded_batch(rays, 0.0, dist, blocked);
     }
 
-    /// The closest surface along each ray, with its shading data (`out[i]` for `rays[i]`):
-    /// [`RenderScene::intersect`] for a batch, the hierarchy traversed in one call.
-    /// `hits` is scratch space.
-    pub fn intersect_batch(
-        &self,
-        rays: &[Ray],
-        hits: &mut Vec<Option<prism_accel::Hit>>,
-        out: &mut Vec<Option<Interaction>>,
-    ) {
+    /// The closest hit along each ray (`hits[i]` for `rays[i]`), the hierarchy traversed in
+    /// one call; [`RenderScene::hit_records`] turns them into shading data.
+    pub fn closest_hits(&self, rays: &[Ray], hits: &mut Vec<Option<prism_accel::Hit>>) {
         hits.clear();
         hits.resize(rays.len(), None);
         self.bvh.intersect_batch(rays, 0.0, f32::INFINITY, hits);
+    }
+
+    /// The shading data of each of [`RenderScene::closest_hits`]' hits (`out[i]` for
+    /// `hits[i]` along `rays[i]`): with them, [`RenderScene::intersect`] for a batch.
+    pub fn hit_records(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<prism_accel::Hit>],
+        out: &mut Vec<Option<Interaction>>,
+    ) {
         out.clear();
         // The hits land anywhere in the scene's tables: start loading a later hit's
         // primitive record, and a nearer one's vertices, while this one is computed, so that

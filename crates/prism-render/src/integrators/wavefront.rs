@@ -12,6 +12,7 @@ use super::{diffuse16, power};
 use crate::camera::Perspective;
 use crate::film::{camera_sample, PixelSum, RenderOptions};
 use crate::interaction::Interaction;
+use crate::profile::{Laps, Profile, Stage};
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
 
@@ -107,6 +108,7 @@ pub(crate) fn tile(
     opts: &RenderOptions,
     pixels: &[(u32, u32)],
     samples: &std::ops::Range<u32>,
+    profile: Option<&Profile>,
 ) -> Vec<PixelSum> {
     let mut sums = vec![PixelSum::default(); pixels.len()];
     let mut active: Vec<usize> = (0..pixels.len()).collect();
@@ -116,6 +118,7 @@ pub(crate) fn tile(
     let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
     let most = samples.len() as u32;
     let mut n = samples.start;
+    let mut laps = Laps::start();
     active.retain(|&k| sums[k].wants_more(most));
     while !active.is_empty() {
         sample_pass(
@@ -128,12 +131,17 @@ pub(crate) fn tile(
             &mut radiance,
             &mut buffers,
             area.as_deref(),
+            &mut laps,
         );
         n += 1;
         active.retain(|&k| {
             sums[k].add(radiance[k], opts);
             sums[k].wants_more(most)
         });
+        laps.lap(Stage::Gathering);
+    }
+    if let Some(p) = profile {
+        p.add(&laps);
     }
     sums
 }
@@ -150,6 +158,7 @@ fn sample_pass(
     radiance: &mut [Rgb],
     b: &mut Buffers,
     area: Option<&[diffuse16::AreaLight]>,
+    laps: &mut Laps,
 ) {
     b.paths.clear();
     b.paths.extend(active.iter().map(|&k| {
@@ -165,15 +174,20 @@ fn sample_pass(
             mis: false,
         }
     }));
+    laps.lap(Stage::Camera);
     while !b.paths.is_empty() {
         b.rays.clear();
         b.rays.extend(b.paths.iter().map(|p| p.ray));
-        scene.intersect_batch(&b.rays, &mut b.bvh_hits, &mut b.hits);
+        scene.closest_hits(&b.rays, &mut b.bvh_hits);
+        laps.lap(Stage::ClosestHits);
+        scene.hit_records(&b.rays, &b.bvh_hits, &mut b.hits);
+        laps.lap(Stage::HitRecords);
         b.shadows.clear();
         b.lights.clear();
         for (p, hit) in b.paths.iter_mut().zip(b.hits.iter_mut()) {
             emit(scene, opts, p, hit);
         }
+        laps.lap(Stage::Emission);
         let count = b.paths.len();
         b.pending.clear();
         b.pending.resize(count, None);
@@ -200,6 +214,7 @@ fn sample_pass(
             )
             .is_some();
         }
+        laps.lap(Stage::Scattering);
         if let Some(lights) = area {
             let mut out = diffuse16::Outputs {
                 samples: &mut b.samples,
@@ -212,9 +227,11 @@ fn sample_pass(
                 diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.hits, group, &mut out);
             }
         }
+        laps.lap(Stage::DiffuseLanes);
         b.blocked.clear();
         b.blocked.resize(b.shadows.len(), false);
         scene.occluded_batch(&b.shadows.rays, &b.shadows.dists, &mut b.blocked);
+        laps.lap(Stage::ShadowRays);
         for (p, w) in b.paths.iter_mut().zip(&b.pending) {
             let Some(w) = w else {
                 continue;
