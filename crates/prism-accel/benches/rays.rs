@@ -5,6 +5,11 @@
 //! - random: 2,000,000 rays with origins uniform in the mesh's box and directions uniform
 //!   on the sphere.
 //!
+//!
+//! Each set is traced one ray per call (`Bvh::intersect`, as the Embree script calls
+//! `rtcIntersect1`), then a chunk per call (`primary-batch`, `random-batch`:
+//! `Bvh::intersect_batch`, which walks two rays at a time).
+//!
 //! The mesh is `PRISM_RAYS_MESH` (.obj, .ply or .dae), by default the staged bunny
 //! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
 //! Each figure is the median of 5 runs. `PRISM_RAYS_QUICK=1` traces each set once on one
@@ -38,7 +43,9 @@ fn load(path: &Path) -> Vec<[Vec3; 3]> {
         .collect()
 }
 
-fn trace(bvh: &Bvh, rays: &[Ray], threads: usize) -> (Duration, f64) {
+/// Traces `rays` on `threads` threads in chunks of 4096: one ray per call
+/// ([`Bvh::intersect`]), or, with `batch`, a chunk per call ([`Bvh::intersect_batch`]).
+fn trace(bvh: &Bvh, rays: &[Ray], threads: usize, batch: bool) -> (Duration, f64) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -48,9 +55,15 @@ fn trace(bvh: &Bvh, rays: &[Ray], threads: usize) -> (Duration, f64) {
         let hits: usize = rays
             .par_chunks(4096)
             .map(|c| {
-                c.iter()
-                    .filter(|r| bvh.intersect(r, 0.0, f32::INFINITY).is_some())
-                    .count()
+                if batch {
+                    let mut hits = vec![None; c.len()];
+                    bvh.intersect_batch(c, 0.0, f32::INFINITY, &mut hits);
+                    hits.iter().filter(|h| h.is_some()).count()
+                } else {
+                    c.iter()
+                        .filter(|r| bvh.intersect(r, 0.0, f32::INFINITY).is_some())
+                        .count()
+                }
             })
             .sum();
         (t.elapsed(), hits as f64 / rays.len() as f64)
@@ -117,17 +130,24 @@ fn main() {
         .collect();
     let quick = std::env::var_os("PRISM_RAYS_QUICK").is_some();
     let (thread_counts, n_runs): (&[usize], usize) = if quick { (&[1], 1) } else { (&[1, 2], 5) };
-    for (kind, rays) in [("primary", &primary), ("random", &random)] {
+    let sets = [
+        ("primary", &primary, false),
+        ("random", &random, false),
+        ("primary-batch", &primary, true),
+        ("random-batch", &random, true),
+    ];
+    for (kind, rays, batch) in sets {
         for &threads in thread_counts {
             if !quick {
-                trace(&bvh, &rays[..10_000], threads);
+                trace(&bvh, &rays[..10_000], threads, batch);
             }
-            let runs: Vec<(Duration, f64)> =
-                (0..n_runs).map(|_| trace(&bvh, rays, threads)).collect();
+            let runs: Vec<(Duration, f64)> = (0..n_runs)
+                .map(|_| trace(&bvh, rays, threads, batch))
+                .collect();
             let hit = runs[0].1;
             let med = median(runs.iter().map(|r| r.0).collect());
             println!(
-                "{kind:7} threads={threads} rays={} hit={hit:.3} median={:.1} ms Mrays/s={:.2}",
+                "{kind:13} threads={threads} rays={} hit={hit:.3} median={:.1} ms Mrays/s={:.2}",
                 rays.len(),
                 med.as_secs_f64() * 1e3,
                 rays.len() as f64 / med.as_secs_f64() / 1e6

@@ -713,69 +713,56 @@ impl Bvh {
         tmax: f32,
         skip: u32,
     ) -> Option<Hit> {
-        let r = RayPre::new(ray);
-        let slab = SlabRay::new(&r);
-        let mut best: Option<Hit> = None;
-        let mut tmax = tmax;
-        let mut stack = Stack::<(u32, f32)>::new();
-        let mut sp = 0usize;
-        let mut node_ref = 0u32;
-        loop {
-            if node_ref & LEAF != 0 {
-                if let Some(h) = self.leaf(node_ref, &r, ray, tmin, &mut tmax, false) {
-                    best = Some(h);
-                }
-            } else {
-                let n = &self.nodes[node_ref as usize];
-                let (near, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
-                if node_ref == 0 {
-                    mask &= !skip;
-                }
-                if mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if mask == 0 {
-                        // One child entered: go on to it without the stack.
-                        node_ref = n.child[i];
-                        continue;
-                    }
-                    // Sort the children entered, nearest first; push all but the nearest,
-                    // farthest first, and go on to the nearest.
-                    let mut hits = [(0u32, 0f32); 8];
-                    hits[0] = (n.child[i], near[i]);
-                    let mut count = 1;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        let mut j = count;
-                        while j > 0 && hits[j - 1].1 > near[i] {
-                            hits[j] = hits[j - 1];
-                            j -= 1;
-                        }
-                        hits[j] = (n.child[i], near[i]);
-                        count += 1;
-                    }
-                    for k in (1..count).rev() {
-                        stack.push(sp, hits[k]);
-                        sp += 1;
-                    }
-                    // The second nearest is likely visited next after the nearest's subtree.
-                    self.prefetch(hits[1].0);
-                    node_ref = hits[0].0;
-                    continue;
-                }
+        let mut walk = Walk::new(ray, tmax);
+        while walk.step::<AVX>(self, ray, tmin, skip) {}
+        walk.best
+    }
+
+    /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
+    /// at once, a step of one then a step of the other: each step waits on memory (a node,
+    /// a leaf's triangles) that the other's step is computed under. Each ray's walk is the
+    /// one [`Bvh::intersect_with`] takes, so the hits are the same.
+    #[inline(always)]
+    fn intersect_pairs<const AVX: bool>(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: f32,
+        hits: &mut [Option<Hit>],
+    ) {
+        let n = rays.len();
+        if n < 2 {
+            for (ray, hit) in rays.iter().zip(hits) {
+                *hit = self.intersect_with::<AVX>(ray, tmin, tmax, 0);
             }
-            // Pop the nearest pending child that may still hold a closer hit.
-            loop {
-                if sp == 0 {
-                    return best;
+            return;
+        }
+        // The rays walking in the two slots, and the next ray to start.
+        let (mut a, mut b, mut next) = (0, 1, 2);
+        let mut wa = Walk::new(&rays[a], tmax);
+        let mut wb = Walk::new(&rays[b], tmax);
+        loop {
+            if !wa.step::<AVX>(self, &rays[a], tmin, 0) {
+                hits[a] = wa.best;
+                if next == n {
+                    while wb.step::<AVX>(self, &rays[b], tmin, 0) {}
+                    hits[b] = wb.best;
+                    return;
                 }
-                sp -= 1;
-                let (next, t_near) = stack.get(sp);
-                if t_near <= tmax {
-                    node_ref = next;
-                    break;
+                a = next;
+                next += 1;
+                wa.reset(&rays[a], tmax);
+            }
+            if !wb.step::<AVX>(self, &rays[b], tmin, 0) {
+                hits[b] = wb.best;
+                if next == n {
+                    while wa.step::<AVX>(self, &rays[a], tmin, 0) {}
+                    hits[a] = wa.best;
+                    return;
                 }
+                b = next;
+                next += 1;
+                wb.reset(&rays[b], tmax);
             }
         }
     }
@@ -838,9 +825,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn intersect_batch_with(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
-        for (ray, hit) in rays.iter().zip(hits) {
-            *hit = self.intersect_with::<true>(ray, tmin, tmax, 0);
-        }
+        self.intersect_pairs::<true>(rays, tmin, tmax, hits);
     }
 
     /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
@@ -1217,6 +1202,111 @@ impl<T: Copy> Stack<T> {
         // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
         // passes the highest slot written), so it holds an initialized value.
         unsafe { self.items[i].assume_init() }
+    }
+}
+
+/// One ray's closest-hit walk through the tree, a node or leaf per [`Walk::step`].
+struct Walk {
+    pre: RayPre,
+    slab: SlabRay,
+    best: Option<Hit>,
+    tmax: f32,
+    stack: Stack<(u32, f32)>,
+    sp: usize,
+    /// The node or leaf the next step visits.
+    node: u32,
+}
+
+impl Walk {
+    /// A walk of `ray` up to `tmax`, starting at the root.
+    #[inline(always)]
+    fn new(ray: &Ray, tmax: f32) -> Walk {
+        let pre = RayPre::new(ray);
+        Walk {
+            slab: SlabRay::new(&pre),
+            pre,
+            best: None,
+            tmax,
+            stack: Stack::new(),
+            sp: 0,
+            node: 0,
+        }
+    }
+
+    /// Starts the walk over, for `ray` up to `tmax` (the stack's memory is kept).
+    #[inline(always)]
+    fn reset(&mut self, ray: &Ray, tmax: f32) {
+        self.pre = RayPre::new(ray);
+        self.slab = SlabRay::new(&self.pre);
+        self.best = None;
+        self.tmax = tmax;
+        self.sp = 0;
+        self.node = 0;
+    }
+
+    /// Visits the next node or leaf (the root's children in the slots of `skip` left out)
+    /// and chooses the one after it: the nearest child entered, else the nearest pending
+    /// child that may still hold a closer hit. False when none is left: the walk is over
+    /// and `best` is the closest hit.
+    #[inline(always)]
+    fn step<const AVX: bool>(&mut self, bvh: &Bvh, ray: &Ray, tmin: f32, skip: u32) -> bool {
+        let node_ref = self.node;
+        if node_ref & LEAF != 0 {
+            if let Some(h) = bvh.leaf(node_ref, &self.pre, ray, tmin, &mut self.tmax, false) {
+                self.best = Some(h);
+            }
+        } else {
+            let n = &bvh.nodes[node_ref as usize];
+            let (near, mut mask) = Bvh::node_hit::<AVX>(n, &self.slab, tmin, self.tmax);
+            if node_ref == 0 {
+                mask &= !skip;
+            }
+            if mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    // One child entered: go on to it without the stack.
+                    self.node = n.child[i];
+                    bvh.prefetch(self.node);
+                    return true;
+                }
+                // Sort the children entered, nearest first; push all but the nearest,
+                // farthest first, and go on to the nearest.
+                let mut hits = [(0u32, 0f32); 8];
+                hits[0] = (n.child[i], near[i]);
+                let mut count = 1;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let mut j = count;
+                    while j > 0 && hits[j - 1].1 > near[i] {
+                        hits[j] = hits[j - 1];
+                        j -= 1;
+                    }
+                    hits[j] = (n.child[i], near[i]);
+                    count += 1;
+                }
+                for k in (1..count).rev() {
+                    self.stack.push(self.sp, hits[k]);
+                    self.sp += 1;
+                }
+                self.node = hits[0].0;
+                bvh.prefetch(self.node);
+                // The second nearest is likely visited next after the nearest's subtree.
+                bvh.prefetch(hits[1].0);
+                return true;
+            }
+        }
+        // Pop the nearest pending child that may still hold a closer hit.
+        while self.sp > 0 {
+            self.sp -= 1;
+            let (next, t_near) = self.stack.get(self.sp);
+            if t_near <= self.tmax {
+                self.node = next;
+                return true;
+            }
+        }
+        false
     }
 }
 

@@ -224,10 +224,8 @@ proptest! {
     }
 }
 
-/// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at
-/// its vertices and edge midpoints (where tests that are not watertight leak), always hit.
-#[test]
-fn closed_mesh_is_watertight() {
+/// A closed triangulated sphere of radius 3.7 about the origin: its vertices and triangles.
+fn sphere_mesh() -> (Vec<Vec3>, Vec<[Vec3; 3]>) {
     let mut verts = vec![];
     let mut tris = vec![];
     let (nu, nv) = (64, 32);
@@ -247,6 +245,14 @@ fn closed_mesh_is_watertight() {
             tris.push([verts[a], verts[d], verts[c]]);
         }
     }
+    (verts, tris)
+}
+
+/// Property: watertightness. Rays from the centre of a closed triangulated sphere, aimed at
+/// its vertices and edge midpoints (where tests that are not watertight leak), always hit.
+#[test]
+fn closed_mesh_is_watertight() {
+    let (verts, tris) = sphere_mesh();
     let bvh = Bvh::build(&tris, &[], &BuildOptions::default());
     let centre = Vec3::new(1e-3, -2e-3, 0.5e-3);
     let mut rng = Pcg32::new(3, 4);
@@ -265,6 +271,44 @@ fn closed_mesh_is_watertight() {
                 "leak towards {p}"
             );
         }
+    }
+}
+
+/// Oracle: the one-ray calls, on a mesh whose root holds no leaf (so no list: the batched
+/// closest-hit query walks two rays at a time through the whole tree). Batches of every
+/// size from 0 to 9 and a long one, rays from inside and outside the sphere, some aimed at
+/// vertices (shared edges, hits at one distance): every hit is the one-ray call's, bit for
+/// bit, on every instruction set.
+#[test]
+fn mesh_batches_equal_single_rays() {
+    let (verts, mut tris) = sphere_mesh();
+    let mut rng = Pcg32::new(5, 6);
+    let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+    // Small triangles inside, so that walks differ in length.
+    for _ in 0..500 {
+        let a = r() * 3.0;
+        tris.push([a, a + r() * 0.2, a + r() * 0.2]);
+    }
+    let bvh = Bvh::build(&tris, &[], &BuildOptions::default());
+    let rays: Vec<Ray> = (0..1500)
+        .map(|i| match i % 3 {
+            0 => Ray::new(r() * 2.0, r()),
+            1 => Ray::new(r() * 9.0, verts[i % verts.len()] - r() * 9.0),
+            _ => Ray::new(Vec3::ZERO, verts[i % verts.len()]),
+        })
+        .collect();
+    let ends: Vec<f32> = (0..rays.len()).map(|i| 1.0 + (i % 7) as f32).collect();
+    let mut start = 0;
+    for len in (0..10).chain([rays.len()]) {
+        let end = (start + len).min(rays.len());
+        let (rays, ends) = if len == rays.len() {
+            (&rays[..], &ends[..])
+        } else {
+            (&rays[start..end], &ends[start..end])
+        };
+        check_batches(&bvh, rays, ends, f32::INFINITY).unwrap();
+        check_batches(&bvh, rays, ends, 4.0).unwrap();
+        start = end;
     }
 }
 
