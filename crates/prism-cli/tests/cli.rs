@@ -8,42 +8,8 @@ fn prism() -> Command {
     Command::new(env!("CARGO_BIN_EXE_prism"))
 }
 
-/// A scratch folder for one test, removed when the test passes (kept, for a look, when it
-/// fails).
-struct Scratch(PathBuf);
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-impl std::ops::Deref for Scratch {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Scratch {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::ffi::OsStr> for Scratch {
-    fn as_ref(&self) -> &std::ffi::OsStr {
-        self.0.as_os_str()
-    }
-}
-
-fn scratch(name: &str) -> Scratch {
-    let d = std::env::temp_dir().join(format!("prism-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    Scratch(d)
+fn scratch(name: &str) -> prism_testkit::Scratch {
+    prism_testkit::scratch("prism-cli", name)
 }
 
 fn run_svg(dir: &Path, svg: &str, extra: &[&str]) -> (Output, PathBuf) {

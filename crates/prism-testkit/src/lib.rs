@@ -1,4 +1,5 @@
-//! Test helpers shared by prism's crates: golden-image comparison that explains itself.
+//! Test helpers shared by prism's crates: golden-image comparison that explains itself, and
+//! scratch folders that tidy up after passing tests.
 //!
 //! [`compare_golden`] decodes both PNGs, reports the identical-pixel fraction and the largest
 //! channel error, and on failure writes an `expected | diff | actual` triptych under
@@ -9,6 +10,50 @@
 use std::path::{Path, PathBuf};
 
 use prism_image::{compare_rgb8, read_png, write_png, DiffStats, Image, Rgb8Image};
+
+/// A scratch folder for one test, removed when the test passes (kept, for a look, when it
+/// fails). It derefs to its path.
+pub struct Scratch(PathBuf);
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+/// An empty scratch folder `<temp>/<prefix>-<name>-<process id>`, emptied first if a failed
+/// run left it.
+///
+/// # Panics
+/// If the folder cannot be made.
+#[must_use]
+pub fn scratch(prefix: &str, name: &str) -> Scratch {
+    let d = std::env::temp_dir().join(format!("{prefix}-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch folder");
+    Scratch(d)
+}
 
 /// The workspace root (two levels above this crate's manifest).
 #[must_use]
@@ -188,6 +233,22 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Property: a scratch folder starts empty (a failed run's leftovers gone) and is
+    /// removed, with what was written in it, when it goes out of scope.
+    #[test]
+    fn scratch_starts_empty_and_is_removed() {
+        let path = {
+            let d = scratch("prism-testkit", "scratch");
+            std::fs::write(d.join("a.txt"), "a").unwrap();
+            d.to_path_buf()
+        };
+        assert!(!path.exists());
+        std::fs::create_dir_all(&path).unwrap();
+        std::fs::write(path.join("left.txt"), "b").unwrap();
+        let d = scratch("prism-testkit", "scratch");
+        assert_eq!(std::fs::read_dir(&*d).unwrap().count(), 0);
+    }
 
     #[test]
     fn triptych_marks_differences() {

@@ -1,7 +1,7 @@
 //! The mesh mode driven headlessly: hovering finds elements, and each edit equals the
 //! halfedge mesh's own operation (the oracle), refused edits change nothing, undo restores.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use prism_mesh::{parse_obj, HalfedgeMesh};
 use prism_view::{Hover, Input, Key, MeshMode, Mode, Viewer};
@@ -12,42 +12,8 @@ const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
 
 const SIZE: (u32, u32) = (120, 90);
 
-/// A scratch folder for one test, removed when the test passes (kept, for a look, when it
-/// fails).
-struct Scratch(PathBuf);
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-impl std::ops::Deref for Scratch {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Scratch {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::ffi::OsStr> for Scratch {
-    fn as_ref(&self) -> &std::ffi::OsStr {
-        self.0.as_os_str()
-    }
-}
-
-fn scratch(name: &str) -> Scratch {
-    let d = std::env::temp_dir().join(format!("prism-view-mesh-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    Scratch(d)
+fn scratch(name: &str) -> prism_testkit::Scratch {
+    prism_testkit::scratch("prism-view-mesh", name)
 }
 
 fn mesh(obj: &str) -> HalfedgeMesh {

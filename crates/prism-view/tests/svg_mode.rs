@@ -1,7 +1,7 @@
 //! The SVG mode driven headlessly, event by event, each control checked against what it must
 //! do to the state and to the picture.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use prism_raster::{read_svg, Dialect};
 use prism_view::{Input, Key, SvgMode, Viewer};
@@ -10,42 +10,8 @@ const TRIANGLE: &str = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" he
   <polygon points="10,10 90,30 30,90" fill="black"/>
 </svg>"#;
 
-/// A scratch folder for one test, removed when the test passes (kept, for a look, when it
-/// fails).
-struct Scratch(PathBuf);
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-impl std::ops::Deref for Scratch {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Scratch {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<std::ffi::OsStr> for Scratch {
-    fn as_ref(&self) -> &std::ffi::OsStr {
-        self.0.as_os_str()
-    }
-}
-
-fn scratch(name: &str) -> Scratch {
-    let d = std::env::temp_dir().join(format!("prism-view-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    Scratch(d)
+fn scratch(name: &str) -> prism_testkit::Scratch {
+    prism_testkit::scratch("prism-view", name)
 }
 
 fn mode(dir: &Path) -> SvgMode {
