@@ -741,30 +741,38 @@ impl Bvh {
         let (mut a, mut b, mut next) = (0, 1, 2);
         let mut wa = Walk::new(&rays[a], tmax);
         let mut wb = Walk::new(&rays[b], tmax);
-        loop {
-            if !wa.step::<AVX>(self, &rays[a], tmin, 0) {
-                hits[a] = wa.best;
-                if next == n {
-                    while wb.step::<AVX>(self, &rays[b], tmin, 0) {}
-                    hits[b] = wb.best;
-                    return;
-                }
-                a = next;
-                next += 1;
-                wa.reset(&rays[a], tmax);
-            }
-            if !wb.step::<AVX>(self, &rays[b], tmin, 0) {
-                hits[b] = wb.best;
-                if next == n {
-                    while wa.step::<AVX>(self, &rays[a], tmin, 0) {}
-                    hits[a] = wa.best;
-                    return;
-                }
-                b = next;
-                next += 1;
-                wb.reset(&rays[b], tmax);
-            }
+        let query = (rays, tmin, tmax);
+        while self.pair_step::<AVX>(query, hits, (&mut wa, &mut a), (&mut wb, b), &mut next)
+            && self.pair_step::<AVX>(query, hits, (&mut wb, &mut b), (&mut wa, a), &mut next)
+        {
         }
+    }
+
+    /// A step of [`Bvh::intersect_pairs`]' walk in one slot (`walk` of ray `i`). When the
+    /// walk ends, its hit is stored and the slot takes ray `next`; with no ray left, the
+    /// other slot's walk (of ray `j`) is finished, and the answer is false: all are done.
+    #[inline(always)]
+    fn pair_step<const AVX: bool>(
+        &self,
+        (rays, tmin, tmax): (&[Ray], f32, f32),
+        hits: &mut [Option<Hit>],
+        (walk, i): (&mut Walk, &mut usize),
+        (other, j): (&mut Walk, usize),
+        next: &mut usize,
+    ) -> bool {
+        if walk.step::<AVX>(self, &rays[*i], tmin, 0) {
+            return true;
+        }
+        hits[*i] = walk.best;
+        if *next == rays.len() {
+            while other.step::<AVX>(self, &rays[j], tmin, 0) {}
+            hits[j] = other.best;
+            return false;
+        }
+        *i = *next;
+        *next += 1;
+        walk.reset(&rays[*i], tmax);
+        true
     }
 
     /// [`Bvh::intersect`] for each ray of `rays` (`hits[i]` for `rays[i]`), in one call:
