@@ -5,7 +5,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_render::{render, render_share, Integrator, Part, RenderOptions, RenderScene, Share};
+use prism_render::{
+    render, render_share_profiled, Integrator, Part, RenderOptions, RenderScene, Share,
+};
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
 use crate::UserError;
@@ -471,8 +473,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .sum();
         let bar = crate::progress::samples_bar(pixels * share.samples.len() as u64, a.quiet);
         let t2 = Instant::now();
-        let sums = pool
-            .install(|| render_share(&prepared, &options, &share, &|done| bar.set_position(done)));
+        let profile = prism_render::Profile::default();
+        let sums = pool.install(|| {
+            render_share_profiled(
+                &prepared,
+                &options,
+                &share,
+                &|done| bar.set_position(done),
+                &profile,
+            )
+        });
         let render_time = t2.elapsed();
         bar.finish_and_clear();
         let t3 = Instant::now();
@@ -494,6 +504,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 "samples/s: {:.0}",
                 samples as f64 / render_time.as_secs_f64()
             );
+            print_stages(&profile);
         }
         return Ok(());
     }
@@ -546,15 +557,21 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "samples/s: {:.0}",
             out.total_samples as f64 / render_time.as_secs_f64()
         );
-        if let Some(shares) = out.profile.shares() {
-            let stages: Vec<String> = shares
-                .iter()
-                .map(|(stage, share)| format!("{} {:.1}%", stage.name(), 100.0 * share))
-                .collect();
-            eprintln!("stages: {}", stages.join(", "));
-        }
+        print_stages(&out.profile);
     }
     Ok(())
+}
+
+/// Prints the path integrator's share of time per stage (`stages: camera rays 5.9%, ...`),
+/// if it ran.
+fn print_stages(profile: &prism_render::Profile) {
+    if let Some(shares) = profile.shares() {
+        let stages: Vec<String> = shares
+            .iter()
+            .map(|(stage, share)| format!("{} {:.1}%", stage.name(), 100.0 * share))
+            .collect();
+        eprintln!("stages: {}", stages.join(", "));
+    }
 }
 
 /// The line printed when a render ends on a terminal: size, samples, times, outputs.

@@ -151,6 +151,16 @@ fn sample_splits_merge_to_the_single_render_byte_for_byte() {
             "{n} sample ranges x {tiles} tile shares: the EXR differs"
         );
     }
+    // A part's `--stats` include the path integrator's share of time per stage.
+    let o = ok(run(
+        args[0],
+        &args[1..],
+        &["--tile", "1/3", "--stats"],
+        &dir.join("stats.exr"),
+    ));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let stages = err.lines().find_map(|l| l.strip_prefix("stages: "));
+    assert_eq!(stages.map(|s| s.split(", ").count()), Some(8), "{err}");
 }
 
 /// Oracle: the single Whitted render, bloom included (merge adds it after assembling, as

@@ -167,6 +167,17 @@ pub fn render_share(
     render_share_except(scene, opts, share, None, progress)
 }
 
+/// [`render_share`], adding the path integrator's time per stage to `profile`.
+pub fn render_share_profiled(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    share: &Share,
+    progress: &(dyn Fn(u64) + Sync),
+    profile: &Profile,
+) -> Image<PixelSum> {
+    render_tiles(scene, opts, share, None, progress, Some(profile))
+}
+
 /// [`render_share`] leaving out the pixels `skip` marks (row by row, `width x height`
 /// entries): they hold no samples. A progressive renderer uses it to stop converged pixels.
 ///
