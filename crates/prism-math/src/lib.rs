@@ -23,6 +23,6 @@ pub use geometry::{Aabb, Frame, Ray};
 pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};
 pub use isa::Isa;
-pub use random::{hash_words, mix64, unit_f32, Pcg32};
+pub use random::{hash_extend, hash_words, mix64, unit_f32, word_mix, Pcg32};
 pub use text::LineIndex;
 pub use transform::Transform;

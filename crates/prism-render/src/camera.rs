@@ -1,6 +1,7 @@
 //! [`Perspective`], the perspective camera: primary rays through image positions, from a
 //! pinhole or across a thin lens.
 
+use prism_math::lanes::{F16, V16};
 use prism_math::{warp, Ray, Vec2, Vec3};
 use prism_scene::Camera;
 
@@ -71,6 +72,27 @@ impl Perspective {
                 Ray::new(origin, (focus - origin).normalize())
             }
         }
+    }
+
+    /// The point every ray leaves, for a pinhole camera (none with a lens).
+    #[must_use]
+    pub(crate) fn pinhole(&self) -> Option<Vec3> {
+        self.lens.is_none().then_some(self.eye)
+    }
+
+    /// The directions of a pinhole camera's [`Perspective::ray`] through sixteen image
+    /// positions at once, the same operations lane by lane: the same bits.
+    #[inline(always)]
+    pub(crate) fn pinhole_dirs(&self, x: F16, y: F16) -> V16 {
+        let sx = x * 2.0 / self.width - 1.0;
+        let sy = F16::splat(1.0) - y * 2.0 / self.height;
+        let (f, r, u) = (self.forward, self.right, self.up);
+        V16 {
+            x: F16::splat(f.x) + sx * r.x + sy * u.x,
+            y: F16::splat(f.y) + sx * r.y + sy * u.y,
+            z: F16::splat(f.z) + sx * r.z + sy * u.z,
+        }
+        .normalize()
     }
 }
 

@@ -340,6 +340,13 @@ pub(crate) fn camera_sample(
 ) -> (Sampler, Ray) {
     let index = u64::from(y) * u64::from(opts.width) + u64::from(x);
     let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
+    let ray = camera_ray(camera, (x, y), &mut sampler);
+    (sampler, ray)
+}
+
+/// The camera ray through pixel `(x, y)` that a sample's first dimensions choose (the
+/// position in the pixel, then the lens point if there is a lens).
+pub(crate) fn camera_ray(camera: &Perspective, (x, y): (u32, u32), sampler: &mut Sampler) -> Ray {
     let u = sampler.next_2d();
     // The lens takes dimensions only when there is one: pinhole images keep their bytes.
     let lens = if camera.has_lens() {
@@ -347,8 +354,7 @@ pub(crate) fn camera_sample(
     } else {
         prism_math::Vec2::ZERO
     };
-    let ray = camera.ray(x as f32 + u.x, y as f32 + u.y, lens);
-    (sampler, ray)
+    camera.ray(x as f32 + u.x, y as f32 + u.y, lens)
 }
 
 fn pixel(

@@ -4,17 +4,17 @@
 //! path draws the same random numbers in the same order and adds the same terms in the same
 //! order as the one-path-at-a-time integrator (`path`), so the two give identical images.
 
-use prism_math::lanes::LANES;
+use prism_math::lanes::{F16, LANES};
 use prism_math::{Ray, Rgb, Vec3};
 
 use super::direct::light_term;
 use super::{diffuse16, power};
 use crate::camera::Perspective;
-use crate::film::{camera_sample, PixelSum, RenderOptions};
+use crate::film::{camera_ray, PixelSum, RenderOptions};
 use crate::interaction::Interaction;
 use crate::profile::{Laps, Profile, Stage};
 use crate::render_scene::RenderScene;
-use crate::sampler::Sampler;
+use crate::sampler::{lane_keys, lane_values, Sampler};
 
 /// A path in flight: its pixel, random numbers, the ray to trace next, and what it carries.
 pub(super) struct PathState {
@@ -114,6 +114,11 @@ pub(crate) fn tile(
     let mut active: Vec<usize> = (0..pixels.len()).collect();
     let mut radiance = vec![Rgb::BLACK; pixels.len()];
     let mut buffers = Buffers::default();
+    let width = u64::from(opts.width);
+    let keys: Vec<u64> = pixels
+        .iter()
+        .map(|&(x, y)| Sampler::pixel_key(opts.seed, u64::from(y) * width + u64::from(x)))
+        .collect();
     // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
     let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
     let most = samples.len() as u32;
@@ -125,7 +130,7 @@ pub(crate) fn tile(
             scene,
             camera,
             opts,
-            pixels,
+            (pixels, &keys),
             &active,
             n,
             &mut radiance,
@@ -152,7 +157,7 @@ fn sample_pass(
     scene: &RenderScene,
     camera: &Perspective,
     opts: &RenderOptions,
-    pixels: &[(u32, u32)],
+    pixels: (&[(u32, u32)], &[u64]),
     active: &[usize],
     n: u32,
     radiance: &mut [Rgb],
@@ -161,19 +166,7 @@ fn sample_pass(
     laps: &mut Laps,
 ) {
     b.paths.clear();
-    b.paths.extend(active.iter().map(|&k| {
-        let (sampler, ray) = camera_sample(camera, opts, pixels[k], n);
-        PathState {
-            pixel: k,
-            ray,
-            sampler,
-            l: Rgb::BLACK,
-            beta: Rgb::WHITE,
-            bounce: 0,
-            pdf: 0.0,
-            mis: false,
-        }
-    }));
+    start_paths(camera, pixels, active, n, &mut b.paths);
     laps.lap(Stage::Camera);
     while !b.paths.is_empty() {
         b.rays.clear();
@@ -258,6 +251,118 @@ fn sample_pass(
             }
             keep_going
         });
+    }
+}
+
+impl PathState {
+    /// A path leaving the camera from pixel `pixel` of the tile's list.
+    fn start(pixel: usize, sampler: Sampler, ray: Ray) -> PathState {
+        PathState {
+            pixel,
+            ray,
+            sampler,
+            l: Rgb::BLACK,
+            beta: Rgb::WHITE,
+            bounce: 0,
+            pdf: 0.0,
+            mis: false,
+        }
+    }
+}
+
+/// Starts sample `n`'s path at each pixel of `active` (indices into `pixels`, whose
+/// samplers' [`Sampler::pixel_key`]s are `keys`): its sampler and camera ray, those of
+/// [`crate::film::camera_sample`]. A pinhole camera's rays are made sixteen at a time.
+fn start_paths(
+    camera: &Perspective,
+    (pixels, keys): (&[(u32, u32)], &[u64]),
+    active: &[usize],
+    n: u32,
+    paths: &mut Vec<PathState>,
+) {
+    let Some(eye) = camera.pinhole() else {
+        paths.extend(active.iter().map(|&k| {
+            let mut sampler = Sampler::from_pixel_key(keys[k], u64::from(n));
+            let ray = camera_ray(camera, pixels[k], &mut sampler);
+            PathState::start(k, sampler, ray)
+        }));
+        return;
+    };
+    let start = Pinhole {
+        camera,
+        eye,
+        pixels,
+        keys,
+        n,
+    };
+    #[cfg(target_arch = "x86_64")]
+    {
+        if prism_math::Isa::avx512() {
+            // SAFETY: the processor has AVX-512F and AVX-512DQ.
+            return unsafe { start.paths_avx512(active, paths) };
+        }
+        if prism_math::Isa::avx2() {
+            // SAFETY: the processor has AVX2.
+            return unsafe { start.paths_avx2(active, paths) };
+        }
+    }
+    start.paths(active, paths);
+}
+
+/// What [`start_paths`] needs for a pinhole camera's paths.
+struct Pinhole<'a> {
+    camera: &'a Perspective,
+    eye: Vec3,
+    pixels: &'a [(u32, u32)],
+    keys: &'a [u64],
+    n: u32,
+}
+
+impl Pinhole<'_> {
+    /// The paths of `active`, sixteen at a time: the samplers' keys, the two draws placing
+    /// the sample in its pixel, and the ray directions on lanes (the last group padded with
+    /// its first pixel).
+    #[inline(always)]
+    fn paths(&self, active: &[usize], paths: &mut Vec<PathState>) {
+        for group in active.chunks(LANES) {
+            let k = |i: usize| group[i.min(group.len() - 1)];
+            let pixel_keys: [u64; LANES] = std::array::from_fn(|i| self.keys[k(i)]);
+            let key = lane_keys(&pixel_keys, u64::from(self.n));
+            let dim = [0; LANES];
+            let ux = lane_values(&key, &dim, 0);
+            let uy = lane_values(&key, &dim, 1);
+            let x = F16(std::array::from_fn(|i| self.pixels[k(i)].0 as f32)) + ux;
+            let y = F16(std::array::from_fn(|i| self.pixels[k(i)].1 as f32)) + uy;
+            let d = self.camera.pinhole_dirs(x, y);
+            paths.extend(group.iter().enumerate().map(|(i, &pixel)| {
+                let dir = Vec3::new(d.x.0[i], d.y.0[i], d.z.0[i]);
+                PathState::start(
+                    pixel,
+                    Sampler::from_state(key[i], 2),
+                    Ray::new(self.eye, dir),
+                )
+            }));
+        }
+    }
+
+    /// [`Pinhole::paths`] compiled for AVX-512.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F and AVX-512DQ.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq")]
+    unsafe fn paths_avx512(&self, active: &[usize], paths: &mut Vec<PathState>) {
+        self.paths(active, paths);
+    }
+
+    /// [`Pinhole::paths`] compiled for AVX2.
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn paths_avx2(&self, active: &[usize], paths: &mut Vec<PathState>) {
+        self.paths(active, paths);
     }
 }
 
