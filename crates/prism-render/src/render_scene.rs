@@ -326,6 +326,7 @@ impl RenderScene {
     }
 
     /// The shading data of `hit` along `ray`.
+    #[inline(always)]
     fn interaction(&self, ray: &Ray, hit: prism_accel::Hit) -> Interaction {
         let b0 = 1.0 - hit.b1 - hit.b2;
         match self.prims[hit.prim as usize] {
