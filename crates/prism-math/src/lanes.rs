@@ -157,6 +157,28 @@ impl F16 {
         F16(r)
     }
 
+    /// [`crate::exp`] of each lane.
+    #[inline(always)]
+    pub fn exp(self) -> F16 {
+        F16(self.0.map(crate::exp))
+    }
+
+    /// [`crate::ln`] of each lane.
+    #[inline(always)]
+    pub fn ln(self) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = crate::ln(self.0[i]);
+        }
+        F16(r)
+    }
+
+    /// [`crate::acos`] of each lane.
+    #[inline(always)]
+    pub fn acos(self) -> F16 {
+        F16(self.0.map(crate::acos))
+    }
+
     /// Absolute values.
     #[inline(always)]
     pub fn abs(self) -> F16 {

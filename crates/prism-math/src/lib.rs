@@ -7,6 +7,7 @@
 
 mod cache;
 mod color;
+mod elementary;
 mod exact;
 mod geometry;
 mod isa;
@@ -18,6 +19,7 @@ pub mod warp;
 
 pub use cache::prefetch;
 pub use color::Rgb;
+pub use elementary::{acos, exp, ln};
 pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
 pub use glam;

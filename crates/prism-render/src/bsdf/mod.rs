@@ -3,7 +3,7 @@
 //! `sample`, whose weight is `eval / pdf` (or the delta lobe's weight).
 
 use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use prism_math::{Rgb, Vec2, Vec3};
+use prism_math::{acos, exp, ln, Rgb, Vec2, Vec3};
 use prism_scene::Material;
 use std::f32::consts::PI;
 
@@ -270,7 +270,7 @@ fn beckmann_d(h: Vec3, alpha: f32) -> f32 {
         return 0.0;
     }
     let tan2 = (1.0 - c2) / c2;
-    (-tan2 / (alpha * alpha)).exp() / (PI * alpha * alpha * c2 * c2)
+    exp(-tan2 / (alpha * alpha)) / (PI * alpha * alpha * c2 * c2)
 }
 
 /// Samples a Beckmann normal visible from `wo` (upper hemisphere), with density
@@ -307,13 +307,13 @@ fn beckmann_visible_slopes(cos: f32, u: Vec2) -> (f32, f32) {
     let cot = cos / sin;
     let top = erf(cot);
     let inv_sqrt_pi = 1.0 / PI.sqrt();
-    let norm = 1.0 / (1.0 + top + inv_sqrt_pi * tan * (-cot * cot).exp());
-    let theta = cos.acos();
+    let norm = 1.0 / (1.0 + top + inv_sqrt_pi * tan * exp(-cot * cot));
+    let theta = acos(cos);
     let fit = 1.0 + theta * (-0.876 + theta * (0.4265 - 0.0594 * theta));
-    let mut b = top - (1.0 + top) * (1.0 - ux).powf(fit);
+    let mut b = top - (1.0 + top) * exp(fit * ln(1.0 - ux));
     for _ in 0..3 {
         let s = erf_inv(b);
-        let value = norm * (1.0 + b + inv_sqrt_pi * tan * (-s * s).exp()) - ux;
+        let value = norm * (1.0 + b + inv_sqrt_pi * tan * exp(-s * s)) - ux;
         let slope = norm * (1.0 - s * tan);
         if slope.abs() > 1e-12 {
             b = (b - value / slope).clamp(-1.0 + 1e-6, top.min(1.0 - 1e-6));
@@ -329,43 +329,49 @@ fn erf(x: f32) -> f32 {
     let poly = t
         * (0.254_829_6
             + t * (-0.284_496_74 + t * (1.421_413_7 + t * (-1.453_152 + t * 1.061_405_4))));
-    (1.0 - poly * (-a * a).exp()).copysign(x)
+    (1.0 - poly * exp(-a * a)).copysign(x)
 }
 
 /// The inverse error function on (-1, 1) (Giles' single-precision approximation, 2010).
 fn erf_inv(x: f32) -> f32 {
-    let w = -((1.0 - x) * (1.0 + x)).ln();
+    let w = -ln((1.0 - x) * (1.0 + x));
     let p = if w < 5.0 {
         let w = w - 2.5;
-        [
-            3.432_739_4e-7,
-            -3.523_387_7e-6,
-            -4.391_506_5e-6,
-            2.185_808_7e-4,
-            -1.253_725e-3,
-            -4.177_681_6e-3,
-            0.246_640_73,
-            1.501_409_4,
-        ]
-        .iter()
-        .fold(2.810_226_4e-8, |p, c| c + p * w)
+        ERF_INV_NEAR
+            .iter()
+            .fold(ERF_INV_NEAR_LEAD, |p, c| c + p * w)
     } else {
         let w = w.sqrt() - 3.0;
-        [
-            1.009_505_6e-4,
-            1.349_343_2e-3,
-            -3.673_428_4e-3,
-            5.739_507_7e-3,
-            -7.622_461_3e-3,
-            9.438_870_5e-3,
-            1.001_674,
-            2.832_976_8,
-        ]
-        .iter()
-        .fold(-2.002_142_6e-4, |p, c| c + p * w)
+        ERF_INV_FAR.iter().fold(ERF_INV_FAR_LEAD, |p, c| c + p * w)
     };
     p * x
 }
+
+/// [`erf_inv`]'s polynomial in `w - 2.5` for `w < 5`: the leading coefficient, then the
+/// others in Horner order.
+const ERF_INV_NEAR_LEAD: f32 = 2.810_226_4e-8;
+const ERF_INV_NEAR: [f32; 8] = [
+    3.432_739_4e-7,
+    -3.523_387_7e-6,
+    -4.391_506_5e-6,
+    2.185_808_7e-4,
+    -1.253_725e-3,
+    -4.177_681_6e-3,
+    0.246_640_73,
+    1.501_409_4,
+];
+/// [`erf_inv`]'s polynomial in `sqrt(w) - 3` for `w >= 5`.
+const ERF_INV_FAR_LEAD: f32 = -2.002_142_6e-4;
+const ERF_INV_FAR: [f32; 8] = [
+    1.009_505_6e-4,
+    1.349_343_2e-3,
+    -3.673_428_4e-3,
+    5.739_507_7e-3,
+    -7.622_461_3e-3,
+    9.438_870_5e-3,
+    1.001_674,
+    2.832_976_8,
+];
 
 /// Smith's masking for Beckmann with Walter's rational approximation.
 fn smith_g1(v: Vec3, h: Vec3, alpha: f32) -> f32 {
@@ -439,5 +445,6 @@ fn refract(wo: Vec3, ior: f32) -> Option<(Vec3, f32)> {
     Some((wi, eta * eta))
 }
 
+pub(crate) mod lanes;
 #[cfg(test)]
 mod tests;

@@ -3,10 +3,10 @@
 //! `wavefront` runs a tile's paths together, stage by stage, to the same result as `path`;
 //! `whitted` is the Delft ray tracer's recursive integrator.
 
-mod diffuse16;
 mod direct;
 mod normals;
 mod path;
+mod smooth16;
 pub(crate) mod wavefront;
 pub mod whitted;
 

@@ -8,7 +8,8 @@ use prism_math::lanes::{F16, LANES};
 use prism_math::{Ray, Rgb, Vec3};
 
 use super::direct::light_term;
-use super::{diffuse16, power};
+use super::{power, smooth16};
+use crate::bsdf::lanes::SmoothKind;
 use crate::camera::Perspective;
 use crate::film::{camera_ray, PixelSum, RenderOptions};
 use crate::interaction::Interaction;
@@ -90,10 +91,10 @@ struct Buffers {
     /// The rays of the paths, and the hierarchy's hits along them.
     rays: Vec<Ray>,
     bvh_hits: Vec<Option<prism_accel::Hit>>,
-    /// Paths whose step runs sixteen at a time.
-    fast: Vec<usize>,
+    /// Paths whose step runs sixteen at a time: at diffuse surfaces, then at conductors.
+    fast: [Vec<usize>; 2],
     /// Their light samples, sixteen at a time.
-    samples: Vec<diffuse16::Candidate>,
+    samples: Vec<smooth16::Candidate>,
     shadows: Shadows,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
@@ -120,7 +121,7 @@ pub(crate) fn tile(
         .map(|&(x, y)| Sampler::pixel_key(opts.seed, u64::from(y) * width + u64::from(x)))
         .collect();
     // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
-    let area = diffuse16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
+    let area = smooth16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
     let most = samples.len() as u32;
     let mut n = samples.start;
     let mut laps = Laps::start();
@@ -162,7 +163,7 @@ fn sample_pass(
     n: u32,
     radiance: &mut [Rgb],
     b: &mut Buffers,
-    area: Option<&[diffuse16::AreaLight]>,
+    area: Option<&[smooth16::AreaLight]>,
     laps: &mut Laps,
 ) {
     b.paths.clear();
@@ -186,15 +187,15 @@ fn sample_pass(
         b.pending.resize(count, None);
         b.alive.clear();
         b.alive.resize(count, false);
-        b.fast.clear();
+        b.fast.iter_mut().for_each(Vec::clear);
         // The next bounce's light and BSDF samples: diffuse surfaces under area lights
         // sixteen at a time, the others one by one.
         for (i, surf) in b.hits.iter().enumerate() {
             let Some(hit) = surf else {
                 continue;
             };
-            if area.is_some() && diffuse16::diffuse_albedo(hit).is_some() {
-                b.fast.push(i);
+            if let (Some(_), Some(kind)) = (area, smooth16::smooth_kind(hit)) {
+                b.fast[kind as usize].push(i);
                 continue;
             }
             b.alive[i] = scatter(
@@ -209,15 +210,22 @@ fn sample_pass(
         }
         laps.lap(Stage::Scattering);
         if let Some(lights) = area {
-            let mut out = diffuse16::Outputs {
+            let mut out = smooth16::Outputs {
                 samples: &mut b.samples,
                 shadows: &mut b.shadows,
                 light_terms: &mut b.lights,
                 pending: &mut b.pending,
                 alive: &mut b.alive,
             };
-            for group in b.fast.chunks(LANES) {
-                diffuse16::step_dispatch(opts, lights, &mut b.paths, &b.hits, group, &mut out);
+            for (fast, kind) in b
+                .fast
+                .iter()
+                .zip([SmoothKind::Diffuse, SmoothKind::Conductor])
+            {
+                for group in fast.chunks(LANES) {
+                    let paths = &mut b.paths;
+                    smooth16::step_dispatch(kind, opts, lights, paths, &b.hits, group, &mut out);
+                }
             }
         }
         laps.lap(Stage::DiffuseLanes);

@@ -1,8 +1,9 @@
-//! The wavefront's step for sixteen paths at once at diffuse surfaces in scenes lit by area
-//! lights only (the course's Cornell boxes): shading frames, light samples with their MIS
-//! weights and shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random
-//! numbers and the cosine-weighted directions too. Each lane does the scalar code's
-//! operations in the same order, so the result is the scalar path's, bit for bit.
+//! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
+//! conductor, one kind per group) in scenes lit by area lights only (the course's Cornell
+//! boxes): shading frames, light samples with their MIS weights and shadow rays, the BSDF
+//! sample and Russian roulette on sixteen lanes, the random numbers and the BSDFs'
+//! evaluation and sampling too. Each lane does the scalar code's operations in the same
+//! order, so the result is the scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
@@ -11,7 +12,7 @@ use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::{Ray, Rgb, Vec3};
 
 use super::wavefront::{LightTerms, PathState, Pending, Shadows};
-use crate::bsdf::Bsdf;
+use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
@@ -53,12 +54,9 @@ pub(super) fn area_lights(lights: &[RenderLight]) -> Option<Vec<AreaLight>> {
         .collect()
 }
 
-/// The albedo of a surface this step handles.
-pub(super) fn diffuse_albedo(hit: &Interaction) -> Option<Rgb> {
-    match hit.bsdf {
-        Bsdf::Diffuse { albedo } => Some(albedo),
-        _ => None,
-    }
+/// The kind of smooth BSDF at a surface this step handles.
+pub(super) fn smooth_kind(hit: &Interaction) -> Option<SmoothKind> {
+    SmoothKind::of(&hit.bsdf)
 }
 
 /// What the step reads and writes besides the paths.
@@ -144,10 +142,12 @@ fn power(nf: f32, f: F16, g: F16) -> F16 {
     F16::select(both, zero, a * a / (a * a + g * g))
 }
 
-/// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces are
-/// diffuse, in a scene lit by `lights` only, with light sampling kept at this bounce.
+/// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces have
+/// smooth BSDFs of kind `kind`, in a scene lit by `lights` only, with light sampling kept at
+/// this bounce.
 #[inline(always)]
 pub(super) fn step(
+    kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[AreaLight],
     paths: &mut [PathState],
@@ -158,7 +158,7 @@ pub(super) fn step(
     let m = group.len();
     let lane_in = M16::first(m);
     let (mut p, mut ng, mut n, mut wo) = Default::default();
-    let mut albedo = [F16::default(); 3];
+    let mut bsdf = SmoothLanes::new(kind);
     let mut beta = [F16::default(); 3];
     let mut key = [0u64; LANES];
     let mut dim = [0u64; LANES];
@@ -171,10 +171,9 @@ pub(super) fn step(
         put(&mut ng, lane, hit.ng);
         put(&mut n, lane, hit.ns);
         put(&mut wo, lane, -path.ray.dir);
-        let a = diffuse_albedo(hit).unwrap_or(Rgb::BLACK);
+        bsdf.put(lane, &hit.bsdf);
         let b = path.beta;
-        for (c, (a, b)) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)].into_iter().enumerate() {
-            albedo[c].0[lane] = a;
+        for (c, b) in [b.r, b.g, b.b].into_iter().enumerate() {
             beta[c].0[lane] = b;
         }
     }
@@ -187,7 +186,6 @@ pub(super) fn step(
     let wo_l = local(wo);
     let wo_front = F16::splat(0.0).lt(wo.dot(ng));
     let zero = F16::splat(0.0);
-    let flip = wo_l.z.lt(zero);
 
     // Light samples: per light, `count` samples, each a possible shadow ray.
     let count = opts.light_samples.max(1);
@@ -216,13 +214,8 @@ pub(super) fn step(
             ok = ok & zero.lt(cos_l);
             let pdf = dist2 / (F16::splat(light.area) * cos_l);
             ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
-            let wi_l = local(wi);
-            ok = ok & !(wo_l.z * wi_l.z).le(zero);
-            let wiz = F16::select(flip, -wi_l.z, wi_l.z);
-            let scale = wiz / F16::splat(std::f32::consts::PI);
-            let f = [albedo[0] * scale, albedo[1] * scale, albedo[2] * scale];
+            let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi));
             ok = ok & !max_channel(&f).le(zero);
-            let bsdf_pdf = wiz.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
             let mis = power(count as f32, pdf, bsdf_pdf);
             let w = mis / pdf;
             let li = [light.radiance.r, light.radiance.g, light.radiance.b];
@@ -267,33 +260,28 @@ pub(super) fn step(
         });
     }
 
-    // The BSDF sample: a cosine-weighted direction (the disk's trigonometry lane by lane).
+    // The BSDF sample.
     let bounce = paths[group[0]].bounce + 1;
     let roulette = bounce >= opts.rr_bounces;
-    // The lobe choice (unused by a diffuse BSDF), the direction, then the roulette's.
+    // The lobe choice (unused by a smooth BSDF), the direction, then the roulette's.
     let (u2x, u2y) = (
         lane_values(&key, &dim, draw + 1),
         lane_values(&key, &dim, draw + 2),
     );
     let rr = lane_values(&key, &dim, draw + 3);
     let drawn = draw + 3 + u64::from(roulette);
-    let dl = prism_math::warp::cosine_hemisphere_lanes(u2x, u2y);
     for &k in group {
         paths[k].sampler.advance(drawn);
     }
-    let mut ok = lane_in & !wo_l.z.eq(zero) & zero.lt(dl.z);
-    let pdf = dl.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
-    let wi_l = V16 {
-        x: dl.x,
-        y: dl.y,
-        z: F16::select(flip, -dl.z, dl.z),
-    };
-    let wi = s * wi_l.x + t * wi_l.y + n * wi_l.z;
+    let sample = bsdf.sample(wo_l, u2x, u2y);
+    let mut ok = lane_in & sample.ok;
+    let pdf = sample.pdf;
+    let wi = s * sample.wi.x + t * sample.wi.y + n * sample.wi.z;
     ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
     let mut b = [
-        beta[0] * albedo[0],
-        beta[1] * albedo[1],
-        beta[2] * albedo[2],
+        beta[0] * sample.weight[0],
+        beta[1] * sample.weight[1],
+        beta[2] * sample.weight[2],
     ];
     let bmax = max_channel(&b);
     ok = ok & !bmax.le(zero);
@@ -332,6 +320,7 @@ pub(super) fn step(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq")]
 pub(super) unsafe fn step_avx512(
+    kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[AreaLight],
     paths: &mut [PathState],
@@ -339,7 +328,7 @@ pub(super) unsafe fn step_avx512(
     group: &[usize],
     out: &mut Outputs,
 ) {
-    step(opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, paths, surfs, group, out);
 }
 
 /// [`step`] compiled for AVX2.
@@ -349,6 +338,7 @@ pub(super) unsafe fn step_avx512(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn step_avx2(
+    kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[AreaLight],
     paths: &mut [PathState],
@@ -356,11 +346,12 @@ pub(super) unsafe fn step_avx2(
     group: &[usize],
     out: &mut Outputs,
 ) {
-    step(opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, paths, surfs, group, out);
 }
 
 /// [`step`] on the best instructions the processor has.
 pub(super) fn step_dispatch(
+    kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[AreaLight],
     paths: &mut [PathState],
@@ -372,12 +363,12 @@ pub(super) fn step_dispatch(
     {
         if prism_math::Isa::avx512() {
             // SAFETY: the processor has AVX-512F and AVX-512DQ.
-            return unsafe { step_avx512(opts, lights, paths, surfs, group, out) };
+            return unsafe { step_avx512(kind, opts, lights, paths, surfs, group, out) };
         }
         if prism_math::Isa::avx2() {
             // SAFETY: the processor has AVX2.
-            return unsafe { step_avx2(opts, lights, paths, surfs, group, out) };
+            return unsafe { step_avx2(kind, opts, lights, paths, surfs, group, out) };
         }
     }
-    step(opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, paths, surfs, group, out);
 }
