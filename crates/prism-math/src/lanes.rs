@@ -160,7 +160,11 @@ impl F16 {
     /// [`crate::exp`] of each lane.
     #[inline(always)]
     pub fn exp(self) -> F16 {
-        F16(self.0.map(crate::exp))
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = crate::exp(self.0[i]);
+        }
+        F16(r)
     }
 
     /// [`crate::ln`] of each lane.
@@ -176,7 +180,11 @@ impl F16 {
     /// [`crate::acos`] of each lane.
     #[inline(always)]
     pub fn acos(self) -> F16 {
-        F16(self.0.map(crate::acos))
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = crate::acos(self.0[i]);
+        }
+        F16(r)
     }
 
     /// Absolute values.

@@ -15,11 +15,12 @@ pub enum Stage {
     HitRecords,
     /// Emission found by the rays, and paths that end.
     Emission,
-    /// Light and BSDF samples one path at a time (every surface but diffuse ones under area
-    /// lights).
+    /// Light and BSDF samples one path at a time (every surface but diffuse and rough
+    /// conductor ones under area lights).
     Scattering,
-    /// Light and BSDF samples of diffuse surfaces under area lights, sixteen paths at a time.
-    DiffuseLanes,
+    /// Light and BSDF samples of diffuse and rough conductor surfaces under area lights,
+    /// sixteen paths at a time.
+    SmoothLanes,
     /// Shadow rays (the BVH).
     ShadowRays,
     /// Adding up the unblocked light samples, and retiring the paths that ended.
@@ -34,7 +35,7 @@ impl Stage {
         Stage::HitRecords,
         Stage::Emission,
         Stage::Scattering,
-        Stage::DiffuseLanes,
+        Stage::SmoothLanes,
         Stage::ShadowRays,
         Stage::Gathering,
     ];
@@ -48,7 +49,7 @@ impl Stage {
             Stage::HitRecords => "hit records",
             Stage::Emission => "emission",
             Stage::Scattering => "scattering",
-            Stage::DiffuseLanes => "diffuse lanes",
+            Stage::SmoothLanes => "smooth lanes",
             Stage::ShadowRays => "shadow rays",
             Stage::Gathering => "gathering",
         }

@@ -96,14 +96,22 @@ impl SmoothLanes {
             SmoothKind::Diffuse => {
                 let scale = wi.z / F16::splat(PI);
                 (
-                    self.color.map(|a| a * scale),
+                    [
+                        self.color[0] * scale,
+                        self.color[1] * scale,
+                        self.color[2] * scale,
+                    ],
                     wi.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI),
                 )
             }
             SmoothKind::Conductor => self.conductor_eval_pdf(wo, wi),
         };
         (
-            f.map(|c| F16::select(apart, zero, c)),
+            [
+                F16::select(apart, zero, f[0]),
+                F16::select(apart, zero, f[1]),
+                F16::select(apart, zero, f[2]),
+            ],
             F16::select(apart, zero, pdf),
         )
     }
@@ -120,7 +128,11 @@ impl SmoothLanes {
         let cos = wi.dot(h);
         let denom = F16::splat(4.0) * wo.z;
         let scale = d * g / denom;
-        let f = [0, 1, 2].map(|c| fresnel_conductor(cos, self.color[c], self.k[c]) * scale);
+        let f = [
+            fresnel_conductor(cos, self.color[0], self.k[0]) * scale,
+            fresnel_conductor(cos, self.color[1], self.k[1]) * scale,
+            fresnel_conductor(cos, self.color[2], self.k[2]) * scale,
+        ];
         (f, g1_wo * d / denom)
     }
 
@@ -159,7 +171,7 @@ impl SmoothLanes {
                 LaneSample {
                     ok: ok & !pdf.le(zero),
                     wi,
-                    weight: f.map(|c| c * inv),
+                    weight: [f[0] * inv, f[1] * inv, f[2] * inv],
                     pdf,
                 }
             }
@@ -257,10 +269,45 @@ fn sample_beckmann_visible(wo: V16, alpha: F16, ux: F16, uy: F16) -> V16 {
     .normalize()
 }
 
-/// `beckmann_visible_slopes` lane by lane (both of its cases computed, then chosen). Not
-/// inlined: the sixteen-lane step with this in it is more than the compiler can take.
-#[inline(never)]
+/// `beckmann_visible_slopes` lane by lane, on the best instructions the processor has.
 fn beckmann_visible_slopes(cos: F16, ux: F16, uy: F16) -> (F16, F16) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if prism_math::Isa::avx512() {
+            // SAFETY: the processor has AVX-512F.
+            return unsafe { slopes_avx512(cos, ux, uy) };
+        }
+        if prism_math::Isa::avx2() {
+            // SAFETY: the processor has AVX2.
+            return unsafe { slopes_avx2(cos, ux, uy) };
+        }
+    }
+    slopes(cos, ux, uy)
+}
+
+/// [`slopes`] compiled for AVX-512.
+///
+/// # Safety
+/// The processor must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn slopes_avx512(cos: F16, ux: F16, uy: F16) -> (F16, F16) {
+    slopes(cos, ux, uy)
+}
+
+/// [`slopes`] compiled for AVX2.
+///
+/// # Safety
+/// The processor must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn slopes_avx2(cos: F16, ux: F16, uy: F16) -> (F16, F16) {
+    slopes(cos, ux, uy)
+}
+
+/// `beckmann_visible_slopes` lane by lane (both of its cases computed, then chosen).
+#[inline(always)]
+fn slopes(cos: F16, ux: F16, uy: F16) -> (F16, F16) {
     let one = F16::splat(1.0);
     let (lo, hi) = (F16::splat(1e-6), F16::splat(1.0 - 1e-6));
     let y = erf_inv(F16::splat(2.0) * clamp(uy, lo, hi) - one);
@@ -308,17 +355,15 @@ fn erf_inv(x: F16) -> F16 {
     let one = F16::splat(1.0);
     let w = -((one - x) * (one + x)).ln();
     let near = w - F16::splat(2.5);
-    let p_near = super::ERF_INV_NEAR
-        .iter()
-        .fold(F16::splat(super::ERF_INV_NEAR_LEAD), |p, &c| {
-            F16::splat(c) + p * near
-        });
+    let mut p_near = F16::splat(super::ERF_INV_NEAR_LEAD);
+    for c in super::ERF_INV_NEAR {
+        p_near = F16::splat(c) + p_near * near;
+    }
     let far = w.sqrt() - F16::splat(3.0);
-    let p_far = super::ERF_INV_FAR
-        .iter()
-        .fold(F16::splat(super::ERF_INV_FAR_LEAD), |p, &c| {
-            F16::splat(c) + p * far
-        });
+    let mut p_far = F16::splat(super::ERF_INV_FAR_LEAD);
+    for c in super::ERF_INV_FAR {
+        p_far = F16::splat(c) + p_far * far;
+    }
     F16::select(w.lt(F16::splat(5.0)), p_near, p_far) * x
 }
 

@@ -228,7 +228,7 @@ fn sample_pass(
                 }
             }
         }
-        laps.lap(Stage::DiffuseLanes);
+        laps.lap(Stage::SmoothLanes);
         b.blocked.clear();
         b.blocked.resize(b.shadows.len(), false);
         scene.occluded_batch(&b.shadows.rays, &b.shadows.dists, &mut b.blocked);
