@@ -259,6 +259,7 @@ fn sample_pass(
             }
             keep_going
         });
+        laps.lap(Stage::Gathering);
     }
 }
 
