@@ -188,8 +188,8 @@ fn sample_pass(
         b.alive.clear();
         b.alive.resize(count, false);
         b.fast.iter_mut().for_each(Vec::clear);
-        // The next bounce's light and BSDF samples: diffuse surfaces under area lights
-        // sixteen at a time, the others one by one.
+        // The next bounce's light and BSDF samples: diffuse and rough conductor surfaces
+        // under area lights sixteen at a time (one list per kind), the others one by one.
         for (i, surf) in b.hits.iter().enumerate() {
             let Some(hit) = surf else {
                 continue;
