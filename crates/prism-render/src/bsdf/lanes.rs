@@ -44,9 +44,13 @@ pub(crate) struct SmoothLanes {
 /// A sample drawn on lanes: the lanes that have one, and their directions, weights and
 /// densities (as [`super::BsdfSample`], never a delta lobe).
 pub(crate) struct LaneSample {
+    /// Lanes with a sample.
     pub ok: M16,
+    /// Sampled incident directions (local frame).
     pub wi: V16,
+    /// `eval / pdf`, per channel.
     pub weight: [F16; 3],
+    /// Solid-angle densities.
     pub pdf: F16,
 }
 
