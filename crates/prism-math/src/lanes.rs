@@ -157,34 +157,33 @@ impl F16 {
         F16(r)
     }
 
+    /// `f` of each lane, as a loop over the lanes (which the vectoriser turns into lane
+    /// operations once `f` is inlined).
+    #[inline(always)]
+    fn each(self, f: impl Fn(f32) -> f32) -> F16 {
+        let mut r = [0.0; LANES];
+        for i in 0..LANES {
+            r[i] = f(self.0[i]);
+        }
+        F16(r)
+    }
+
     /// [`crate::exp`] of each lane.
     #[inline(always)]
     pub fn exp(self) -> F16 {
-        let mut r = [0.0; LANES];
-        for i in 0..LANES {
-            r[i] = crate::exp(self.0[i]);
-        }
-        F16(r)
+        self.each(crate::exp)
     }
 
     /// [`crate::ln`] of each lane.
     #[inline(always)]
     pub fn ln(self) -> F16 {
-        let mut r = [0.0; LANES];
-        for i in 0..LANES {
-            r[i] = crate::ln(self.0[i]);
-        }
-        F16(r)
+        self.each(crate::ln)
     }
 
     /// [`crate::acos`] of each lane.
     #[inline(always)]
     pub fn acos(self) -> F16 {
-        let mut r = [0.0; LANES];
-        for i in 0..LANES {
-            r[i] = crate::acos(self.0[i]);
-        }
-        F16(r)
+        self.each(crate::acos)
     }
 
     /// Absolute values.
