@@ -79,6 +79,13 @@ pub(crate) fn lane_keys(pixel_keys: &[u64; LANES], index: u64) -> [u64; LANES] {
     for i in 0..LANES {
         z[i] = pixel_keys[i] ^ w;
     }
+    mix_lanes(z)
+}
+
+/// `prism_math::mix64` of each lane, in its operations.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+fn mix_lanes(mut z: [u64; LANES]) -> [u64; LANES] {
     for i in 0..LANES {
         z[i] = (z[i] ^ (z[i] >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     }
@@ -100,17 +107,11 @@ pub(crate) fn lane_values(key: &[u64; LANES], dim: &[u64; LANES], j: u64) -> F16
     for i in 0..LANES {
         z[i] = key[i] ^ dim[i].wrapping_add(j).wrapping_mul(DIM_MUL);
     }
-    for i in 0..LANES {
-        z[i] = (z[i] ^ (z[i] >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    }
-    for i in 0..LANES {
-        z[i] = (z[i] ^ (z[i] >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    }
+    let z = mix_lanes(z);
     let mut r = [0.0; LANES];
     for i in 0..LANES {
-        let h = z[i] ^ (z[i] >> 31);
         // The top 24 bits, as `unit_f32` takes them; exact in i32 and in f32.
-        r[i] = ((h >> 40) as i32) as f32 * (1.0 / 16_777_216.0);
+        r[i] = ((z[i] >> 40) as i32) as f32 * (1.0 / 16_777_216.0);
     }
     F16(r)
 }
