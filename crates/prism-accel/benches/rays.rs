@@ -8,12 +8,14 @@
 //!
 //! Each set is traced one ray per call (`Bvh::intersect`, as the Embree script calls
 //! `rtcIntersect1`), then a chunk per call (`primary-batch`, `random-batch`:
-//! `Bvh::intersect_batch`, which walks two rays at a time).
+//! `Bvh::intersect_batch`, which walks groups of sixteen primary rays as packets, and
+//! random rays two at a time).
 //!
 //! The mesh is `PRISM_RAYS_MESH` (.obj, .ply or .dae), by default the staged bunny
 //! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
 //! Each figure is the median of 5 runs. `PRISM_RAYS_QUICK=1` traces each set once on one
-//! thread, for instruction counts under `valgrind --tool=callgrind`.
+//! thread, for instruction counts under `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a
+//! comma-separated list such as `primary,random-batch`) traces only the sets named.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -136,7 +138,14 @@ fn main() {
         ("primary-batch", &primary, true),
         ("random-batch", &random, true),
     ];
+    let only = std::env::var("PRISM_RAYS_SETS").ok();
     for (kind, rays, batch) in sets {
+        if only
+            .as_deref()
+            .is_some_and(|o| !o.split(',').any(|k| k == kind))
+        {
+            continue;
+        }
         for &threads in thread_counts {
             if !quick {
                 trace(&bvh, &rays[..10_000], threads, batch);

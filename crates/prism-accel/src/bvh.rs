@@ -6,7 +6,7 @@ use prism_math::{prefetch, Aabb, Isa, Ray, Vec3};
 use rayon::prelude::*;
 
 use crate::flat::{Flat, Lanes, FLAT_MAX};
-use crate::node8::{self, Node8, SlabRay};
+use crate::node8::{self, widen, Node8, SlabRay};
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512, Simd};
@@ -14,11 +14,11 @@ use crate::tri4::Tri4;
 
 /// A leaf: `packs` triangle packs from `pack_start`, `spheres` spheres from `sphere_start`.
 #[derive(Clone, Copy, Debug, Default)]
-struct LeafRec {
-    pack_start: u32,
-    sphere_start: u32,
-    packs: u16,
-    spheres: u16,
+pub(crate) struct LeafRec {
+    pub(crate) pack_start: u32,
+    pub(crate) sphere_start: u32,
+    pub(crate) packs: u16,
+    pub(crate) spheres: u16,
 }
 
 /// Build parameters.
@@ -85,7 +85,7 @@ pub struct BvhStats {
     pub bytes: usize,
 }
 
-const LEAF: u32 = 1 << 31;
+pub(crate) const LEAF: u32 = 1 << 31;
 /// In a leaf reference, bits 28 to 30 hold the number of triangle packs of a leaf with
 /// triangles only (the low bits are then its first pack); zero means the low bits index
 /// the leaf table.
@@ -100,15 +100,15 @@ const MAX_LEAF_REF: usize = 16;
 /// A bounding volume hierarchy over triangles and spheres.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node8>,
+    pub(crate) nodes: Vec<Node8>,
     /// Triangles in packs of four, leaf by leaf.
-    packs: Vec<Tri4>,
+    pub(crate) packs: Vec<Tri4>,
     /// Leaves: their packs, and their spheres in `leaf_spheres`.
     leaves: Vec<LeafRec>,
     /// Sphere primitive numbers, leaf by leaf.
-    leaf_spheres: Vec<u32>,
-    spheres: Vec<Sphere>,
-    triangle_count: u32,
+    pub(crate) leaf_spheres: Vec<u32>,
+    pub(crate) spheres: Vec<Sphere>,
+    pub(crate) triangle_count: u32,
     bounds: Aabb,
     stats: BvhStats,
     /// For small hierarchies, the primitives in one list, for the batched queries.
@@ -240,7 +240,7 @@ const BINS: usize = 16;
 /// Depth after which splits are by median, so that no tree is deeper than this plus 32
 /// and the traversal stacks below cannot overflow.
 const MEDIAN_DEPTH: usize = 64;
-const STACK: usize = 7 * (MEDIAN_DEPTH + 34) + 8;
+pub(crate) const STACK: usize = 7 * (MEDIAN_DEPTH + 34) + 8;
 
 impl Bvh {
     /// Builds the hierarchy. Degenerate triangles (zero area or non-finite) and spheres with
@@ -590,7 +590,7 @@ impl Bvh {
 
     /// The packs and spheres of leaf reference `r`.
     #[inline(always)]
-    fn leaf_rec(&self, r: u32) -> LeafRec {
+    pub(crate) fn leaf_rec(&self, r: u32) -> LeafRec {
         let in_ref = (r >> PACKS_SHIFT) & 7;
         if in_ref != 0 {
             LeafRec {
@@ -829,11 +829,38 @@ impl Bvh {
         }
     }
 
-    /// The loop of [`Bvh::intersect_batch`], inlined into each compiled variant.
+    /// The loop of [`Bvh::intersect_batch`], inlined into each compiled variant: each group
+    /// of `width` coherent rays (`packet::coherent`) takes the packet walk (`packet`, which
+    /// returns the lanes it leaves to the one-ray walk); the rays between are walked in
+    /// pairs.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_with(&self, rays: &[Ray], tmin: f32, tmax: f32, hits: &mut [Option<Hit>]) {
-        self.intersect_pairs::<true>(rays, tmin, tmax, hits);
+    fn intersect_batch_with(
+        &self,
+        rays: &[Ray],
+        (tmin, tmax): (f32, f32),
+        hits: &mut [Option<Hit>],
+        width: usize,
+        packet: impl Fn(&[Ray], &mut [Option<Hit>]) -> u16,
+    ) {
+        // The first ray not yet walked.
+        let mut loose = 0;
+        let mut i = 0;
+        while i + width <= rays.len() {
+            let group = &rays[i..i + width];
+            if crate::packet::coherent(group, width) {
+                self.intersect_pairs::<true>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
+                let mut defer = packet(group, &mut hits[i..i + width]);
+                while defer != 0 {
+                    let lane = defer.trailing_zeros() as usize;
+                    defer &= defer - 1;
+                    hits[i + lane] = self.intersect_with::<true>(&group[lane], tmin, tmax, 0);
+                }
+                loose = i + width;
+            }
+            i += width;
+        }
+        self.intersect_pairs::<true>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
     }
 
     /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
@@ -1000,7 +1027,10 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, tmin, tmax, hits);
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx512::W, |r, h| {
+            // SAFETY: the processor has AVX-512VL, hence AVX-512F.
+            unsafe { crate::packet::closest_avx512(self, r, (tmin, tmax), h) }
+        });
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX2 (one-instruction broadcasts).
@@ -1016,7 +1046,10 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, tmin, tmax, hits);
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx2::W, |r, h| {
+            // SAFETY: the processor has AVX2.
+            unsafe { crate::packet::closest_avx2(self, r, (tmin, tmax), h) }
+        });
     }
 
     /// [`Bvh::occluded`] for each ray of `rays` with its own end (`blocked[i]` for `rays[i]`
@@ -1219,6 +1252,8 @@ struct Walk {
     slab: SlabRay,
     best: Option<Hit>,
     tmax: f32,
+    /// `widen(tmax)`: children entered no farther than this are visited.
+    reach: f32,
     stack: Stack<(u32, f32)>,
     sp: usize,
     /// The node or leaf the next step visits.
@@ -1235,6 +1270,7 @@ impl Walk {
             pre,
             best: None,
             tmax,
+            reach: widen(tmax),
             stack: Stack::new(),
             sp: 0,
             node: 0,
@@ -1248,6 +1284,7 @@ impl Walk {
         self.slab = SlabRay::new(&self.pre);
         self.best = None;
         self.tmax = tmax;
+        self.reach = widen(tmax);
         self.sp = 0;
         self.node = 0;
     }
@@ -1262,10 +1299,11 @@ impl Walk {
         if node_ref & LEAF != 0 {
             if let Some(h) = bvh.leaf(node_ref, &self.pre, ray, tmin, &mut self.tmax, false) {
                 self.best = Some(h);
+                self.reach = widen(self.tmax);
             }
         } else {
             let n = &bvh.nodes[node_ref as usize];
-            let (near, mut mask) = Bvh::node_hit::<AVX>(n, &self.slab, tmin, self.tmax);
+            let (near, mut mask) = Bvh::node_hit::<AVX>(n, &self.slab, tmin, self.reach);
             if node_ref == 0 {
                 mask &= !skip;
             }
@@ -1309,7 +1347,7 @@ impl Walk {
         while self.sp > 0 {
             self.sp -= 1;
             let (next, t_near) = self.stack.get(self.sp);
-            if t_near <= self.tmax {
+            if t_near <= self.reach {
                 self.node = next;
                 return true;
             }

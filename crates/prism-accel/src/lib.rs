@@ -14,13 +14,18 @@
 //!   room's walls and floor) are built apart under one child of the root, so that the
 //!   collapse lifts their leaves into the root.
 //! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
-//!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays.
+//!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays. A child
+//!   is entered when its entry is no farther than the nearest hit found so far, moved up
+//!   past the tests' rounding, so walks in any order find the same nearest hit.
 //! - [`Bvh::intersect_batch`] and [`Bvh::occluded_batch`] answer many rays in one call. On
 //!   processors with AVX-512 (AVX2), when the root's leaves hold at most 24 primitives (a
 //!   Cornell box's walls, or all of a small scene), they test sixteen (eight) rays at once
 //!   against those primitives, with the one-ray tests' operations on each lane, and against the boxes of
 //!   the root's other children; only rays that enter one of those before their nearest hit
-//!   traverse the rest. They return the one-ray calls' hits, bit for bit.
+//!   traverse the rest. Otherwise [`Bvh::intersect_batch`] walks each group of sixteen
+//!   (eight) coherent rays, one origin and one direction octant (a camera's), through the
+//!   tree together, each node's children and each leaf's triangles tested on lanes; other
+//!   rays are walked two at a time. They return the one-ray calls' hits, bit for bit.
 //! - [`Bvh::levels`], [`Bvh::level_boxes`] and [`Bvh::leaf_views`] show the 8-wide tree
 //!   level by level and leaf by leaf, for drawing and checking it.
 #![warn(missing_docs)]
@@ -28,7 +33,11 @@
 mod bvh;
 mod flat;
 mod inspect;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod node8;
+#[cfg(target_arch = "x86_64")]
+mod packet;
 mod shapes;
 #[cfg(target_arch = "x86_64")]
 mod simd;

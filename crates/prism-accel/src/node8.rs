@@ -46,6 +46,11 @@ impl Node8 {
         self.used |= 1 << slot;
     }
 
+    /// Bit i is set when slot i holds a child.
+    pub(crate) fn used(&self) -> u32 {
+        self.used
+    }
+
     /// True if `slot` holds a child.
     pub(crate) fn slot_used(&self, slot: usize) -> bool {
         self.used & (1 << slot) != 0
@@ -89,6 +94,16 @@ impl SlabRay {
 /// Rounding in the slab test may shrink the interval by a few ulps; widening the far end by
 /// this factor keeps hits on box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
 pub(crate) const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
+
+/// `t` moved up by 1/1024 of its size and by the smallest normal float: past a distance by
+/// far more than the slab and triangle tests' rounding (subnormal distances included).
+/// Walks enter every child whose entry is no farther than the nearest hit so widened, so a
+/// hit a few ulps short of its box's computed entry is never lost, whatever order the
+/// children are visited in: walks in any order find the same nearest hit.
+#[inline(always)]
+pub(crate) fn widen(t: f32) -> f32 {
+    t + t.abs() * (1.0 / 1024.0) + f32::MIN_POSITIVE
+}
 
 /// Entry distances of the ray into the eight child boxes, and which it enters (with an entry
 /// in `[tmin, tmax]`), by 4-wide SSE halves.

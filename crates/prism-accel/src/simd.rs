@@ -71,6 +71,10 @@ pub(crate) trait Simd {
     unsafe fn and_not(a: Self::M, b: Self::M) -> Self::M;
     /// The lanes as bits, lane 0 lowest.
     unsafe fn bits(m: Self::M) -> u16;
+    /// The mask of bits `b`, lane 0 lowest (bits past the width are ignored).
+    unsafe fn from_bits(b: u16) -> Self::M;
+    /// The least of `v`'s lanes in `m` (infinity for no lane).
+    unsafe fn min_of(m: Self::M, v: Self::F) -> f32;
     /// Lane i takes lane `idx[i]` of `v` (indices 0 to 3).
     unsafe fn permute(idx: Self::I, v: Self::F) -> Self::F;
     /// The four floats repeated across the lanes (lane i holds `p[i % 4]`).
@@ -202,6 +206,14 @@ impl Simd for Avx512 {
     #[inline(always)]
     unsafe fn bits(m: __mmask16) -> u16 {
         m
+    }
+    #[inline(always)]
+    unsafe fn from_bits(b: u16) -> __mmask16 {
+        b
+    }
+    #[inline(always)]
+    unsafe fn min_of(m: __mmask16, v: __m512) -> f32 {
+        _mm512_mask_reduce_min_ps(m, v)
     }
     #[inline(always)]
     unsafe fn permute(idx: __m512i, v: __m512) -> __m512 {
@@ -360,6 +372,20 @@ impl Simd for Avx2 {
     #[inline(always)]
     unsafe fn bits(m: __m256) -> u16 {
         _mm256_movemask_ps(m) as u16
+    }
+    #[inline(always)]
+    unsafe fn from_bits(b: u16) -> __m256 {
+        let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        let set = _mm256_and_si256(_mm256_set1_epi32(i32::from(b)), lane_bits);
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, lane_bits))
+    }
+    #[inline(always)]
+    unsafe fn min_of(m: __m256, v: __m256) -> f32 {
+        let v = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), v, m);
+        let h = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+        let h = _mm_min_ps(h, _mm_movehl_ps(h, h));
+        let h = _mm_min_ss(h, _mm_shuffle_ps::<1>(h, h));
+        _mm_cvtss_f32(h)
     }
     #[inline(always)]
     unsafe fn permute(idx: __m256i, v: __m256) -> __m256 {

@@ -35,6 +35,16 @@ impl Tri4 {
         Tri4 { v, prim }
     }
 
+    /// Vertex `i` of the triangle in `lane`, padded to four floats (`x, y, z, 0`).
+    pub(crate) fn corner(&self, lane: usize, i: usize) -> [f32; 4] {
+        [
+            self.v[i][0][lane],
+            self.v[i][1][lane],
+            self.v[i][2][lane],
+            0.0,
+        ]
+    }
+
     fn vertex(&self, lane: usize, i: usize) -> Vec3 {
         Vec3::new(self.v[i][0][lane], self.v[i][1][lane], self.v[i][2][lane])
     }

@@ -312,6 +312,53 @@ fn mesh_batches_equal_single_rays() {
     }
 }
 
+/// Oracle: the one-ray calls, on batches that mix groups of coherent rays (a pinhole
+/// camera's: one origin, one octant, which the batched query walks as packets) with loose
+/// rays, in runs of every length: every hit is the one-ray call's, bit for bit, on every
+/// instruction set. Some camera rays pass through the sphere's vertices exactly.
+#[test]
+fn camera_batches_equal_single_rays() {
+    let (verts, mut tris) = sphere_mesh();
+    let mut rng = Pcg32::new(7, 8);
+    let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - Vec3::ONE;
+    for _ in 0..300 {
+        let a = r() * 3.0;
+        tris.push([a, a + r() * 0.3, a + r() * 0.3]);
+    }
+    let spheres = [Sphere {
+        center: Vec3::new(0.5, -0.5, 1.0),
+        radius: 0.4,
+    }];
+    let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+    let mut rays = vec![];
+    for k in 0..40 {
+        let eye = if k % 2 == 0 {
+            r() * 0.5
+        } else {
+            r() * 2.0 + Vec3::new(0.0, 0.0, 9.0)
+        };
+        let aim = r() * 2.0;
+        // A camera's rays, in scanline order, sixteen or eight to a row.
+        for i in 0..32 {
+            let pixel = Vec3::new((i % 16) as f32, (i / 16) as f32, 0.0) * 0.01;
+            rays.push(Ray::new(eye, aim + pixel - eye));
+        }
+        // Rays through vertices from one origin.
+        for i in 0..16 {
+            rays.push(Ray::new(eye, verts[(k * 37 + i) % verts.len()] - eye));
+        }
+        // Loose rays between the groups.
+        for _ in 0..k % 5 {
+            rays.push(Ray::new(r() * 4.0, r()));
+        }
+    }
+    let ends: Vec<f32> = (0..rays.len()).map(|i| 2.0 + (i % 5) as f32).collect();
+    for skip in [0, 3, 8] {
+        check_batches(&bvh, &rays[skip..], &ends[skip..], f32::INFINITY).unwrap();
+        check_batches(&bvh, &rays[skip..], &ends[skip..], 6.0).unwrap();
+    }
+}
+
 /// Property: the hierarchy is the same whatever the thread count (same statistics and the
 /// same hits), and statistics are consistent.
 #[test]
