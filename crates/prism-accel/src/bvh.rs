@@ -7,6 +7,8 @@ use rayon::prelude::*;
 
 use crate::flat::{Flat, Lanes, FLAT_MAX};
 use crate::node8::{self, widen, Node8, SlabRay};
+#[cfg(target_arch = "x86_64")]
+use crate::packet::Query;
 use crate::shapes::{intersect_sphere, RayPre, Sphere};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512, Simd};
@@ -841,7 +843,7 @@ impl Bvh {
         (tmin, tmax): (f32, f32),
         hits: &mut [Option<Hit>],
         width: usize,
-        packet: impl Fn(&[Ray], &mut [Option<Hit>]) -> u16,
+        packet: impl Fn(&Query, &mut [Option<Hit>]) -> u16,
     ) {
         // The first ray not yet walked.
         let mut loose = 0;
@@ -850,7 +852,14 @@ impl Bvh {
             let group = &rays[i..i + width];
             if crate::packet::coherent(group, width) {
                 self.intersect_pairs::<true>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
-                let mut defer = packet(group, &mut hits[i..i + width]);
+                let query = Query {
+                    rays: group,
+                    tmin,
+                    ends: [tmax; 16],
+                    lanes: u16::MAX,
+                    skip: 0,
+                };
+                let mut defer = packet(&query, &mut hits[i..i + width]);
                 while defer != 0 {
                     let lane = defer.trailing_zeros() as usize;
                     defer &= defer - 1;
@@ -865,7 +874,8 @@ impl Bvh {
 
     /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
     /// against the list on lanes (`closest`), then the rest of the tree for the rays that
-    /// enter it. Inlined into each compiled variant.
+    /// enter it: as a packet (`packet`) when the group is coherent and a quarter of its
+    /// rays or more enter, else ray by ray. Inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn intersect_batch_list(
@@ -875,9 +885,15 @@ impl Bvh {
         hits: &mut [Option<Hit>],
         (flat, width): (&Flat, usize),
         closest: impl Fn(&[Ray], &mut [Option<Hit>]) -> Lanes,
+        packet: impl Fn(&Query, &mut [Option<Hit>]) -> u16,
     ) {
         for (rays, hits) in rays.chunks(width).zip(hits.chunks_mut(width)) {
             let lanes = closest(rays, hits);
+            let tree = lanes.need & !lanes.defer;
+            if 2 * tree.count_ones() as usize >= width && crate::packet::coherent(rays, width) {
+                self.list_packet(rays, (tmin, tmax), hits, (flat, lanes), &packet);
+                continue;
+            }
             // The list's hits stand, but in the lanes that must consult the tree.
             let mut rest = u32::from(lanes.defer | lanes.need) & ((1 << rays.len()) - 1);
             while rest != 0 {
@@ -903,6 +919,50 @@ impl Bvh {
         }
     }
 
+    /// The tree part of [`Bvh::intersect_batch_list`] for a coherent group, as a packet:
+    /// the lanes that enter the rest of the tree walk it together, each up to just past
+    /// its list hit; the lanes the list or the packet defers, and those where the tree and
+    /// the list meet one distance, take the one-ray walk over the whole tree.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn list_packet(
+        &self,
+        rays: &[Ray],
+        (tmin, tmax): (f32, f32),
+        hits: &mut [Option<Hit>],
+        (flat, lanes): (&Flat, Lanes),
+        packet: &impl Fn(&Query, &mut [Option<Hit>]) -> u16,
+    ) {
+        let tree = lanes.need & !lanes.defer;
+        let mut list = [None; 16];
+        list[..hits.len()].copy_from_slice(hits);
+        let mut ends = [tmax; 16];
+        for (end, hit) in ends.iter_mut().zip(&list) {
+            *end = hit.map_or(tmax, |h| h.t.next_up());
+        }
+        let query = Query {
+            rays,
+            tmin,
+            ends,
+            lanes: tree,
+            skip: flat.skip,
+        };
+        let mut found = [None; 16];
+        let deferred = packet(&query, &mut found[..hits.len()]);
+        for (lane, hit) in hits.iter_mut().enumerate() {
+            let bit = 1 << lane;
+            let whole = lanes.defer & bit != 0
+                || deferred & bit != 0
+                || (tree & bit != 0
+                    && found[lane].is_some_and(|h| list[lane].is_some_and(|n| n.t == h.t)));
+            if whole {
+                *hit = self.intersect_with::<true>(&rays[lane], tmin, tmax, 0);
+            } else if tree & bit != 0 && found[lane].is_some() {
+                *hit = found[lane];
+            }
+        }
+    }
+
     /// [`Bvh::intersect_batch_list`] on sixteen lanes of AVX-512.
     ///
     /// # Safety
@@ -917,10 +977,15 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, Avx512::W), |r, h| {
-            // SAFETY: the processor has AVX-512F.
-            unsafe { crate::flat::closest_avx512(flat, r, (tmin, tmax), h) }
-        });
+        self.intersect_batch_list(
+            rays,
+            (tmin, tmax),
+            hits,
+            (flat, Avx512::W),
+            // SAFETY (both): the processor has AVX-512F.
+            |r, h| unsafe { crate::flat::closest_avx512(flat, r, (tmin, tmax), h) },
+            |q, h| unsafe { crate::packet::closest_avx512(self, q, h) },
+        );
     }
 
     /// [`Bvh::intersect_batch_list`] on eight lanes of AVX2.
@@ -937,10 +1002,15 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(rays, (tmin, tmax), hits, (flat, Avx2::W), |r, h| {
-            // SAFETY: the processor has AVX2.
-            unsafe { crate::flat::closest_avx2(flat, r, (tmin, tmax), h) }
-        });
+        self.intersect_batch_list(
+            rays,
+            (tmin, tmax),
+            hits,
+            (flat, Avx2::W),
+            // SAFETY (both): the processor has AVX2.
+            |r, h| unsafe { crate::flat::closest_avx2(flat, r, (tmin, tmax), h) },
+            |q, h| unsafe { crate::packet::closest_avx2(self, q, h) },
+        );
     }
 
     /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_list`].
@@ -1027,9 +1097,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx512::W, |r, h| {
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
             // SAFETY: the processor has AVX-512VL, hence AVX-512F.
-            unsafe { crate::packet::closest_avx512(self, r, (tmin, tmax), h) }
+            unsafe { crate::packet::closest_avx512(self, q, h) }
         });
     }
 
@@ -1046,9 +1116,9 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx2::W, |r, h| {
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
             // SAFETY: the processor has AVX2.
-            unsafe { crate::packet::closest_avx2(self, r, (tmin, tmax), h) }
+            unsafe { crate::packet::closest_avx2(self, q, h) }
         });
     }
 

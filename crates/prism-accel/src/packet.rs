@@ -34,28 +34,35 @@ struct Pending<S: Simd> {
     near: [std::mem::MaybeUninit<S::F>; STACK],
 }
 
-/// The closest hits of `rays` (at most the lanes) with `t.0 < t < t.1`, written to `out` (one
-/// per ray) except in the lanes the returned bits name, whose answer must come from the
-/// one-ray walk.
+/// A packet walk's query: the rays (at most the lanes), their common start `tmin`, each
+/// lane's end, the lanes to answer, and the root's slots to leave out (as the one-ray walk
+/// leaves out the list's leaves).
+pub(crate) struct Query<'a> {
+    pub(crate) rays: &'a [Ray],
+    pub(crate) tmin: f32,
+    /// Each lane's end (sixteen; past the rays, any value).
+    pub(crate) ends: [f32; 16],
+    pub(crate) lanes: u16,
+    pub(crate) skip: u32,
+}
+
+/// The closest hits of the query's rays with `tmin < t < end`, written to `out` (one per
+/// ray, in the query's lanes) except in the lanes the returned bits name, whose answer must
+/// come from the one-ray walk.
 #[inline(always)]
-unsafe fn closest<S: Simd>(
-    bvh: &Bvh,
-    rays: &[Ray],
-    (tmin, tmax): (f32, f32),
-    out: &mut [Option<Hit>],
-) -> u16 {
-    let n = rays.len().min(S::W);
-    let real = if n >= 16 { u16::MAX } else { (1u16 << n) - 1 };
+unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16 {
+    let n = q.rays.len().min(S::W);
+    let real = q.lanes & if n >= 16 { u16::MAX } else { (1u16 << n) - 1 };
     // SAFETY (all below): the caller runs on `S`'s instruction set.
     unsafe {
-        let g = Group::<S>::new(rays);
+        let g = Group::<S>::new(q.rays);
         let one = S::splat(1.0);
         let inv = [
             S::div(one, g.dir[0]),
             S::div(one, g.dir[1]),
             S::div(one, g.dir[2]),
         ];
-        let (lo, hi) = (S::splat(tmin), S::splat(tmax));
+        let (lo, hi) = (S::splat(q.tmin), S::load(&q.ends));
         let zero = S::splat(0.0);
         let mut best = Nearest::<S> {
             t: hi,
@@ -108,6 +115,9 @@ unsafe fn closest<S: Simd>(
                 let mut nears = [zero; 8];
                 let mut count = 0;
                 let mut used = n.used();
+                if node == 0 {
+                    used &= !q.skip;
+                }
                 while used != 0 {
                     let slot = used.trailing_zeros() as usize;
                     used &= used - 1;
@@ -184,6 +194,9 @@ unsafe fn finish<S: Simd>(
         S::store_i(best.prim, &mut prim);
         let found = S::bits(best.found);
         for (lane, hit) in out.iter_mut().enumerate().take(S::W) {
+            if real & (1 << lane) == 0 {
+                continue;
+            }
             *hit = (found & (1 << lane) != 0).then(|| Hit {
                 t: t[lane],
                 prim: prim[lane],
@@ -200,14 +213,9 @@ unsafe fn finish<S: Simd>(
 /// # Safety
 /// The processor must support AVX-512F.
 #[target_feature(enable = "avx512f")]
-pub(crate) unsafe fn closest_avx512(
-    bvh: &Bvh,
-    rays: &[Ray],
-    t: (f32, f32),
-    out: &mut [Option<Hit>],
-) -> u16 {
+pub(crate) unsafe fn closest_avx512(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16 {
     // SAFETY: compiled for AVX-512F, which the caller guarantees.
-    unsafe { closest::<Avx512>(bvh, rays, t, out) }
+    unsafe { closest::<Avx512>(bvh, q, out) }
 }
 
 /// [`closest`] on eight lanes of AVX2.
@@ -215,14 +223,9 @@ pub(crate) unsafe fn closest_avx512(
 /// # Safety
 /// The processor must support AVX2.
 #[target_feature(enable = "avx2")]
-pub(crate) unsafe fn closest_avx2(
-    bvh: &Bvh,
-    rays: &[Ray],
-    t: (f32, f32),
-    out: &mut [Option<Hit>],
-) -> u16 {
+pub(crate) unsafe fn closest_avx2(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16 {
     // SAFETY: compiled for AVX2, which the caller guarantees.
-    unsafe { closest::<Avx2>(bvh, rays, t, out) }
+    unsafe { closest::<Avx2>(bvh, q, out) }
 }
 
 #[cfg(test)]
@@ -309,11 +312,18 @@ mod tests {
                 for rays in rays.chunks(width) {
                     let mut out = vec![None; width];
                     // SAFETY: the processor has the instruction set (checked above).
+                    let q = Query {
+                        rays,
+                        tmin: 1e-3,
+                        ends: [tmax; 16],
+                        lanes: u16::MAX,
+                        skip: 0,
+                    };
                     let defer = unsafe {
                         if width == 16 {
-                            closest_avx512(&bvh, rays, (1e-3, tmax), &mut out)
+                            closest_avx512(&bvh, &q, &mut out)
                         } else {
-                            closest_avx2(&bvh, rays, (1e-3, tmax), &mut out)
+                            closest_avx2(&bvh, &q, &mut out)
                         }
                     };
                     for (lane, ray) in rays.iter().enumerate() {

@@ -314,8 +314,10 @@ fn mesh_batches_equal_single_rays() {
 
 /// Oracle: the one-ray calls, on batches that mix groups of coherent rays (a pinhole
 /// camera's: one origin, one octant, which the batched query walks as packets) with loose
-/// rays, in runs of every length: every hit is the one-ray call's, bit for bit, on every
-/// instruction set. Some camera rays pass through the sphere's vertices exactly.
+/// rays, in runs of every length, in a closed mesh alone and inside a room (whose walls the
+/// batched query tests on lanes before the packet walks the rest): every hit is the one-ray
+/// call's, bit for bit, on every instruction set. Some camera rays pass through the
+/// sphere's vertices exactly.
 #[test]
 fn camera_batches_equal_single_rays() {
     let (verts, mut tris) = sphere_mesh();
@@ -329,7 +331,49 @@ fn camera_batches_equal_single_rays() {
         center: Vec3::new(0.5, -0.5, 1.0),
         radius: 0.4,
     }];
-    let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+    let mut room = tris.clone();
+    let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 12.0;
+    for [a, b, cc, d] in [
+        [
+            c(-1., -1., -1.),
+            c(1., -1., -1.),
+            c(1., -1., 1.),
+            c(-1., -1., 1.),
+        ],
+        [
+            c(-1., 1., -1.),
+            c(-1., 1., 1.),
+            c(1., 1., 1.),
+            c(1., 1., -1.),
+        ],
+        [
+            c(-1., -1., -1.),
+            c(-1., 1., -1.),
+            c(1., 1., -1.),
+            c(1., -1., -1.),
+        ],
+        [
+            c(-1., -1., -1.),
+            c(-1., -1., 1.),
+            c(-1., 1., 1.),
+            c(-1., 1., -1.),
+        ],
+    ] {
+        room.push([a, b, cc]);
+        room.push([a, cc, d]);
+    }
+    for tris in [tris, room] {
+        camera_batches(&verts, &tris, &spheres, &mut r);
+    }
+}
+
+fn camera_batches(
+    verts: &[Vec3],
+    tris: &[[Vec3; 3]],
+    spheres: &[Sphere],
+    r: &mut impl FnMut() -> Vec3,
+) {
+    let bvh = Bvh::build(tris, spheres, &BuildOptions::default());
     let mut rays = vec![];
     for k in 0..40 {
         let eye = if k % 2 == 0 {
@@ -346,6 +390,13 @@ fn camera_batches_equal_single_rays() {
         // Rays through vertices from one origin.
         for i in 0..16 {
             rays.push(Ray::new(eye, verts[(k * 37 + i) % verts.len()] - eye));
+        }
+        // A camera looking past the sphere, at the walls.
+        for i in 0..16 {
+            rays.push(Ray::new(
+                eye,
+                aim * 4.0 + Vec3::new(i as f32, 0.0, 0.0) * 0.3 - eye,
+            ));
         }
         // Loose rays between the groups.
         for _ in 0..k % 5 {
