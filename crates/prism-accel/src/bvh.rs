@@ -1408,6 +1408,7 @@ impl Walk {
                 self.sp += count - 1;
                 self.node = n.child[a];
                 bvh.prefetch(self.node);
+                bvh.prefetch(n.child[b]);
                 return true;
             } else {
                 let i = mask.trailing_zeros() as usize;
