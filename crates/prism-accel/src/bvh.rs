@@ -721,10 +721,7 @@ impl Bvh {
     }
 
     /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
-    /// at once, a step of one then a step of the other: each step waits on memory (a node,
-    /// a leaf's triangles) that the other's step is computed under. Each ray's walk is the
-    /// one [`Bvh::intersect_with`] takes, so the hits are the same; its children are
-    /// chosen by selects (`Walk::step`), as the rays of a batch are mostly incoherent.
+    /// at once ([`Bvh::walk_pairs`]).
     #[inline(always)]
     fn intersect_pairs<const AVX: bool>(
         &self,
@@ -733,48 +730,72 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        let n = rays.len();
+        self.walk_pairs::<AVX>(rays, tmin, (rays.len(), |k| (k, tmax, 0)), hits);
+    }
+
+    /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
+    /// `rays`), its end and the root's slots it leaves out, and writes query k's hit to
+    /// `hits[k]`. Two walks go on at once, a step of one then a step of the other: each
+    /// step waits on memory (a node, a leaf's triangles) that the other's step is computed
+    /// under. Each walk is the one [`Bvh::intersect_with`] takes, so the hits are the same;
+    /// its children are chosen by selects (`Walk::step`), as the rays of a batch are mostly
+    /// incoherent.
+    #[inline(always)]
+    fn walk_pairs<const AVX: bool>(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        (n, job): (usize, impl Fn(usize) -> (usize, f32, u32)),
+        hits: &mut [Option<Hit>],
+    ) {
         if n < 2 {
-            for (ray, hit) in rays.iter().zip(hits) {
-                *hit = self.intersect_with::<AVX>(ray, tmin, tmax, 0);
+            for (k, hit) in hits.iter_mut().enumerate().take(n) {
+                let (i, tmax, skip) = job(k);
+                *hit = self.intersect_with::<AVX>(&rays[i], tmin, tmax, skip);
             }
             return;
         }
-        // The rays walking in the two slots, and the next ray to start.
-        let (mut a, mut b, mut next) = (0, 1, 2);
-        let mut wa = Walk::new(&rays[a], tmax);
-        let mut wb = Walk::new(&rays[b], tmax);
-        let query = (rays, tmin, tmax);
-        while self.pair_step::<AVX>(query, hits, (&mut wa, &mut a), (&mut wb, b), &mut next)
-            && self.pair_step::<AVX>(query, hits, (&mut wb, &mut b), (&mut wa, a), &mut next)
-        {
-        }
+        let mut a = Slot::start(rays, &job, 0);
+        let mut b = Slot::start(rays, &job, 1);
+        let mut next = 2;
+        let (walks, out) = ((rays, tmin, (n, &job)), hits);
+        while self.pair_step::<AVX>(walks, out, &mut a, &mut b, &mut next)
+            && self.pair_step::<AVX>(walks, out, &mut b, &mut a, &mut next)
+        {}
     }
 
-    /// A step of [`Bvh::intersect_pairs`]' walk in one slot (`walk` of ray `i`). When the
-    /// walk ends, its hit is stored and the slot takes ray `next`; with no ray left, the
-    /// other slot's walk (of ray `j`) is finished, and the answer is false: all are done.
+    /// A step of [`Bvh::walk_pairs`]' walk in slot `slot`. When its walk ends, its hit is
+    /// stored and the slot takes query `next`; with no query left, the `other` slot's walk
+    /// is finished, and the answer is false: all are done.
     #[inline(always)]
+    #[allow(clippy::type_complexity)]
     fn pair_step<const AVX: bool>(
         &self,
-        (rays, tmin, tmax): (&[Ray], f32, f32),
+        (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, u32))),
         hits: &mut [Option<Hit>],
-        (walk, i): (&mut Walk, &mut usize),
-        (other, j): (&mut Walk, usize),
+        slot: &mut Slot,
+        other: &mut Slot,
         next: &mut usize,
     ) -> bool {
-        if walk.step::<AVX, true>(self, &rays[*i], tmin, 0) {
+        if slot
+            .walk
+            .step::<AVX, true>(self, &rays[slot.ray], tmin, slot.skip)
+        {
             return true;
         }
-        hits[*i] = walk.best;
-        if *next == rays.len() {
-            while other.step::<AVX, true>(self, &rays[j], tmin, 0) {}
-            hits[j] = other.best;
+        hits[slot.query] = slot.walk.best;
+        if *next == n {
+            while other
+                .walk
+                .step::<AVX, true>(self, &rays[other.ray], tmin, other.skip)
+            {}
+            hits[other.query] = other.walk.best;
             return false;
         }
-        *i = *next;
+        let (ray, tmax, skip) = job(*next);
+        slot.walk.reset(&rays[ray], tmax);
+        (slot.ray, slot.skip, slot.query) = (ray, skip, *next);
         *next += 1;
-        walk.reset(&rays[*i], tmax);
         true
     }
 
@@ -888,7 +909,12 @@ impl Bvh {
         closest: impl Fn(&[Ray], &mut [Option<Hit>]) -> Lanes,
         packet: impl Fn(&Query, &mut [Option<Hit>]) -> u16,
     ) {
-        for (rays, hits) in rays.chunks(width).zip(hits.chunks_mut(width)) {
+        // The tree walks still to make, over the whole batch: each ray, its end, the
+        // root's slots it leaves out, and whether it is over the whole tree.
+        let mut jobs: Vec<(usize, f32, u32)> = vec![];
+        let mut whole: Vec<bool> = vec![];
+        let groups = rays.chunks(width).zip(hits.chunks_mut(width));
+        for (g, (rays, hits)) in groups.enumerate() {
             let lanes = closest(rays, hits);
             let tree = lanes.need & !lanes.defer;
             if 2 * tree.count_ones() as usize >= width && crate::packet::coherent(rays, width) {
@@ -900,23 +926,29 @@ impl Bvh {
             while rest != 0 {
                 let lane = rest.trailing_zeros() as usize;
                 rest &= rest - 1;
-                let ray = &rays[lane];
-                let near = hits[lane];
-                hits[lane] = if lanes.defer & (1 << lane) != 0 {
-                    self.intersect_with::<true>(ray, tmin, tmax, 0)
+                let all = lanes.defer & (1 << lane) != 0;
+                // The rest of the tree, for a hit no farther than the list's.
+                let end = hits[lane].map_or(tmax, |h| h.t.next_up());
+                jobs.push(if all {
+                    (g * width + lane, tmax, 0)
                 } else {
-                    // The rest of the tree, for a hit no farther than the list's.
-                    let end = near.map_or(tmax, |h| h.t.next_up());
-                    match self.intersect_with::<true>(ray, tmin, end, flat.skip) {
-                        // Two primitives at one distance: the tree's order decides.
-                        Some(h) if near.is_some_and(|n| n.t == h.t) => {
-                            self.intersect_with::<true>(ray, tmin, tmax, 0)
-                        }
-                        Some(h) => Some(h),
-                        None => near,
-                    }
-                };
+                    (g * width + lane, end, flat.skip)
+                });
+                whole.push(all);
             }
+        }
+        let mut found = vec![None; jobs.len()];
+        self.walk_pairs::<true>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
+        for ((&(i, ..), all), h) in jobs.iter().zip(whole).zip(found) {
+            hits[i] = match h {
+                _ if all => h,
+                // Two primitives at one distance: the tree's order decides.
+                Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
+                    self.intersect_with::<true>(&rays[i], tmin, tmax, 0)
+                }
+                Some(h) => Some(h),
+                None => hits[i],
+            };
         }
     }
 
@@ -1314,6 +1346,29 @@ impl<T: Copy> Stack<T> {
         // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
         // passes the highest slot written), so it holds an initialized value.
         unsafe { self.items[i].assume_init() }
+    }
+}
+
+/// A slot of [`Bvh::walk_pairs`]: the walk of query `query`, of ray `ray` with the root's
+/// slots `skip` left out.
+struct Slot {
+    walk: Walk,
+    ray: usize,
+    skip: u32,
+    query: usize,
+}
+
+impl Slot {
+    /// The slot walking query `k` of `job`.
+    #[inline(always)]
+    fn start(rays: &[Ray], job: &impl Fn(usize) -> (usize, f32, u32), k: usize) -> Slot {
+        let (ray, tmax, skip) = job(k);
+        Slot {
+            walk: Walk::new(&rays[ray], tmax),
+            ray,
+            skip,
+            query: k,
+        }
     }
 }
 
