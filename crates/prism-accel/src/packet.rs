@@ -275,8 +275,10 @@ mod tests {
     }
 
     /// Oracle: the one-ray walk. Packets of coherent rays (a pinhole camera's, from inside
-    /// and outside the sphere, and from grid points towards grid points) get the one-ray
-    /// walk's hit, bit for bit, in every lane they answer; they leave few lanes to it.
+    /// and outside the sphere, and from grid points towards grid points), and packets of
+    /// hostile directions (along an axis, tiny, subnormal, zero, NaN, infinite), get the
+    /// one-ray walk's hit, bit for bit, in every lane they answer; they leave few lanes to
+    /// it.
     #[test]
     fn packets_equal_the_one_ray_walk() {
         let bvh = Bvh::build(&scene(48), &[], &BuildOptions::default());
@@ -337,6 +339,62 @@ mod tests {
                             h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()))
                         };
                         assert_eq!(bits(out[lane]), bits(want), "group {group}, lane {lane}");
+                    }
+                }
+            }
+        }
+        // Hostile lanes: directions along an axis (slab planes the ray lies in), tiny,
+        // subnormal, zero and NaN components, from a grid point and from the sphere's
+        // centre.
+        let odd = [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.0, 1e-30, -1.0),
+            Vec3::new(1e-40, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, -1e-30),
+            Vec3::new(0.5, 0.5, -1e-38),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(f32::NAN, 0.0, -1.0),
+            Vec3::new(0.0, f32::INFINITY, -1.0),
+        ];
+        for origin in [
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::ZERO,
+            Vec3::new(0.5, 0.5, -5.0),
+        ] {
+            let rays: Vec<Ray> = odd
+                .iter()
+                .chain(&odd)
+                .map(|&d| Ray::new(origin, d))
+                .collect();
+            for (width, isa) in [(16, Isa::Avx512), (8, Isa::Avx2)] {
+                if Isa::get() < isa {
+                    continue;
+                }
+                for rays in rays.chunks(width) {
+                    let mut out = vec![None; width];
+                    let q = Query {
+                        rays,
+                        tmin: 0.0,
+                        ends: [f32::INFINITY; 16],
+                        lanes: u16::MAX,
+                        skip: 0,
+                    };
+                    // SAFETY: the processor has the instruction set (checked above).
+                    let defer = unsafe {
+                        if width == 16 {
+                            closest_avx512(&bvh, &q, &mut out)
+                        } else {
+                            closest_avx2(&bvh, &q, &mut out)
+                        }
+                    };
+                    for (lane, ray) in rays.iter().enumerate() {
+                        if defer & (1 << lane) == 0 {
+                            let want = bvh.intersect(ray, 0.0, f32::INFINITY);
+                            let bits = |h: Option<Hit>| {
+                                h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()))
+                            };
+                            assert_eq!(bits(out[lane]), bits(want), "{origin}, lane {lane}");
+                        }
                     }
                 }
             }
