@@ -153,15 +153,7 @@ mod queries {
             let g = Group::<S>::new(rays);
             let (lo, hi) = (S::splat(tmin), S::splat(tmax));
             let zero = S::splat(0.0);
-            let mut near = Nearest::<S> {
-                t: hi,
-                v: zero,
-                w: zero,
-                det: zero,
-                prim: S::splat_i(-1),
-                found: S::none(),
-                tie: S::none(),
-            };
+            let mut near = Nearest::<S>::none(hi);
             let mut defer = S::none();
             let mut prepared = Prepared::<S>::new();
             prepared.fill(flat, &g);
@@ -174,32 +166,11 @@ mod queries {
                 let (t, hit) = sphere(&g, s, lo, hi);
                 near.update((t, zero, zero, zero), *prim, hit);
             }
-            // The barycentric weights `v / det` and `w / det` (the one-ray test's
-            // operations), zero for spheres.
-            let inv = S::div(S::splat(1.0), near.det);
-            let sphere = S::ge_u32(near.prim, S::splat_i(flat.first_sphere as i32));
-            let b1 = S::select(sphere, S::mul(near.v, inv), zero);
-            let b2 = S::select(sphere, S::mul(near.w, inv), zero);
-            let mut t = [0f32; 16];
-            let mut b = [[0f32; 16]; 2];
-            let mut prim = [0u32; 16];
-            S::store(near.t, &mut t);
-            S::store(b1, &mut b[0]);
-            S::store(b2, &mut b[1]);
-            S::store_i(near.prim, &mut prim);
-            let found = S::bits(near.found);
+            near.write(flat.first_sphere, u16::MAX, out);
             let defer = S::bits(defer) | S::bits(near.tie);
             // Past a hit the list found, a margin far wider than the slab test's rounding.
             let reach = S::select(near.found, hi, widen::<S>(near.t));
             let need = need(flat, &g, lo, reach) & !defer;
-            for (lane, hit) in out.iter_mut().enumerate().take(S::W) {
-                *hit = (found & (1 << lane) != 0).then(|| Hit {
-                    t: t[lane],
-                    prim: prim[lane],
-                    b1: b[0][lane],
-                    b2: b[1][lane],
-                });
-            }
             Lanes {
                 blocked: 0,
                 defer,

@@ -6,6 +6,7 @@
 
 use prism_math::{Aabb, Ray};
 
+use crate::bvh::Hit;
 use crate::node8::FAR_WIDEN;
 use crate::shapes::Sphere;
 use crate::simd::Simd;
@@ -272,6 +273,57 @@ pub(crate) struct Nearest<S: Simd> {
 }
 
 impl<S: Simd> Nearest<S> {
+    /// Nothing found yet on any lane, up to `tmax`.
+    #[inline(always)]
+    pub(crate) unsafe fn none(tmax: S::F) -> Nearest<S> {
+        // SAFETY: the caller runs on `S`'s instruction set.
+        unsafe {
+            let zero = S::splat(0.0);
+            Nearest {
+                t: tmax,
+                v: zero,
+                w: zero,
+                det: zero,
+                prim: S::splat_i(-1),
+                found: S::none(),
+                tie: S::none(),
+            }
+        }
+    }
+
+    /// Writes each lane's hit in `lanes` to `out` (none where nothing was found), with the
+    /// barycentric weights `v / det` and `w / det` as the one-ray test divides them (zero
+    /// for spheres, the primitives from `first_sphere` on).
+    #[inline(always)]
+    pub(crate) unsafe fn write(&self, first_sphere: u32, lanes: u16, out: &mut [Option<Hit>]) {
+        // SAFETY: the caller runs on `S`'s instruction set.
+        unsafe {
+            let zero = S::splat(0.0);
+            let inv = S::div(S::splat(1.0), self.det);
+            let sphere = S::ge_u32(self.prim, S::splat_i(first_sphere as i32));
+            let b1 = S::select(sphere, S::mul(self.v, inv), zero);
+            let b2 = S::select(sphere, S::mul(self.w, inv), zero);
+            let mut t = [0f32; 16];
+            let mut b = [[0f32; 16]; 2];
+            let mut prim = [0u32; 16];
+            S::store(self.t, &mut t);
+            S::store(b1, &mut b[0]);
+            S::store(b2, &mut b[1]);
+            S::store_i(self.prim, &mut prim);
+            let found = S::bits(self.found);
+            for (lane, hit) in out.iter_mut().enumerate().take(S::W) {
+                if lanes & (1 << lane) != 0 {
+                    *hit = (found & (1 << lane) != 0).then(|| Hit {
+                        t: t[lane],
+                        prim: prim[lane],
+                        b1: b[0][lane],
+                        b2: b[1][lane],
+                    });
+                }
+            }
+        }
+    }
+
     /// Takes a primitive's hits (`hit` lanes at `t`) where they are nearer.
     #[inline(always)]
     pub(crate) unsafe fn update(

@@ -64,15 +64,7 @@ unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16
         ];
         let (lo, hi) = (S::splat(q.tmin), S::load(&q.ends));
         let zero = S::splat(0.0);
-        let mut best = Nearest::<S> {
-            t: hi,
-            v: zero,
-            w: zero,
-            det: zero,
-            prim: S::splat_i(-1),
-            found: S::none(),
-            tie: S::none(),
-        };
+        let mut best = Nearest::<S>::none(hi);
         let mut reach = widen::<S>(hi);
         let mut defer = S::none();
         let mut stack = Pending::<S> {
@@ -153,7 +145,8 @@ unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16
             // Pop the nearest pending child that some lane may still find a nearer hit in.
             loop {
                 if sp == 0 {
-                    return finish(bvh, &best, S::or(defer, best.tie), real, out);
+                    best.write(bvh.triangle_count, real, out);
+                    return S::bits(S::or(defer, best.tie)) & real;
                 }
                 sp -= 1;
                 let near = stack.near[sp].assume_init();
@@ -165,46 +158,6 @@ unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16
                 }
             }
         }
-    }
-}
-
-/// Writes the packet's hits to `out` (barycentric weights as the one-ray test divides them)
-/// and returns the lanes left to the one-ray walk.
-#[inline(always)]
-unsafe fn finish<S: Simd>(
-    bvh: &Bvh,
-    best: &Nearest<S>,
-    defer: S::M,
-    real: u16,
-    out: &mut [Option<Hit>],
-) -> u16 {
-    // SAFETY: the caller runs on `S`'s instruction set.
-    unsafe {
-        let zero = S::splat(0.0);
-        let inv = S::div(S::splat(1.0), best.det);
-        let sphere = S::ge_u32(best.prim, S::splat_i(bvh.triangle_count as i32));
-        let b1 = S::select(sphere, S::mul(best.v, inv), zero);
-        let b2 = S::select(sphere, S::mul(best.w, inv), zero);
-        let mut t = [0f32; 16];
-        let mut b = [[0f32; 16]; 2];
-        let mut prim = [0u32; 16];
-        S::store(best.t, &mut t);
-        S::store(b1, &mut b[0]);
-        S::store(b2, &mut b[1]);
-        S::store_i(best.prim, &mut prim);
-        let found = S::bits(best.found);
-        for (lane, hit) in out.iter_mut().enumerate().take(S::W) {
-            if real & (1 << lane) == 0 {
-                continue;
-            }
-            *hit = (found & (1 << lane) != 0).then(|| Hit {
-                t: t[lane],
-                prim: prim[lane],
-                b1: b[0][lane],
-                b2: b[1][lane],
-            });
-        }
-        S::bits(defer) & real
     }
 }
 
@@ -274,6 +227,26 @@ mod tests {
         tris
     }
 
+    /// The packet walk's answer to `q` on `width` lanes: the hits, and the lanes left to
+    /// the one-ray walk. The processor must have the width's instruction set.
+    fn answer(bvh: &Bvh, q: &Query, width: usize) -> (Vec<Option<Hit>>, u16) {
+        let mut out = vec![None; width];
+        // SAFETY: the callers check the instruction set first.
+        let defer = unsafe {
+            if width == 16 {
+                closest_avx512(bvh, q, &mut out)
+            } else {
+                closest_avx2(bvh, q, &mut out)
+            }
+        };
+        (out, defer)
+    }
+
+    /// A hit's bits, for exact comparison.
+    fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32)> {
+        h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()))
+    }
+
     /// Oracle: the one-ray walk. Packets of coherent rays (a pinhole camera's, from inside
     /// and outside the sphere, and from grid points towards grid points), and packets of
     /// hostile directions (along an axis, tiny, subnormal, zero, NaN, infinite), get the
@@ -312,8 +285,6 @@ mod tests {
                     continue;
                 }
                 for rays in rays.chunks(width) {
-                    let mut out = vec![None; width];
-                    // SAFETY: the processor has the instruction set (checked above).
                     let q = Query {
                         rays,
                         tmin: 1e-3,
@@ -321,13 +292,7 @@ mod tests {
                         lanes: u16::MAX,
                         skip: 0,
                     };
-                    let defer = unsafe {
-                        if width == 16 {
-                            closest_avx512(&bvh, &q, &mut out)
-                        } else {
-                            closest_avx2(&bvh, &q, &mut out)
-                        }
-                    };
+                    let (out, defer) = answer(&bvh, &q, width);
                     for (lane, ray) in rays.iter().enumerate() {
                         lanes += 1;
                         if defer & (1 << lane) != 0 {
@@ -335,9 +300,6 @@ mod tests {
                             continue;
                         }
                         let want = bvh.intersect(ray, 1e-3, tmax);
-                        let bits = |h: Option<Hit>| {
-                            h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()))
-                        };
                         assert_eq!(bits(out[lane]), bits(want), "group {group}, lane {lane}");
                     }
                 }
@@ -371,7 +333,6 @@ mod tests {
                     continue;
                 }
                 for rays in rays.chunks(width) {
-                    let mut out = vec![None; width];
                     let q = Query {
                         rays,
                         tmin: 0.0,
@@ -379,20 +340,10 @@ mod tests {
                         lanes: u16::MAX,
                         skip: 0,
                     };
-                    // SAFETY: the processor has the instruction set (checked above).
-                    let defer = unsafe {
-                        if width == 16 {
-                            closest_avx512(&bvh, &q, &mut out)
-                        } else {
-                            closest_avx2(&bvh, &q, &mut out)
-                        }
-                    };
+                    let (out, defer) = answer(&bvh, &q, width);
                     for (lane, ray) in rays.iter().enumerate() {
                         if defer & (1 << lane) == 0 {
                             let want = bvh.intersect(ray, 0.0, f32::INFINITY);
-                            let bits = |h: Option<Hit>| {
-                                h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()))
-                            };
                             assert_eq!(bits(out[lane]), bits(want), "{origin}, lane {lane}");
                         }
                     }
