@@ -227,19 +227,49 @@ mod tests {
         tris
     }
 
-    /// The packet walk's answer to `q` on `width` lanes: the hits, and the lanes left to
-    /// the one-ray walk. The processor must have the width's instruction set.
-    fn answer(bvh: &Bvh, q: &Query, width: usize) -> (Vec<Option<Hit>>, u16) {
-        let mut out = vec![None; width];
-        // SAFETY: the callers check the instruction set first.
-        let defer = unsafe {
-            if width == 16 {
-                closest_avx512(bvh, q, &mut out)
-            } else {
-                closest_avx2(bvh, q, &mut out)
+    /// Oracle: the one-ray walk. Walks `rays` as packets of sixteen and of eight lanes (on
+    /// the instruction sets the processor has) with `tmin < t < tmax`, asserts that every
+    /// lane a packet answers has the one-ray walk's hit, bit for bit, and returns how many
+    /// lanes were walked and how many were left to the one-ray walk.
+    fn check(bvh: &Bvh, rays: &[Ray], (tmin, tmax): (f32, f32), what: &str) -> (usize, usize) {
+        let (mut lanes, mut deferred) = (0, 0);
+        for (width, isa) in [(16, Isa::Avx512), (8, Isa::Avx2)] {
+            if Isa::get() < isa {
+                continue;
             }
-        };
-        (out, defer)
+            for rays in rays.chunks(width) {
+                let q = Query {
+                    rays,
+                    tmin,
+                    ends: [tmax; 16],
+                    lanes: u16::MAX,
+                    skip: 0,
+                };
+                let mut out = vec![None; width];
+                // SAFETY: the processor has the instruction set (checked above).
+                let defer = unsafe {
+                    if width == 16 {
+                        closest_avx512(bvh, &q, &mut out)
+                    } else {
+                        closest_avx2(bvh, &q, &mut out)
+                    }
+                };
+                for (lane, ray) in rays.iter().enumerate() {
+                    lanes += 1;
+                    if defer & (1 << lane) != 0 {
+                        deferred += 1;
+                        continue;
+                    }
+                    let want = bvh.intersect(ray, tmin, tmax);
+                    assert_eq!(
+                        bits(out[lane]),
+                        bits(want),
+                        "{what}, width {width}, lane {lane}"
+                    );
+                }
+            }
+        }
+        (lanes, deferred)
     }
 
     /// A hit's bits, for exact comparison.
@@ -280,30 +310,9 @@ mod tests {
                 })
                 .collect();
             let tmax = if group % 4 == 0 { 8.0 } else { f32::INFINITY };
-            for (width, isa) in [(16, Isa::Avx512), (8, Isa::Avx2)] {
-                if Isa::get() < isa {
-                    continue;
-                }
-                for rays in rays.chunks(width) {
-                    let q = Query {
-                        rays,
-                        tmin: 1e-3,
-                        ends: [tmax; 16],
-                        lanes: u16::MAX,
-                        skip: 0,
-                    };
-                    let (out, defer) = answer(&bvh, &q, width);
-                    for (lane, ray) in rays.iter().enumerate() {
-                        lanes += 1;
-                        if defer & (1 << lane) != 0 {
-                            deferred += 1;
-                            continue;
-                        }
-                        let want = bvh.intersect(ray, 1e-3, tmax);
-                        assert_eq!(bits(out[lane]), bits(want), "group {group}, lane {lane}");
-                    }
-                }
-            }
+            let (n, d) = check(&bvh, &rays, (1e-3, tmax), &format!("group {group}"));
+            lanes += n;
+            deferred += d;
         }
         // Hostile lanes: directions along an axis (slab planes the ray lies in), tiny,
         // subnormal, zero and NaN components, from a grid point and from the sphere's
@@ -328,27 +337,7 @@ mod tests {
                 .chain(&odd)
                 .map(|&d| Ray::new(origin, d))
                 .collect();
-            for (width, isa) in [(16, Isa::Avx512), (8, Isa::Avx2)] {
-                if Isa::get() < isa {
-                    continue;
-                }
-                for rays in rays.chunks(width) {
-                    let q = Query {
-                        rays,
-                        tmin: 0.0,
-                        ends: [f32::INFINITY; 16],
-                        lanes: u16::MAX,
-                        skip: 0,
-                    };
-                    let (out, defer) = answer(&bvh, &q, width);
-                    for (lane, ray) in rays.iter().enumerate() {
-                        if defer & (1 << lane) == 0 {
-                            let want = bvh.intersect(ray, 0.0, f32::INFINITY);
-                            assert_eq!(bits(out[lane]), bits(want), "{origin}, lane {lane}");
-                        }
-                    }
-                }
-            }
+            check(&bvh, &rays, (0.0, f32::INFINITY), &format!("from {origin}"));
         }
         // Grid-point packets meet edges exactly and duplicated triangles: some lanes are
         // left to the one-ray walk, but few.
