@@ -138,7 +138,19 @@ fn main() {
         ("primary-batch", &primary, true),
         ("random-batch", &random, true),
     ];
-    let only = std::env::var("PRISM_RAYS_SETS").ok();
+    let only = std::env::var("PRISM_RAYS_SETS")
+        .ok()
+        .filter(|o| !o.trim().is_empty());
+    if let Some(o) = &only {
+        let known: Vec<&str> = sets.iter().map(|s| s.0).collect();
+        if let Some(bad) = o.split(',').map(str::trim).find(|k| !known.contains(k)) {
+            eprintln!(
+                "PRISM_RAYS_SETS: no ray set {bad:?}; the sets are {}",
+                known.join(", ")
+            );
+            std::process::exit(2);
+        }
+    }
     for (kind, rays, batch) in sets {
         if only
             .as_deref()
