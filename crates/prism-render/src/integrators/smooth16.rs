@@ -72,7 +72,9 @@ pub(super) struct Outputs<'a> {
 /// Sixteen light samples: the lanes that keep theirs, and their shadow rays' origins,
 /// directions and ends, and the terms they add if unblocked.
 pub(super) struct Candidate {
-    keep: M16,
+    /// Bit i set where lane i keeps its sample (bits rather than a mask: testing a lane of
+    /// a vector mask stores the vector and loads the lane back, lane after lane).
+    keep: u32,
     origin: V16,
     dir: V16,
     end: F16,
@@ -227,7 +229,7 @@ pub(super) fn step(
             );
             let origin = spawn(p, ng, wi);
             cand.push(Candidate {
-                keep: ok,
+                keep: ok.bits(),
                 origin,
                 dir: wi,
                 end: shadow_dist,
@@ -240,7 +242,7 @@ pub(super) fn step(
         for (l, _) in lights.iter().enumerate() {
             let first = out.shadows.len();
             for c in &out.samples[l * count as usize..(l + 1) * count as usize] {
-                if c.keep.get(i) {
+                if c.keep >> i & 1 != 0 {
                     let at = |v: &V16| Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i]);
                     out.shadows.push(
                         Ray::new(at(&c.origin), at(&c.dir)),
@@ -295,9 +297,10 @@ pub(super) fn step(
         b = b.map(|c| c * inv);
     }
     let origin = spawn(p, ng, wi);
+    let ok = ok.bits();
     for i in 0..m {
         let k = group[i];
-        let alive = ok.get(i);
+        let alive = ok >> i & 1 != 0;
         out.alive[k] = alive;
         if alive {
             let path = &mut paths[k];
