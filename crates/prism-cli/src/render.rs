@@ -118,8 +118,9 @@ pub struct RenderArgs {
     /// Camera placement.
     #[arg(long, value_enum, default_value_t = CameraArg::Course)]
     camera: CameraArg,
-    /// Print BVH statistics, times (`render: 12.3 ms`), samples/s and the path integrator's
-    /// share of time per stage (camera rays, closest hits, hit records, ...) on stderr.
+    /// Print BVH statistics, times (`render: 12.3 ms`), samples/s, and the path integrator's
+    /// share of time per stage (camera rays, closest hits, hit records, ...) and its time
+    /// per stage summed over the threads, on stderr.
     #[arg(long)]
     stats: bool,
     /// Render only share I of N (I from 0) of the image's 32x32 tiles, dealt round-robin,
@@ -562,8 +563,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Prints the path integrator's share of time per stage (`stages: camera rays 5.9%, ...`),
-/// if it ran.
+/// Prints the path integrator's share of time per stage (`stages: camera rays 5.9%, ...`)
+/// and its time per stage summed over the threads (`stage times: camera rays 61.2 ms,
+/// ...`), if it ran.
 fn print_stages(profile: &prism_render::Profile) {
     if let Some(shares) = profile.shares() {
         let stages: Vec<String> = shares
@@ -571,6 +573,14 @@ fn print_stages(profile: &prism_render::Profile) {
             .map(|(stage, share)| format!("{} {:.1}%", stage.name(), 100.0 * share))
             .collect();
         eprintln!("stages: {}", stages.join(", "));
+        let times: Vec<String> = shares
+            .iter()
+            .map(|&(stage, _)| {
+                let ms = profile.time(stage).as_secs_f64() * 1e3;
+                format!("{} {ms:.1} ms", stage.name())
+            })
+            .collect();
+        eprintln!("stage times: {}", times.join(", "));
     }
 }
 

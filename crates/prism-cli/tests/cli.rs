@@ -519,6 +519,8 @@ fn render_scenes_and_errors() {
             "--batch",
             "2",
             "--stats",
+            "-t",
+            "1",
             "-o",
         ])
         .arg(&out)
@@ -567,6 +569,24 @@ fn render_scenes_and_errors() {
     assert_eq!(shares.len(), 8, "{stages}");
     assert!((shares.iter().sum::<f64>() - 100.0).abs() < 0.5, "{stages}");
     assert!(stages.starts_with("camera rays ") && stages.contains(", shadow rays "));
+    // Property: on one thread, the stages' times add up to no more than the render's time.
+    let ms = |prefix: &str| -> Vec<f64> {
+        let body = err.lines().find_map(|l| l.strip_prefix(prefix)).unwrap();
+        body.split(", ")
+            .map(|s| {
+                let v = s.trim_end_matches(" ms");
+                v.rsplit(' ').next().unwrap().parse().unwrap()
+            })
+            .collect()
+    };
+    let times = ms("stage times: ");
+    let render = ms("render: ")[0];
+    assert_eq!(times.len(), 8, "{err}");
+    let sum: f64 = times.iter().sum();
+    assert!(
+        sum > 0.0 && sum <= render + 0.5,
+        "stages {sum} ms, render {render} ms: {err}"
+    );
     let bunny = prism_testkit::shared_assets().join("pathtracer/dae/sky/CBbunny.dae");
     let o = prism()
         .args([
