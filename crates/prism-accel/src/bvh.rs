@@ -1444,15 +1444,17 @@ impl Walk {
             if node_ref == 0 {
                 mask &= !skip;
             }
-            let count = mask.count_ones() as usize;
-            if count == 0 {
+            // The entered children but the lowest slot's: none when one is entered. (Bit
+            // tricks rather than a count: the walks are compiled without `popcnt`.)
+            let rest = mask & mask.wrapping_sub(1);
+            if mask == 0 {
                 // Nothing entered: pop below.
-            } else if count == 1 && !SELECT {
+            } else if rest == 0 && !SELECT {
                 // One child entered: go on to it without the stack.
                 self.node = n.child[mask.trailing_zeros() as usize];
                 bvh.prefetch(self.node);
                 return true;
-            } else if count <= 2 && SELECT {
+            } else if rest & rest.wrapping_sub(1) == 0 && SELECT {
                 // One or two children entered, without a branch on which: push the farther
                 // (when there are two) and go on to the nearer.
                 let first = mask.trailing_zeros() as usize;
@@ -1460,7 +1462,7 @@ impl Walk {
                 let swap = near[last] < near[first];
                 let (a, b) = if swap { (last, first) } else { (first, last) };
                 self.stack.push(self.sp, (n.child[b], near[b]));
-                self.sp += count - 1;
+                self.sp += usize::from(rest != 0);
                 self.node = n.child[a];
                 bvh.prefetch(self.node);
                 bvh.prefetch(n.child[b]);

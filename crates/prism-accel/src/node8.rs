@@ -117,7 +117,9 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
     let mut mask = 0;
     for half in 0..2 {
         let t = |plane: usize, axis: usize| {
-            (n.bounds[plane][half] - Vec4::splat(r.origin[axis])) * Vec4::splat(r.inv_dir[axis])
+            // SAFETY: `SlabRay::new` makes every plane index 0..6.
+            let b = unsafe { n.bounds.get_unchecked(plane) };
+            (b[half] - Vec4::splat(r.origin[axis])) * Vec4::splat(r.inv_dir[axis])
         };
         let near = t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))));
         let far = t(r.far[2], 2).min(t(r.far[1], 1).min(t(r.far[0], 0).min(Vec4::INFINITY)));
@@ -141,15 +143,16 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
         _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
         _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ,
     };
-    // SAFETY: `bounds[plane]` is 32 bytes at a 32-byte aligned offset of a 64-byte aligned
-    // node, as `_mm256_load_ps` requires; the store writes eight floats into an array of
+    // SAFETY: `SlabRay::new` makes every plane index 0..6, so `bounds[plane]` is one of the
+    // node's planes: 32 bytes at a 32-byte aligned offset of a 64-byte aligned node, as
+    // `_mm256_load_ps` requires; the store writes eight floats into an array of
     // eight.
     unsafe {
         macro_rules! t {
             ($plane:expr, $axis:expr) => {
                 _mm256_mul_ps(
                     _mm256_sub_ps(
-                        _mm256_load_ps(n.bounds[$plane].as_ptr().cast::<f32>()),
+                        _mm256_load_ps(n.bounds.get_unchecked($plane).as_ptr().cast::<f32>()),
                         _mm256_set1_ps(r.origin[$axis]),
                     ),
                     _mm256_set1_ps(r.inv_dir[$axis]),
