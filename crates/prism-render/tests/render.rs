@@ -465,10 +465,11 @@ fn textured_diffuse_shows_its_texture_the_right_way_up() {
 
 /// Oracle: the one-path-at-a-time integrator. The wavefront integrator (the default `path`)
 /// draws the same random numbers and adds the same terms in the same order, so it must give
-/// the same bytes: on every staged scene with a light (diffuse surfaces under area lights run
-/// sixteen at a time; mirrors, glass, conductors, textures and mesh lights one by one), on
-/// the furnace's environment light, and with the options that change which paths take which
-/// step (one bounce kept, several light samples, adaptive sampling, a thin lens, short
+/// the same bytes: on every staged scene with a light (diffuse surfaces under area, point and
+/// directional lights run sixteen at a time; mirrors, glass, conductors, textures and mesh
+/// lights one by one), on the furnace's environment light, under point and directional
+/// lights alone and beside an area light, and with the options that change which paths take
+/// which step (one bounce kept, several light samples, adaptive sampling, a thin lens, short
 /// paths, early roulette).
 #[test]
 fn wavefront_equals_path_scalar_bit_for_bit() {
@@ -565,6 +566,33 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
     ];
     for (what, opts) in variants {
         same(&cornell, opts, what);
+    }
+    // Point and directional lights (one sample each, unweighted), alone and beside the
+    // area light with several samples of its own.
+    let point = Light::Point {
+        position: Vec3::new(0.3, 1.2, 0.2),
+        intensity: Rgb::new(2.0, 1.5, 1.0),
+    };
+    let sun = Light::Directional {
+        direction: Vec3::new(0.3, -1.0, -0.2).normalize(),
+        irradiance: Rgb::new(0.5, 0.6, 0.7),
+    };
+    for (what, lights, samples) in [
+        ("point light", vec![point.clone()], 1),
+        ("directional light", vec![sun.clone()], 1),
+        ("area, point and directional lights", vec![point, sun], 3),
+    ] {
+        let mut lit = prism_scene::cornell_box();
+        if what.starts_with("area") {
+            lit.lights.extend(lights);
+        } else {
+            lit.lights = lights;
+        }
+        let opts = RenderOptions {
+            light_samples: samples,
+            ..small
+        };
+        same(&RenderScene::new(&lit), opts, what);
     }
     let mut lens = prism_scene::cornell_box();
     lens.camera.lens = Some(prism_scene::ThinLens {

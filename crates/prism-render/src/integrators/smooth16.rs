@@ -1,9 +1,9 @@
 //! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
-//! conductor, one kind per group) in scenes lit by area lights only (the course's Cornell
-//! boxes): shading frames, light samples with their MIS weights and shadow rays, the BSDF
-//! sample and Russian roulette on sixteen lanes, the random numbers and the BSDFs'
-//! evaluation and sampling too. Each lane does the scalar code's operations in the same
-//! order, so the result is the scalar path's, bit for bit.
+//! conductor, one kind per group) in scenes lit by area, point and directional lights only
+//! (the course's Cornell boxes): shading frames, light samples with their MIS weights and
+//! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
+//! and the BSDFs' evaluation and sampling too. Each lane does the scalar code's operations
+//! in the same order, so the result is the scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
@@ -18,40 +18,15 @@ use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::sampler::lane_values;
 
-/// An area light's sampling data.
-#[derive(Clone, Copy)]
-pub(super) struct AreaLight {
-    corner: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-    normal: Vec3,
-    area: f32,
-    radiance: Rgb,
-}
-
-/// The scene's lights as area lights, if every one is.
-pub(super) fn area_lights(lights: &[RenderLight]) -> Option<Vec<AreaLight>> {
-    lights
-        .iter()
-        .map(|l| match *l {
-            RenderLight::Area {
-                corner,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-            } => Some(AreaLight {
-                corner,
-                e1,
-                e2,
-                normal,
-                area,
-                radiance,
-            }),
-            _ => None,
-        })
-        .collect()
+/// True if the step can sample every one of `lights` on lanes: area, point and directional
+/// lights.
+pub(super) fn lanes_light(lights: &[RenderLight]) -> bool {
+    lights.iter().all(|l| {
+        matches!(
+            l,
+            RenderLight::Area { .. } | RenderLight::Point { .. } | RenderLight::Directional { .. }
+        )
+    })
 }
 
 /// The kind of smooth BSDF at a surface this step handles.
@@ -145,13 +120,13 @@ fn power(nf: f32, f: F16, g: F16) -> F16 {
 }
 
 /// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces have
-/// smooth BSDFs of kind `kind`, in a scene lit by `lights` only, with light sampling kept at
-/// this bounce.
+/// smooth BSDFs of kind `kind`, in a scene lit by `lights` only (all of the kinds
+/// [`lanes_light`] takes), with light sampling kept at this bounce.
 #[inline(always)]
 pub(super) fn step(
     kind: SmoothKind,
     opts: &RenderOptions,
-    lights: &[AreaLight],
+    lights: &[RenderLight],
     paths: &mut [PathState],
     surfs: &[Option<Interaction>],
     group: &[usize],
@@ -189,39 +164,80 @@ pub(super) fn step(
     let wo_front = F16::splat(0.0).lt(wo.dot(ng));
     let zero = F16::splat(0.0);
 
-    // Light samples: per light, `count` samples, each a possible shadow ray.
-    let count = opts.light_samples.max(1);
-    let samples = lights.len() * count as usize;
+    // Light samples: per light, `count` samples (one for a delta light), each a possible
+    // shadow ray.
+    let many = opts.light_samples.max(1);
+    let count = |l: &RenderLight| if l.is_delta() { 1 } else { many };
     let cand = &mut *out.samples;
     cand.clear();
-    cand.reserve(samples);
+    cand.reserve(lights.iter().map(|l| count(l) as usize).sum());
     let mut draw = 0;
     for light in lights {
+        let count = count(light);
         for _ in 0..count {
             let ux = lane_values(&key, &dim, draw);
             let uy = lane_values(&key, &dim, draw + 1);
             draw += 2;
-            let q =
-                V16::splat(light.corner) + V16::splat(light.e1) * ux + V16::splat(light.e2) * uy;
-            let d = q - p;
-            let dist2 = d.dot(d);
-            let dist = dist2.sqrt();
-            let mut ok = zero.lt(dist) & lane_in;
-            let wi = V16 {
-                x: d.x / dist,
-                y: d.y / dist,
-                z: d.z / dist,
+            // Per lane: the direction to the light, its distance, the lanes with a sample,
+            // the incident radiance, and the density with its MIS weight (none: delta).
+            let (wi, dist, mut ok, li, pdf) = match *light {
+                RenderLight::Area {
+                    corner,
+                    e1,
+                    e2,
+                    normal,
+                    area,
+                    radiance,
+                } => {
+                    let q = V16::splat(corner) + V16::splat(e1) * ux + V16::splat(e2) * uy;
+                    let d = q - p;
+                    let dist2 = d.dot(d);
+                    let dist = dist2.sqrt();
+                    let wi = V16 {
+                        x: d.x / dist,
+                        y: d.y / dist,
+                        z: d.z / dist,
+                    };
+                    let cos_l = -dot1(wi, normal);
+                    let ok = zero.lt(dist) & lane_in & zero.lt(cos_l);
+                    let pdf = dist2 / (F16::splat(area) * cos_l);
+                    let li = [radiance.r, radiance.g, radiance.b].map(F16::splat);
+                    (wi, dist, ok, li, Some(pdf))
+                }
+                RenderLight::Point {
+                    position,
+                    intensity,
+                } => {
+                    let d = V16::splat(position) - p;
+                    let dist2 = d.dot(d);
+                    let dist = dist2.sqrt();
+                    let wi = V16 {
+                        x: d.x / dist,
+                        y: d.y / dist,
+                        z: d.z / dist,
+                    };
+                    let inv = F16::splat(1.0) / dist2;
+                    let li = [intensity.r, intensity.g, intensity.b].map(|c| F16::splat(c) * inv);
+                    (wi, dist, zero.lt(dist) & lane_in, li, None)
+                }
+                RenderLight::Directional {
+                    to_light,
+                    irradiance,
+                } => {
+                    let li = [irradiance.r, irradiance.g, irradiance.b].map(F16::splat);
+                    let dist = F16::splat(f32::INFINITY);
+                    (V16::splat(to_light), dist, lane_in, li, None)
+                }
+                _ => unreachable!("`lanes_light` admits area, point and directional lights"),
             };
-            let cos_l = -dot1(wi, light.normal);
-            ok = ok & zero.lt(cos_l);
-            let pdf = dist2 / (F16::splat(light.area) * cos_l);
             ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
             let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi));
             ok = ok & !max_channel(&f).le(zero);
-            let mis = power(count as f32, pdf, bsdf_pdf);
-            let w = mis / pdf;
-            let li = [light.radiance.r, light.radiance.g, light.radiance.b];
-            let term = [0, 1, 2].map(|c| f[c] * F16::splat(li[c]) * w);
+            // `f li (w / pdf)`; a delta light's weight and density are both 1.
+            let w = pdf.map_or(F16::splat(1.0), |pdf| {
+                power(count as f32, pdf, bsdf_pdf) / pdf
+            });
+            let term = [0, 1, 2].map(|c| f[c] * li[c] * w);
             let shadow_dist = F16::select(
                 dist.is_finite(),
                 dist * F16::splat(1.0 - 1e-4) - F16::splat(1e-4),
@@ -239,9 +255,11 @@ pub(super) fn step(
     }
     for i in 0..m {
         let first_light = out.light_terms.len();
-        for (l, _) in lights.iter().enumerate() {
+        let mut c = out.samples.iter();
+        for light in lights {
+            let count = count(light);
             let first = out.shadows.len();
-            for c in &out.samples[l * count as usize..(l + 1) * count as usize] {
+            for c in c.by_ref().take(count as usize) {
                 if c.keep >> i & 1 != 0 {
                     let at = |v: &V16| Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i]);
                     out.shadows.push(
@@ -325,7 +343,7 @@ pub(super) fn step(
 pub(super) unsafe fn step_avx512(
     kind: SmoothKind,
     opts: &RenderOptions,
-    lights: &[AreaLight],
+    lights: &[RenderLight],
     paths: &mut [PathState],
     surfs: &[Option<Interaction>],
     group: &[usize],
@@ -343,7 +361,7 @@ pub(super) unsafe fn step_avx512(
 pub(super) unsafe fn step_avx2(
     kind: SmoothKind,
     opts: &RenderOptions,
-    lights: &[AreaLight],
+    lights: &[RenderLight],
     paths: &mut [PathState],
     surfs: &[Option<Interaction>],
     group: &[usize],
@@ -356,7 +374,7 @@ pub(super) unsafe fn step_avx2(
 pub(super) fn step_dispatch(
     kind: SmoothKind,
     opts: &RenderOptions,
-    lights: &[AreaLight],
+    lights: &[RenderLight],
     paths: &mut [PathState],
     surfs: &[Option<Interaction>],
     group: &[usize],

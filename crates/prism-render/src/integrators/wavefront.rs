@@ -13,6 +13,7 @@ use crate::bsdf::lanes::SmoothKind;
 use crate::camera::Perspective;
 use crate::film::{camera_ray, PixelSum, RenderOptions};
 use crate::interaction::Interaction;
+use crate::lights::RenderLight;
 use crate::profile::{Laps, Profile, Stage};
 use crate::render_scene::RenderScene;
 use crate::sampler::{lane_keys, lane_values, Sampler};
@@ -120,8 +121,10 @@ pub(crate) fn tile(
         .iter()
         .map(|&(x, y)| Sampler::pixel_key(opts.seed, u64::from(y) * width + u64::from(x)))
         .collect();
-    // Light sampling at every bounce, under area lights only: the sixteen-lane step applies.
-    let area = smooth16::area_lights(&scene.lights).filter(|_| opts.only_bounce.is_none());
+    // Light sampling at every bounce, under lights the sixteen-lane step samples: that step
+    // applies.
+    let lanes = (smooth16::lanes_light(&scene.lights) && opts.only_bounce.is_none())
+        .then_some(scene.lights.as_slice());
     let most = samples.len() as u32;
     let mut n = samples.start;
     let mut laps = Laps::start();
@@ -136,7 +139,7 @@ pub(crate) fn tile(
             n,
             &mut radiance,
             &mut buffers,
-            area.as_deref(),
+            lanes,
             &mut laps,
         );
         n += 1;
@@ -163,7 +166,7 @@ fn sample_pass(
     n: u32,
     radiance: &mut [Rgb],
     b: &mut Buffers,
-    area: Option<&[smooth16::AreaLight]>,
+    lanes: Option<&[RenderLight]>,
     laps: &mut Laps,
 ) {
     b.paths.clear();
@@ -189,12 +192,13 @@ fn sample_pass(
         b.alive.resize(count, false);
         b.fast.iter_mut().for_each(Vec::clear);
         // The next bounce's light and BSDF samples: diffuse and rough conductor surfaces
-        // under area lights sixteen at a time (one list per kind), the others one by one.
+        // under lights the lanes sample, sixteen at a time (one list per kind); the others
+        // one by one.
         for (i, surf) in b.hits.iter().enumerate() {
             let Some(hit) = surf else {
                 continue;
             };
-            if let (Some(_), Some(kind)) = (area, smooth16::smooth_kind(hit)) {
+            if let (Some(_), Some(kind)) = (lanes, smooth16::smooth_kind(hit)) {
                 b.fast[kind as usize].push(i);
                 continue;
             }
@@ -209,7 +213,7 @@ fn sample_pass(
             .is_some();
         }
         laps.lap(Stage::Scattering);
-        if let Some(lights) = area {
+        if let Some(lights) = lanes {
             let mut out = smooth16::Outputs {
                 samples: &mut b.samples,
                 shadows: &mut b.shadows,
