@@ -465,12 +465,12 @@ fn textured_diffuse_shows_its_texture_the_right_way_up() {
 
 /// Oracle: the one-path-at-a-time integrator. The wavefront integrator (the default `path`)
 /// draws the same random numbers and adds the same terms in the same order, so it must give
-/// the same bytes: on every staged scene with a light (diffuse surfaces under area, point and
-/// directional lights run sixteen at a time; mirrors, glass, conductors, textures and mesh
-/// lights one by one), on the furnace's environment light, under point and directional
-/// lights alone and beside an area light, and with the options that change which paths take
-/// which step (one bounce kept, several light samples, adaptive sampling, a thin lens, short
-/// paths, early roulette).
+/// the same bytes: on every staged scene with a light (diffuse and rough conductor surfaces
+/// under area, point, directional and hemisphere lights run sixteen at a time; mirrors,
+/// glass and the other lights one by one), on the furnace's environment light, under point
+/// and directional lights alone and beside an area light, and with the options that change
+/// which paths take which step (one bounce kept, several light samples, adaptive sampling,
+/// a thin lens, short paths, early roulette).
 #[test]
 fn wavefront_equals_path_scalar_bit_for_bit() {
     let same = |scene: &RenderScene, opts: RenderOptions, what: &str| {

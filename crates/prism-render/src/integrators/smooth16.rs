@@ -1,6 +1,6 @@
 //! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
-//! conductor, one kind per group) in scenes lit by area, point and directional lights only
-//! (the course's Cornell boxes): shading frames, light samples with their MIS weights and
+//! conductor, one kind per group) in scenes lit by area, point, directional and hemisphere
+//! lights only (the course's Cornell boxes and skies): shading frames, light samples with their MIS weights and
 //! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
 //! and the BSDFs' evaluation and sampling too. Each lane does the scalar code's operations
 //! in the same order, so the result is the scalar path's, bit for bit.
@@ -9,7 +9,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use prism_math::lanes::{F16, LANES, M16, V16};
-use prism_math::{Ray, Rgb, Vec3};
+use prism_math::warp::cosine_hemisphere_lanes;
+use prism_math::{Frame, Ray, Rgb, Vec3};
 
 use super::wavefront::{LightTerms, PathState, Pending, Shadows};
 use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
@@ -18,13 +19,16 @@ use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::sampler::lane_values;
 
-/// True if the step can sample every one of `lights` on lanes: area, point and directional
-/// lights.
+/// True if the step can sample every one of `lights` on lanes: area, point, directional and
+/// hemisphere lights.
 pub(super) fn lanes_light(lights: &[RenderLight]) -> bool {
     lights.iter().all(|l| {
         matches!(
             l,
-            RenderLight::Area { .. } | RenderLight::Point { .. } | RenderLight::Directional { .. }
+            RenderLight::Area { .. }
+                | RenderLight::Point { .. }
+                | RenderLight::Directional { .. }
+                | RenderLight::Hemisphere { .. }
         )
     })
 }
@@ -171,6 +175,7 @@ pub(super) fn step(
     let cand = &mut *out.samples;
     cand.clear();
     cand.reserve(lights.iter().map(|l| count(l) as usize).sum());
+    let sky = Frame::from_normal(Vec3::Y);
     let mut draw = 0;
     for light in lights {
         let count = count(light);
@@ -228,7 +233,18 @@ pub(super) fn step(
                     let dist = F16::splat(f32::INFINITY);
                     (V16::splat(to_light), dist, lane_in, li, None)
                 }
-                _ => unreachable!("`lanes_light` admits area, point and directional lights"),
+                RenderLight::Hemisphere { radiance } => {
+                    // `cosine_hemisphere` about world +Y, in `Frame::to_world`'s order.
+                    let local = cosine_hemisphere_lanes(ux, uy);
+                    let wi = V16::splat(sky.s) * local.x
+                        + V16::splat(sky.t) * local.y
+                        + V16::splat(sky.n) * local.z;
+                    let pdf = local.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
+                    let li = [radiance.r, radiance.g, radiance.b].map(F16::splat);
+                    let dist = F16::splat(f32::INFINITY);
+                    (wi, dist, lane_in & zero.lt(local.z), li, Some(pdf))
+                }
+                _ => unreachable!("`lanes_light` admits no other lights"),
             };
             ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
             let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi));
