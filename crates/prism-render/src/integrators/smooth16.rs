@@ -74,6 +74,27 @@ fn dot1(v: V16, o: Vec3) -> F16 {
     v.x * o.x + v.y * o.y + v.z * o.z
 }
 
+/// The unit direction from `p` to `q`, the distance and its square, in the scalar light
+/// samples' order (`d / |d|`, `|d|^2` as `d.d`).
+#[inline(always)]
+fn toward(p: V16, q: V16) -> (V16, F16, F16) {
+    let d = q - p;
+    let dist2 = d.dot(d);
+    let dist = dist2.sqrt();
+    let wi = V16 {
+        x: d.x / dist,
+        y: d.y / dist,
+        z: d.z / dist,
+    };
+    (wi, dist, dist2)
+}
+
+/// A colour on every lane, channel by channel.
+#[inline(always)]
+fn rgb(c: Rgb) -> [F16; 3] {
+    [c.r, c.g, c.b].map(F16::splat)
+}
+
 /// `f32::max` over the three channels, in `Rgb::max_channel`'s order.
 #[inline(always)]
 fn max_channel(c: &[F16; 3]) -> F16 {
@@ -195,43 +216,27 @@ pub(super) fn step(
                     radiance,
                 } => {
                     let q = V16::splat(corner) + V16::splat(e1) * ux + V16::splat(e2) * uy;
-                    let d = q - p;
-                    let dist2 = d.dot(d);
-                    let dist = dist2.sqrt();
-                    let wi = V16 {
-                        x: d.x / dist,
-                        y: d.y / dist,
-                        z: d.z / dist,
-                    };
+                    let (wi, dist, dist2) = toward(p, q);
                     let cos_l = -dot1(wi, normal);
                     let ok = zero.lt(dist) & lane_in & zero.lt(cos_l);
                     let pdf = dist2 / (F16::splat(area) * cos_l);
-                    let li = [radiance.r, radiance.g, radiance.b].map(F16::splat);
-                    (wi, dist, ok, li, Some(pdf))
+                    (wi, dist, ok, rgb(radiance), Some(pdf))
                 }
                 RenderLight::Point {
                     position,
                     intensity,
                 } => {
-                    let d = V16::splat(position) - p;
-                    let dist2 = d.dot(d);
-                    let dist = dist2.sqrt();
-                    let wi = V16 {
-                        x: d.x / dist,
-                        y: d.y / dist,
-                        z: d.z / dist,
-                    };
+                    let (wi, dist, dist2) = toward(p, V16::splat(position));
                     let inv = F16::splat(1.0) / dist2;
-                    let li = [intensity.r, intensity.g, intensity.b].map(|c| F16::splat(c) * inv);
+                    let li = rgb(intensity).map(|c| c * inv);
                     (wi, dist, zero.lt(dist) & lane_in, li, None)
                 }
                 RenderLight::Directional {
                     to_light,
                     irradiance,
                 } => {
-                    let li = [irradiance.r, irradiance.g, irradiance.b].map(F16::splat);
                     let dist = F16::splat(f32::INFINITY);
-                    (V16::splat(to_light), dist, lane_in, li, None)
+                    (V16::splat(to_light), dist, lane_in, rgb(irradiance), None)
                 }
                 RenderLight::Hemisphere { radiance } => {
                     // `cosine_hemisphere` about world +Y, in `Frame::to_world`'s order.
@@ -240,9 +245,14 @@ pub(super) fn step(
                         + V16::splat(sky.t) * local.y
                         + V16::splat(sky.n) * local.z;
                     let pdf = local.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
-                    let li = [radiance.r, radiance.g, radiance.b].map(F16::splat);
                     let dist = F16::splat(f32::INFINITY);
-                    (wi, dist, lane_in & zero.lt(local.z), li, Some(pdf))
+                    (
+                        wi,
+                        dist,
+                        lane_in & zero.lt(local.z),
+                        rgb(radiance),
+                        Some(pdf),
+                    )
                 }
                 _ => unreachable!("`lanes_light` admits no other lights"),
             };
