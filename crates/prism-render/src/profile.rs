@@ -16,10 +16,10 @@ pub enum Stage {
     /// Emission found by the rays, and paths that end.
     Emission,
     /// Light and BSDF samples one path at a time (every surface but diffuse and rough
-    /// conductor ones under area, point, directional and hemisphere lights).
+    /// conductor ones, and every surface when one bounce is kept).
     Scattering,
-    /// Light and BSDF samples of diffuse and rough conductor surfaces under those lights,
-    /// sixteen paths at a time.
+    /// Light and BSDF samples of diffuse and rough conductor surfaces, sixteen paths at a
+    /// time.
     SmoothLanes,
     /// Shadow rays (the BVH).
     ShadowRays,

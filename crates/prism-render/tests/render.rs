@@ -466,11 +466,11 @@ fn textured_diffuse_shows_its_texture_the_right_way_up() {
 /// Oracle: the one-path-at-a-time integrator. The wavefront integrator (the default `path`)
 /// draws the same random numbers and adds the same terms in the same order, so it must give
 /// the same bytes: on every staged scene with a light (diffuse and rough conductor surfaces
-/// under area, point, directional and hemisphere lights run sixteen at a time; mirrors,
-/// glass and the other lights one by one), on the furnace's environment light, under point
-/// and directional lights alone and beside an area light, and with the options that change
-/// which paths take which step (one bounce kept, several light samples, adaptive sampling,
-/// a thin lens, short paths, early roulette).
+/// run sixteen at a time, mirrors and glass one by one), on the furnace's environment
+/// light, under point and directional lights alone and beside an area light, under an
+/// emissive mesh and an environment map (which the lanes sample lane by lane), and with the
+/// options that change which paths take which step (one bounce kept, several light samples,
+/// adaptive sampling, a thin lens, short paths, early roulette).
 #[test]
 fn wavefront_equals_path_scalar_bit_for_bit() {
     let same = |scene: &RenderScene, opts: RenderOptions, what: &str| {
@@ -594,6 +594,41 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         };
         same(&RenderScene::new(&lit), opts, what);
     }
+    // An emissive mesh (a tilted triangle pair under the ceiling) beside the area light,
+    // and a map of varying radiance around an open scene: lights the lanes sample lane by
+    // lane with their own code.
+    let mut glowing = prism_scene::cornell_box();
+    glowing.materials.push(Material::Emission {
+        radiance: Rgb::new(4.0, 3.0, 2.0),
+    });
+    glowing.meshes.push(prism_scene::TriangleMesh {
+        name: "glow".into(),
+        positions: vec![
+            Vec3::new(-0.6, 1.2, -0.3),
+            Vec3::new(-0.2, 1.3, -0.3),
+            Vec3::new(-0.2, 1.1, 0.2),
+            Vec3::new(-0.6, 1.0, 0.2),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        shading: prism_scene::Shading::Flat,
+        material: glowing.materials.len() - 1,
+        uvs: None,
+    });
+    let opts = RenderOptions {
+        light_samples: 2,
+        ..small
+    };
+    same(&RenderScene::new(&glowing), opts, "emissive mesh");
+    let mut mapped = furnace(Material::Diffuse {
+        reflectance: Rgb::splat(0.6),
+        texture: None,
+    });
+    mapped.lights = vec![Light::EnvironmentMap {
+        radiance: std::sync::Arc::new(prism_image::Image::from_fn(16, 8, |x, y| {
+            Rgb::new(0.2 + x as f32 * 0.1, 1.0 / (1.0 + y as f32), 0.5)
+        })),
+    }];
+    same(&RenderScene::new(&mapped), small, "environment map");
     let mut lens = prism_scene::cornell_box();
     lens.camera.lens = Some(prism_scene::ThinLens {
         radius: 0.05,

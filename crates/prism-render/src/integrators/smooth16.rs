@@ -1,16 +1,17 @@
 //! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
-//! conductor, one kind per group) in scenes lit by area, point, directional and hemisphere
-//! lights only (the course's Cornell boxes and skies): shading frames, light samples with their MIS weights and
+//! conductor, one kind per group): shading frames, light samples with their MIS weights and
 //! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
-//! and the BSDFs' evaluation and sampling too. Each lane does the scalar code's operations
-//! in the same order, so the result is the scalar path's, bit for bit.
+//! and the BSDFs' evaluation and sampling too. Area, point, directional and hemisphere
+//! lights are sampled on the lanes; mesh and environment lights by their own sampling code,
+//! lane by lane. Each lane does the scalar code's operations in the same order, so the
+//! result is the scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
 
 use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::warp::cosine_hemisphere_lanes;
-use prism_math::{Frame, Ray, Rgb, Vec3};
+use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 
 use super::wavefront::{LightTerms, PathState, Pending, Shadows};
 use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
@@ -18,20 +19,6 @@ use crate::film::RenderOptions;
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::sampler::lane_values;
-
-/// True if the step can sample every one of `lights` on lanes: area, point, directional and
-/// hemisphere lights.
-pub(super) fn lanes_light(lights: &[RenderLight]) -> bool {
-    lights.iter().all(|l| {
-        matches!(
-            l,
-            RenderLight::Area { .. }
-                | RenderLight::Point { .. }
-                | RenderLight::Directional { .. }
-                | RenderLight::Hemisphere { .. }
-        )
-    })
-}
 
 /// The kind of smooth BSDF at a surface this step handles.
 pub(super) fn smooth_kind(hit: &Interaction) -> Option<SmoothKind> {
@@ -145,8 +132,8 @@ fn power(nf: f32, f: F16, g: F16) -> F16 {
 }
 
 /// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces have
-/// smooth BSDFs of kind `kind`, in a scene lit by `lights` only (all of the kinds
-/// [`lanes_light`] takes), with light sampling kept at this bounce.
+/// smooth BSDFs of kind `kind`, in a scene lit by `lights`, with light sampling kept at
+/// this bounce.
 #[inline(always)]
 pub(super) fn step(
     kind: SmoothKind,
@@ -254,7 +241,29 @@ pub(super) fn step(
                         Some(pdf),
                     )
                 }
-                _ => unreachable!("`lanes_light` admits no other lights"),
+                RenderLight::Mesh(_)
+                | RenderLight::Environment { .. }
+                | RenderLight::EnvironmentMap(_) => {
+                    // No lane version of the sample: the light's own, lane by lane.
+                    let (mut wi, mut dist) = (V16::splat(Vec3::Z), F16::splat(1.0));
+                    let (mut li, mut pdf) = (rgb(Rgb::BLACK), F16::splat(1.0));
+                    let mut found = 0;
+                    for lane in 0..m {
+                        let at = Vec3::new(p.x.0[lane], p.y.0[lane], p.z.0[lane]);
+                        let u = Vec2::new(ux.0[lane], uy.0[lane]);
+                        if let Some(ls) = light.sample(at, u) {
+                            put(&mut wi, lane, ls.wi);
+                            dist.0[lane] = ls.dist;
+                            pdf.0[lane] = ls.pdf;
+                            for (c, v) in li.iter_mut().zip([ls.li.r, ls.li.g, ls.li.b]) {
+                                c.0[lane] = v;
+                            }
+                            found |= 1 << lane;
+                        }
+                    }
+                    let pdf = (!light.is_delta()).then_some(pdf);
+                    (wi, dist, M16::from_bits(found), li, pdf)
+                }
             };
             ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
             let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi));

@@ -121,9 +121,10 @@ pub(crate) fn tile(
         .iter()
         .map(|&(x, y)| Sampler::pixel_key(opts.seed, u64::from(y) * width + u64::from(x)))
         .collect();
-    // Light sampling at every bounce, under lights the sixteen-lane step samples: that step
-    // applies.
-    let lanes = (smooth16::lanes_light(&scene.lights) && opts.only_bounce.is_none())
+    // Light sampling at every bounce: the sixteen-lane step applies.
+    let lanes = opts
+        .only_bounce
+        .is_none()
         .then_some(scene.lights.as_slice());
     let most = samples.len() as u32;
     let mut n = samples.start;
@@ -192,8 +193,7 @@ fn sample_pass(
         b.alive.resize(count, false);
         b.fast.iter_mut().for_each(Vec::clear);
         // The next bounce's light and BSDF samples: diffuse and rough conductor surfaces
-        // under lights the lanes sample, sixteen at a time (one list per kind); the others
-        // one by one.
+        // sixteen at a time (one list per kind), the others one by one.
         for (i, surf) in b.hits.iter().enumerate() {
             let Some(hit) = surf else {
                 continue;
