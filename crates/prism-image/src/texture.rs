@@ -197,13 +197,17 @@ impl Texture {
         };
         let fold = |i: i64, n: i64, wrap: Wrap| match wrap {
             Wrap::Clamp => i.clamp(0, n - 1) as u32,
+            // Inside the image, or one past its end (a bilinear lookup's second texel), no
+            // division is needed.
+            Wrap::Repeat if (0..n).contains(&i) => i as u32,
+            Wrap::Repeat if i == n => 0,
             Wrap::Repeat => i.rem_euclid(n) as u32,
         };
         let clamp_x = |x: i64| fold(x, w, self.wrap[0]);
         let clamp_y = |y: i64| fold(y, h, self.wrap[1]);
         match mode {
             PixelSampling::Nearest => {
-                let (x, y) = ((gx + 0.5).floor(), (gy + 0.5).floor());
+                let (x, y) = (floor(gx + 0.5), floor(gy + 0.5));
                 if !x.is_finite() || !y.is_finite() {
                     return im.get(0, 0);
                 }
@@ -213,7 +217,7 @@ impl Texture {
                 if !gx.is_finite() || !gy.is_finite() {
                     return im.get(0, 0);
                 }
-                let (x0, y0) = (gx.floor(), gy.floor());
+                let (x0, y0) = (floor(gx), floor(gy));
                 let (tx, ty) = ((gx - x0) as f32, (gy - y0) as f32);
                 let (x0, y0) = (x0 as i64, y0 as i64);
                 // (Coordinates far out saturate; the next texel must not overflow past them.)
@@ -285,9 +289,78 @@ impl Texture {
     }
 }
 
+/// `x.floor()`, bit for bit (NaN gives NaN), without a call into the C
+/// library where the processor's rounding instruction is not compiled in: truncation, moved
+/// down for negative non-integers. From 2^52 up every float is an integer, its own floor.
+#[inline]
+fn floor(x: f64) -> f64 {
+    const INTEGRAL: f64 = 4_503_599_627_370_496.0; // 2^52
+    if x.is_nan() || x.abs() >= INTEGRAL {
+        return x;
+    }
+    let t = x as i64 as f64;
+    if t == x {
+        // An integer, its sign of zero kept.
+        x
+    } else if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Oracle: the standard library's `floor`, bit for bit, on edge cases (signed zeros,
+    /// halves, the 2^52 boundary, huge values, infinities) and a million random floats.
+    #[test]
+    fn floor_equals_std_floor_bit_for_bit() {
+        let same = |x: f64| {
+            let (a, b) = (floor(x), x.floor());
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "{x:e}"
+            );
+        };
+        let big = 4_503_599_627_370_496.0_f64;
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            0.999_999_999,
+            -1e-300,
+            1e-300,
+            big,
+            -big,
+            big - 0.5,
+            -big + 0.5,
+            big + 1.0,
+            1e19,
+            -1e19,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+            f64::MIN,
+        ] {
+            same(x);
+        }
+        let mut rng = prism_math::Pcg32::new(7, 1);
+        for _ in 0..1_000_000 {
+            let bits = (u64::from(rng.next_u32()) << 32) | u64::from(rng.next_u32());
+            same(f64::from_bits(bits));
+            same((f64::from(rng.next_f32()) - 0.5) * 4096.0);
+        }
+    }
 
     fn checker(n: u32) -> RgbImage {
         Image::from_fn(n, n, |x, y| {
