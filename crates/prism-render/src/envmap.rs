@@ -86,7 +86,20 @@ impl EnvMap {
     /// The solid-angle density with which [`EnvMap::sample`] picks direction `d`.
     #[must_use]
     pub fn pdf(&self, d: Vec3) -> f32 {
+        self.pdf_at(d, direction_to_uv(d))
+    }
+
+    /// [`EnvMap::radiance`] and [`EnvMap::pdf`] of direction `d` at once, its map position
+    /// computed once.
+    #[must_use]
+    pub fn radiance_pdf(&self, d: Vec3) -> (Rgb, f32) {
         let uv = direction_to_uv(d);
+        let radiance = self.texture.sample_level(uv, 0, PixelSampling::Bilinear);
+        (radiance, self.pdf_at(d, uv))
+    }
+
+    /// [`EnvMap::pdf`] of direction `d`, whose map position is `uv`.
+    fn pdf_at(&self, d: Vec3, uv: Vec2) -> f32 {
         // sin theta from the direction itself: exact near the poles, where acos is not.
         let sin = (d.x * d.x + d.z * d.z).sqrt() / d.length();
         if sin <= 0.0 {

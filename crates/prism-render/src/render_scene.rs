@@ -239,6 +239,21 @@ impl RenderScene {
         }
     }
 
+    /// What a ray leaving the scene along `dir` after a bounce sees (as
+    /// [`RenderScene::escaped`]), and the density with which light sampling picks `dir`
+    /// from the scene's infinite light (0 without one), for MIS.
+    #[must_use]
+    pub fn escaped_mis(&self, dir: Vec3) -> (Rgb, f32) {
+        match self.infinite.map(|i| &self.lights[i]) {
+            Some(RenderLight::EnvironmentMap(map)) => map.radiance_pdf(dir),
+            Some(light) => (
+                self.escaped(dir, false),
+                light.pdf(dir, f32::INFINITY, Vec3::ZERO),
+            ),
+            None => (Rgb::BLACK, 0.0),
+        }
+    }
+
     /// The BVH's build statistics.
     #[must_use]
     pub fn bvh_stats(&self) -> BvhStats {

@@ -422,15 +422,11 @@ fn emitted(
         let bounce = p.bounce;
         match hit {
             None => {
-                if let (Some(i), true) = (scene.infinite, keep(bounce)) {
-                    let le = scene.escaped(dir, false);
+                if let (Some(_), true) = (scene.infinite, keep(bounce)) {
+                    let (le, light_pdf) = scene.escaped_mis(dir);
                     if le.max_channel() > 0.0 {
                         let w = if p.mis {
-                            power(
-                                1.0,
-                                p.pdf,
-                                nlights * scene.lights[i].pdf(dir, f32::INFINITY, Vec3::ZERO),
-                            )
+                            power(1.0, p.pdf, nlights * light_pdf)
                         } else {
                             1.0
                         };
