@@ -289,9 +289,9 @@ impl Texture {
     }
 }
 
-/// `x.floor()`, bit for bit (NaN gives NaN), without a call into the C
-/// library where the processor's rounding instruction is not compiled in: truncation, moved
-/// down for negative non-integers. From 2^52 up every float is an integer, its own floor.
+/// `x.floor()`, bit for bit (NaN gives NaN), without a call into the C library where the
+/// processor's rounding instruction is not compiled in: truncation, moved down for negative
+/// non-integers. From 2^52 up every float is an integer, its own floor.
 #[inline]
 fn floor(x: f64) -> f64 {
     const INTEGRAL: f64 = 4_503_599_627_370_496.0; // 2^52

@@ -64,8 +64,12 @@ impl EnvMap {
     /// Radiance arriving from direction `d` (towards the light), bilinear in the map.
     #[must_use]
     pub fn radiance(&self, d: Vec3) -> Rgb {
-        self.texture
-            .sample_level(direction_to_uv(d), 0, PixelSampling::Bilinear)
+        self.radiance_at(direction_to_uv(d))
+    }
+
+    /// [`EnvMap::radiance`] at map position `uv`.
+    fn radiance_at(&self, uv: Vec2) -> Rgb {
+        self.texture.sample_level(uv, 0, PixelSampling::Bilinear)
     }
 
     /// A direction towards the light for uniform `u`, with its radiance and solid-angle
@@ -94,8 +98,7 @@ impl EnvMap {
     #[must_use]
     pub fn radiance_pdf(&self, d: Vec3) -> (Rgb, f32) {
         let uv = direction_to_uv(d);
-        let radiance = self.texture.sample_level(uv, 0, PixelSampling::Bilinear);
-        (radiance, self.pdf_at(d, uv))
+        (self.radiance_at(uv), self.pdf_at(d, uv))
     }
 
     /// [`EnvMap::pdf`] of direction `d`, whose map position is `uv`.
