@@ -510,11 +510,14 @@ impl Bvh {
             first_sphere: nt,
             ..Flat::default()
         };
+        // Each primitive with its leaf, whose box gates it as the walk's root test does.
         let mut prims = Vec::new();
         for slot in (0..8).filter(|&k| root.slot_used(k)) {
             let child = root.child[slot];
             if Bvh::is_leaf_ref(child) {
-                prims.extend(self.leaf_prims(child));
+                let leaf = flat.leaf_boxes.len() as u8;
+                flat.leaf_boxes.push(root.child_box(slot));
+                prims.extend(self.leaf_prims(child).into_iter().map(|p| (p, leaf)));
                 flat.skip |= 1 << slot;
             } else {
                 flat.inner.push(root.child_box(slot));
@@ -524,11 +527,12 @@ impl Bvh {
             return None;
         }
         prims.sort_unstable();
-        for p in prims {
+        for (p, leaf) in prims {
             if p < nt {
-                flat.push_triangle(triangles[p as usize], p);
+                flat.push_triangle(triangles[p as usize], p, leaf);
             } else {
                 flat.spheres.push((spheres[(p - nt) as usize], p));
+                flat.sphere_leaves.push(leaf);
             }
         }
         Some(flat)

@@ -1,13 +1,14 @@
 //! [`Flat`], the primitives of the root's leaves in one list, and the batched queries on it:
 //! sixteen rays at once against each primitive with AVX-512 (eight with AVX2: the queries
-//! are written once, in the operations of [`crate::simd::Simd`]), with no branch that
-//! depends on a ray, then the same rays against the boxes of the root's other children, to
-//! find the
-//! rays that must still traverse those. In a small scene that is every primitive; in a
-//! Cornell box, the walls. Each lane computes the one-ray tests' operations in their order,
-//! so it finds the hit the hierarchy finds. A lane that meets an edge function of exactly
-//! zero (which the one-ray test settles in double precision) or two primitives at the same
-//! nearest distance (where the hierarchy's visiting order decides) is left to the hierarchy.
+//! are written once, in the operations of [`crate::simd::Simd`]), then the same rays against
+//! the boxes of the root's other children, to find the rays that must still traverse those.
+//! In a small scene that is every primitive; in a Cornell box, the walls. Each lane computes
+//! the one-ray tests' operations in their order, so it finds the hit the hierarchy finds.
+//! The only branches are per group of rays: a leaf whose box no ray of the group enters (by
+//! the walk's own root test) is skipped, as the walk skips it. A lane that meets an edge
+//! function of exactly zero (which the one-ray test settles in double precision) or two
+//! primitives at the same nearest distance (where the hierarchy's visiting order decides)
+//! is left to the hierarchy.
 
 use prism_math::{Aabb, Vec3};
 
@@ -34,6 +35,12 @@ pub(crate) struct Flat {
     pub(crate) spheres: Vec<(Sphere, u32)>,
     /// Primitive numbers from this one on are spheres.
     pub(crate) first_sphere: u32,
+    /// Per triangle, its leaf: an index into `leaf_boxes`.
+    pub(crate) triangle_leaves: Vec<u8>,
+    /// Per sphere, its leaf.
+    pub(crate) sphere_leaves: Vec<u8>,
+    /// The boxes of the root's children that are leaves (at most eight).
+    pub(crate) leaf_boxes: Vec<Aabb>,
     /// The boxes of the root's children that are not leaves.
     pub(crate) inner: Vec<Aabb>,
     /// The root's slots whose leaves are in the list.
@@ -53,8 +60,9 @@ pub(crate) struct Lanes {
 }
 
 impl Flat {
-    /// Adds triangle `tri`, primitive `prim`, sharing the vertices already listed.
-    pub(crate) fn push_triangle(&mut self, tri: [Vec3; 3], prim: u32) {
+    /// Adds triangle `tri`, primitive `prim`, of leaf `leaf`, sharing the vertices already
+    /// listed.
+    pub(crate) fn push_triangle(&mut self, tri: [Vec3; 3], prim: u32, leaf: u8) {
         let corners = tri.map(|v| {
             let padded = [v.x, v.y, v.z, 0.0];
             let bits = padded.map(f32::to_bits);
@@ -70,6 +78,7 @@ impl Flat {
         });
         self.triangles.push((tri, prim));
         self.corners.push(corners);
+        self.triangle_leaves.push(leaf);
     }
 }
 
@@ -85,25 +94,57 @@ mod queries {
     use crate::simd::{Avx2, Avx512, Simd};
     use prism_math::Ray;
 
-    /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`.
+    /// `1 / dir` of a group's rays, as the slab tests take it.
     #[inline(always)]
-    unsafe fn need<S: Simd>(flat: &Flat, g: &Group<S>, tmin: S::F, tmax: S::F) -> u16 {
-        if flat.inner.is_empty() {
-            return 0;
-        }
+    unsafe fn inverse<S: Simd>(g: &Group<S>) -> [S::F; 3] {
         // SAFETY: the caller runs on `S`'s instruction set.
         unsafe {
             let one = S::splat(1.0);
-            let inv = [
+            [
                 S::div(one, g.dir[0]),
                 S::div(one, g.dir[1]),
                 S::div(one, g.dir[2]),
-            ];
+            ]
+        }
+    }
+
+    /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`.
+    #[inline(always)]
+    unsafe fn need<S: Simd>(
+        flat: &Flat,
+        g: &Group<S>,
+        inv: &[S::F; 3],
+        tmin: S::F,
+        tmax: S::F,
+    ) -> u16 {
+        // SAFETY: the caller runs on `S`'s instruction set.
+        unsafe {
             let mut need = S::none();
             for b in &flat.inner {
-                need = S::or(need, enters(g, &inv, b, tmin, tmax).1);
+                need = S::or(need, enters(g, inv, b, tmin, tmax).1);
             }
             S::bits(need)
+        }
+    }
+
+    /// The root's leaves (bit `k` for `flat.leaf_boxes[k]`) that some lane enters with an
+    /// entry in `[tmin, tmax]`: the one-ray walk's root test, so the primitives of the
+    /// others are those the walk would not test on any lane.
+    #[inline(always)]
+    unsafe fn live<S: Simd>(
+        flat: &Flat,
+        g: &Group<S>,
+        inv: &[S::F; 3],
+        tmin: S::F,
+        tmax: S::F,
+    ) -> u32 {
+        // SAFETY: the caller runs on `S`'s instruction set.
+        unsafe {
+            let mut live = 0;
+            for (k, b) in flat.leaf_boxes.iter().enumerate() {
+                live |= u32::from(S::bits(enters(g, inv, b, tmin, tmax).1) != 0) << k;
+            }
+            live
         }
     }
 
@@ -155,14 +196,23 @@ mod queries {
             let zero = S::splat(0.0);
             let mut near = Nearest::<S>::none(hi);
             let mut defer = S::none();
+            let inv = inverse(&g);
+            let live = live(flat, &g, &inv, lo, widen::<S>(hi));
             let mut prepared = Prepared::<S>::new();
             prepared.fill(flat, &g);
-            for (corners, (_, prim)) in flat.corners.iter().zip(&flat.triangles) {
+            let triangles = flat.corners.iter().zip(&flat.triangles);
+            for ((corners, (_, prim)), &leaf) in triangles.zip(&flat.triangle_leaves) {
+                if live >> leaf & 1 == 0 {
+                    continue;
+                }
                 let (t, v, w, det, hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
                 defer = S::or(defer, zeros);
                 near.update((t, v, w, det), *prim, hit);
             }
-            for (s, prim) in &flat.spheres {
+            for ((s, prim), &leaf) in flat.spheres.iter().zip(&flat.sphere_leaves) {
+                if live >> leaf & 1 == 0 {
+                    continue;
+                }
                 let (t, hit) = sphere(&g, s, lo, hi);
                 near.update((t, zero, zero, zero), *prim, hit);
             }
@@ -170,7 +220,7 @@ mod queries {
             let defer = S::bits(defer) | S::bits(near.tie);
             // Past a hit the list found, a margin far wider than the slab test's rounding.
             let reach = S::select(near.found, hi, widen::<S>(near.t));
-            let need = need(flat, &g, lo, reach) & !defer;
+            let need = need(flat, &g, &inv, lo, reach) & !defer;
             Lanes {
                 blocked: 0,
                 defer,
@@ -191,14 +241,22 @@ mod queries {
             let lo = S::splat(tmin);
             let hi = S::load(&ends);
             let (mut blocked, mut defer) = (S::none(), S::none());
+            let inv = inverse(&g);
+            let live = live(flat, &g, &inv, lo, hi);
             let mut prepared = Prepared::<S>::new();
             prepared.fill(flat, &g);
-            for corners in &flat.corners {
+            for (corners, &leaf) in flat.corners.iter().zip(&flat.triangle_leaves) {
+                if live >> leaf & 1 == 0 {
+                    continue;
+                }
                 let (.., hit, zeros) = triangle(&g, prepared.get(corners), lo, hi);
                 blocked = S::or(blocked, hit);
                 defer = S::or(defer, zeros);
             }
-            for (s, _) in &flat.spheres {
+            for ((s, _), &leaf) in flat.spheres.iter().zip(&flat.sphere_leaves) {
+                if live >> leaf & 1 == 0 {
+                    continue;
+                }
                 blocked = S::or(blocked, sphere(&g, s, lo, hi).1);
             }
             let (blocked, defer) = (S::bits(blocked), S::bits(defer));
@@ -209,7 +267,7 @@ mod queries {
             Lanes {
                 blocked,
                 defer,
-                need: need(flat, &g, lo, reach) & !blocked & !defer,
+                need: need(flat, &g, &inv, lo, reach) & !blocked & !defer,
             }
         }
     }
