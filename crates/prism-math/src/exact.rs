@@ -25,7 +25,10 @@ impl ExactSum {
         // the general path below truncates towards zero).
         let v = f64::from(x) * SCALE;
         if v.abs() < 9_223_372_036_854_775_808.0 {
-            return Some(i128::from(v as i64));
+            // SAFETY: `v` is finite (NaN fails the test above) and below 2^63 in magnitude,
+            // so its truncation is an i64: the value `v as i64` gives, without the checks
+            // for saturation.
+            return Some(i128::from(unsafe { v.to_int_unchecked::<i64>() }));
         }
         let bits = x.to_bits();
         let exp = ((bits >> 23) & 0xff) as i32;
