@@ -170,6 +170,17 @@ impl RenderLight {
         )
     }
 
+    /// Samples taken of the light at a shading point when `light_samples` are asked for:
+    /// one of a delta light (all would be the same), else `light_samples` (at least one).
+    #[must_use]
+    pub fn sample_count(&self, light_samples: u32) -> u32 {
+        if self.is_delta() {
+            1
+        } else {
+            light_samples.max(1)
+        }
+    }
+
     /// Samples incident light at `p` from `u`.
     #[must_use]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {

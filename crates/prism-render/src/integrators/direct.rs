@@ -49,11 +49,7 @@ pub(super) fn direct_lights(
     }
     let mut total = Rgb::BLACK;
     for light in &scene.lights {
-        let count = if light.is_delta() {
-            1
-        } else {
-            opts.light_samples.max(1)
-        };
+        let count = light.sample_count(opts.light_samples);
         let mut acc = Rgb::BLACK;
         for _ in 0..count {
             let u = sampler.next_2d();

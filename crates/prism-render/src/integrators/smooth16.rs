@@ -3,8 +3,9 @@
 //! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
 //! and the BSDFs' evaluation and sampling too. Area, point, directional and hemisphere
 //! lights are sampled on the lanes; mesh and environment lights by their own sampling code,
-//! lane by lane. Each lane does the scalar code's operations in the same order, so the
-//! result is the scalar path's, bit for bit.
+//! lane by lane. The light samples wait on lanes for their shadow rays, and their sum is
+//! taken on lanes too ([`GroupTerms::gather`]). Each lane does the scalar code's operations
+//! in the same order, so the result is the scalar path's, bit for bit.
 
 // Plain index loops over the lanes are what the vectoriser turns into single instructions.
 #![allow(clippy::needless_range_loop)]
@@ -13,7 +14,7 @@ use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::warp::cosine_hemisphere_lanes;
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 
-use super::wavefront::{LightTerms, PathState, Pending, Shadows};
+use super::wavefront::{PathState, Shadows};
 use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
@@ -29,9 +30,11 @@ pub(super) fn smooth_kind(hit: &Interaction) -> Option<SmoothKind> {
 pub(super) struct Outputs<'a> {
     /// Scratch: the light samples of a group, kept between groups.
     pub samples: &'a mut Vec<Candidate>,
+    /// The light samples of every group, waiting for their shadow rays.
+    pub waiting: &'a mut Vec<Waiting>,
+    /// Each group's next-event estimate, waiting for its shadow rays.
+    pub groups: &'a mut Vec<GroupTerms>,
     pub shadows: &'a mut Shadows,
-    pub light_terms: &'a mut Vec<LightTerms>,
-    pub pending: &'a mut [Option<Pending>],
     pub alive: &'a mut [bool],
 }
 
@@ -45,6 +48,73 @@ pub(super) struct Candidate {
     dir: V16,
     end: F16,
     term: [F16; 3],
+}
+
+/// Sixteen light samples waiting for their shadow rays: the lanes that have one, where the
+/// first of those rays is in `Shadows` (the others follow in lane order), and the terms they
+/// add if unblocked.
+pub(super) struct Waiting {
+    keep: u32,
+    first: usize,
+    term: [F16; 3],
+}
+
+/// A group's next-event estimate waiting for its shadow rays: its paths (indices into the
+/// pass's paths, `len` of them), their throughputs, and its light samples (a range of
+/// [`Waiting`]s, light by light, `count` samples each).
+pub(super) struct GroupTerms {
+    paths: [u32; LANES],
+    len: usize,
+    beta: [F16; 3],
+    samples: (usize, usize),
+}
+
+impl GroupTerms {
+    /// Adds the group's estimate to its paths, given which shadow rays are `blocked`: for
+    /// each path, the terms of its unblocked samples summed light by light, each light's sum
+    /// over its sample count, times the throughput, in the scalar gathering's order.
+    #[inline(always)]
+    pub(super) fn gather(
+        &self,
+        opts: &RenderOptions,
+        lights: &[RenderLight],
+        waiting: &[Waiting],
+        blocked: &[bool],
+        paths: &mut [PathState],
+    ) {
+        let zero = F16::splat(0.0);
+        let mut total = [zero; 3];
+        let mut samples = waiting[self.samples.0..self.samples.1].iter();
+        for light in lights {
+            let count = light.sample_count(opts.light_samples);
+            let mut acc = [zero; 3];
+            for w in samples.by_ref().take(count as usize) {
+                // Adding zero where a lane has no term leaves its sum as skipping it does:
+                // a sum from +0 is never -0.
+                let mut open = 0;
+                let mut bits = w.keep;
+                let mut k = w.first;
+                while bits != 0 {
+                    let lane = bits.trailing_zeros();
+                    bits &= bits - 1;
+                    open |= u32::from(!blocked[k]) << lane;
+                    k += 1;
+                }
+                let open = M16::from_bits(open);
+                for c in 0..3 {
+                    acc[c] = acc[c] + F16::select(open, w.term[c], zero);
+                }
+            }
+            let inv = F16::splat(1.0 / count as f32);
+            for c in 0..3 {
+                total[c] = total[c] + acc[c] * inv;
+            }
+        }
+        let add = [0, 1, 2].map(|c| self.beta[c] * total[c]);
+        for i in 0..self.len {
+            paths[self.paths[i] as usize].l += Rgb::new(add[0].0[i], add[1].0[i], add[2].0[i]);
+        }
+    }
 }
 
 /// Sets lane `lane` of `v`.
@@ -178,15 +248,18 @@ pub(super) fn step(
 
     // Light samples: per light, `count` samples (one for a delta light), each a possible
     // shadow ray.
-    let many = opts.light_samples.max(1);
-    let count = |l: &RenderLight| if l.is_delta() { 1 } else { many };
     let cand = &mut *out.samples;
     cand.clear();
-    cand.reserve(lights.iter().map(|l| count(l) as usize).sum());
+    cand.reserve(
+        lights
+            .iter()
+            .map(|l| l.sample_count(opts.light_samples) as usize)
+            .sum(),
+    );
     let sky = Frame::from_normal(Vec3::Y);
     let mut draw = 0;
     for light in lights {
-        let count = count(light);
+        let count = light.sample_count(opts.light_samples);
         for _ in 0..count {
             let ux = lane_values(&key, &dim, draw);
             let uy = lane_values(&key, &dim, draw + 1);
@@ -288,32 +361,29 @@ pub(super) fn step(
             });
         }
     }
-    for i in 0..m {
-        let first_light = out.light_terms.len();
-        let mut c = out.samples.iter();
-        for light in lights {
-            let count = count(light);
-            let first = out.shadows.len();
-            for c in c.by_ref().take(count as usize) {
-                if c.keep >> i & 1 != 0 {
-                    let at = |v: &V16| Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i]);
-                    out.shadows.push(
-                        Ray::new(at(&c.origin), at(&c.dir)),
-                        c.end.0[i],
-                        Rgb::new(c.term[0].0[i], c.term[1].0[i], c.term[2].0[i]),
-                    );
-                }
-            }
-            out.light_terms.push(LightTerms {
-                shadows: (first, out.shadows.len()),
-                count,
-            });
+    let first = out.waiting.len();
+    for c in out.samples.iter() {
+        let start = out.shadows.len();
+        let mut bits = c.keep;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let at = |v: &V16| Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i]);
+            out.shadows
+                .push_ray(Ray::new(at(&c.origin), at(&c.dir)), c.end.0[i]);
         }
-        out.pending[group[i]] = Some(Pending {
-            beta: paths[group[i]].beta,
-            lights: (first_light, out.light_terms.len()),
+        out.waiting.push(Waiting {
+            keep: c.keep,
+            first: start,
+            term: c.term,
         });
     }
+    out.groups.push(GroupTerms {
+        paths: std::array::from_fn(|i| group[i.min(m - 1)] as u32),
+        len: m,
+        beta,
+        samples: (first, out.waiting.len()),
+    });
 
     // The BSDF sample.
     let bounce = paths[group[0]].bounce + 1;

@@ -25,7 +25,7 @@ pub(super) struct PathState {
     pub(super) sampler: Sampler,
     pub(super) ray: Ray,
     /// Radiance gathered so far.
-    l: Rgb,
+    pub(super) l: Rgb,
     /// Throughput.
     pub(super) beta: Rgb,
     /// Bounces taken by `ray` (0 for the camera ray).
@@ -37,8 +37,10 @@ pub(super) struct PathState {
     pub(super) mis: bool,
 }
 
-/// Light samples waiting for their shadow rays: the rays, where each ends, and the term each
-/// adds if unblocked (arrays side by side, as the batched query takes them).
+/// Light samples waiting for their shadow rays: the rays and where each ends (arrays side by
+/// side, as the batched query takes them), and the term each sample of a one-by-one step
+/// adds if unblocked. Those samples come first; the sixteen-lane step's keep their terms on
+/// lanes ([`smooth16::Waiting`]).
 #[derive(Default)]
 pub(super) struct Shadows {
     rays: Vec<Ray>,
@@ -50,9 +52,21 @@ impl Shadows {
     /// Adds a sample.
     #[inline]
     pub(super) fn push(&mut self, ray: Ray, dist: f32, term: Rgb) {
+        debug_assert_eq!(
+            self.terms.len(),
+            self.rays.len(),
+            "samples with terms come first"
+        );
         self.rays.push(ray);
         self.dists.push(dist);
         self.terms.push(term);
+    }
+
+    /// Adds a sample whose term is kept elsewhere (after every sample with a term).
+    #[inline]
+    pub(super) fn push_ray(&mut self, ray: Ray, dist: f32) {
+        self.rays.push(ray);
+        self.dists.push(dist);
     }
 
     /// Samples held.
@@ -94,8 +108,11 @@ struct Buffers {
     bvh_hits: Vec<Option<prism_accel::Hit>>,
     /// Paths whose step runs sixteen at a time: at diffuse surfaces, then at conductors.
     fast: [Vec<usize>; 2],
-    /// Their light samples, sixteen at a time.
+    /// Their light samples, sixteen at a time (scratch).
     samples: Vec<smooth16::Candidate>,
+    /// Their light samples waiting for shadow rays, and each group's estimate.
+    waiting: Vec<smooth16::Waiting>,
+    groups: Vec<smooth16::GroupTerms>,
     shadows: Shadows,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
@@ -192,6 +209,8 @@ fn sample_pass(
         b.alive.clear();
         b.alive.resize(count, false);
         b.fast.iter_mut().for_each(Vec::clear);
+        b.waiting.clear();
+        b.groups.clear();
         // The next bounce's light and BSDF samples: diffuse and rough conductor surfaces
         // sixteen at a time (one list per kind), the others one by one.
         for (i, surf) in b.hits.iter().enumerate() {
@@ -216,9 +235,9 @@ fn sample_pass(
         if let Some(lights) = lanes {
             let mut out = smooth16::Outputs {
                 samples: &mut b.samples,
+                waiting: &mut b.waiting,
+                groups: &mut b.groups,
                 shadows: &mut b.shadows,
-                light_terms: &mut b.lights,
-                pending: &mut b.pending,
                 alive: &mut b.alive,
             };
             for (fast, kind) in b
@@ -252,6 +271,11 @@ fn sample_pass(
                 total += acc * (1.0 / light.count as f32);
             }
             p.l += w.beta * total;
+        }
+        if let Some(lights) = lanes {
+            for g in &b.groups {
+                g.gather(opts, lights, &b.waiting, &b.blocked, &mut b.paths);
+            }
         }
         let mut i = 0;
         let alive = &b.alive;
@@ -479,11 +503,7 @@ fn scatter(
         let first_light = light_terms.len();
         if hit.bsdf.is_smooth() {
             for light in &scene.lights {
-                let count = if light.is_delta() {
-                    1
-                } else {
-                    opts.light_samples.max(1)
-                };
+                let count = light.sample_count(opts.light_samples);
                 let first = shadows.len();
                 for _ in 0..count {
                     let u = p.sampler.next_2d();
