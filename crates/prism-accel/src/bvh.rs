@@ -1,6 +1,8 @@
 //! [`Bvh`], the bounding volume hierarchy over triangles and spheres: binned-SAH build,
 //! collapse into 8-wide nodes, statistics, and closest-hit and occlusion traversal.
 
+use std::mem::MaybeUninit;
+
 use prism_math::glam::Vec3A;
 use prism_math::{prefetch, Aabb, Isa, Ray, Vec3};
 use rayon::prelude::*;
@@ -180,6 +182,12 @@ struct PrimRef {
 }
 
 impl PrimRef {
+    /// A placeholder for a primitive left out (no primitive has its number).
+    const NONE: PrimRef = PrimRef {
+        bounds: B3::EMPTY,
+        id: u32::MAX,
+    };
+
     /// Twice the box centre: the split position, without a multiply.
     #[inline(always)]
     fn centroid2(&self) -> Vec3A {
@@ -259,11 +267,16 @@ impl Bvh {
             })
         };
         let mut prims: Vec<PrimRef> = if nt > opts.parallel_threshold {
+            // Written in place, in order, those left out marked and then dropped (a
+            // filtered parallel collection gathers pieces and copies them again).
+            let mut refs = Vec::with_capacity(nt);
             triangles
                 .par_iter()
                 .enumerate()
-                .filter_map(tri_ref)
-                .collect()
+                .map(|t| tri_ref(t).unwrap_or(PrimRef::NONE))
+                .collect_into_vec(&mut refs);
+            refs.retain(|p| p.id != PrimRef::NONE.id);
+            refs
         } else {
             triangles.iter().enumerate().filter_map(tri_ref).collect()
         };
@@ -291,7 +304,7 @@ impl Bvh {
                 ..*opts
             };
             let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
-            let big = take_big(&mut prims, b3);
+            let big = take_big(&mut prims, b3, opts.parallel_threshold);
             if big == 0 {
                 Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
             } else {
@@ -316,7 +329,11 @@ impl Bvh {
                 ))
             }
         };
-        let ids: Vec<u32> = prims.iter().map(|p| p.id).collect();
+        let ids: Vec<u32> = if prims.len() > opts.parallel_threshold {
+            prims.par_iter().map(|p| p.id).collect()
+        } else {
+            prims.iter().map(|p| p.id).collect()
+        };
         let mut bvh = Bvh {
             spheres: spheres.to_vec(),
             triangle_count: nt as u32,
@@ -460,9 +477,11 @@ impl Bvh {
         parallel_threshold: usize,
     ) {
         let total = jobs.last().map_or(0, |j| j.pack_start + j.packs);
-        self.packs = vec![Tri4::new(&[]); total];
+        // Each pack is written once, by its leaf's job (in parallel, so that the first
+        // touch of the memory is shared too).
+        let mut packs: Vec<Tri4> = Vec::with_capacity(total);
         let nt = self.triangle_count;
-        let fill = |job: &LeafJob, out: &mut [Tri4]| {
+        let fill = |job: &LeafJob, out: &mut [MaybeUninit<Tri4>]| {
             let mut tris = [([Vec3::ZERO; 3], 0u32); MAX_LEAF_REF];
             // The build order visits triangles out of the mesh's order: start loading those
             // a few leaves ahead, so that the misses overlap.
@@ -478,11 +497,16 @@ impl Bvh {
                 tris[n] = (triangles[p as usize], p);
                 n += 1;
             }
+            assert_eq!(
+                n.div_ceil(4),
+                out.len(),
+                "a leaf's packs hold its triangles"
+            );
             for (pack, four) in out.iter_mut().zip(tris[..n].chunks(4)) {
-                *pack = Tri4::new(four);
+                pack.write(Tri4::new(four));
             }
         };
-        let mut rest = self.packs.as_mut_slice();
+        let mut rest = &mut packs.spare_capacity_mut()[..total];
         let mut outs = Vec::with_capacity(jobs.len());
         for job in jobs {
             let (out, tail) = std::mem::take(&mut rest).split_at_mut(job.packs);
@@ -499,6 +523,10 @@ impl Bvh {
                 fill(job, out);
             }
         }
+        // SAFETY: the jobs' ranges tile `0..total` (each starts where the last ended) and
+        // each job wrote every pack of its range (asserted above).
+        unsafe { packs.set_len(total) };
+        self.packs = packs;
     }
 
     /// The primitives of the root's leaves in one list, with the boxes of the root's other
@@ -1571,17 +1599,22 @@ const BIG_MAX: usize = 12;
 /// Sets apart the large primitives of a scene with more than [`FLAT_MAX`] (walls and floors
 /// of a room, among small ones): moves up to [`BIG_MAX`] of them (largest first) to the
 /// front of `prims`, in primitive order, and returns how many (none if there are no small
-/// ones to keep apart from). `b3` bounds the scene.
-fn take_big(prims: &mut [PrimRef], b3: B3) -> usize {
+/// ones to keep apart from). `b3` bounds the scene; over `parallel_threshold` primitives,
+/// the search runs in parallel.
+fn take_big(prims: &mut [PrimRef], b3: B3, parallel_threshold: usize) -> usize {
     if prims.len() <= FLAT_MAX {
         return 0;
     }
     let least = b3.area() * BIG_AREA;
-    let mut big: Vec<(f32, u32)> = prims
-        .iter()
-        .filter(|p| p.bounds.area() >= least)
-        .map(|p| (p.bounds.area(), p.id))
-        .collect();
+    let big_one = |p: &PrimRef| {
+        let area = p.bounds.area();
+        (area >= least).then_some((area, p.id))
+    };
+    let mut big: Vec<(f32, u32)> = if prims.len() > parallel_threshold {
+        prims.par_iter().filter_map(big_one).collect()
+    } else {
+        prims.iter().filter_map(big_one).collect()
+    };
     if big.is_empty() || big.len() == prims.len() {
         return 0;
     }

@@ -412,6 +412,36 @@ fn camera_batches(
 
 /// Property: the hierarchy is the same whatever the thread count (same statistics and the
 /// same hits), and statistics are consistent.
+/// Property: degenerate triangles (zero area, or a non-finite corner) are left out alike by
+/// the parallel build and the serial one: the same layout, byte for byte in its debug form,
+/// over only the others.
+#[test]
+fn parallel_build_leaves_out_degenerate_triangles_as_the_serial_one() {
+    let mut rng = Pcg32::new(5, 3);
+    let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+    let tris: Vec<[Vec3; 3]> = (0..3000)
+        .map(|i| {
+            let a = r();
+            match i % 7 {
+                0 => [a, a, a + Vec3::X],
+                1 => [a, a + Vec3::new(f32::NAN, 0.0, 0.0), a + Vec3::Y],
+                _ => [a, a + r() * 0.05, a + r() * 0.05],
+            }
+        })
+        .collect();
+    let serial = Bvh::build(&tris, &[], &BuildOptions::default());
+    let parallel = Bvh::build(
+        &tris,
+        &[],
+        &BuildOptions {
+            parallel_threshold: 64,
+            ..BuildOptions::default()
+        },
+    );
+    assert_eq!(serial.stats().primitives, 3000 - 2 * 3000usize.div_ceil(7));
+    assert_eq!(format!("{serial:?}"), format!("{parallel:?}"));
+}
+
 #[test]
 fn build_is_deterministic_and_stats_add_up() {
     let mut rng = Pcg32::new(9, 1);
