@@ -158,6 +158,17 @@ fn max_channel(c: &[F16; 3]) -> F16 {
     c[0].max_num(c[1]).max_num(c[2])
 }
 
+/// `v` in the frame `(s, t, n)` (`Frame::to_local`), lane by lane. A function, not a
+/// closure: a closure is compiled on its own, without the caller's instruction set.
+#[inline(always)]
+fn local(v: V16, (s, t, n): (V16, V16, V16)) -> V16 {
+    V16 {
+        x: v.dot(s),
+        y: v.dot(t),
+        z: v.dot(n),
+    }
+}
+
 /// The shading frame of `Frame::from_normal`, lane by lane.
 #[inline(always)]
 fn frame(n: V16) -> (V16, V16) {
@@ -209,7 +220,7 @@ pub(super) fn step(
     kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[RenderLight],
-    paths: &mut [PathState],
+    (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
     group: &[usize],
     out: &mut Outputs,
@@ -229,7 +240,7 @@ pub(super) fn step(
         put(&mut p, lane, hit.p);
         put(&mut ng, lane, hit.ng);
         put(&mut n, lane, hit.ns);
-        put(&mut wo, lane, -path.ray.dir);
+        put(&mut wo, lane, -rays[k].dir);
         bsdf.put(lane, &hit.bsdf);
         let b = path.beta;
         for (c, b) in [b.r, b.g, b.b].into_iter().enumerate() {
@@ -237,12 +248,7 @@ pub(super) fn step(
         }
     }
     let (s, t) = frame(n);
-    let local = |v: V16| V16 {
-        x: v.dot(s),
-        y: v.dot(t),
-        z: v.dot(n),
-    };
-    let wo_l = local(wo);
+    let wo_l = local(wo, (s, t, n));
     let wo_front = F16::splat(0.0).lt(wo.dot(ng));
     let zero = F16::splat(0.0);
 
@@ -339,7 +345,7 @@ pub(super) fn step(
                 }
             };
             ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
-            let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi));
+            let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi, (s, t, n)));
             ok = ok & !max_channel(&f).le(zero);
             // `f li (w / pdf)`; a delta light's weight and density are both 1.
             let w = pdf.map_or(F16::splat(1.0), |pdf| {
@@ -378,8 +384,12 @@ pub(super) fn step(
             term: c.term,
         });
     }
+    let mut group_paths = [0; LANES];
+    for (lane, &k) in group_paths.iter_mut().zip(group) {
+        *lane = k as u32;
+    }
     out.groups.push(GroupTerms {
-        paths: std::array::from_fn(|i| group[i.min(m - 1)] as u32),
+        paths: group_paths,
         len: m,
         beta,
         samples: (first, out.waiting.len()),
@@ -428,7 +438,7 @@ pub(super) fn step(
         if alive {
             let path = &mut paths[k];
             path.beta = Rgb::new(b[0].0[i], b[1].0[i], b[2].0[i]);
-            path.ray = Ray::new(
+            rays[k] = Ray::new(
                 Vec3::new(origin.x.0[i], origin.y.0[i], origin.z.0[i]),
                 Vec3::new(wi.x.0[i], wi.y.0[i], wi.z.0[i]),
             );
@@ -449,12 +459,12 @@ pub(super) unsafe fn step_avx512(
     kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[RenderLight],
-    paths: &mut [PathState],
+    (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
     group: &[usize],
     out: &mut Outputs,
 ) {
-    step(kind, opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, (paths, rays), surfs, group, out);
 }
 
 /// [`step`] compiled for AVX2.
@@ -467,12 +477,12 @@ pub(super) unsafe fn step_avx2(
     kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[RenderLight],
-    paths: &mut [PathState],
+    (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
     group: &[usize],
     out: &mut Outputs,
 ) {
-    step(kind, opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, (paths, rays), surfs, group, out);
 }
 
 /// [`step`] on the best instructions the processor has.
@@ -480,7 +490,7 @@ pub(super) fn step_dispatch(
     kind: SmoothKind,
     opts: &RenderOptions,
     lights: &[RenderLight],
-    paths: &mut [PathState],
+    (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
     group: &[usize],
     out: &mut Outputs,
@@ -489,12 +499,12 @@ pub(super) fn step_dispatch(
     {
         if prism_math::Isa::avx512() {
             // SAFETY: the processor has AVX-512F and AVX-512DQ.
-            return unsafe { step_avx512(kind, opts, lights, paths, surfs, group, out) };
+            return unsafe { step_avx512(kind, opts, lights, (paths, rays), surfs, group, out) };
         }
         if prism_math::Isa::avx2() {
             // SAFETY: the processor has AVX2.
-            return unsafe { step_avx2(kind, opts, lights, paths, surfs, group, out) };
+            return unsafe { step_avx2(kind, opts, lights, (paths, rays), surfs, group, out) };
         }
     }
-    step(kind, opts, lights, paths, surfs, group, out);
+    step(kind, opts, lights, (paths, rays), surfs, group, out);
 }

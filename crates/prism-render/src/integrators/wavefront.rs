@@ -18,21 +18,21 @@ use crate::profile::{Laps, Profile, Stage};
 use crate::render_scene::RenderScene;
 use crate::sampler::{lane_keys, lane_values, Sampler};
 
-/// A path in flight: its pixel, random numbers, the ray to trace next, and what it carries.
+/// A path in flight: its pixel, random numbers and what it carries (the ray it traces next
+/// is kept beside it, in the pass's list of rays).
 pub(super) struct PathState {
     /// Index of the pixel in the tile's list.
     pixel: usize,
     pub(super) sampler: Sampler,
-    pub(super) ray: Ray,
     /// Radiance gathered so far.
     pub(super) l: Rgb,
     /// Throughput.
     pub(super) beta: Rgb,
-    /// Bounces taken by `ray` (0 for the camera ray).
+    /// Bounces taken by its ray (0 for the camera ray).
     pub(super) bounce: u32,
-    /// The density of the BSDF sample that chose `ray`.
+    /// The density of the BSDF sample that chose its ray.
     pub(super) pdf: f32,
-    /// True if emission found by `ray` is weighted against light sampling (the sample was
+    /// True if emission found by its ray is weighted against light sampling (the sample was
     /// not a delta lobe, and the BSDF is smooth).
     pub(super) mis: bool,
 }
@@ -103,7 +103,7 @@ struct Buffers {
     /// Per path, the surface its ray found, then the surface it scatters from next (none
     /// if it ends).
     hits: Vec<Option<Interaction>>,
-    /// The rays of the paths, and the hierarchy's hits along them.
+    /// The ray each path traces next, and the hierarchy's hits along them.
     rays: Vec<Ray>,
     bvh_hits: Vec<Option<prism_accel::Hit>>,
     /// Paths whose step runs sixteen at a time: at diffuse surfaces, then at conductors.
@@ -188,19 +188,18 @@ fn sample_pass(
     laps: &mut Laps,
 ) {
     b.paths.clear();
-    start_paths(camera, pixels, active, n, &mut b.paths);
+    b.rays.clear();
+    start_paths(camera, pixels, active, n, (&mut b.paths, &mut b.rays));
     laps.lap(Stage::Camera);
     while !b.paths.is_empty() {
-        b.rays.clear();
-        b.rays.extend(b.paths.iter().map(|p| p.ray));
         scene.closest_hits(&b.rays, &mut b.bvh_hits);
         laps.lap(Stage::ClosestHits);
         scene.hit_records(&b.rays, &b.bvh_hits, &mut b.hits);
         laps.lap(Stage::HitRecords);
         b.shadows.clear();
         b.lights.clear();
-        for (p, hit) in b.paths.iter_mut().zip(b.hits.iter_mut()) {
-            emit(scene, opts, p, hit);
+        for ((p, ray), hit) in b.paths.iter_mut().zip(&b.rays).zip(b.hits.iter_mut()) {
+            emit(scene, opts, p, ray.dir, hit);
         }
         laps.lap(Stage::Emission);
         let count = b.paths.len();
@@ -224,7 +223,7 @@ fn sample_pass(
             b.alive[i] = scatter(
                 scene,
                 opts,
-                &mut b.paths[i],
+                (&mut b.paths[i], &mut b.rays[i]),
                 hit,
                 (&mut b.shadows, &mut b.lights),
                 &mut b.pending[i],
@@ -246,7 +245,7 @@ fn sample_pass(
                 .zip([SmoothKind::Diffuse, SmoothKind::Conductor])
             {
                 for group in fast.chunks(LANES) {
-                    let paths = &mut b.paths;
+                    let paths = (&mut b.paths[..], &mut b.rays[..]);
                     smooth16::step_dispatch(kind, opts, lights, paths, &b.hits, group, &mut out);
                 }
             }
@@ -287,16 +286,20 @@ fn sample_pass(
             }
             keep_going
         });
+        let mut i = 0;
+        b.rays.retain(|_| {
+            i += 1;
+            alive[i - 1]
+        });
         laps.lap(Stage::Gathering);
     }
 }
 
 impl PathState {
     /// A path leaving the camera from pixel `pixel` of the tile's list.
-    fn start(pixel: usize, sampler: Sampler, ray: Ray) -> PathState {
+    fn start(pixel: usize, sampler: Sampler) -> PathState {
         PathState {
             pixel,
-            ray,
             sampler,
             l: Rgb::BLACK,
             beta: Rgb::WHITE,
@@ -315,14 +318,14 @@ fn start_paths(
     (pixels, keys): (&[(u32, u32)], &[u64]),
     active: &[usize],
     n: u32,
-    paths: &mut Vec<PathState>,
+    (paths, rays): (&mut Vec<PathState>, &mut Vec<Ray>),
 ) {
     let Some(eye) = camera.pinhole() else {
-        paths.extend(active.iter().map(|&k| {
+        for &k in active {
             let mut sampler = Sampler::from_pixel_key(keys[k], u64::from(n));
-            let ray = camera_ray(camera, pixels[k], &mut sampler);
-            PathState::start(k, sampler, ray)
-        }));
+            rays.push(camera_ray(camera, pixels[k], &mut sampler));
+            paths.push(PathState::start(k, sampler));
+        }
         return;
     };
     let start = Pinhole {
@@ -336,14 +339,14 @@ fn start_paths(
     {
         if prism_math::Isa::avx512() {
             // SAFETY: the processor has AVX-512F and AVX-512DQ.
-            return unsafe { start.paths_avx512(active, paths) };
+            return unsafe { start.paths_avx512(active, paths, rays) };
         }
         if prism_math::Isa::avx2() {
             // SAFETY: the processor has AVX2.
-            return unsafe { start.paths_avx2(active, paths) };
+            return unsafe { start.paths_avx2(active, paths, rays) };
         }
     }
-    start.paths(active, paths);
+    start.paths(active, paths, rays);
 }
 
 /// What [`start_paths`] needs for a pinhole camera's paths.
@@ -360,25 +363,29 @@ impl Pinhole<'_> {
     /// the sample in its pixel, and the ray directions on lanes (the last group padded with
     /// its first pixel).
     #[inline(always)]
-    fn paths(&self, active: &[usize], paths: &mut Vec<PathState>) {
+    fn paths(&self, active: &[usize], paths: &mut Vec<PathState>, rays: &mut Vec<Ray>) {
+        paths.reserve(active.len());
+        rays.reserve(active.len());
         for group in active.chunks(LANES) {
-            let k = |i: usize| group[i.min(group.len() - 1)];
-            let pixel_keys: [u64; LANES] = std::array::from_fn(|i| self.keys[k(i)]);
+            // Plain loops: `array::from_fn` is not always inlined.
+            let (mut pixel_keys, mut x, mut y) = ([0; LANES], F16::default(), F16::default());
+            for i in 0..LANES {
+                let k = group[i.min(group.len() - 1)];
+                pixel_keys[i] = self.keys[k];
+                x.0[i] = self.pixels[k].0 as f32;
+                y.0[i] = self.pixels[k].1 as f32;
+            }
             let key = lane_keys(&pixel_keys, u64::from(self.n));
             let dim = [0; LANES];
             let ux = lane_values(&key, &dim, 0);
             let uy = lane_values(&key, &dim, 1);
-            let x = F16(std::array::from_fn(|i| self.pixels[k(i)].0 as f32)) + ux;
-            let y = F16(std::array::from_fn(|i| self.pixels[k(i)].1 as f32)) + uy;
+            let (x, y) = (x + ux, y + uy);
             let d = self.camera.pinhole_dirs(x, y);
-            paths.extend(group.iter().enumerate().map(|(i, &pixel)| {
+            for (i, &pixel) in group.iter().enumerate() {
+                paths.push(PathState::start(pixel, Sampler::from_state(key[i], 2)));
                 let dir = Vec3::new(d.x.0[i], d.y.0[i], d.z.0[i]);
-                PathState::start(
-                    pixel,
-                    Sampler::from_state(key[i], 2),
-                    Ray::new(self.eye, dir),
-                )
-            }));
+                rays.push(Ray::new(self.eye, dir));
+            }
         }
     }
 
@@ -388,8 +395,13 @@ impl Pinhole<'_> {
     /// The processor must support AVX-512F and AVX-512DQ.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512dq")]
-    unsafe fn paths_avx512(&self, active: &[usize], paths: &mut Vec<PathState>) {
-        self.paths(active, paths);
+    unsafe fn paths_avx512(
+        &self,
+        active: &[usize],
+        paths: &mut Vec<PathState>,
+        rays: &mut Vec<Ray>,
+    ) {
+        self.paths(active, paths, rays);
     }
 
     /// [`Pinhole::paths`] compiled for AVX2.
@@ -398,20 +410,21 @@ impl Pinhole<'_> {
     /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn paths_avx2(&self, active: &[usize], paths: &mut Vec<PathState>) {
-        self.paths(active, paths);
+    unsafe fn paths_avx2(&self, active: &[usize], paths: &mut Vec<PathState>, rays: &mut Vec<Ray>) {
+        self.paths(active, paths, rays);
     }
 }
 
-/// Adds the emission a path's ray found (or what it sees escaping); leaves in `hit` the
-/// surface the path scatters from next, or none if it ends there.
+/// Adds the emission a path's ray (along `dir`) found, or what it sees escaping; leaves in
+/// `hit` the surface the path scatters from next, or none if it ends there.
 fn emit(
     scene: &RenderScene,
     opts: &RenderOptions,
     p: &mut PathState,
+    dir: Vec3,
     hit: &mut Option<Interaction>,
 ) {
-    if emitted(scene, opts, p, hit.as_ref()).is_none() {
+    if emitted(scene, opts, p, dir, hit.as_ref()).is_none() {
         *hit = None;
     }
 }
@@ -421,11 +434,11 @@ fn emitted(
     scene: &RenderScene,
     opts: &RenderOptions,
     p: &mut PathState,
+    dir: Vec3,
     hit: Option<&Interaction>,
 ) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
     let nlights = opts.light_samples.max(1) as f32;
-    let dir = p.ray.dir;
     // Emission along the ray.
     let hit = if p.bounce == 0 {
         match hit {
@@ -483,19 +496,19 @@ fn emitted(
     Some(())
 }
 
-/// One path's step at `hit`: samples the lights (their shadow rays go to `shadows`, the
-/// estimate's bookkeeping to `waiting`) and the BSDF. Returns `Some(())` if the path goes
-/// on with a new ray.
+/// One path's step at `hit`, reached by `ray`: samples the lights (their shadow rays go to
+/// `shadows`, the estimate's bookkeeping to `waiting`) and the BSDF. Returns `Some(())` if
+/// the path goes on, with its next ray in `ray`.
 fn scatter(
     scene: &RenderScene,
     opts: &RenderOptions,
-    p: &mut PathState,
+    (p, ray): (&mut PathState, &mut Ray),
     hit: &Interaction,
     (shadows, light_terms): (&mut Shadows, &mut Vec<LightTerms>),
     waiting: &mut Option<Pending>,
 ) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
-    let dir = p.ray.dir;
+    let dir = ray.dir;
     let bounce = p.bounce + 1;
     let wo = -dir;
     let (frame, wo_l) = hit.shading_frame(wo);
@@ -543,7 +556,7 @@ fn scatter(
         }
         p.beta *= 1.0 / q;
     }
-    p.ray = hit.spawn(wi);
+    *ray = hit.spawn(wi);
     p.bounce = bounce;
     p.pdf = s.pdf;
     p.mis = !s.delta && hit.bsdf.is_smooth();
