@@ -152,6 +152,12 @@ fn rgb(c: Rgb) -> [F16; 3] {
     [c.r, c.g, c.b].map(F16::splat)
 }
 
+/// Two consecutive draws of sixteen samplers, `j` and `j + 1` dimensions on.
+#[inline(always)]
+fn pair(key: &[u64; LANES], dim: &[u64; LANES], j: u64) -> (F16, F16) {
+    (lane_values(key, dim, j), lane_values(key, dim, j + 1))
+}
+
 /// `f32::max` over the three channels, in `Rgb::max_channel`'s order.
 #[inline(always)]
 fn max_channel(c: &[F16; 3]) -> F16 {
@@ -267,8 +273,8 @@ pub(super) fn step(
     for light in lights {
         let count = light.sample_count(opts.light_samples);
         for _ in 0..count {
-            let ux = lane_values(&key, &dim, draw);
-            let uy = lane_values(&key, &dim, draw + 1);
+            // The sample's two numbers, drawn only where used (a delta light needs none).
+            let u = draw;
             draw += 2;
             // Per lane: the direction to the light, its distance, the lanes with a sample,
             // the incident radiance, and the density with its MIS weight (none: delta).
@@ -281,6 +287,7 @@ pub(super) fn step(
                     area,
                     radiance,
                 } => {
+                    let (ux, uy) = pair(&key, &dim, u);
                     let q = V16::splat(corner) + V16::splat(e1) * ux + V16::splat(e2) * uy;
                     let (wi, dist, dist2) = toward(p, q);
                     let cos_l = -dot1(wi, normal);
@@ -306,6 +313,7 @@ pub(super) fn step(
                 }
                 RenderLight::Hemisphere { radiance } => {
                     // `cosine_hemisphere` about world +Y, in `Frame::to_world`'s order.
+                    let (ux, uy) = pair(&key, &dim, u);
                     let local = cosine_hemisphere_lanes(ux, uy);
                     let wi = V16::splat(sky.s) * local.x
                         + V16::splat(sky.t) * local.y
@@ -324,13 +332,14 @@ pub(super) fn step(
                 | RenderLight::Environment { .. }
                 | RenderLight::EnvironmentMap(_) => {
                     // No lane version of the sample: the light's own, lane by lane.
+                    let (ux, uy) = pair(&key, &dim, u);
                     let (mut wi, mut dist) = (V16::splat(Vec3::Z), F16::splat(1.0));
                     let (mut li, mut pdf) = (rgb(Rgb::BLACK), F16::splat(1.0));
                     let mut found = 0;
                     for lane in 0..m {
                         let at = Vec3::new(p.x.0[lane], p.y.0[lane], p.z.0[lane]);
-                        let u = Vec2::new(ux.0[lane], uy.0[lane]);
-                        if let Some(ls) = light.sample(at, u) {
+                        let uv = Vec2::new(ux.0[lane], uy.0[lane]);
+                        if let Some(ls) = light.sample(at, uv) {
                             put(&mut wi, lane, ls.wi);
                             dist.0[lane] = ls.dist;
                             pdf.0[lane] = ls.pdf;
