@@ -233,25 +233,49 @@ pub(super) fn step(
 ) {
     let m = group.len();
     let lane_in = M16::first(m);
-    let (mut p, mut ng, mut n, mut wo) = Default::default();
+    let (mut p, mut ng, mut n, mut wo): (V16, V16, V16, V16) = Default::default();
     let mut bsdf = SmoothLanes::new(kind);
     let mut beta = [F16::default(); 3];
     let mut key = [0u64; LANES];
     let mut dim = [0u64; LANES];
+    // The sixteen records first, then each field in a loop of its own, which the compiler
+    // can turn into one gather.
+    let no_surface = "scattering paths have a surface";
+    let mut hits = [surfs[group[0]].as_ref().expect(no_surface); LANES];
+    let mut from = [&paths[group[0]]; LANES];
+    let mut dirs = [Vec3::ZERO; LANES];
     for lane in 0..LANES {
         let k = group[lane.min(m - 1)];
-        let hit = surfs[k].as_ref().expect("scattering paths have a surface");
-        let path = &paths[k];
-        (key[lane], dim[lane]) = path.sampler.state();
-        put(&mut p, lane, hit.p);
-        put(&mut ng, lane, hit.ng);
-        put(&mut n, lane, hit.ns);
-        put(&mut wo, lane, -rays[k].dir);
-        bsdf.put(lane, &hit.bsdf);
-        let b = path.beta;
-        for (c, b) in [b.r, b.g, b.b].into_iter().enumerate() {
-            beta[c].0[lane] = b;
-        }
+        hits[lane] = surfs[k].as_ref().expect(no_surface);
+        from[lane] = &paths[k];
+        dirs[lane] = rays[k].dir;
+    }
+    macro_rules! lanes {
+        ($dst:expr, $src:ident . $($field:tt).+) => {
+            for lane in 0..LANES {
+                $dst.0[lane] = $src[lane].$($field).+;
+            }
+        };
+    }
+    lanes!(p.x, hits.p.x);
+    lanes!(p.y, hits.p.y);
+    lanes!(p.z, hits.p.z);
+    lanes!(ng.x, hits.ng.x);
+    lanes!(ng.y, hits.ng.y);
+    lanes!(ng.z, hits.ng.z);
+    lanes!(n.x, hits.ns.x);
+    lanes!(n.y, hits.ns.y);
+    lanes!(n.z, hits.ns.z);
+    lanes!(wo.x, dirs.x);
+    lanes!(wo.y, dirs.y);
+    lanes!(wo.z, dirs.z);
+    wo = -wo;
+    lanes!(beta[0], from.beta.r);
+    lanes!(beta[1], from.beta.g);
+    lanes!(beta[2], from.beta.b);
+    for lane in 0..LANES {
+        (key[lane], dim[lane]) = from[lane].sampler.state();
+        bsdf.put(lane, &hits[lane].bsdf);
     }
     let (s, t) = frame(n);
     let wo_l = local(wo, (s, t, n));
