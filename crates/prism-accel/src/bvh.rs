@@ -607,7 +607,7 @@ impl Bvh {
         unsafe { self.nodes.get_unchecked(r as usize) }
     }
 
-    /// Starts loading a node or a leaf's first triangles into the cache.
+    /// Starts loading a node, or a leaf's first two packs of triangles, into the cache.
     #[inline(always)]
     fn prefetch(&self, r: u32) {
         #[cfg(target_arch = "x86_64")]
@@ -628,6 +628,12 @@ impl Bvh {
                 _mm_prefetch::<_MM_HINT_T0>(p);
                 _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
                 _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(128));
+                if r & LEAF != 0 && (r >> PACKS_SHIFT) & 6 != 0 {
+                    // The second pack of a leaf of two or more, tested with the first.
+                    _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(192));
+                    _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(256));
+                    _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(319));
+                }
             }
         }
     }
@@ -676,9 +682,10 @@ impl Bvh {
     }
 
     /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
-    /// the first hit.
+    /// the first hit. With `AVX`, its packs are tested two at a time
+    /// ([`Tri4::intersect_pair_avx`]), which finds the same hits.
     #[inline(always)]
-    fn leaf(
+    fn leaf<const AVX: bool>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -690,12 +697,27 @@ impl Bvh {
         let rec = self.leaf_rec(r);
         let mut best = None;
         let p0 = rec.pack_start as usize;
-        for pack in &self.packs[p0..p0 + rec.packs as usize] {
-            if let Some((t, lane, b1, b2)) = pack.intersect(pre, tmin, *tmax) {
+        let mut packs = &self.packs[p0..p0 + rec.packs as usize];
+        while let [a, rest @ ..] = packs {
+            let (found, prims) = match rest {
+                #[cfg(target_arch = "x86_64")]
+                [b, tail @ ..] if AVX => {
+                    packs = tail;
+                    // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
+                    // their callers enter after detecting it.
+                    let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *tmax) };
+                    (found, [a.prim, b.prim])
+                }
+                _ => {
+                    packs = rest;
+                    (a.intersect(pre, tmin, *tmax), [a.prim; 2])
+                }
+            };
+            if let Some((t, lane, b1, b2)) = found {
                 *tmax = t;
                 best = Some(Hit {
                     t,
-                    prim: pack.prim[lane],
+                    prim: prims[lane / 4][lane % 4],
                     b1,
                     b2,
                 });
@@ -1361,7 +1383,10 @@ impl Bvh {
         loop {
             if node_ref & LEAF != 0 {
                 let mut t = tmax;
-                if self.leaf(node_ref, &r, ray, tmin, &mut t, true).is_some() {
+                if self
+                    .leaf::<AVX>(node_ref, &r, ray, tmin, &mut t, true)
+                    .is_some()
+                {
                     return true;
                 }
             } else {
@@ -1509,7 +1534,8 @@ impl Walk {
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
-            if let Some(h) = bvh.leaf(node_ref, &self.pre, ray, tmin, &mut self.tmax, false) {
+            if let Some(h) = bvh.leaf::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.tmax, false)
+            {
                 self.best = Some(h);
                 self.reach = widen(self.tmax);
             }
