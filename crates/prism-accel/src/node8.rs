@@ -214,7 +214,11 @@ mod tests {
             for axis in 0..3 {
                 let t0 = (b.min[axis] - ray.origin[axis]) * inv[axis];
                 let t1 = (b.max[axis] - ray.origin[axis]) * inv[axis];
-                let (tn, tf) = if inv[axis].is_sign_negative() { (t1, t0) } else { (t0, t1) };
+                let (tn, tf) = if inv[axis].is_sign_negative() {
+                    (t1, t0)
+                } else {
+                    (t0, t1)
+                };
                 if !tn.is_nan() {
                     near = near.max(tn);
                 }
@@ -245,7 +249,14 @@ mod tests {
                 if slot == 0 || grid() > -2.0 {
                     let a = Vec3::new(grid(), grid(), grid());
                     let b = Vec3::new(grid(), grid(), grid());
-                    n.set(slot, Aabb { min: a.min(b), max: a.max(b) }, slot as u32);
+                    n.set(
+                        slot,
+                        Aabb {
+                            min: a.min(b),
+                            max: a.max(b),
+                        },
+                        slot as u32,
+                    );
                 }
             }
             let origin = Vec3::new(grid(), grid(), grid());
