@@ -61,7 +61,8 @@ impl RayPre {
         let perm = 2 * kz + usize::from(da[kz] < 0.0);
         let [kx, ky, kz] = PERMS[perm];
         let inv_dir = d.recip();
-        let inv_z = 1.0 / da[kz];
+        // `1 / da[kz]`, already computed.
+        let inv_z = inv_dir.to_array()[kz];
         RayPre {
             origin: ray.origin,
             dir: d,
