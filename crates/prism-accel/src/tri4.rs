@@ -95,20 +95,12 @@ impl Tri4 {
         let t = sz * (u * az + v * bz + w * cz) * (Vec4::ONE / det);
         let hit =
             inside & det.cmpne(zero) & t.cmpgt(Vec4::splat(tmin)) & t.cmplt(Vec4::splat(tmax));
-        let mut mask = hit.bitmask();
+        let mask = hit.bitmask();
         if mask == 0 {
             return None;
         }
         let ta = t.to_array();
-        let mut best = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        while mask != 0 {
-            let lane = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if ta[lane] < ta[best] {
-                best = lane;
-            }
-        }
+        let best = nearest_lane(mask, &ta);
         let inv = 1.0 / det.to_array()[best];
         Some((
             ta[best],
@@ -220,21 +212,13 @@ impl Tri4 {
                     _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(tmax)),
                 ),
             );
-            let mut mask = _mm256_movemask_ps(hit) as u32;
+            let mask = _mm256_movemask_ps(hit) as u32;
             if mask == 0 {
                 return None;
             }
             let mut ta = [0f32; 8];
             _mm256_storeu_ps(ta.as_mut_ptr(), t);
-            let mut best = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if ta[lane] < ta[best] {
-                    best = lane;
-                }
-            }
+            let best = nearest_lane(mask, &ta);
             let (mut va, mut wa, mut da) = ([0f32; 8], [0f32; 8], [0f32; 8]);
             _mm256_storeu_ps(va.as_mut_ptr(), v);
             _mm256_storeu_ps(wa.as_mut_ptr(), w);
@@ -262,6 +246,22 @@ impl Tri4 {
         }
         best
     }
+}
+
+/// The lane of `mask` (not empty) with the smallest `t`, the lowest of equals: the one a
+/// scan of the lanes in order keeps.
+#[inline(always)]
+fn nearest_lane(mut mask: u32, t: &[f32]) -> usize {
+    let mut best = mask.trailing_zeros() as usize;
+    mask &= mask - 1;
+    while mask != 0 {
+        let lane = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        if t[lane] < t[best] {
+            best = lane;
+        }
+    }
+    best
 }
 
 #[cfg(test)]
