@@ -1556,25 +1556,10 @@ impl Walk {
                 self.node = n.child[mask.trailing_zeros() as usize];
                 bvh.prefetch(self.node);
                 return true;
-            } else if rest & rest.wrapping_sub(1) == 0 && !SELECT {
-                // Two children entered: push the farther and go on to the nearer (the
-                // order the sort below gives, the lower slot first of equals).
-                let first = mask.trailing_zeros() as usize;
-                let last = 31 - mask.leading_zeros() as usize;
-                let (a, b) = if near[last] < near[first] {
-                    (last, first)
-                } else {
-                    (first, last)
-                };
-                self.stack.push(self.sp, (n.child[b], near[b]));
-                self.sp += 1;
-                self.node = n.child[a];
-                bvh.prefetch(self.node);
-                bvh.prefetch(n.child[b]);
-                return true;
-            } else if rest & rest.wrapping_sub(1) == 0 && SELECT {
-                // One or two children entered, without a branch on which: push the farther
-                // (when there are two) and go on to the nearer.
+            } else if rest & rest.wrapping_sub(1) == 0 {
+                // Two children entered (with `SELECT`, one or two, without a branch on
+                // which): push the farther (when there are two) and go on to the nearer, the
+                // lower slot first of equals, as the sort below orders them.
                 let first = mask.trailing_zeros() as usize;
                 let last = 31 - mask.leading_zeros() as usize;
                 let swap = near[last] < near[first];
