@@ -75,6 +75,9 @@ pub(crate) struct SlabRay {
     inv_dir: [f32; 3],
     near: [usize; 3],
     far: [usize; 3],
+    /// The origin and `inv_dir` are finite and no `inv_dir` is zero: no slab distance is
+    /// NaN.
+    plain: bool,
 }
 
 impl SlabRay {
@@ -87,6 +90,9 @@ impl SlabRay {
             inv_dir: r.inv_dir.to_array(),
             near,
             far: [3 * (1 - neg(0)), 1 + 3 * (1 - neg(1)), 2 + 3 * (1 - neg(2))],
+            plain: r.origin.is_finite()
+                && r.inv_dir.is_finite()
+                && !r.inv_dir.cmpeq(Vec3::ZERO).any(),
         }
     }
 }
@@ -117,7 +123,11 @@ pub(crate) fn widen(t: f32) -> f32 {
 /// A slab distance is NaN (0 * inf) for a ray lying in a slab's plane, and that slab does not
 /// cut the interval: SSE and AVX max return their second operand when either is NaN, so with
 /// the slab value first a NaN drops out of the entry, and a far slab counts as passed when
-/// the entry is not greater than it (true when it is NaN).
+/// the entry is not greater than it (true when it is NaN). For a [`SlabRay`] with no NaN
+/// distance (`plain`: every ray but those parallel to an axis plane), the near distances
+/// are instead taken in pairs, `max(max(x, y), max(z, tmin))`: the same value (max of
+/// numbers picks the same number in any order, up to the sign of a zero, which no
+/// comparison sees), two dependent steps rather than three on the path every node waits on.
 #[inline(always)]
 pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
     let mut near_out = [0f32; 8];
@@ -128,7 +138,13 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
             let b = unsafe { n.bounds.get_unchecked(plane) };
             (b[half] - Vec4::splat(r.origin[axis])) * Vec4::splat(r.inv_dir[axis])
         };
-        let near = t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))));
+        let near = if r.plain {
+            t(r.near[0], 0)
+                .max(t(r.near[1], 1))
+                .max(t(r.near[2], 2).max(Vec4::splat(tmin)))
+        } else {
+            t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))))
+        };
         let before = |plane: usize, axis: usize| !near.cmpgt(t(plane, axis) * FAR_WIDEN);
         let enters = (before(r.far[0], 0) & before(r.far[1], 1))
             & (before(r.far[2], 2) & near.cmple(Vec4::splat(tmax)));
@@ -168,13 +184,20 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
                 )
             };
         }
-        let near = _mm256_max_ps(
-            t!(r.near[2], 2),
+        let near = if r.plain {
             _mm256_max_ps(
-                t!(r.near[1], 1),
-                _mm256_max_ps(t!(r.near[0], 0), _mm256_set1_ps(tmin)),
-            ),
-        );
+                _mm256_max_ps(t!(r.near[0], 0), t!(r.near[1], 1)),
+                _mm256_max_ps(t!(r.near[2], 2), _mm256_set1_ps(tmin)),
+            )
+        } else {
+            _mm256_max_ps(
+                t!(r.near[2], 2),
+                _mm256_max_ps(
+                    t!(r.near[1], 1),
+                    _mm256_max_ps(t!(r.near[0], 0), _mm256_set1_ps(tmin)),
+                ),
+            )
+        };
         macro_rules! before {
             ($plane:expr, $axis:expr) => {
                 _mm256_cmp_ps::<_CMP_NGT_UQ>(
@@ -237,11 +260,12 @@ mod tests {
     /// Property: the SSE and AVX tests enter exactly the children the scalar interval test
     /// enters, with the same entry distances, on boxes with corners on a small integer grid
     /// and rays from grid points along axes (slab distances of 0 * inf = NaN), on box faces,
-    /// and in random directions.
+    /// and in random directions (with no NaN distance, whose entries are combined in
+    /// another order).
     #[test]
     fn node_tests_match_the_scalar_interval_test() {
         let mut rng = Pcg32::new(3, 9);
-        let mut entered = 0;
+        let (mut entered, mut plain) = (0, 0);
         for k in 0..20_000 {
             let mut grid = || (rng.next_u32() % 7) as f32 - 3.0;
             let mut n = Node8::empty();
@@ -270,6 +294,7 @@ mod tests {
             }
             let ray = Ray::new(origin, dir);
             let slab = SlabRay::new(&RayPre::new(&ray));
+            plain += usize::from(slab.plain);
             let tmax = if k % 5 == 0 { 2.5 } else { f32::INFINITY };
             let want = reference(&n, &ray, 0.0, tmax);
             let sse = hit_sse(&n, &slab, 0.0, tmax);
@@ -289,5 +314,9 @@ mod tests {
             entered += want.1.count_ones();
         }
         assert!(entered > 10_000, "{entered} children entered");
+        assert!(
+            (5000..15_000).contains(&plain),
+            "{plain} rays with no NaN distance"
+        );
     }
 }
