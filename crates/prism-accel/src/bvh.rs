@@ -608,7 +608,7 @@ impl Bvh {
         unsafe { self.nodes.get_unchecked(r as usize) }
     }
 
-    /// Starts loading a node, or a leaf's first two packs of triangles, into the cache.
+    /// Starts loading a node, or a leaf's first three packs of triangles, into the cache.
     #[inline(always)]
     fn prefetch(&self, r: u32) {
         #[cfg(target_arch = "x86_64")]
@@ -634,6 +634,12 @@ impl Bvh {
                     _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(192));
                     _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(256));
                     _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(319));
+                    if (r >> PACKS_SHIFT) & 7 >= 3 {
+                        // The third pack, tested right after the first two.
+                        _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(383));
+                        _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(447));
+                        _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(479));
+                    }
                 }
             }
         }
