@@ -803,9 +803,98 @@ impl Bvh {
         tmax: f32,
         skip: u32,
     ) -> Option<Hit> {
-        let mut walk = Walk::new(ray, tmax);
-        while walk.step::<AVX, false>(self, ray, tmin, skip) {}
-        walk.best
+        // `Walk::step`'s walk, written as one loop over local variables, so that its state
+        // stays in registers (a `Walk`, stepped from outside, lives in memory).
+        let pre = RayPre::new(ray);
+        let slab = SlabRay::new(&pre);
+        let (mut tmax, mut reach, mut best) = (tmax, widen(tmax), None);
+        let mut stack = Stack::new();
+        let mut sp = 0;
+        let mut node_ref = 0;
+        loop {
+            if node_ref & LEAF != 0 {
+                if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut tmax, false) {
+                    best = Some(h);
+                    reach = widen(tmax);
+                }
+            } else {
+                let n = self.node(node_ref);
+                let (near, mut mask) = Bvh::node_hit::<AVX>(n, &slab, tmin, reach);
+                if node_ref == 0 {
+                    mask &= !skip;
+                }
+                if mask != 0 && mask & mask.wrapping_sub(1) == 0 {
+                    // One child entered: go on to it without the stack.
+                    node_ref = n.child[mask.trailing_zeros() as usize];
+                    self.prefetch(node_ref);
+                    continue;
+                }
+                if mask != 0 {
+                    node_ref = self.descend(n, &near, mask, &mut stack, &mut sp);
+                    continue;
+                }
+            }
+            match pop(&stack, &mut sp, reach) {
+                Some(next) => node_ref = next,
+                None => return best,
+            }
+        }
+    }
+
+    /// Orders the children of `n` entered (`mask`, not empty) by their entries `near`,
+    /// nearest first (the lower slot first of equals), pushes all but the nearest onto
+    /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
+    /// told apart and ordered by selects rather than branches (one is pushed and popped
+    /// again at once: `*sp` does not move).
+    #[inline(always)]
+    fn descend(
+        &self,
+        n: &Node8,
+        near: &[f32; 8],
+        mut mask: u32,
+        stack: &mut Stack<(u32, f32)>,
+        sp: &mut usize,
+    ) -> u32 {
+        // The entered children but the lowest slot's: none when one is entered. (Bit
+        // tricks rather than a count: the walks are compiled without `popcnt`.)
+        let rest = mask & mask.wrapping_sub(1);
+        if rest & rest.wrapping_sub(1) == 0 {
+            // Push the farther (when there are two) and go on to the nearer, as the sort
+            // below orders them.
+            let first = mask.trailing_zeros() as usize;
+            let last = 31 - mask.leading_zeros() as usize;
+            let swap = near[last] < near[first];
+            let (a, b) = if swap { (last, first) } else { (first, last) };
+            stack.push(*sp, (n.child[b], near[b]));
+            *sp += usize::from(rest != 0);
+            self.prefetch(n.child[a]);
+            self.prefetch(n.child[b]);
+            return n.child[a];
+        }
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let mut hits = [(0u32, 0f32); 8];
+        hits[0] = (n.child[i], near[i]);
+        let mut count = 1;
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let mut j = count;
+            while j > 0 && hits[j - 1].1 > near[i] {
+                hits[j] = hits[j - 1];
+                j -= 1;
+            }
+            hits[j] = (n.child[i], near[i]);
+            count += 1;
+        }
+        for k in (1..count).rev() {
+            stack.push(*sp, hits[k]);
+            *sp += 1;
+        }
+        self.prefetch(hits[0].0);
+        // The second nearest is likely visited next after the nearest's subtree.
+        self.prefetch(hits[1].0);
+        hits[0].0
     }
 
     /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
@@ -867,7 +956,7 @@ impl Bvh {
     ) -> bool {
         if slot
             .walk
-            .step::<AVX, true>(self, &rays[slot.ray], tmin, slot.skip)
+            .step::<AVX>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
         {
             return true;
         }
@@ -875,8 +964,9 @@ impl Bvh {
         if *next == n {
             while other
                 .walk
-                .step::<AVX, true>(self, &rays[other.ray], tmin, other.skip)
-            {}
+                .step::<AVX>(self, &rays[other.ray], tmin, other.skip, &mut other.stack)
+            {
+            }
             hits[other.query] = other.walk.best;
             return false;
         }
@@ -1460,6 +1550,7 @@ impl<T: Copy> Stack<T> {
 /// slots `skip` left out.
 struct Slot {
     walk: Walk,
+    stack: Stack<(u32, f32)>,
     ray: usize,
     skip: u32,
     query: usize,
@@ -1472,6 +1563,7 @@ impl Slot {
         let (ray, tmax, skip) = job(k);
         Slot {
             walk: Walk::new(&rays[ray], tmax),
+            stack: Stack::new(),
             ray,
             skip,
             query: k,
@@ -1479,7 +1571,9 @@ impl Slot {
     }
 }
 
-/// One ray's closest-hit walk through the tree, a node or leaf per [`Walk::step`].
+/// One ray's closest-hit walk through the tree, a node or leaf per [`Walk::step`], for
+/// [`Bvh::walk_pairs`], which alternates two; its traversal stack is kept apart. A lone walk
+/// is [`Bvh::intersect_with`]'s loop, the same steps.
 struct Walk {
     pre: RayPre,
     slab: SlabRay,
@@ -1487,7 +1581,6 @@ struct Walk {
     tmax: f32,
     /// `widen(tmax)`: children entered no farther than this are visited.
     reach: f32,
-    stack: Stack<(u32, f32)>,
     sp: usize,
     /// The node or leaf the next step visits.
     node: u32,
@@ -1504,7 +1597,6 @@ impl Walk {
             best: None,
             tmax,
             reach: widen(tmax),
-            stack: Stack::new(),
             sp: 0,
             node: 0,
         }
@@ -1527,17 +1619,18 @@ impl Walk {
     /// child that may still hold a closer hit. False when none is left: the walk is over
     /// and `best` is the closest hit.
     ///
-    /// With `SELECT`, one or two children entered are told apart and ordered by selects
-    /// instead of branches: for incoherent rays, whose branches the processor cannot
-    /// predict, that is faster; for coherent ones, slower. The children visited and their
-    /// order are the same either way.
+    /// One or two children entered are told apart and ordered by selects instead of
+    /// branches ([`Bvh::descend`]): for incoherent rays, whose branches the processor cannot
+    /// predict, that is faster (the one-ray walk, mostly coherent, branches on one child).
+    /// The children visited and their order are the same either way.
     #[inline(always)]
-    fn step<const AVX: bool, const SELECT: bool>(
+    fn step<const AVX: bool>(
         &mut self,
         bvh: &Bvh,
         ray: &Ray,
         tmin: f32,
         skip: u32,
+        stack: &mut Stack<(u32, f32)>,
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
@@ -1552,71 +1645,33 @@ impl Walk {
             if node_ref == 0 {
                 mask &= !skip;
             }
-            // The entered children but the lowest slot's: none when one is entered. (Bit
-            // tricks rather than a count: the walks are compiled without `popcnt`.)
-            let rest = mask & mask.wrapping_sub(1);
-            if mask == 0 {
-                // Nothing entered: pop below.
-            } else if rest == 0 && !SELECT {
-                // One child entered: go on to it without the stack.
-                self.node = n.child[mask.trailing_zeros() as usize];
-                bvh.prefetch(self.node);
-                return true;
-            } else if rest & rest.wrapping_sub(1) == 0 {
-                // Two children entered (with `SELECT`, one or two, without a branch on
-                // which): push the farther (when there are two) and go on to the nearer, the
-                // lower slot first of equals, as the sort below orders them.
-                let first = mask.trailing_zeros() as usize;
-                let last = 31 - mask.leading_zeros() as usize;
-                let swap = near[last] < near[first];
-                let (a, b) = if swap { (last, first) } else { (first, last) };
-                self.stack.push(self.sp, (n.child[b], near[b]));
-                self.sp += usize::from(rest != 0);
-                self.node = n.child[a];
-                bvh.prefetch(self.node);
-                bvh.prefetch(n.child[b]);
-                return true;
-            } else {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                // Sort the children entered, nearest first; push all but the nearest,
-                // farthest first, and go on to the nearest.
-                let mut hits = [(0u32, 0f32); 8];
-                hits[0] = (n.child[i], near[i]);
-                let mut count = 1;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let mut j = count;
-                    while j > 0 && hits[j - 1].1 > near[i] {
-                        hits[j] = hits[j - 1];
-                        j -= 1;
-                    }
-                    hits[j] = (n.child[i], near[i]);
-                    count += 1;
-                }
-                for k in (1..count).rev() {
-                    self.stack.push(self.sp, hits[k]);
-                    self.sp += 1;
-                }
-                self.node = hits[0].0;
-                bvh.prefetch(self.node);
-                // The second nearest is likely visited next after the nearest's subtree.
-                bvh.prefetch(hits[1].0);
+            if mask != 0 {
+                self.node = bvh.descend(n, &near, mask, stack, &mut self.sp);
                 return true;
             }
         }
-        // Pop the nearest pending child that may still hold a closer hit.
-        while self.sp > 0 {
-            self.sp -= 1;
-            let (next, t_near) = self.stack.get(self.sp);
-            if t_near <= self.reach {
+        match pop(stack, &mut self.sp, self.reach) {
+            Some(next) => {
                 self.node = next;
-                return true;
+                true
             }
+            None => false,
         }
-        false
     }
+}
+
+/// Pops the nearest pending child that may still hold a closer hit (one entered no farther
+/// than `reach`), dropping those that cannot.
+#[inline(always)]
+fn pop(stack: &Stack<(u32, f32)>, sp: &mut usize, reach: f32) -> Option<u32> {
+    while *sp > 0 {
+        *sp -= 1;
+        let (next, t_near) = stack.get(*sp);
+        if t_near <= reach {
+            return Some(next);
+        }
+    }
+    None
 }
 
 fn root_bounds(n: &BuildNode) -> Aabb {
