@@ -228,6 +228,128 @@ impl Tri4 {
         }
     }
 
+    /// The nearest hit among the triangles of three or four packs with `tmin < t < tmax`,
+    /// `(t, lane, b1, b2)` with lane `4 * k + i` for lane `i` of pack `k`: [`Tri4::intersect`]'s
+    /// operations on 512-bit AVX-512 lanes, so the same hit as testing the packs one after
+    /// the other, each below the hits before it (the nearest, the first lane of equals).
+    /// Three packs fill the last four lanes with the third again, and those lanes are left
+    /// out.
+    ///
+    /// # Safety
+    /// The processor must support AVX-512F.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) unsafe fn intersect_wide_avx512(
+        packs: &[Tri4],
+        r: &RayPre,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, usize, f32, f32)> {
+        use std::arch::x86_64::{
+            _mm512_add_ps, _mm512_castps128_ps512, _mm512_cmp_ps_mask, _mm512_div_ps,
+            _mm512_insertf32x4, _mm512_mul_ps, _mm512_set1_ps, _mm512_setzero_ps, _mm512_storeu_ps,
+            _mm512_sub_ps, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ,
+        };
+        debug_assert!(packs.len() == 3 || packs.len() == 4);
+        let (a, b, c) = (&packs[0], &packs[1], &packs[2]);
+        let d = packs.get(3).unwrap_or(c);
+        let live: u16 = if packs.len() == 4 { 0xffff } else { 0x0fff };
+        let [kx, ky, kz] = crate::shapes::PERMS[r.perm];
+        let o = r.origin.to_array();
+        // SAFETY: the caller ensures AVX-512F; each load reads one aligned `Vec4` of a pack
+        // (a pack is 32-byte aligned and its vectors sit at multiples of 16 bytes).
+        unsafe {
+            macro_rules! rel {
+                ($i:expr, $axis:expr) => {
+                    _mm512_sub_ps(
+                        _mm512_insertf32x4::<3>(
+                            _mm512_insertf32x4::<2>(
+                                _mm512_insertf32x4::<1>(
+                                    _mm512_castps128_ps512(_mm_load_ps(
+                                        a.v[$i][$axis].as_ref().as_ptr(),
+                                    )),
+                                    _mm_load_ps(b.v[$i][$axis].as_ref().as_ptr()),
+                                ),
+                                _mm_load_ps(c.v[$i][$axis].as_ref().as_ptr()),
+                            ),
+                            _mm_load_ps(d.v[$i][$axis].as_ref().as_ptr()),
+                        ),
+                        _mm512_set1_ps(o[$axis]),
+                    )
+                };
+            }
+            macro_rules! sub {
+                ($x:expr, $y:expr) => {
+                    _mm512_sub_ps($x, $y)
+                };
+            }
+            macro_rules! mul {
+                ($x:expr, $y:expr) => {
+                    _mm512_mul_ps($x, $y)
+                };
+            }
+            let (sx, sy, sz) = (
+                _mm512_set1_ps(r.shear.x),
+                _mm512_set1_ps(r.shear.y),
+                _mm512_set1_ps(r.shear.z),
+            );
+            let (az, bz, cz) = (rel!(0, kz), rel!(1, kz), rel!(2, kz));
+            let ax = sub!(rel!(0, kx), mul!(sx, az));
+            let ay = sub!(rel!(0, ky), mul!(sy, az));
+            let bx = sub!(rel!(1, kx), mul!(sx, bz));
+            let by = sub!(rel!(1, ky), mul!(sy, bz));
+            let cx = sub!(rel!(2, kx), mul!(sx, cz));
+            let cy = sub!(rel!(2, ky), mul!(sy, cz));
+            let u = sub!(mul!(cx, by), mul!(cy, bx));
+            let v = sub!(mul!(ax, cy), mul!(ay, cx));
+            let w = sub!(mul!(bx, ay), mul!(by, ax));
+            let zero = _mm512_setzero_ps();
+            // Lanes where `$cmp` holds for any of the three edge functions.
+            macro_rules! sign {
+                ($cmp:ident) => {
+                    _mm512_cmp_ps_mask::<$cmp>(u, zero)
+                        | _mm512_cmp_ps_mask::<$cmp>(v, zero)
+                        | _mm512_cmp_ps_mask::<$cmp>(w, zero)
+                };
+            }
+            if sign!(_CMP_EQ_OQ) & live != 0 {
+                // An edge function is exactly zero: the packs one by one, as they decide it.
+                let mut best: Option<(f32, usize, f32, f32)> = None;
+                for (k, p) in packs.iter().enumerate() {
+                    if let Some((t, lane, b1, b2)) =
+                        p.intersect(r, tmin, best.map_or(tmax, |h| h.0))
+                    {
+                        best = Some((t, 4 * k + lane, b1, b2));
+                    }
+                }
+                return best;
+            }
+            let inside = (sign!(_CMP_LT_OQ) ^ sign!(_CMP_GT_OQ)) & live;
+            if inside == 0 {
+                return None;
+            }
+            let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
+            let dist = _mm512_add_ps(_mm512_add_ps(mul!(u, az), mul!(v, bz)), mul!(w, cz));
+            let t = mul!(mul!(sz, dist), _mm512_div_ps(_mm512_set1_ps(1.0), det));
+            let hit = inside
+                & _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(det, zero)
+                & _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, _mm512_set1_ps(tmin))
+                & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, _mm512_set1_ps(tmax));
+            if hit == 0 {
+                return None;
+            }
+            let mut ta = [0f32; 16];
+            _mm512_storeu_ps(ta.as_mut_ptr(), t);
+            let best = nearest_lane(u32::from(hit), &ta);
+            let (mut va, mut wa, mut da) = ([0f32; 16], [0f32; 16], [0f32; 16]);
+            _mm512_storeu_ps(va.as_mut_ptr(), v);
+            _mm512_storeu_ps(wa.as_mut_ptr(), w);
+            _mm512_storeu_ps(da.as_mut_ptr(), det);
+            let inv = 1.0 / da[best];
+            Some((ta[best], best, va[best] * inv, wa[best] * inv))
+        }
+    }
+
     fn scalar(&self, r: &RayPre, tmin: f32, mut tmax: f32) -> Option<(f32, usize, f32, f32)> {
         let mut best = None;
         for lane in 0..4 {
@@ -309,6 +431,58 @@ mod tests {
                 ties += usize::from(first.is_some_and(|f| seq.is_some_and(|s| s.0 == f.0)));
             }
             assert!(hits > 2000 && ties > 100, "{hits} hits, {ties} ties");
+        }
+    }
+
+    /// Property: the 16-lane test of three or four packs returns exactly what testing the
+    /// packs one after the other returns, on the cases of the pair test above.
+    #[test]
+    fn wide_test_equals_the_packs_one_by_one() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            let mut rng = Pcg32::new(12, 5);
+            let coord = |rng: &mut Pcg32| (rng.next_u32() % 5) as f32 - 2.0;
+            let (mut hits, mut later) = (0, 0);
+            for k in 0..40_000 {
+                let count = 3 + k % 2;
+                let packs: Vec<Tri4> = (0..count)
+                    .map(|j| {
+                        let n = 1 + (k / 2 + j) % 4;
+                        let tris: Vec<_> = (0..n)
+                            .map(|i| {
+                                let mut v =
+                                    || Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
+                                ([v(), v(), v()], (4 * j + i) as u32)
+                            })
+                            .collect();
+                        Tri4::new(&tris)
+                    })
+                    .collect();
+                let o = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng)) * 1.5;
+                let d = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
+                if d == Vec3::ZERO {
+                    continue;
+                }
+                let pre = RayPre::new(&Ray::new(o, d));
+                let tmax = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
+                let mut seq: Option<(f32, usize, f32, f32)> = None;
+                for (j, p) in packs.iter().enumerate() {
+                    if let Some((t, lane, b1, b2)) =
+                        p.intersect(&pre, 0.0, seq.map_or(tmax, |h| h.0))
+                    {
+                        seq = Some((t, 4 * j + lane, b1, b2));
+                    }
+                }
+                // SAFETY: AVX-512F was detected above.
+                let wide = unsafe { Tri4::intersect_wide_avx512(&packs, &pre, 0.0, tmax) };
+                assert_eq!(wide, seq, "case {k}");
+                hits += usize::from(seq.is_some());
+                later += usize::from(seq.is_some_and(|h| h.1 >= 8));
+            }
+            assert!(
+                hits > 2000 && later > 500,
+                "{hits} hits, {later} in the third or fourth pack"
+            );
         }
     }
 }
