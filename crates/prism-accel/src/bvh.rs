@@ -588,16 +588,12 @@ impl Bvh {
     }
 
     /// Entry distances of the ray into a node's eight child boxes, and which it enters.
-    ///
-    /// Here and in the traversals, `W` is the width in floats of the widest vectors the
-    /// calling code is compiled for: 4 (SSE), 8 (AVX, AVX2) or 16 (AVX-512). Every width
-    /// finds the same hits.
     #[inline(always)]
-    fn node_hit<const W: usize>(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+    fn node_hit<const AVX: bool>(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
         #[cfg(target_arch = "x86_64")]
-        if W >= 8 {
-            // SAFETY: `W` is 8 or more only in the traversals compiled for AVX or AVX-512,
-            // which their callers enter after detecting it.
+        if AVX {
+            // SAFETY: `AVX` is true only in the traversals `intersect` and `occluded` call
+            // after detecting AVX.
             return unsafe { node8::hit_avx(n, r, tmin, tmax) };
         }
         node8::hit_sse(n, r, tmin, tmax)
@@ -694,11 +690,10 @@ impl Bvh {
     }
 
     /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
-    /// the first hit. With AVX (`W` 8 or more), its packs are tested two at a time
-    /// ([`Tri4::intersect_pair_avx`]); with AVX-512, three or four at once
-    /// ([`Tri4::intersect_wide_avx512`]). Both find the hits of the packs one by one.
+    /// the first hit. With `AVX`, its packs are tested two at a time
+    /// ([`Tri4::intersect_pair_avx`]), which finds the same hits.
     #[inline(always)]
-    fn leaf<const W: usize>(
+    fn leaf<const AVX: bool>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -711,32 +706,13 @@ impl Bvh {
         let mut best = None;
         let p0 = rec.pack_start as usize;
         let mut packs = &self.packs[p0..p0 + rec.packs as usize];
-        #[cfg(target_arch = "x86_64")]
-        if W == 16 && matches!(packs.len(), 3 | 4) {
-            // SAFETY: `W` is 16 only in the traversals compiled for AVX-512, which their
-            // callers enter after detecting it.
-            let found = unsafe { Tri4::intersect_wide_avx512(packs, pre, tmin, *tmax) };
-            packs = &[];
-            if let Some((t, lane, b1, b2)) = found {
-                *tmax = t;
-                best = Some(Hit {
-                    t,
-                    prim: self.packs[p0 + lane / 4].prim[lane % 4],
-                    b1,
-                    b2,
-                });
-                if any {
-                    return best;
-                }
-            }
-        }
         while let [a, rest @ ..] = packs {
             let (found, prims) = match rest {
                 #[cfg(target_arch = "x86_64")]
-                [b, tail @ ..] if W >= 8 => {
+                [b, tail @ ..] if AVX => {
                     packs = tail;
-                    // SAFETY: `W` is 8 or more only in the traversals compiled for AVX or
-                    // AVX-512, which their callers enter after detecting it.
+                    // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
+                    // their callers enter after detecting it.
                     let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *tmax) };
                     (found, [a.prim, b.prim])
                 }
@@ -794,7 +770,7 @@ impl Bvh {
                 return unsafe { self.intersect_avx(ray, tmin, tmax) };
             }
         }
-        self.intersect_with::<4>(ray, tmin, tmax, 0)
+        self.intersect_with::<false>(ray, tmin, tmax, 0)
     }
 
     /// [`Bvh::intersect`] compiled for AVX-512VL: the same 256-bit operations, with twice
@@ -805,7 +781,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn intersect_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<16>(ray, tmin, tmax, 0)
+        self.intersect_with::<true>(ray, tmin, tmax, 0)
     }
 
     /// [`Bvh::intersect`] compiled for AVX.
@@ -815,13 +791,13 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<8>(ray, tmin, tmax, 0)
+        self.intersect_with::<true>(ray, tmin, tmax, 0)
     }
 
     /// The closest hit with `tmin < t < tmax`, leaving out the root's children in the slots
     /// of `skip`.
     #[inline(always)]
-    fn intersect_with<const W: usize>(
+    fn intersect_with<const AVX: bool>(
         &self,
         ray: &Ray,
         tmin: f32,
@@ -838,13 +814,13 @@ impl Bvh {
         let mut node_ref = 0;
         loop {
             if node_ref & LEAF != 0 {
-                if let Some(h) = self.leaf::<W>(node_ref, &pre, ray, tmin, &mut tmax, false) {
+                if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut tmax, false) {
                     best = Some(h);
                     reach = widen(tmax);
                 }
             } else {
                 let n = self.node(node_ref);
-                let (near, mut mask) = Bvh::node_hit::<W>(n, &slab, tmin, reach);
+                let (near, mut mask) = Bvh::node_hit::<AVX>(n, &slab, tmin, reach);
                 if node_ref == 0 {
                     mask &= !skip;
                 }
@@ -925,14 +901,14 @@ impl Bvh {
     /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
     /// at once ([`Bvh::walk_pairs`]).
     #[inline(always)]
-    fn intersect_pairs<const W: usize>(
+    fn intersect_pairs<const AVX: bool>(
         &self,
         rays: &[Ray],
         tmin: f32,
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.walk_pairs::<W>(rays, tmin, (rays.len(), |k| (k, tmax, 0)), hits);
+        self.walk_pairs::<AVX>(rays, tmin, (rays.len(), |k| (k, tmax, 0)), hits);
     }
 
     /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
@@ -943,7 +919,7 @@ impl Bvh {
     /// its children are chosen by selects (`Walk::step`), as the rays of a batch are mostly
     /// incoherent.
     #[inline(always)]
-    fn walk_pairs<const W: usize>(
+    fn walk_pairs<const AVX: bool>(
         &self,
         rays: &[Ray],
         tmin: f32,
@@ -953,7 +929,7 @@ impl Bvh {
         if n < 2 {
             for (k, hit) in hits.iter_mut().enumerate().take(n) {
                 let (i, tmax, skip) = job(k);
-                *hit = self.intersect_with::<W>(&rays[i], tmin, tmax, skip);
+                *hit = self.intersect_with::<AVX>(&rays[i], tmin, tmax, skip);
             }
             return;
         }
@@ -961,8 +937,8 @@ impl Bvh {
         let mut b = Slot::start(rays, &job, 1);
         let mut next = 2;
         let (walks, out) = ((rays, tmin, (n, &job)), hits);
-        while self.pair_step::<W>(walks, out, &mut a, &mut b, &mut next)
-            && self.pair_step::<W>(walks, out, &mut b, &mut a, &mut next)
+        while self.pair_step::<AVX>(walks, out, &mut a, &mut b, &mut next)
+            && self.pair_step::<AVX>(walks, out, &mut b, &mut a, &mut next)
         {}
     }
 
@@ -971,7 +947,7 @@ impl Bvh {
     /// is finished, and the answer is false: all are done.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
-    fn pair_step<const W: usize>(
+    fn pair_step<const AVX: bool>(
         &self,
         (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, u32))),
         hits: &mut [Option<Hit>],
@@ -981,7 +957,7 @@ impl Bvh {
     ) -> bool {
         if slot
             .walk
-            .step::<W>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
+            .step::<AVX>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
         {
             return true;
         }
@@ -989,8 +965,9 @@ impl Bvh {
         if *next == n {
             while other
                 .walk
-                .step::<W>(self, &rays[other.ray], tmin, other.skip, &mut other.stack)
-            {}
+                .step::<AVX>(self, &rays[other.ray], tmin, other.skip, &mut other.stack)
+            {
+            }
             hits[other.query] = other.walk.best;
             return false;
         }
@@ -1061,7 +1038,7 @@ impl Bvh {
     /// pairs.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_with<const W: usize>(
+    fn intersect_batch_with(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1075,7 +1052,7 @@ impl Bvh {
         while i + width <= rays.len() {
             let group = &rays[i..i + width];
             if crate::packet::coherent(group, width) {
-                self.intersect_pairs::<W>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
+                self.intersect_pairs::<true>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
                 let query = Query {
                     rays: group,
                     tmin,
@@ -1087,13 +1064,13 @@ impl Bvh {
                 while defer != 0 {
                     let lane = defer.trailing_zeros() as usize;
                     defer &= defer - 1;
-                    hits[i + lane] = self.intersect_with::<W>(&group[lane], tmin, tmax, 0);
+                    hits[i + lane] = self.intersect_with::<true>(&group[lane], tmin, tmax, 0);
                 }
                 loose = i + width;
             }
             i += width;
         }
-        self.intersect_pairs::<W>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
+        self.intersect_pairs::<true>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
     }
 
     /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
@@ -1102,7 +1079,7 @@ impl Bvh {
     /// rays or more enter, else ray by ray. Inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_list<const W: usize>(
+    fn intersect_batch_list(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1120,7 +1097,7 @@ impl Bvh {
             let lanes = closest(rays, hits);
             let tree = lanes.need & !lanes.defer;
             if 2 * tree.count_ones() as usize >= width && crate::packet::coherent(rays, width) {
-                self.list_packet::<W>(rays, (tmin, tmax), hits, (flat, lanes), &packet);
+                self.list_packet(rays, (tmin, tmax), hits, (flat, lanes), &packet);
                 continue;
             }
             // The list's hits stand, but in the lanes that must consult the tree.
@@ -1140,13 +1117,13 @@ impl Bvh {
             }
         }
         let mut found = vec![None; jobs.len()];
-        self.walk_pairs::<W>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
+        self.walk_pairs::<true>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
         for ((&(i, ..), all), h) in jobs.iter().zip(whole).zip(found) {
             hits[i] = match h {
                 _ if all => h,
                 // Two primitives at one distance: the tree's order decides.
                 Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
-                    self.intersect_with::<W>(&rays[i], tmin, tmax, 0)
+                    self.intersect_with::<true>(&rays[i], tmin, tmax, 0)
                 }
                 Some(h) => Some(h),
                 None => hits[i],
@@ -1160,7 +1137,7 @@ impl Bvh {
     /// the list meet one distance, take the one-ray walk over the whole tree.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn list_packet<const W: usize>(
+    fn list_packet(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1191,7 +1168,7 @@ impl Bvh {
                 || (tree & bit != 0
                     && found[lane].is_some_and(|h| list[lane].is_some_and(|n| n.t == h.t)));
             if whole {
-                *hit = self.intersect_with::<W>(&rays[lane], tmin, tmax, 0);
+                *hit = self.intersect_with::<true>(&rays[lane], tmin, tmax, 0);
             } else if tree & bit != 0 && found[lane].is_some() {
                 *hit = found[lane];
             }
@@ -1212,7 +1189,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list::<{ Avx512::W }>(
+        self.intersect_batch_list(
             rays,
             (tmin, tmax),
             hits,
@@ -1237,7 +1214,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list::<{ Avx2::W }>(
+        self.intersect_batch_list(
             rays,
             (tmin, tmax),
             hits,
@@ -1251,7 +1228,7 @@ impl Bvh {
     /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_list`].
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn occluded_batch_list<const W: usize>(
+    fn occluded_batch_list(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, &[f32]),
@@ -1268,9 +1245,9 @@ impl Bvh {
                 *b = if lanes.blocked & bit != 0 {
                     true
                 } else if lanes.defer & bit != 0 {
-                    self.occluded_with::<W>(ray, tmin, end, 0)
+                    self.occluded_with::<true>(ray, tmin, end, 0)
                 } else if lanes.need & bit != 0 {
-                    self.occluded_with::<W>(ray, tmin, end, flat.skip)
+                    self.occluded_with::<true>(ray, tmin, end, flat.skip)
                 } else {
                     false
                 };
@@ -1292,16 +1269,10 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list::<{ Avx512::W }>(
-            rays,
-            (tmin, tmax),
-            blocked,
-            (flat, Avx512::W),
-            |r, e| {
-                // SAFETY: the processor has AVX-512F.
-                unsafe { crate::flat::occluded_avx512(flat, r, tmin, e) }
-            },
-        );
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
+            // SAFETY: the processor has AVX-512F.
+            unsafe { crate::flat::occluded_avx512(flat, r, tmin, e) }
+        });
     }
 
     /// [`Bvh::occluded_batch_list`] on eight lanes of AVX2.
@@ -1318,16 +1289,10 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list::<{ Avx2::W }>(
-            rays,
-            (tmin, tmax),
-            blocked,
-            (flat, Avx2::W),
-            |r, e| {
-                // SAFETY: the processor has AVX2.
-                unsafe { crate::flat::occluded_avx2(flat, r, tmin, e) }
-            },
-        );
+        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
+            // SAFETY: the processor has AVX2.
+            unsafe { crate::flat::occluded_avx2(flat, r, tmin, e) }
+        });
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX-512VL: the same 256-bit operations, with
@@ -1344,7 +1309,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<{ Avx512::W }>(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
             // SAFETY: the processor has AVX-512VL, hence AVX-512F.
             unsafe { crate::packet::closest_avx512(self, q, h) }
         });
@@ -1363,7 +1328,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<{ Avx2::W }>(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
+        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
             // SAFETY: the processor has AVX2.
             unsafe { crate::packet::closest_avx2(self, q, h) }
         });
@@ -1426,15 +1391,9 @@ impl Bvh {
     /// The loop of [`Bvh::occluded_batch`], inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn occluded_batch_with<const W: usize>(
-        &self,
-        rays: &[Ray],
-        tmin: f32,
-        tmax: &[f32],
-        blocked: &mut [bool],
-    ) {
+    fn occluded_batch_with(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<W>(ray, tmin, t, 0);
+            *b = self.occluded_with::<true>(ray, tmin, t, 0);
         }
     }
 
@@ -1451,7 +1410,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<{ Avx512::W }>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX2.
@@ -1467,7 +1426,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<{ Avx2::W }>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with(rays, tmin, tmax, blocked);
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
@@ -1487,7 +1446,7 @@ impl Bvh {
                 return unsafe { self.occluded_avx(ray, tmin, tmax) };
             }
         }
-        self.occluded_with::<4>(ray, tmin, tmax, 0)
+        self.occluded_with::<false>(ray, tmin, tmax, 0)
     }
 
     /// [`Bvh::occluded`] compiled for AVX-512VL.
@@ -1497,7 +1456,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn occluded_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<16>(ray, tmin, tmax, 0)
+        self.occluded_with::<true>(ray, tmin, tmax, 0)
     }
 
     /// [`Bvh::occluded`] compiled for AVX.
@@ -1507,13 +1466,13 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<8>(ray, tmin, tmax, 0)
+        self.occluded_with::<true>(ray, tmin, tmax, 0)
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax`, leaving out the root's
     /// children in the slots of `skip`.
     #[inline(always)]
-    fn occluded_with<const W: usize>(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
+    fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
         let r = RayPre::new(ray);
         let slab = SlabRay::new(&r);
         let mut stack = Stack::<u32>::new();
@@ -1523,14 +1482,14 @@ impl Bvh {
             if node_ref & LEAF != 0 {
                 let mut t = tmax;
                 if self
-                    .leaf::<W>(node_ref, &r, ray, tmin, &mut t, true)
+                    .leaf::<AVX>(node_ref, &r, ray, tmin, &mut t, true)
                     .is_some()
                 {
                     return true;
                 }
             } else {
                 let n = self.node(node_ref);
-                let (_, mut mask) = Self::node_hit::<W>(n, &slab, tmin, tmax);
+                let (_, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
                 if node_ref == 0 {
                     mask &= !skip;
                 }
@@ -1666,7 +1625,7 @@ impl Walk {
     /// predict, that is faster (the one-ray walk, mostly coherent, branches on one child).
     /// The children visited and their order are the same either way.
     #[inline(always)]
-    fn step<const W: usize>(
+    fn step<const AVX: bool>(
         &mut self,
         bvh: &Bvh,
         ray: &Ray,
@@ -1676,13 +1635,14 @@ impl Walk {
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
-            if let Some(h) = bvh.leaf::<W>(node_ref, &self.pre, ray, tmin, &mut self.tmax, false) {
+            if let Some(h) = bvh.leaf::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.tmax, false)
+            {
                 self.best = Some(h);
                 self.reach = widen(self.tmax);
             }
         } else {
             let n = bvh.node(node_ref);
-            let (near, mut mask) = Bvh::node_hit::<W>(n, &self.slab, tmin, self.reach);
+            let (near, mut mask) = Bvh::node_hit::<AVX>(n, &self.slab, tmin, self.reach);
             if node_ref == 0 {
                 mask &= !skip;
             }
@@ -2042,10 +2002,13 @@ mod tests {
                 let ray = Ray::new(o.floor(), d);
                 // SAFETY: AVX was detected above.
                 let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
-                assert_eq!(avx, bvh.intersect_with::<4>(&ray, 0.0, f32::INFINITY, 0));
+                assert_eq!(
+                    avx,
+                    bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, 0)
+                );
                 // SAFETY: as above.
                 let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
-                assert_eq!(occ, bvh.occluded_with::<4>(&ray, 0.0, 5.0, 0));
+                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, 0));
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");
