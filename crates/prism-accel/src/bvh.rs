@@ -130,7 +130,61 @@ enum BuildNode {
     Interior {
         bounds: Aabb,
         children: Box<[BuildNode; 2]>,
+        /// `slots[j - 1]`: the least total area of the 8-wide nodes of the subtree held in
+        /// at most `j` slots of the node above it ([`BuildNode::interior`]).
+        slots: [f32; 8],
     },
+}
+
+impl BuildNode {
+    /// An interior node over `children`, its slot costs computed from theirs.
+    ///
+    /// The 8-wide tree keeps the binary tree's leaves, so collapses differ only in their
+    /// nodes, and a random ray visits a node with a chance proportional to its surface area:
+    /// the collapse minimises the nodes' total area. A subtree given `j` slots of the node
+    /// above it either takes one, as a node of its own (its area, plus its children's cost
+    /// in that node's eight slots), or, for `j` of two or more, hands `k` and `j - k` down
+    /// to its two children. The least of these is its cost in `j` slots, computed bottom-up
+    /// as the build returns (a dynamic programme, as in Ylitie, Karras and Laine,
+    /// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", 2017); a
+    /// leaf's is zero.
+    fn interior(bounds: Aabb, children: [BuildNode; 2]) -> BuildNode {
+        let (a, b) = (children[0].slots(), children[1].slots());
+        let mut slots = [0f32; 8];
+        for (j, slot) in slots.iter_mut().enumerate().skip(1) {
+            *slot = split_cost(&a, &b, j + 1).0;
+        }
+        slots[0] = bounds.surface_area() + slots[7];
+        for j in 1..8 {
+            slots[j] = slots[j].min(slots[j - 1]);
+        }
+        BuildNode::Interior {
+            bounds,
+            children: Box::new(children),
+            slots,
+        }
+    }
+
+    /// The subtree's cost in at most `j` slots at `j - 1`.
+    fn slots(&self) -> [f32; 8] {
+        match self {
+            BuildNode::Leaf { .. } => [0.0; 8],
+            BuildNode::Interior { slots, .. } => *slots,
+        }
+    }
+}
+
+/// The least cost of two subtrees with slot costs `a` and `b` sharing `j` >= 2 slots, and
+/// the slots the first takes (the fewest of equals).
+fn split_cost(a: &[f32; 8], b: &[f32; 8], j: usize) -> (f32, usize) {
+    let mut best = (f32::INFINITY, 1);
+    for k in 1..j {
+        let c = a[k - 1] + b[j - k - 1];
+        if c < best.0 {
+            best = (c, k);
+        }
+    }
+    best
 }
 
 /// What the build learns of a subtree on its way back up, so that no pass over the binary
@@ -323,10 +377,7 @@ impl Bvh {
                 let (b, sb) = build_node(r, big, 1, &opts, rb, rc);
                 let bounds = b3.to_aabb();
                 Some((
-                    BuildNode::Interior {
-                        bounds,
-                        children: Box::new([a, b]),
-                    },
+                    BuildNode::interior(bounds, [a, b]),
                     Summary::interior(&bounds, opts.traversal_cost, sa, sb),
                 ))
             }
@@ -352,18 +403,8 @@ impl Bvh {
             bvh.nodes.reserve(bvh.stats.leaves / 7 + 1);
             bvh.bounds = bounds;
             let mut jobs = Vec::with_capacity(summary.leaves);
-            match &root {
-                BuildNode::Leaf { .. } => {
-                    // A lone leaf still sits under a node.
-                    let mut n = Node8::empty();
-                    let r = bvh.plan_leaf(&root, &ids, &mut jobs);
-                    n.set(0, bounds, r);
-                    bvh.nodes.push(n);
-                }
-                BuildNode::Interior { .. } => {
-                    bvh.collapse(&root, &ids, &mut jobs);
-                }
-            }
+            // A lone leaf still sits under a node.
+            bvh.collapse(&root, &ids, &mut jobs);
             bvh.pack_leaves(&jobs, triangles, &ids, opts.parallel_threshold);
             free(root, 0);
         }
@@ -382,48 +423,20 @@ impl Bvh {
         bvh
     }
 
-    /// Flattens an interior binary node and its subtree into 8-wide nodes: each takes up to
-    /// eight descendants, opening the interior child of largest area first. Returns the
-    /// node's index.
+    /// Flattens a binary node and its subtree into 8-wide nodes: the node's slots hold the
+    /// descendants that give the least total node area ([`BuildNode::interior`]). Returns
+    /// the node's index.
     fn collapse(&mut self, n: &BuildNode, order: &[u32], jobs: &mut Vec<LeafJob>) -> u32 {
-        let mut kids: [&BuildNode; 8] = [n; 8];
-        let mut area = [0f32; 8];
-        let mut len = 1;
-        if let BuildNode::Interior { children, .. } = n {
-            kids[0] = &children[0];
-            kids[1] = &children[1];
-            len = 2;
-        }
-        let interior_area = |k: &BuildNode| match k {
-            BuildNode::Interior { bounds, .. } => bounds.surface_area(),
-            BuildNode::Leaf { .. } => f32::NEG_INFINITY,
-        };
-        for i in 0..len {
-            area[i] = interior_area(kids[i]);
-        }
-        while len < 8 {
-            // The interior child of largest area (the first of equals).
-            let mut widest = None;
-            for i in 0..len {
-                if area[i] > f32::NEG_INFINITY && widest.is_none_or(|w: usize| area[i] > area[w]) {
-                    widest = Some(i);
-                }
+        let mut kids = Vec::with_capacity(8);
+        match n {
+            BuildNode::Interior { children, .. } => {
+                hand_down(&children[0], &children[1], 8, &mut kids);
             }
-            let Some(i) = widest else { break };
-            let BuildNode::Interior { children, .. } = kids[i] else {
-                unreachable!("only interior children have a finite area here")
-            };
-            kids.copy_within(i + 1..len, i + 2);
-            area.copy_within(i + 1..len, i + 2);
-            kids[i] = &children[0];
-            kids[i + 1] = &children[1];
-            area[i] = interior_area(kids[i]);
-            area[i + 1] = interior_area(kids[i + 1]);
-            len += 1;
+            BuildNode::Leaf { .. } => kids.push(n),
         }
         let index = self.nodes.len();
         self.nodes.push(Node8::empty());
-        for (slot, &k) in kids[..len].iter().enumerate() {
+        for (slot, &k) in kids.iter().enumerate() {
             let r = match k {
                 BuildNode::Leaf { .. } => self.plan_leaf(k, order, jobs),
                 BuildNode::Interior { .. } => self.collapse(k, order, jobs),
@@ -1933,10 +1946,7 @@ fn build_node(
         )
     };
     (
-        BuildNode::Interior {
-            bounds,
-            children: Box::new([a, b]),
-        },
+        BuildNode::interior(bounds, [a, b]),
         Summary::interior(&bounds, opts.traversal_cost, sa, sb),
     )
 }
@@ -1961,6 +1971,36 @@ fn bins(scaled: Vec3A) -> [usize; 3] {
     }
 }
 
+/// Lists in `out`, in order, the subtrees that fill the slots two sibling subtrees `a` and `b`
+/// share at least cost ([`BuildNode::interior`]), given `j` >= 2 slots.
+fn hand_down<'a>(a: &'a BuildNode, b: &'a BuildNode, j: usize, out: &mut Vec<&'a BuildNode>) {
+    let k = split_cost(&a.slots(), &b.slots(), j).1;
+    place(a, k, out);
+    place(b, j - k, out);
+}
+
+/// Lists in `out` the subtrees that hold subtree `n` in at most `j` slots at least cost: `n`
+/// itself, or its children's.
+fn place<'a>(n: &'a BuildNode, j: usize, out: &mut Vec<&'a BuildNode>) {
+    let BuildNode::Interior {
+        children, slots, ..
+    } = n
+    else {
+        out.push(n);
+        return;
+    };
+    // The fewest slots that reach the least cost.
+    let mut j = j;
+    while j > 1 && slots[j - 2] <= slots[j - 1] {
+        j -= 1;
+    }
+    if j == 1 {
+        out.push(n);
+    } else {
+        hand_down(&children[0], &children[1], j, out);
+    }
+}
+
 /// Cost of testing `n` primitives: they are tested four at a time.
 fn packs(n: u32) -> f32 {
     n.div_ceil(4) as f32
@@ -1970,6 +2010,7 @@ fn packs(n: u32) -> f32 {
 mod tests {
     use super::*;
     use prism_math::Pcg32;
+    use std::collections::HashMap;
 
     /// Property: the AVX and SSE node tests are the same computation, so both traversals
     /// return bit-identical hits (checked on random rays, and on axis-aligned rays, whose
@@ -2012,6 +2053,103 @@ mod tests {
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");
+        }
+    }
+
+    /// Every set of at most `max` descendants of `n` (itself included) that holds each of
+    /// its leaves exactly once: what slots of a node could hold in its place.
+    fn frontiers(n: &BuildNode, max: usize) -> Vec<Vec<&BuildNode>> {
+        let mut all = vec![vec![n]];
+        if let BuildNode::Interior { children, .. } = n {
+            if max >= 2 {
+                for fa in frontiers(&children[0], max - 1) {
+                    for fb in frontiers(&children[1], max - fa.len()) {
+                        all.push(fa.iter().chain(&fb).copied().collect());
+                    }
+                }
+            }
+        }
+        all
+    }
+
+    /// The least total area of the 8-wide nodes of subtree `n` made a node, by trying
+    /// every set of descendants its slots could hold (a brute force over those sets,
+    /// memoised by node, not the slot-cost recurrence).
+    fn least_node_area(n: &BuildNode, memo: &mut HashMap<usize, f64>) -> f64 {
+        let BuildNode::Interior {
+            bounds, children, ..
+        } = n
+        else {
+            return 0.0;
+        };
+        let key = std::ptr::from_ref(n) as usize;
+        if let Some(&c) = memo.get(&key) {
+            return c;
+        }
+        let mut best = f64::INFINITY;
+        for fa in frontiers(&children[0], 7) {
+            for fb in frontiers(&children[1], 8 - fa.len()) {
+                let c: f64 = fa.iter().chain(&fb).map(|f| least_node_area(f, memo)).sum();
+                best = best.min(c);
+            }
+        }
+        let c = f64::from(bounds.surface_area()) + best;
+        memo.insert(key, c);
+        c
+    }
+
+    /// Closed form against brute force: the collapse's 8-wide tree has the least total node
+    /// area any collapse of the binary tree has (every set of descendants each node's slots
+    /// could hold tried), on random soups of 20 to 60 triangles in leaves of one.
+    #[test]
+    fn collapse_has_least_node_area() {
+        let mut rng = Pcg32::new(11, 4);
+        for case in 0..24 {
+            let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let n = 20 + case * 40 / 24;
+            let tris: Vec<[Vec3; 3]> = (0..n)
+                .map(|k| {
+                    let a = r() * 8.0;
+                    let size = if k % 5 == 0 { 1.5 } else { 0.4 };
+                    [a, a + r() * size, a + r() * size]
+                })
+                .collect();
+            let opts = BuildOptions {
+                max_leaf: 1,
+                ..BuildOptions::default()
+            };
+            let bvh = Bvh::build(&tris, &[], &opts);
+            // The same binary tree, as the build makes it.
+            let mut prims: Vec<PrimRef> = tris
+                .iter()
+                .enumerate()
+                .map(|(i, t)| PrimRef {
+                    bounds: B3::from_aabb(Aabb::point(t[0]).extend(t[1]).extend(t[2])),
+                    id: i as u32,
+                })
+                .collect();
+            let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
+            assert_eq!(take_big(&mut prims, b3, opts.parallel_threshold), 0);
+            let (root, _) = build_node(&mut prims, 0, 0, &opts, b3, cb);
+            let want = least_node_area(&root, &mut HashMap::new());
+            // The built tree's node area: the root's box, then each child node's box as
+            // its parent holds it.
+            let mut got = f64::from(bvh.bounds().surface_area());
+            let mut stack = vec![0usize];
+            while let Some(i) = stack.pop() {
+                let node = &bvh.nodes[i];
+                for slot in 0..8 {
+                    if node.slot_used(slot) && !Bvh::is_leaf_ref(node.child[slot]) {
+                        got += f64::from(node.child_box(slot).surface_area());
+                        stack.push(node.child[slot] as usize);
+                    }
+                }
+            }
+            assert!(
+                (got - want).abs() <= 1e-5 * want,
+                "case {case}: collapse area {got}, least {want}"
+            );
+            free(root, 0);
         }
     }
 }

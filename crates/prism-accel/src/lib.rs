@@ -4,9 +4,11 @@
 //! - Triangles use the watertight test of Woop, Benthin and Wald (JCGT 2013): a ray through
 //!   a shared edge or vertex of a closed mesh hits at least one of the triangles.
 //! - The BVH is built top-down with a binned surface area heuristic (16 bins on each axis,
-//!   leaves costed in packs of four triangles; every subtree of at most eight primitives
-//!   one leaf), in parallel above a size threshold, then
-//!   collapsed into 8-wide nodes whose eight child boxes are tested at once with SIMD: AVX
+//!   leaves costed in packs of four triangles; every subtree of at most sixteen primitives
+//!   one leaf), in parallel above a size threshold, then collapsed into 8-wide nodes, the
+//!   descendants each node's slots hold chosen by dynamic programming to give the nodes the
+//!   least total surface area (the expected number of node visits of a random ray), and
+//!   their eight child boxes tested at once with SIMD: AVX
 //!   when the processor has it (detected at run time), else two SSE halves, with identical
 //!   results. Leaf triangles are stored in packs of four, also tested at once. The layout is
 //!   a pure function of the input, whatever the thread count. In scenes of more than 24
