@@ -42,11 +42,10 @@ impl Default for BuildOptions {
     fn default() -> BuildOptions {
         BuildOptions {
             // Four packs, the most a leaf reference holds. Split further, a subtree of
-            // sixteen costs a node of the 8-wide tree (a node test and a cache miss) to save
-            // at most two pack tests, which with AVX are one test of eight lanes: on the
-            // 56k-triangle bunny, leaves of sixteen rather than twelve make the tree 30%
-            // smaller (1637 nodes rather than 2351; 49.0 bytes per triangle rather than
-            // 52.5) and the build 7-12% faster, and trace as fast or faster.
+            // sixteen takes more slots or a node of the 8-wide tree to save at most two pack
+            // tests, which with AVX are one test of eight lanes: on the 56k-triangle bunny,
+            // leaves of sixteen rather than twelve make the tree about 30% smaller and the
+            // build 7-12% faster, and trace as fast or faster.
             max_leaf: MAX_LEAF_REF,
             // One 8-wide node test replaces about three binary ones and costs about one
             // triangle pack test.
@@ -131,8 +130,9 @@ enum BuildNode {
         bounds: Aabb,
         children: Box<[BuildNode; 2]>,
         /// `slots[j - 1]`: the least total area of the 8-wide nodes of the subtree held in
-        /// at most `j` slots of the node above it ([`BuildNode::interior`]).
-        slots: [f32; 8],
+        /// at most `j` slots of the node above it ([`BuildNode::interior`]), in `f64`, which
+        /// no sum of areas of finite `f32` boxes overflows.
+        slots: [f64; 8],
     },
 }
 
@@ -140,21 +140,21 @@ impl BuildNode {
     /// An interior node over `children`, its slot costs computed from theirs.
     ///
     /// The 8-wide tree keeps the binary tree's leaves, so collapses differ only in their
-    /// nodes, and a random ray visits a node with a chance proportional to its surface area:
+    /// nodes, which a random ray visits with a chance proportional to their surface area:
     /// the collapse minimises the nodes' total area. A subtree given `j` slots of the node
-    /// above it either takes one, as a node of its own (its area, plus its children's cost
-    /// in that node's eight slots), or, for `j` of two or more, hands `k` and `j - k` down
-    /// to its two children. The least of these is its cost in `j` slots, computed bottom-up
-    /// as the build returns (a dynamic programme, as in Ylitie, Karras and Laine,
-    /// "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", 2017); a
-    /// leaf's is zero.
+    /// above it takes one, as a node of its own (its area, plus its children's cost in
+    /// that node's eight slots), or, for `j` of two or more, hands `k` and `j - k` down to
+    /// its two children: its cost in `j` slots is the least of these (a dynamic programme,
+    /// as in Ylitie, Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through
+    /// Compressed Wide BVHs", 2017). A leaf's is zero.
     fn interior(bounds: Aabb, children: [BuildNode; 2]) -> BuildNode {
         let (a, b) = (children[0].slots(), children[1].slots());
-        let mut slots = [0f32; 8];
+        let mut slots = [0f64; 8];
         for (j, slot) in slots.iter_mut().enumerate().skip(1) {
             *slot = split_cost(&a, &b, j + 1).0;
         }
-        slots[0] = bounds.surface_area() + slots[7];
+        let e = (bounds.max - bounds.min).as_dvec3();
+        slots[0] = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) + slots[7];
         for j in 1..8 {
             slots[j] = slots[j].min(slots[j - 1]);
         }
@@ -166,7 +166,7 @@ impl BuildNode {
     }
 
     /// The subtree's cost in at most `j` slots at `j - 1`.
-    fn slots(&self) -> [f32; 8] {
+    fn slots(&self) -> [f64; 8] {
         match self {
             BuildNode::Leaf { .. } => [0.0; 8],
             BuildNode::Interior { slots, .. } => *slots,
@@ -176,8 +176,8 @@ impl BuildNode {
 
 /// The least cost of two subtrees with slot costs `a` and `b` sharing `j` >= 2 slots, and
 /// the slots the first takes (the fewest of equals).
-fn split_cost(a: &[f32; 8], b: &[f32; 8], j: usize) -> (f32, usize) {
-    let mut best = (f32::INFINITY, 1);
+fn split_cost(a: &[f64; 8], b: &[f64; 8], j: usize) -> (f64, usize) {
+    let mut best = (f64::INFINITY, 1);
     for k in 1..j {
         let c = a[k - 1] + b[j - k - 1];
         if c < best.0 {
@@ -365,7 +365,8 @@ impl Bvh {
                 Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
             } else {
                 // The large primitives under one child of the root (leaves of two, which the
-                // collapse lifts into the root), the others under the other.
+                // collapse lifts into the root when that saves node area, as their nodes'
+                // large boxes usually make it), the others under the other.
                 let (l, r) = prims.split_at_mut(big);
                 let (lb, lc) = bounds_of(l, opts.parallel_threshold);
                 let (rb, rc) = bounds_of(r, opts.parallel_threshold);
@@ -1827,8 +1828,7 @@ fn build_node(
             Summary::leaf(&bounds, n, depth),
         )
     };
-    // A subtree small enough for one leaf is one: split, it would cost a node of the
-    // 8-wide tree (a node test and a cache miss) for at most one pack test saved.
+    // A subtree small enough for one leaf is one (see `BuildOptions::default`).
     if n <= opts.max_leaf {
         return leaf();
     }
@@ -1980,7 +1980,7 @@ fn hand_down<'a>(a: &'a BuildNode, b: &'a BuildNode, j: usize, out: &mut Vec<&'a
 }
 
 /// Lists in `out` the subtrees that hold subtree `n` in at most `j` slots at least cost: `n`
-/// itself, or its children's.
+/// itself, or descendants of it.
 fn place<'a>(n: &'a BuildNode, j: usize, out: &mut Vec<&'a BuildNode>) {
     let BuildNode::Interior {
         children, slots, ..
@@ -2056,6 +2056,12 @@ mod tests {
         }
     }
 
+    /// The surface area of `b`, in `f64`.
+    fn area64(b: &Aabb) -> f64 {
+        let e = (b.max - b.min).as_dvec3();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+
     /// Every set of at most `max` descendants of `n` (itself included) that holds each of
     /// its leaves exactly once: what slots of a node could hold in its place.
     fn frontiers(n: &BuildNode, max: usize) -> Vec<Vec<&BuildNode>> {
@@ -2093,14 +2099,14 @@ mod tests {
                 best = best.min(c);
             }
         }
-        let c = f64::from(bounds.surface_area()) + best;
+        let c = area64(bounds) + best;
         memo.insert(key, c);
         c
     }
 
-    /// Closed form against brute force: the collapse's 8-wide tree has the least total node
-    /// area any collapse of the binary tree has (every set of descendants each node's slots
-    /// could hold tried), on random soups of 20 to 60 triangles in leaves of one.
+    /// Oracle: brute force. The collapse's 8-wide tree has the least total node area any
+    /// collapse of the binary tree has (every set of descendants each node's slots could
+    /// hold tried), on random soups of 20 to 58 triangles in leaves of one.
     #[test]
     fn collapse_has_least_node_area() {
         let mut rng = Pcg32::new(11, 4);
@@ -2130,17 +2136,23 @@ mod tests {
                 .collect();
             let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
             assert_eq!(take_big(&mut prims, b3, opts.parallel_threshold), 0);
-            let (root, _) = build_node(&mut prims, 0, 0, &opts, b3, cb);
+            let (root, summary) = build_node(&mut prims, 0, 0, &opts, b3, cb);
+            assert_eq!(
+                bvh.stats().primitives,
+                n,
+                "case {case}: no triangle left out"
+            );
+            assert_eq!(bvh.stats().leaves, summary.leaves, "case {case}");
             let want = least_node_area(&root, &mut HashMap::new());
             // The built tree's node area: the root's box, then each child node's box as
             // its parent holds it.
-            let mut got = f64::from(bvh.bounds().surface_area());
+            let mut got = area64(&bvh.bounds());
             let mut stack = vec![0usize];
             while let Some(i) = stack.pop() {
                 let node = &bvh.nodes[i];
                 for slot in 0..8 {
                     if node.slot_used(slot) && !Bvh::is_leaf_ref(node.child[slot]) {
-                        got += f64::from(node.child_box(slot).surface_area());
+                        got += area64(&node.child_box(slot));
                         stack.push(node.child[slot] as usize);
                     }
                 }
