@@ -153,8 +153,7 @@ impl BuildNode {
         for (j, slot) in slots.iter_mut().enumerate().skip(1) {
             *slot = split_cost(&a, &b, j + 1).0;
         }
-        let e = (bounds.max - bounds.min).as_dvec3();
-        slots[0] = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) + slots[7];
+        slots[0] = area64(&bounds) + slots[7];
         for j in 1..8 {
             slots[j] = slots[j].min(slots[j - 1]);
         }
@@ -172,6 +171,12 @@ impl BuildNode {
             BuildNode::Interior { slots, .. } => *slots,
         }
     }
+}
+
+/// The surface area of `b`, in `f64`.
+fn area64(b: &Aabb) -> f64 {
+    let e = (b.max - b.min).as_dvec3();
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
 /// The least cost of two subtrees with slot costs `a` and `b` sharing `j` >= 2 slots, and
@@ -2054,12 +2059,6 @@ mod tests {
             }
             assert!(hits > 2000, "{hits} hits");
         }
-    }
-
-    /// The surface area of `b`, in `f64`.
-    fn area64(b: &Aabb) -> f64 {
-        let e = (b.max - b.min).as_dvec3();
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
 
     /// Every set of at most `max` descendants of `n` (itself included) that holds each of
