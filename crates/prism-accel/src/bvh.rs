@@ -753,6 +753,27 @@ impl Bvh {
                 }
             }
         }
+        if rec.spheres != 0 {
+            if let Some(h) = self.leaf_spheres(&rec, ray, tmin, tmax, any) {
+                return Some(h);
+            }
+        }
+        best
+    }
+
+    /// [`Bvh::leaf`]'s test of a leaf's spheres: the nearest hit below `tmax`, narrowing it
+    /// (with `any`, the first hit). Never inlined: inlined, its per-ray values would be
+    /// computed at the start of every walk, spheres or not.
+    #[inline(never)]
+    fn leaf_spheres(
+        &self,
+        rec: &LeafRec,
+        ray: &Ray,
+        tmin: f32,
+        tmax: &mut f32,
+        any: bool,
+    ) -> Option<Hit> {
+        let mut best = None;
         let s0 = rec.sphere_start as usize;
         for &p in &self.leaf_spheres[s0..s0 + rec.spheres as usize] {
             let s = &self.spheres[(p - self.triangle_count) as usize];
@@ -789,6 +810,13 @@ impl Bvh {
                 return unsafe { self.intersect_avx(ray, tmin, tmax) };
             }
         }
+        self.intersect_sse(ray, tmin, tmax)
+    }
+
+    /// [`Bvh::intersect`] without AVX. Never inlined: inlined, its walk's frame (a traversal
+    /// stack of kilobytes) would be set up at every call, whichever walk the call takes.
+    #[inline(never)]
+    fn intersect_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
         self.intersect_with::<false>(ray, tmin, tmax, 0)
     }
 
@@ -844,13 +872,13 @@ impl Bvh {
                     mask &= !skip;
                 }
                 if mask != 0 && mask & mask.wrapping_sub(1) == 0 {
-                    // One child entered: go on to it without the stack.
+                    // One child entered: go on to it without the stack (its loads follow at
+                    // once, so it is not prefetched).
                     node_ref = n.child[mask.trailing_zeros() as usize];
-                    self.prefetch(node_ref);
                     continue;
                 }
                 if mask != 0 {
-                    node_ref = self.descend(n, &near, mask, &mut stack, &mut sp);
+                    node_ref = self.descend::<false>(n, &near, mask, &mut stack, &mut sp);
                     continue;
                 }
             }
@@ -865,9 +893,11 @@ impl Bvh {
     /// nearest first (the lower slot first of equals), pushes all but the nearest onto
     /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
     /// told apart and ordered by selects rather than branches (one is pushed and popped
-    /// again at once: `*sp` does not move).
+    /// again at once: `*sp` does not move). The next child on the stack is prefetched, and
+    /// with `NEAREST` the nearest too: worth it when another walk's step comes between
+    /// ([`Bvh::walk_pairs`]), not in a lone walk, whose next loads are the nearest's.
     #[inline(always)]
-    fn descend(
+    fn descend<const NEAREST: bool>(
         &self,
         n: &Node8,
         near: &[f32; 8],
@@ -887,7 +917,9 @@ impl Bvh {
             let (a, b) = if swap { (last, first) } else { (first, last) };
             stack.push(*sp, (n.child[b], near[b]));
             *sp += usize::from(rest != 0);
-            self.prefetch(n.child[a]);
+            if NEAREST {
+                self.prefetch(n.child[a]);
+            }
             self.prefetch(n.child[b]);
             return n.child[a];
         }
@@ -911,7 +943,9 @@ impl Bvh {
             stack.push(*sp, hits[k]);
             *sp += 1;
         }
-        self.prefetch(hits[0].0);
+        if NEAREST {
+            self.prefetch(hits[0].0);
+        }
         // The second nearest is likely visited next after the nearest's subtree.
         self.prefetch(hits[1].0);
         hits[0].0
@@ -1465,6 +1499,12 @@ impl Bvh {
                 return unsafe { self.occluded_avx(ray, tmin, tmax) };
             }
         }
+        self.occluded_sse(ray, tmin, tmax)
+    }
+
+    /// [`Bvh::occluded`] without AVX, never inlined (as [`Bvh::intersect_sse`]).
+    #[inline(never)]
+    fn occluded_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
         self.occluded_with::<false>(ray, tmin, tmax, 0)
     }
 
@@ -1666,7 +1706,7 @@ impl Walk {
                 mask &= !skip;
             }
             if mask != 0 {
-                self.node = bvh.descend(n, &near, mask, stack, &mut self.sp);
+                self.node = bvh.descend::<true>(n, &near, mask, stack, &mut self.sp);
                 return true;
             }
         }
