@@ -726,25 +726,27 @@ impl Bvh {
         let p0 = rec.pack_start as usize;
         let mut packs = &self.packs[p0..p0 + rec.packs as usize];
         while let [a, rest @ ..] = packs {
-            let (found, prims) = match rest {
+            // The pack of lanes 4..8 (the first again when tested alone).
+            let (found, second) = match rest {
                 #[cfg(target_arch = "x86_64")]
                 [b, tail @ ..] if AVX => {
                     packs = tail;
                     // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
                     // their callers enter after detecting it.
                     let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *tmax) };
-                    (found, [a.prim, b.prim])
+                    (found, b)
                 }
                 _ => {
                     packs = rest;
-                    (a.intersect(pre, tmin, *tmax), [a.prim; 2])
+                    (a.intersect(pre, tmin, *tmax), a)
                 }
             };
             if let Some((t, lane, b1, b2)) = found {
                 *tmax = t;
+                let pack = if lane < 4 { a } else { second };
                 best = Some(Hit {
                     t,
-                    prim: prims[lane / 4][lane % 4],
+                    prim: pack.prim[lane % 4],
                     b1,
                     b2,
                 });

@@ -59,7 +59,8 @@ impl Node8 {
     /// The box of the child in `slot` (the empty box for an unused slot).
     pub(crate) fn child_box(&self, slot: usize) -> Aabb {
         let (half, lane) = (slot / 4, slot % 4);
-        let plane = |p: usize| self.bounds[p][half][lane];
+        // Array elements: indexing a `Vec4` itself is a branch on the index.
+        let plane = |p: usize| self.bounds[p][half].as_ref()[lane];
         Aabb {
             min: Vec3::new(plane(0), plane(1), plane(2)),
             max: Vec3::new(plane(3), plane(4), plane(5)),

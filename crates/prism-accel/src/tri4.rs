@@ -37,16 +37,20 @@ impl Tri4 {
 
     /// Vertex `i` of the triangle in `lane`, padded to four floats (`x, y, z, 0`).
     pub(crate) fn corner(&self, lane: usize, i: usize) -> [f32; 4] {
-        [
-            self.v[i][0][lane],
-            self.v[i][1][lane],
-            self.v[i][2][lane],
-            0.0,
-        ]
+        let [x, y, z] = self.coords(lane, i);
+        [x, y, z, 0.0]
     }
 
     fn vertex(&self, lane: usize, i: usize) -> Vec3 {
-        Vec3::new(self.v[i][0][lane], self.v[i][1][lane], self.v[i][2][lane])
+        Vec3::from_array(self.coords(lane, i))
+    }
+
+    /// The coordinates of vertex `i` of the triangle in `lane`, read as array elements
+    /// (indexing a `Vec4` itself is a branch on the index).
+    #[inline(always)]
+    fn coords(&self, lane: usize, i: usize) -> [f32; 3] {
+        let [x, y, z] = &self.v[i];
+        [x.as_ref()[lane], y.as_ref()[lane], z.as_ref()[lane]]
     }
 
     /// The nearest hit among the four with `tmin < t < tmax`: `(t, lane, b1, b2)`.
