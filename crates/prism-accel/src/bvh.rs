@@ -570,6 +570,7 @@ impl Bvh {
                 flat.skip |= 1 << slot;
             } else {
                 flat.inner.push(root.child_box(slot));
+                flat.inner_nodes.push(child);
             }
         }
         if !(1..=FLAT_MAX).contains(&prims.len()) {
@@ -819,7 +820,7 @@ impl Bvh {
     /// stack of kilobytes) would be set up at every call, whichever walk the call takes.
     #[inline(never)]
     fn intersect_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<false>(ray, tmin, tmax, 0)
+        self.intersect_with::<false>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX-512VL: the same 256-bit operations, with twice
@@ -830,7 +831,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn intersect_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax, 0)
+        self.intersect_with::<true>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX.
@@ -840,18 +841,17 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax, 0)
+        self.intersect_with::<true>(ray, tmin, tmax, Start::ROOT)
     }
 
-    /// The closest hit with `tmin < t < tmax`, leaving out the root's children in the slots
-    /// of `skip`.
+    /// The closest hit with `tmin < t < tmax`, in the part of the tree `start` names.
     #[inline(always)]
     fn intersect_with<const AVX: bool>(
         &self,
         ray: &Ray,
         tmin: f32,
         tmax: f32,
-        skip: u32,
+        start: Start,
     ) -> Option<Hit> {
         // `Walk::step`'s walk, written as one loop over local variables, so that its state
         // stays in registers (a `Walk`, stepped from outside, lives in memory).
@@ -860,7 +860,7 @@ impl Bvh {
         let (mut tmax, mut reach, mut best) = (tmax, widen(tmax), None);
         let mut stack = Stack::new();
         let mut sp = 0;
-        let mut node_ref = 0;
+        let mut node_ref = start.node;
         loop {
             if node_ref & LEAF != 0 {
                 if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut tmax, false) {
@@ -871,7 +871,7 @@ impl Bvh {
                 let n = self.node(node_ref);
                 let (near, mut mask) = Bvh::node_hit::<AVX>(n, &slab, tmin, reach);
                 if node_ref == 0 {
-                    mask &= !skip;
+                    mask &= !start.skip;
                 }
                 if mask != 0 && mask & mask.wrapping_sub(1) == 0 {
                     // One child entered: go on to it without the stack (its loads follow at
@@ -963,7 +963,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.walk_pairs::<AVX>(rays, tmin, (rays.len(), |k| (k, tmax, 0)), hits);
+        self.walk_pairs::<AVX>(rays, tmin, (rays.len(), |k| (k, tmax, Start::ROOT)), hits);
     }
 
     /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
@@ -978,13 +978,13 @@ impl Bvh {
         &self,
         rays: &[Ray],
         tmin: f32,
-        (n, job): (usize, impl Fn(usize) -> (usize, f32, u32)),
+        (n, job): (usize, impl Fn(usize) -> (usize, f32, Start)),
         hits: &mut [Option<Hit>],
     ) {
         if n < 2 {
             for (k, hit) in hits.iter_mut().enumerate().take(n) {
-                let (i, tmax, skip) = job(k);
-                *hit = self.intersect_with::<AVX>(&rays[i], tmin, tmax, skip);
+                let (i, tmax, start) = job(k);
+                *hit = self.intersect_with::<AVX>(&rays[i], tmin, tmax, start);
             }
             return;
         }
@@ -1004,7 +1004,7 @@ impl Bvh {
     #[allow(clippy::type_complexity)]
     fn pair_step<const AVX: bool>(
         &self,
-        (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, u32))),
+        (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, Start))),
         hits: &mut [Option<Hit>],
         slot: &mut Slot,
         other: &mut Slot,
@@ -1026,9 +1026,9 @@ impl Bvh {
             hits[other.query] = other.walk.best;
             return false;
         }
-        let (ray, tmax, skip) = job(*next);
-        slot.walk.reset(&rays[ray], tmax);
-        (slot.ray, slot.skip, slot.query) = (ray, skip, *next);
+        let (ray, tmax, start) = job(*next);
+        slot.walk.reset(&rays[ray], tmax, start.node);
+        (slot.ray, slot.skip, slot.query) = (ray, start.skip, *next);
         *next += 1;
         true
     }
@@ -1119,7 +1119,8 @@ impl Bvh {
                 while defer != 0 {
                     let lane = defer.trailing_zeros() as usize;
                     defer &= defer - 1;
-                    hits[i + lane] = self.intersect_with::<true>(&group[lane], tmin, tmax, 0);
+                    hits[i + lane] =
+                        self.intersect_with::<true>(&group[lane], tmin, tmax, Start::ROOT);
                 }
                 loose = i + width;
             }
@@ -1145,7 +1146,7 @@ impl Bvh {
     ) {
         // The tree walks still to make, over the whole batch: each ray, its end, the
         // root's slots it leaves out, and whether it is over the whole tree.
-        let mut jobs: Vec<(usize, f32, u32)> = vec![];
+        let mut jobs: Vec<(usize, f32, Start)> = vec![];
         let mut whole: Vec<bool> = vec![];
         let groups = rays.chunks(width).zip(hits.chunks_mut(width));
         for (g, (rays, hits)) in groups.enumerate() {
@@ -1164,9 +1165,9 @@ impl Bvh {
                 // The rest of the tree, for a hit no farther than the list's.
                 let end = hits[lane].map_or(tmax, |h| h.t.next_up());
                 jobs.push(if all {
-                    (g * width + lane, tmax, 0)
+                    (g * width + lane, tmax, Start::ROOT)
                 } else {
-                    (g * width + lane, end, flat.skip)
+                    (g * width + lane, end, flat.start(lanes.inner[lane]))
                 });
                 whole.push(all);
             }
@@ -1178,7 +1179,7 @@ impl Bvh {
                 _ if all => h,
                 // Two primitives at one distance: the tree's order decides.
                 Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
-                    self.intersect_with::<true>(&rays[i], tmin, tmax, 0)
+                    self.intersect_with::<true>(&rays[i], tmin, tmax, Start::ROOT)
                 }
                 Some(h) => Some(h),
                 None => hits[i],
@@ -1223,7 +1224,7 @@ impl Bvh {
                 || (tree & bit != 0
                     && found[lane].is_some_and(|h| list[lane].is_some_and(|n| n.t == h.t)));
             if whole {
-                *hit = self.intersect_with::<true>(&rays[lane], tmin, tmax, 0);
+                *hit = self.intersect_with::<true>(&rays[lane], tmin, tmax, Start::ROOT);
             } else if tree & bit != 0 && found[lane].is_some() {
                 *hit = found[lane];
             }
@@ -1300,9 +1301,9 @@ impl Bvh {
                 *b = if lanes.blocked & bit != 0 {
                     true
                 } else if lanes.defer & bit != 0 {
-                    self.occluded_with::<true>(ray, tmin, end, 0)
+                    self.occluded_with::<true>(ray, tmin, end, Start::ROOT)
                 } else if lanes.need & bit != 0 {
-                    self.occluded_with::<true>(ray, tmin, end, flat.skip)
+                    self.occluded_with::<true>(ray, tmin, end, flat.start(lanes.inner[lane]))
                 } else {
                     false
                 };
@@ -1448,7 +1449,7 @@ impl Bvh {
     #[inline(always)]
     fn occluded_batch_with(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t, 0);
+            *b = self.occluded_with::<true>(ray, tmin, t, Start::ROOT);
         }
     }
 
@@ -1507,7 +1508,7 @@ impl Bvh {
     /// [`Bvh::occluded`] without AVX, never inlined (as [`Bvh::intersect_sse`]).
     #[inline(never)]
     fn occluded_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<false>(ray, tmin, tmax, 0)
+        self.occluded_with::<false>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::occluded`] compiled for AVX-512VL.
@@ -1517,7 +1518,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn occluded_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax, 0)
+        self.occluded_with::<true>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::occluded`] compiled for AVX.
@@ -1527,18 +1528,24 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax, 0)
+        self.occluded_with::<true>(ray, tmin, tmax, Start::ROOT)
     }
 
-    /// True if anything lies along the ray with `tmin < t < tmax`, leaving out the root's
-    /// children in the slots of `skip`.
+    /// True if anything lies along the ray with `tmin < t < tmax`, in the part of the tree
+    /// `start` names.
     #[inline(always)]
-    fn occluded_with<const AVX: bool>(&self, ray: &Ray, tmin: f32, tmax: f32, skip: u32) -> bool {
+    fn occluded_with<const AVX: bool>(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        start: Start,
+    ) -> bool {
         let r = RayPre::new(ray);
         let slab = SlabRay::new(&r);
         let mut stack = Stack::<u32>::new();
         let mut sp = 0usize;
-        let mut node_ref = 0u32;
+        let mut node_ref = start.node;
         loop {
             if node_ref & LEAF != 0 {
                 let mut t = tmax;
@@ -1552,7 +1559,7 @@ impl Bvh {
                 let n = self.node(node_ref);
                 let (_, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
                 if node_ref == 0 {
-                    mask &= !skip;
+                    mask &= !start.skip;
                 }
                 if mask != 0 {
                     let i = mask.trailing_zeros() as usize;
@@ -1578,6 +1585,19 @@ impl Bvh {
             node_ref = stack.get(sp);
         }
     }
+}
+
+/// Where a one-ray walk starts: at node `node`, and if that is the root, with the root's
+/// children in the slots of `skip` left out.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Start {
+    pub(crate) node: u32,
+    pub(crate) skip: u32,
+}
+
+impl Start {
+    /// The whole tree.
+    pub(crate) const ROOT: Start = Start { node: 0, skip: 0 };
 }
 
 /// A traversal stack that is not cleared before use (clearing a few kilobytes per ray
@@ -1621,13 +1641,13 @@ struct Slot {
 impl Slot {
     /// The slot walking query `k` of `job`.
     #[inline(always)]
-    fn start(rays: &[Ray], job: &impl Fn(usize) -> (usize, f32, u32), k: usize) -> Slot {
-        let (ray, tmax, skip) = job(k);
+    fn start(rays: &[Ray], job: &impl Fn(usize) -> (usize, f32, Start), k: usize) -> Slot {
+        let (ray, tmax, start) = job(k);
         Slot {
-            walk: Walk::new(&rays[ray], tmax),
+            walk: Walk::new(&rays[ray], tmax, start.node),
             stack: Stack::new(),
             ray,
-            skip,
+            skip: start.skip,
             query: k,
         }
     }
@@ -1649,9 +1669,9 @@ struct Walk {
 }
 
 impl Walk {
-    /// A walk of `ray` up to `tmax`, starting at the root.
+    /// A walk of `ray` up to `tmax`, starting at node `start`.
     #[inline(always)]
-    fn new(ray: &Ray, tmax: f32) -> Walk {
+    fn new(ray: &Ray, tmax: f32, start: u32) -> Walk {
         let pre = RayPre::new(ray);
         Walk {
             slab: SlabRay::new(&pre),
@@ -1660,20 +1680,21 @@ impl Walk {
             tmax,
             reach: widen(tmax),
             sp: 0,
-            node: 0,
+            node: start,
         }
     }
 
-    /// Starts the walk over, for `ray` up to `tmax` (the stack's memory is kept).
+    /// Starts the walk over, for `ray` up to `tmax` from node `start` (the stack's memory
+    /// is kept).
     #[inline(always)]
-    fn reset(&mut self, ray: &Ray, tmax: f32) {
+    fn reset(&mut self, ray: &Ray, tmax: f32, start: u32) {
         self.pre = RayPre::new(ray);
         self.slab = SlabRay::new(&self.pre);
         self.best = None;
         self.tmax = tmax;
         self.reach = widen(tmax);
         self.sp = 0;
-        self.node = 0;
+        self.node = start;
     }
 
     /// Visits the next node or leaf (the root's children in the slots of `skip` left out)
@@ -2092,11 +2113,11 @@ mod tests {
                 let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
                 assert_eq!(
                     avx,
-                    bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, 0)
+                    bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, Start::ROOT)
                 );
                 // SAFETY: as above.
                 let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
-                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, 0));
+                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, Start::ROOT));
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");

@@ -43,6 +43,8 @@ pub(crate) struct Flat {
     pub(crate) leaf_boxes: Vec<Aabb>,
     /// The boxes of the root's children that are not leaves.
     pub(crate) inner: Vec<Aabb>,
+    /// Those children's node references.
+    pub(crate) inner_nodes: Vec<u32>,
     /// The root's slots whose leaves are in the list.
     pub(crate) skip: u32,
 }
@@ -57,9 +59,29 @@ pub(crate) struct Lanes {
     /// Lanes that enter one of the root's other children before their nearest hit (or
     /// their end): they must traverse the rest of the hierarchy too.
     pub(crate) need: u16,
+    /// Per lane of `need`, the one of those children it enters (an index into
+    /// `Flat::inner`), or [`SEVERAL`] if it enters more than one.
+    pub(crate) inner: [u32; 16],
 }
 
+/// In [`Lanes::inner`], a lane that enters more than one of the root's other children.
+pub(crate) const SEVERAL: u32 = u32::MAX;
+
 impl Flat {
+    /// Where the walk of a lane of [`Lanes::need`] starts, given its [`Lanes::inner`]: at
+    /// the one child of the root it enters, else at the root, leaving out the list's
+    /// leaves. Both walks find the same hit: the children the lane does not enter hold none
+    /// before the list's, and the root's test would pass straight to the one it enters.
+    pub(crate) fn start(&self, inner: u32) -> crate::bvh::Start {
+        match self.inner_nodes.get(inner as usize) {
+            Some(&node) => crate::bvh::Start { node, skip: 0 },
+            None => crate::bvh::Start {
+                node: 0,
+                skip: self.skip,
+            },
+        }
+    }
+
     /// Adds triangle `tri`, primitive `prim`, of leaf `leaf`, sharing the vertices already
     /// listed.
     pub(crate) fn push_triangle(&mut self, tri: [Vec3; 3], prim: u32, leaf: u8) {
@@ -88,7 +110,7 @@ pub(crate) use queries::{closest_avx2, closest_avx512, occluded_avx2, occluded_a
 /// The queries on the lanes of one width `S`, and their entry points compiled for each.
 #[cfg(target_arch = "x86_64")]
 mod queries {
-    use super::{Flat, Lanes, MAX_VERTICES};
+    use super::{Flat, Lanes, MAX_VERTICES, SEVERAL};
     use crate::bvh::Hit;
     use crate::lanes::{enters, sphere, triangle, widen, Group, Nearest};
     use crate::simd::{Avx2, Avx512, Simd};
@@ -108,7 +130,8 @@ mod queries {
         }
     }
 
-    /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`.
+    /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`, and per lane
+    /// the one it enters ([`Lanes::inner`]).
     #[inline(always)]
     unsafe fn need<S: Simd>(
         flat: &Flat,
@@ -116,14 +139,25 @@ mod queries {
         inv: &[S::F; 3],
         tmin: S::F,
         tmax: S::F,
-    ) -> u16 {
+    ) -> (u16, [u32; 16]) {
         // SAFETY: the caller runs on `S`'s instruction set.
         unsafe {
-            let mut need = S::none();
-            for b in &flat.inner {
-                need = S::or(need, enters(g, inv, b, tmin, tmax).1);
+            // Lanes that enter a box, lanes that enter more than one, and the last each
+            // enters.
+            let (mut any, mut more) = (S::none(), S::none());
+            let mut last = S::splat_i(0);
+            for (k, b) in flat.inner.iter().enumerate() {
+                let enter = enters(g, inv, b, tmin, tmax).1;
+                more = S::or(more, S::and(any, enter));
+                any = S::or(any, enter);
+                last = S::select_i(enter, last, S::splat_i(k as i32));
             }
-            S::bits(need)
+            let mut inner = [SEVERAL; 16];
+            S::store_i(
+                S::select_i(more, last, S::splat_i(SEVERAL as i32)),
+                &mut inner,
+            );
+            (S::bits(any), inner)
         }
     }
 
@@ -220,11 +254,12 @@ mod queries {
             let defer = S::bits(defer) | S::bits(near.tie);
             // Past a hit the list found, a margin far wider than the slab test's rounding.
             let reach = S::select(near.found, hi, widen::<S>(near.t));
-            let need = need(flat, &g, &inv, lo, reach) & !defer;
+            let (need, inner) = need(flat, &g, &inv, lo, reach);
             Lanes {
                 blocked: 0,
                 defer,
-                need,
+                need: need & !defer,
+                inner,
             }
         }
     }
@@ -264,10 +299,12 @@ mod queries {
             // says.
             let defer = defer & !blocked;
             let reach = widen::<S>(hi);
+            let (need, inner) = need(flat, &g, &inv, lo, reach);
             Lanes {
                 blocked,
                 defer,
-                need: need(flat, &g, &inv, lo, reach) & !blocked & !defer,
+                need: need & !blocked & !defer,
+                inner,
             }
         }
     }

@@ -177,9 +177,10 @@ proptest! {
 
     /// Oracle: the one-ray calls, in a room: ten large triangles (its walls, which the build
     /// lifts into the root and the batched queries test on lanes) around a cluster of small
-    /// ones and spheres (which rays that reach them still traverse). Rays start inside, some
-    /// at grid points and axis-aligned (edges met exactly); every hit and occlusion is the
-    /// one-ray call's, bit for bit.
+    /// ones and spheres (which rays that reach them still traverse, from the one child of
+    /// the root they enter, or from the root). Rays start inside, some at grid points and
+    /// axis-aligned (edges met exactly), some aimed at the cluster; every hit and occlusion
+    /// is the one-ray call's, bit for bit.
     #[test]
     fn room_batches_equal_single_rays(
         small in prop::collection::vec(
@@ -215,6 +216,9 @@ proptest! {
                 let ray = match kind {
                     0 => Ray::new(o.round() * 0.5, d),
                     1 => Ray::new(o.round() * 0.5, [Vec3::X, -Vec3::Y, Vec3::Z][(t as usize) % 3]),
+                    // At a point of the cluster: through one or several of the root's
+                    // children that hold it.
+                    2 => Ray::new(o * 0.9, d * 0.2 - o * 0.9),
                     _ => Ray::new(o * 0.9, d),
                 };
                 (ray, t)
