@@ -623,9 +623,9 @@ impl Bvh {
     #[inline(always)]
     fn node(&self, r: u32) -> &Node8 {
         debug_assert!((r as usize) < self.nodes.len());
-        // SAFETY: the walks start at the root, only when there is one, and follow child
-        // references: each is the index of a node pushed before it was stored
-        // (`Bvh::collapse`), and nodes are never removed.
+        // SAFETY: the walks start at the root or at one of its children (`Start`), only
+        // when there is a root, and follow child references: each is the index of a node
+        // pushed before it was stored (`Bvh::collapse`), and nodes are never removed.
         unsafe { self.nodes.get_unchecked(r as usize) }
     }
 
@@ -967,7 +967,7 @@ impl Bvh {
     }
 
     /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
-    /// `rays`), its end and the root's slots it leaves out, and writes query k's hit to
+    /// `rays`), its end and where its walk starts, and writes query k's hit to
     /// `hits[k]`. Two walks go on at once, a step of one then a step of the other: each
     /// step waits on memory (a node, a leaf's triangles) that the other's step is computed
     /// under. Each walk is the one [`Bvh::intersect_with`] takes, so the hits are the same;
@@ -1144,8 +1144,8 @@ impl Bvh {
         closest: impl Fn(&[Ray], &mut [Option<Hit>]) -> Lanes,
         packet: impl Fn(&Query, &mut [Option<Hit>]) -> u16,
     ) {
-        // The tree walks still to make, over the whole batch: each ray, its end, the
-        // root's slots it leaves out, and whether it is over the whole tree.
+        // The tree walks still to make, over the whole batch: each ray, its end, where its
+        // walk starts, and whether it is over the whole tree.
         let mut jobs: Vec<(usize, f32, Start)> = vec![];
         let mut whole: Vec<bool> = vec![];
         let groups = rays.chunks(width).zip(hits.chunks_mut(width));
@@ -2079,6 +2079,107 @@ mod tests {
     use super::*;
     use prism_math::Pcg32;
     use std::collections::HashMap;
+
+    /// Oracle: the one-ray calls, which start at the root. In a room (ten wall triangles,
+    /// set apart into the root's list) around a cluster the root holds in several children,
+    /// rays aimed at the cluster walk on from one child or from the root, as the lanes'
+    /// gate decides (both occur here), and every hit and occlusion is the one-ray call's,
+    /// bit for bit, with ends infinite and finite.
+    #[test]
+    fn walks_past_the_list_start_at_the_child_entered() {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let mut rng = Pcg32::new(9, 10);
+            let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+            let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 10.0;
+            let mut tris = vec![];
+            for [a, b, cc, d] in [
+                [
+                    c(-1., -1., -1.),
+                    c(1., -1., -1.),
+                    c(1., -1., 1.),
+                    c(-1., -1., 1.),
+                ],
+                [
+                    c(-1., 1., -1.),
+                    c(-1., 1., 1.),
+                    c(1., 1., 1.),
+                    c(1., 1., -1.),
+                ],
+                [
+                    c(-1., -1., -1.),
+                    c(-1., 1., -1.),
+                    c(1., 1., -1.),
+                    c(1., -1., -1.),
+                ],
+                [
+                    c(-1., -1., -1.),
+                    c(-1., -1., 1.),
+                    c(-1., 1., 1.),
+                    c(-1., 1., -1.),
+                ],
+                [
+                    c(1., -1., -1.),
+                    c(1., 1., -1.),
+                    c(1., 1., 1.),
+                    c(1., -1., 1.),
+                ],
+            ] {
+                tris.push([a, b, cc]);
+                tris.push([a, cc, d]);
+            }
+            for _ in 0..600 {
+                let a = r() * 3.0;
+                tris.push([a, a + r() * 0.3, a + r() * 0.3]);
+            }
+            let bvh = Bvh::build(&tris, &[], &BuildOptions::default());
+            let flat = bvh.flat.as_ref().expect("the walls make a list");
+            assert!(
+                flat.inner_nodes.len() >= 2,
+                "the cluster under several children"
+            );
+            let rays: Vec<Ray> = (0..4000)
+                .map(|_| {
+                    let o = r() * 9.0;
+                    Ray::new(o, r() * 3.0 - o)
+                })
+                .collect();
+            // How the gate starts the walks of the lanes that go on into the tree.
+            let (mut one, mut several) = (0, 0);
+            for group in rays.chunks(8) {
+                let mut out = [None; 8];
+                // SAFETY: the processor has AVX2.
+                let lanes = unsafe {
+                    crate::flat::closest_avx2(flat, group, (1e-3, f32::INFINITY), &mut out)
+                };
+                for lane in (0..group.len()).filter(|&l| lanes.need & (1 << l) != 0) {
+                    if lanes.inner[lane] == crate::flat::SEVERAL {
+                        several += 1;
+                    } else {
+                        one += 1;
+                    }
+                }
+            }
+            assert!(one > 0 && several > 0, "one child {one}, several {several}");
+            let bits =
+                |h: Option<Hit>| h.map(|h| (h.t.to_bits(), h.prim, h.b1.to_bits(), h.b2.to_bits()));
+            for tmax in [f32::INFINITY, 9.0] {
+                let ends: Vec<f32> = (0..rays.len()).map(|i| 2.0 + (i % 13) as f32).collect();
+                let mut hits = vec![None; rays.len()];
+                bvh.intersect_batch(&rays, 1e-3, tmax, &mut hits);
+                let mut blocked = vec![false; rays.len()];
+                bvh.occluded_batch(&rays, 1e-3, &ends, &mut blocked);
+                for (i, ray) in rays.iter().enumerate() {
+                    assert_eq!(
+                        bits(hits[i]),
+                        bits(bvh.intersect(ray, 1e-3, tmax)),
+                        "ray {i}"
+                    );
+                    assert_eq!(blocked[i], bvh.occluded(ray, 1e-3, ends[i]), "ray {i}");
+                }
+            }
+        }
+    }
 
     /// Property: the AVX and SSE node tests are the same computation, so both traversals
     /// return bit-identical hits (checked on random rays, and on axis-aligned rays, whose

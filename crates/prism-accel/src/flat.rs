@@ -70,8 +70,12 @@ pub(crate) const SEVERAL: u32 = u32::MAX;
 impl Flat {
     /// Where the walk of a lane of [`Lanes::need`] starts, given its [`Lanes::inner`]: at
     /// the one child of the root it enters, else at the root, leaving out the list's
-    /// leaves. Both walks find the same hit: the children the lane does not enter hold none
-    /// before the list's, and the root's test would pass straight to the one it enters.
+    /// leaves. Both walks find the same hit. The gate computes the root's slab test (its
+    /// operations, in order) up to the list's hit or the ray's end, widened as the walk
+    /// widens it; the children it does not enter start beyond that, hold no hit the walk
+    /// would take, and the walk from the root visits the one it enters as it would from
+    /// there. A shadow ray the root's own test (up to the unwidened end) sends nowhere
+    /// finds nothing in the child either: the boxes below it start no nearer.
     pub(crate) fn start(&self, inner: u32) -> crate::bvh::Start {
         match self.inner_nodes.get(inner as usize) {
             Some(&node) => crate::bvh::Start { node, skip: 0 },
@@ -252,8 +256,9 @@ mod queries {
             }
             near.write(flat.first_sphere, u16::MAX, out);
             let defer = S::bits(defer) | S::bits(near.tie);
-            // Past a hit the list found, a margin far wider than the slab test's rounding.
-            let reach = S::select(near.found, hi, widen::<S>(near.t));
+            // Past the list's hit (or the rays' end, `near.t` where nothing was found), the
+            // walk's own margin (`Walk::reach`), far wider than the slab test's rounding.
+            let reach = widen::<S>(near.t);
             let (need, inner) = need(flat, &g, &inv, lo, reach);
             Lanes {
                 blocked: 0,
