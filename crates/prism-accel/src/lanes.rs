@@ -5,6 +5,7 @@
 //! walk (`packet`) are written in these.
 
 use prism_math::{Aabb, Ray};
+use std::arch::x86_64::{_CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ};
 
 use crate::bvh::Hit;
 use crate::node8::FAR_WIDEN;
@@ -140,18 +141,18 @@ pub(crate) unsafe fn triangle<S: Simd>(
         let w = S::sub(S::mul(bx, ay), S::mul(by, ax));
         let zero = S::splat(0.0);
         let zeros = S::or(S::or(S::eq(u, zero), S::eq(v, zero)), S::eq(w, zero));
-        let neg = S::or(S::or(S::lt(u, zero), S::lt(v, zero)), S::lt(w, zero));
-        let pos = S::or(S::or(S::gt(u, zero), S::gt(v, zero)), S::gt(w, zero));
         let det = S::add(S::add(u, v), w);
         let sum = S::add(S::add(S::mul(u, az), S::mul(v, bz)), S::mul(w, cz));
         let t = S::mul(S::mul(sz, sum), S::div(S::splat(1.0), det));
-        let hit = S::and(
-            S::and(
-                S::and_not(S::ne(det, zero), S::and(neg, pos)),
-                S::gt(t, tmin),
-            ),
-            S::lt(t, tmax),
-        );
+        // No edge function of each sign (`!(neg && pos)` of the one-ray test): all at
+        // least zero, or all at most zero. A NaN edge function makes `t` NaN, which no
+        // comparison below passes, so the two forms answer alike.
+        let all_ge =
+            S::cmp_and::<_CMP_GE_OQ>(S::cmp_and::<_CMP_GE_OQ>(S::ge(u, zero), v, zero), w, zero);
+        let all_le =
+            S::cmp_and::<_CMP_LE_OQ>(S::cmp_and::<_CMP_LE_OQ>(S::le(u, zero), v, zero), w, zero);
+        let inside = S::cmp_and::<_CMP_NEQ_UQ>(S::or(all_ge, all_le), det, zero);
+        let hit = S::cmp_and::<_CMP_LT_OQ>(S::cmp_and::<_CMP_GT_OQ>(inside, t, tmin), t, tmax);
         (t, v, w, det, hit, zeros)
     }
 }
@@ -334,8 +335,8 @@ impl<S: Simd> Nearest<S> {
     ) {
         // SAFETY: the caller runs on `S`'s instruction set.
         unsafe {
-            let nearer = S::and(hit, S::lt(t, self.t));
-            let equal = S::and(hit, S::eq(t, self.t));
+            let nearer = S::cmp_and::<_CMP_LT_OQ>(hit, t, self.t);
+            let equal = S::cmp_and::<_CMP_EQ_OQ>(hit, t, self.t);
             self.tie = S::or(S::and_not(self.tie, nearer), equal);
             self.t = S::select(nearer, self.t, t);
             self.v = S::select(nearer, self.v, v);

@@ -49,10 +49,11 @@ pub(crate) trait Simd {
     unsafe fn ge(a: Self::F, b: Self::F) -> Self::M;
     /// `a == b` (false for NaN).
     unsafe fn eq(a: Self::F, b: Self::F) -> Self::M;
-    /// `a != b` (true for NaN).
-    unsafe fn ne(a: Self::F, b: Self::F) -> Self::M;
     /// `a >= b`, unsigned.
     unsafe fn ge_u32(a: Self::I, b: Self::I) -> Self::M;
+    /// `m` and the lanes where `a` compares to `b` by predicate `P` (a `_CMP_*` constant):
+    /// one masked compare with AVX-512, which keeps the mask out of general registers.
+    unsafe fn cmp_and<const P: i32>(m: Self::M, a: Self::F, b: Self::F) -> Self::M;
     /// `b` in the lanes of `m`, `a` in the others.
     unsafe fn select(m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     /// `b` in the lanes of `m`, `a` in the others.
@@ -163,12 +164,12 @@ impl Simd for Avx512 {
         _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b)
     }
     #[inline(always)]
-    unsafe fn ne(a: __m512, b: __m512) -> __mmask16 {
-        _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(a, b)
-    }
-    #[inline(always)]
     unsafe fn ge_u32(a: __m512i, b: __m512i) -> __mmask16 {
         _mm512_cmpge_epu32_mask(a, b)
+    }
+    #[inline(always)]
+    unsafe fn cmp_and<const P: i32>(m: __mmask16, a: __m512, b: __m512) -> __mmask16 {
+        _mm512_mask_cmp_ps_mask::<P>(m, a, b)
     }
     #[inline(always)]
     unsafe fn select(m: __mmask16, a: __m512, b: __m512) -> __m512 {
@@ -307,6 +308,10 @@ impl Simd for Avx2 {
         _mm256_cmp_ps::<_CMP_LT_OQ>(a, b)
     }
     #[inline(always)]
+    unsafe fn cmp_and<const P: i32>(m: __m256, a: __m256, b: __m256) -> __m256 {
+        _mm256_and_ps(m, _mm256_cmp_ps::<P>(a, b))
+    }
+    #[inline(always)]
     unsafe fn le(a: __m256, b: __m256) -> __m256 {
         _mm256_cmp_ps::<_CMP_LE_OQ>(a, b)
     }
@@ -321,10 +326,6 @@ impl Simd for Avx2 {
     #[inline(always)]
     unsafe fn eq(a: __m256, b: __m256) -> __m256 {
         _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b)
-    }
-    #[inline(always)]
-    unsafe fn ne(a: __m256, b: __m256) -> __m256 {
-        _mm256_cmp_ps::<_CMP_NEQ_UQ>(a, b)
     }
     #[inline(always)]
     unsafe fn ge_u32(a: __m256i, b: __m256i) -> __m256 {
