@@ -2091,42 +2091,20 @@ mod tests {
         if std::arch::is_x86_feature_detected!("avx2") {
             let mut rng = Pcg32::new(9, 10);
             let mut r = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
-            let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 10.0;
+            // Five faces of a cube of half-size 10 (all but +z), two triangles each.
             let mut tris = vec![];
-            for [a, b, cc, d] in [
-                [
-                    c(-1., -1., -1.),
-                    c(1., -1., -1.),
-                    c(1., -1., 1.),
-                    c(-1., -1., 1.),
-                ],
-                [
-                    c(-1., 1., -1.),
-                    c(-1., 1., 1.),
-                    c(1., 1., 1.),
-                    c(1., 1., -1.),
-                ],
-                [
-                    c(-1., -1., -1.),
-                    c(-1., 1., -1.),
-                    c(1., 1., -1.),
-                    c(1., -1., -1.),
-                ],
-                [
-                    c(-1., -1., -1.),
-                    c(-1., -1., 1.),
-                    c(-1., 1., 1.),
-                    c(-1., 1., -1.),
-                ],
-                [
-                    c(1., -1., -1.),
-                    c(1., 1., -1.),
-                    c(1., 1., 1.),
-                    c(1., -1., 1.),
-                ],
-            ] {
-                tris.push([a, b, cc]);
-                tris.push([a, cc, d]);
+            for (axis, side) in [(0, -1.0), (0, 1.0), (1, -1.0), (1, 1.0), (2, -1.0)] {
+                let corner = |a: f32, b: f32| {
+                    let mut p = [0.0f32; 3];
+                    p[axis] = side * 10.0;
+                    p[(axis + 1) % 3] = a * 10.0;
+                    p[(axis + 2) % 3] = b * 10.0;
+                    Vec3::from(p)
+                };
+                let [p, q, t, u] =
+                    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| corner(a, b));
+                tris.push([p, q, t]);
+                tris.push([p, t, u]);
             }
             for _ in 0..600 {
                 let a = r() * 3.0;
