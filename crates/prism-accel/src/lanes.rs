@@ -5,7 +5,7 @@
 //! walk (`packet`) are written in these.
 
 use prism_math::{Aabb, Ray};
-use std::arch::x86_64::{_CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _CMP_NEQ_UQ};
+use std::arch::x86_64::{_CMP_EQ_OQ, _CMP_GT_OQ, _CMP_LT_OQ};
 
 use crate::bvh::Hit;
 use crate::node8::FAR_WIDEN;
@@ -120,8 +120,10 @@ impl<S: Simd> Group<S> {
 }
 
 /// One triangle's hit on every lane from its prepared vertices, as a pack of the
-/// hierarchy tests it: `(t, v, w, det, hit, zero)`. `hit` holds the lanes hit with
-/// `tmin < t < tmax`, `zero` those with an edge function of exactly zero.
+/// hierarchy tests it: `(t, v, w, det, hit, zero)`. `zero` holds the lanes with an edge
+/// function of exactly zero, which the one-ray test decides in double precision: the
+/// caller must decide those lanes by it. `hit` holds the other lanes hit with
+/// `tmin < t < tmax`.
 #[inline(always)]
 #[allow(clippy::type_complexity)]
 pub(crate) unsafe fn triangle<S: Simd>(
@@ -144,14 +146,10 @@ pub(crate) unsafe fn triangle<S: Simd>(
         let det = S::add(S::add(u, v), w);
         let sum = S::add(S::add(S::mul(u, az), S::mul(v, bz)), S::mul(w, cz));
         let t = S::mul(S::mul(sz, sum), S::div(S::splat(1.0), det));
-        // No edge function of each sign (`!(neg && pos)` of the one-ray test): all at
-        // least zero, or all at most zero. A NaN edge function makes `t` NaN, which no
-        // comparison below passes, so the two forms answer alike.
-        let all_ge =
-            S::cmp_and::<_CMP_GE_OQ>(S::cmp_and::<_CMP_GE_OQ>(S::ge(u, zero), v, zero), w, zero);
-        let all_le =
-            S::cmp_and::<_CMP_LE_OQ>(S::cmp_and::<_CMP_LE_OQ>(S::le(u, zero), v, zero), w, zero);
-        let inside = S::cmp_and::<_CMP_NEQ_UQ>(S::or(all_ge, all_le), det, zero);
+        // With no edge function zero, the one-ray test's `!(neg && pos)` is a shared sign
+        // bit, and then `det`, a sum of three numbers of one sign, is not zero. A NaN edge
+        // function makes `t` NaN, which no comparison below passes, in both tests alike.
+        let inside = S::same_sign(S::and_not(S::all(), zeros), u, v, w);
         let hit = S::cmp_and::<_CMP_LT_OQ>(S::cmp_and::<_CMP_GT_OQ>(inside, t, tmin), t, tmax);
         (t, v, w, det, hit, zeros)
     }

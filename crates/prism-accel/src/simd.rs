@@ -54,6 +54,8 @@ pub(crate) trait Simd {
     /// `m` and the lanes where `a` compares to `b` by predicate `P` (a `_CMP_*` constant):
     /// one masked compare with AVX-512, which keeps the mask out of general registers.
     unsafe fn cmp_and<const P: i32>(m: Self::M, a: Self::F, b: Self::F) -> Self::M;
+    /// The lanes of `m` where `a`, `b` and `c` have the same sign bit.
+    unsafe fn same_sign(m: Self::M, a: Self::F, b: Self::F, c: Self::F) -> Self::M;
     /// `b` in the lanes of `m`, `a` in the others.
     unsafe fn select(m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     /// `b` in the lanes of `m`, `a` in the others.
@@ -170,6 +172,13 @@ impl Simd for Avx512 {
     #[inline(always)]
     unsafe fn cmp_and<const P: i32>(m: __mmask16, a: __m512, b: __m512) -> __mmask16 {
         _mm512_mask_cmp_ps_mask::<P>(m, a, b)
+    }
+    #[inline(always)]
+    unsafe fn same_sign(m: __mmask16, a: __m512, b: __m512, c: __m512) -> __mmask16 {
+        let [a, b, c] = [a, b, c].map(|x| _mm512_castps_si512(x));
+        // `(a ^ b) | (a ^ c)`: every bit but those where the three agree.
+        let differ = _mm512_ternarylogic_epi32::<0x7e>(a, b, c);
+        _mm512_mask_testn_epi32_mask(m, differ, _mm512_set1_epi32(i32::MIN))
     }
     #[inline(always)]
     unsafe fn select(m: __mmask16, a: __m512, b: __m512) -> __m512 {
@@ -310,6 +319,13 @@ impl Simd for Avx2 {
     #[inline(always)]
     unsafe fn cmp_and<const P: i32>(m: __m256, a: __m256, b: __m256) -> __m256 {
         _mm256_and_ps(m, _mm256_cmp_ps::<P>(a, b))
+    }
+    #[inline(always)]
+    unsafe fn same_sign(m: __m256, a: __m256, b: __m256, c: __m256) -> __m256 {
+        let differ = _mm256_or_ps(_mm256_xor_ps(a, b), _mm256_xor_ps(a, c));
+        // Every bit of a lane set where the sign bits differ.
+        let differ = _mm256_srai_epi32::<31>(_mm256_castps_si256(differ));
+        _mm256_andnot_ps(_mm256_castsi256_ps(differ), m)
     }
     #[inline(always)]
     unsafe fn le(a: __m256, b: __m256) -> __m256 {
