@@ -69,11 +69,13 @@ impl Node8 {
 }
 
 /// A ray prepared for slab tests, `t = (p - origin) * inv_dir`: for each axis, the plane of
-/// a box the ray meets first (`near[axis]` indexes `Node8::bounds`; `far[axis]` is the
-/// other one).
+/// a box the ray meets first (`near[axis]` is the byte offset of its row in
+/// `Node8::bounds`; `far[axis]` is the other one's). Far slabs are measured with `inv_far`,
+/// `inv_dir` widened by [`FAR_WIDEN`].
 pub(crate) struct SlabRay {
     origin: [f32; 3],
     inv_dir: [f32; 3],
+    inv_far: [f32; 3],
     near: [usize; 3],
     far: [usize; 3],
     /// The origin and `inv_dir` are finite and no `inv_dir` is zero: no slab distance is
@@ -85,12 +87,18 @@ impl SlabRay {
     #[inline(always)]
     pub(crate) fn new(r: &RayPre) -> SlabRay {
         let neg = |axis: usize| usize::from(r.inv_dir[axis].is_sign_negative());
-        let near = [3 * neg(0), 1 + 3 * neg(1), 2 + 3 * neg(2)];
+        let row = |plane: usize| plane * PLANE_BYTES;
+        let near = [row(3 * neg(0)), row(1 + 3 * neg(1)), row(2 + 3 * neg(2))];
         SlabRay {
             origin: r.origin.to_array(),
             inv_dir: r.inv_dir.to_array(),
+            inv_far: (r.inv_dir * FAR_WIDEN).to_array(),
             near,
-            far: [3 * (1 - neg(0)), 1 + 3 * (1 - neg(1)), 2 + 3 * (1 - neg(2))],
+            far: [
+                row(3 * (1 - neg(0))),
+                row(1 + 3 * (1 - neg(1))),
+                row(2 + 3 * (1 - neg(2))),
+            ],
             plain: r.origin.is_finite()
                 && r.inv_dir.is_finite()
                 && !r.inv_dir.cmpeq(Vec3::ZERO).any(),
@@ -98,8 +106,36 @@ impl SlabRay {
     }
 }
 
+/// Bytes in one plane's row of `Node8::bounds`.
+const PLANE_BYTES: usize = std::mem::size_of::<[Vec4; 2]>();
+
+impl Node8 {
+    /// The row of `bounds` at byte offset `offset`, without a bounds check.
+    ///
+    /// # Safety
+    /// `offset` must be a multiple of [`PLANE_BYTES`] below `6 * PLANE_BYTES`, as
+    /// [`SlabRay::new`] makes them.
+    #[inline(always)]
+    unsafe fn plane(&self, offset: usize) -> &[Vec4; 2] {
+        debug_assert!(offset.is_multiple_of(PLANE_BYTES) && offset < 6 * PLANE_BYTES);
+        // SAFETY: the caller passes the offset of one of the six rows.
+        unsafe {
+            &*self
+                .bounds
+                .as_ptr()
+                .cast::<u8>()
+                .add(offset)
+                .cast::<[Vec4; 2]>()
+        }
+    }
+}
+
 /// Rounding in the slab test may shrink the interval by a few ulps; widening the far end by
-/// this factor keeps hits on box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013).
+/// this factor keeps hits on box faces (Ize, "Robust BVH Ray Traversal", JCGT 2013, asks
+/// for `1 + 2 gamma_3`, about `1 + 3 EPSILON`). The tests widen the inverse direction of
+/// the far slabs rather than each far distance: `(p - origin) * (inv_dir * FAR_WIDEN)` is
+/// three roundings from the exact widened distance, at least `1 + 4 EPSILON` times the
+/// exact far distance, still more than Ize's margin.
 pub(crate) const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
 
 /// `t` moved up by 1/1024 of its size and by the smallest normal float: past a distance by
@@ -116,10 +152,10 @@ pub(crate) fn widen(t: f32) -> f32 {
 /// in `[tmin, tmax]`), by 4-wide SSE halves.
 ///
 /// The entry is the largest near-slab distance (and `tmin`); a child is entered when the
-/// entry is at most each far-slab distance widened by [`FAR_WIDEN`], and at most `tmax`.
-/// Comparing with each far distance, rather than with their minimum, gives the same answer
-/// (rounding is monotone, so the minimum of widened distances is the widened minimum) in
-/// fewer dependent steps: the test waits on the entry alone.
+/// entry is at most each far-slab distance (measured with the widened inverse direction,
+/// [`FAR_WIDEN`]), and at most `tmax`. Comparing with each far distance, rather than with
+/// their minimum, gives the same answer in fewer dependent steps: the test waits on the
+/// entry alone.
 ///
 /// A slab distance is NaN (0 * inf) for a ray lying in a slab's plane, and that slab does not
 /// cut the interval: SSE and AVX max return their second operand when either is NaN, so with
@@ -134,11 +170,12 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
     let mut near_out = [0f32; 8];
     let mut mask = 0;
     for half in 0..2 {
-        let t = |plane: usize, axis: usize| {
-            // SAFETY: `SlabRay::new` makes every plane index 0..6.
-            let b = unsafe { n.bounds.get_unchecked(plane) };
-            (b[half] - Vec4::splat(r.origin[axis])) * Vec4::splat(r.inv_dir[axis])
+        let slab = |plane: usize, axis: usize, inv: &[f32; 3]| {
+            // SAFETY: `SlabRay::new` makes every plane offset one of a row.
+            let b = unsafe { n.plane(plane) };
+            (b[half] - Vec4::splat(r.origin[axis])) * Vec4::splat(inv[axis])
         };
+        let t = |plane: usize, axis: usize| slab(plane, axis, &r.inv_dir);
         let near = if r.plain {
             t(r.near[0], 0)
                 .max(t(r.near[1], 1))
@@ -146,7 +183,7 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
         } else {
             t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))))
         };
-        let before = |plane: usize, axis: usize| !near.cmpgt(t(plane, axis) * FAR_WIDEN);
+        let before = |plane: usize, axis: usize| !near.cmpgt(slab(plane, axis, &r.inv_far));
         let enters = (before(r.far[0], 0) & before(r.far[1], 1))
             & (before(r.far[2], 2) & near.cmple(Vec4::splat(tmax)));
         near_out[4 * half..4 * half + 4].copy_from_slice(&near.to_array());
@@ -169,19 +206,21 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
         _mm256_and_ps, _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps,
         _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
     };
-    // SAFETY: `SlabRay::new` makes every plane index 0..6, so `bounds[plane]` is one of the
-    // node's planes: 32 bytes at a 32-byte aligned offset of a 64-byte aligned node, as
-    // `_mm256_load_ps` requires; the store writes eight floats into an array of
-    // eight.
+    // SAFETY: `SlabRay::new` makes every plane offset that of one of the node's rows: 32
+    // bytes at a 32-byte aligned offset of a 64-byte aligned node, as `_mm256_load_ps`
+    // requires; the store writes eight floats into an array of eight.
     unsafe {
         macro_rules! t {
             ($plane:expr, $axis:expr) => {
+                t!($plane, $axis, inv_dir)
+            };
+            ($plane:expr, $axis:expr, $inv:ident) => {
                 _mm256_mul_ps(
                     _mm256_sub_ps(
-                        _mm256_load_ps(n.bounds.get_unchecked($plane).as_ptr().cast::<f32>()),
+                        _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
                         _mm256_set1_ps(r.origin[$axis]),
                     ),
-                    _mm256_set1_ps(r.inv_dir[$axis]),
+                    _mm256_set1_ps(r.$inv[$axis]),
                 )
             };
         }
@@ -201,10 +240,7 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
         };
         macro_rules! before {
             ($plane:expr, $axis:expr) => {
-                _mm256_cmp_ps::<_CMP_NGT_UQ>(
-                    near,
-                    _mm256_mul_ps(t!($plane, $axis), _mm256_set1_ps(FAR_WIDEN)),
-                )
+                _mm256_cmp_ps::<_CMP_NGT_UQ>(near, t!($plane, $axis, inv_far))
             };
         }
         let m = _mm256_and_ps(
@@ -227,22 +263,24 @@ mod tests {
     use prism_math::{Pcg32, Ray};
 
     /// The slab test written out per child in scalar arithmetic, as the interval
-    /// `[max(near slabs, tmin), min(min(far slabs) * FAR_WIDEN, tmax)]` with NaN slabs left
-    /// out: the reference the vector tests must match child for child.
+    /// `[max(near slabs, tmin), min(far slabs, tmax)]`, far slabs measured with the inverse
+    /// direction times `FAR_WIDEN`, NaN slabs left out: the reference the vector tests must
+    /// match child for child.
     fn reference(n: &Node8, ray: &Ray, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
         let inv = ray.dir.recip();
+        let inv_far = inv * FAR_WIDEN;
         let (mut near_out, mut mask) = ([0f32; 8], 0);
         for (slot, out) in near_out.iter_mut().enumerate() {
             let b = n.child_box(slot);
             let (mut near, mut far) = (tmin, f32::INFINITY);
             for axis in 0..3 {
-                let t0 = (b.min[axis] - ray.origin[axis]) * inv[axis];
-                let t1 = (b.max[axis] - ray.origin[axis]) * inv[axis];
-                let (tn, tf) = if inv[axis].is_sign_negative() {
-                    (t1, t0)
+                let (lo, hi) = if inv[axis].is_sign_negative() {
+                    (b.max[axis], b.min[axis])
                 } else {
-                    (t0, t1)
+                    (b.min[axis], b.max[axis])
                 };
+                let tn = (lo - ray.origin[axis]) * inv[axis];
+                let tf = (hi - ray.origin[axis]) * inv_far[axis];
                 if !tn.is_nan() {
                     near = near.max(tn);
                 }
@@ -251,7 +289,7 @@ mod tests {
                 }
             }
             *out = near;
-            if near <= (far * FAR_WIDEN).min(tmax) && n.slot_used(slot) {
+            if near <= far.min(tmax) && n.slot_used(slot) {
                 mask |= 1 << slot;
             }
         }
