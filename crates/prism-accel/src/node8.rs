@@ -3,7 +3,7 @@
 //! same operations in the same order, so they enter the same children with the same
 //! distances and traversal is identical either way.
 
-use prism_math::glam::Vec4;
+use prism_math::glam::{Vec3A, Vec4};
 use prism_math::{Aabb, Vec3};
 
 use crate::shapes::RayPre;
@@ -69,40 +69,66 @@ impl Node8 {
 }
 
 /// A ray prepared for slab tests, `t = (p - origin) * inv_dir`: for each axis, the plane of
-/// a box the ray meets first (`near[axis]` is the byte offset of its row in
-/// `Node8::bounds`; `far[axis]` is the other one's). Far slabs are measured with `inv_far`,
-/// `inv_dir` widened by [`FAR_WIDEN`].
+/// a box the ray meets first and the other one, as byte offsets of their rows in
+/// `Node8::bounds` ([`SlabRay::near`], [`SlabRay::far`]). Far slabs are measured with
+/// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`].
 pub(crate) struct SlabRay {
     origin: [f32; 3],
     inv_dir: [f32; 3],
     inv_far: [f32; 3],
-    near: [usize; 3],
-    far: [usize; 3],
+    /// The row of [`PLANES`] for the ray's direction signs.
+    planes: &'static [usize; 6],
     /// The origin and `inv_dir` are finite and no `inv_dir` is zero: no slab distance is
     /// NaN.
     plain: bool,
 }
 
+/// For each set of axes a ray runs down (bit `axis` set), the byte offsets of the near
+/// planes' rows of `Node8::bounds` on x, y and z, then the far planes'. Looked up rather
+/// than computed per ray: a walk keeps a reference to its row.
+static PLANES: [[usize; 6]; 8] = {
+    let mut table = [[0; 6]; 8];
+    let mut down = 0;
+    while down < 8 {
+        let mut axis = 0;
+        while axis < 3 {
+            let neg = (down >> axis) & 1;
+            table[down][axis] = (axis + 3 * neg) * PLANE_BYTES;
+            table[down][3 + axis] = (axis + 3 * (1 - neg)) * PLANE_BYTES;
+            axis += 1;
+        }
+        down += 1;
+    }
+    table
+};
+
 impl SlabRay {
     #[inline(always)]
     pub(crate) fn new(r: &RayPre) -> SlabRay {
-        let neg = |axis: usize| usize::from(r.inv_dir[axis].is_sign_negative());
-        let row = |plane: usize| plane * PLANE_BYTES;
-        let near = [row(3 * neg(0)), row(1 + 3 * neg(1)), row(2 + 3 * neg(2))];
+        // SIMD tests rather than glam's `Vec3` ones, which test component by component with
+        // branches.
+        let down = r.inv_dir.is_negative_bitmask() as usize & 7;
+        let (o, inv) = (Vec3A::from(r.origin).abs(), Vec3A::from(r.inv_dir).abs());
         SlabRay {
             origin: r.origin.to_array(),
             inv_dir: r.inv_dir.to_array(),
             inv_far: (r.inv_dir * FAR_WIDEN).to_array(),
-            near,
-            far: [
-                row(3 * (1 - neg(0))),
-                row(1 + 3 * (1 - neg(1))),
-                row(2 + 3 * (1 - neg(2))),
-            ],
-            plain: r.origin.is_finite()
-                && r.inv_dir.is_finite()
-                && !r.inv_dir.cmpeq(Vec3::ZERO).any(),
+            planes: &PLANES[down],
+            plain: (o.cmplt(Vec3A::INFINITY) & inv.cmplt(Vec3A::INFINITY) & inv.cmpgt(Vec3A::ZERO))
+                .all(),
         }
+    }
+
+    /// The byte offset of the row of the plane on `axis` the ray meets first.
+    #[inline(always)]
+    fn near(&self, axis: usize) -> usize {
+        self.planes[axis]
+    }
+
+    /// The byte offset of the row of the other plane on `axis`.
+    #[inline(always)]
+    fn far(&self, axis: usize) -> usize {
+        self.planes[3 + axis]
     }
 }
 
@@ -177,15 +203,15 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
         };
         let t = |plane: usize, axis: usize| slab(plane, axis, &r.inv_dir);
         let near = if r.plain {
-            t(r.near[0], 0)
-                .max(t(r.near[1], 1))
-                .max(t(r.near[2], 2).max(Vec4::splat(tmin)))
+            t(r.near(0), 0)
+                .max(t(r.near(1), 1))
+                .max(t(r.near(2), 2).max(Vec4::splat(tmin)))
         } else {
-            t(r.near[2], 2).max(t(r.near[1], 1).max(t(r.near[0], 0).max(Vec4::splat(tmin))))
+            t(r.near(2), 2).max(t(r.near(1), 1).max(t(r.near(0), 0).max(Vec4::splat(tmin))))
         };
         let before = |plane: usize, axis: usize| !near.cmpgt(slab(plane, axis, &r.inv_far));
-        let enters = (before(r.far[0], 0) & before(r.far[1], 1))
-            & (before(r.far[2], 2) & near.cmple(Vec4::splat(tmax)));
+        let enters = (before(r.far(0), 0) & before(r.far(1), 1))
+            & (before(r.far(2), 2) & near.cmple(Vec4::splat(tmax)));
         near_out[4 * half..4 * half + 4].copy_from_slice(&near.to_array());
         mask |= enters.bitmask() << (4 * half);
     }
@@ -226,15 +252,15 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
         }
         let near = if r.plain {
             _mm256_max_ps(
-                _mm256_max_ps(t!(r.near[0], 0), t!(r.near[1], 1)),
-                _mm256_max_ps(t!(r.near[2], 2), _mm256_set1_ps(tmin)),
+                _mm256_max_ps(t!(r.near(0), 0), t!(r.near(1), 1)),
+                _mm256_max_ps(t!(r.near(2), 2), _mm256_set1_ps(tmin)),
             )
         } else {
             _mm256_max_ps(
-                t!(r.near[2], 2),
+                t!(r.near(2), 2),
                 _mm256_max_ps(
-                    t!(r.near[1], 1),
-                    _mm256_max_ps(t!(r.near[0], 0), _mm256_set1_ps(tmin)),
+                    t!(r.near(1), 1),
+                    _mm256_max_ps(t!(r.near(0), 0), _mm256_set1_ps(tmin)),
                 ),
             )
         };
@@ -244,9 +270,9 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
             };
         }
         let m = _mm256_and_ps(
-            _mm256_and_ps(before!(r.far[0], 0), before!(r.far[1], 1)),
+            _mm256_and_ps(before!(r.far(0), 0), before!(r.far(1), 1)),
             _mm256_and_ps(
-                before!(r.far[2], 2),
+                before!(r.far(2), 2),
                 _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
             ),
         );
