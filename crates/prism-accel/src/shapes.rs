@@ -34,6 +34,8 @@ pub struct RayPre {
     pub inv_dir: Vec3,
     pub(crate) perm: usize,
     pub(crate) shear: Vec3,
+    /// The origin's coordinates on the axes `(kx, ky, kz)` of `perm`.
+    pub(crate) origin_k: [f32; 3],
 }
 
 /// The axes `(kx, ky, kz)` of each permutation used by the watertight test.
@@ -69,6 +71,10 @@ impl RayPre {
             inv_dir,
             perm,
             shear: Vec3::new(da[kx] * inv_z, da[ky] * inv_z, inv_z),
+            origin_k: {
+                let o = ray.origin.to_array();
+                [o[kx], o[ky], o[kz]]
+            },
         }
     }
 

@@ -62,20 +62,20 @@ impl Tri4 {
         tmax: f32,
     ) -> Option<(f32, usize, f32, f32)> {
         let [kx, ky, kz] = crate::shapes::PERMS[r.perm];
-        let o = r.origin.to_array();
-        let rel = |i: usize, axis: usize| self.v[i][axis] - Vec4::splat(o[axis]);
+        let o = r.origin_k;
+        let rel = |i: usize, k: usize| self.v[i][[kx, ky, kz][k]] - Vec4::splat(o[k]);
         let (sx, sy, sz) = (
             Vec4::splat(r.shear.x),
             Vec4::splat(r.shear.y),
             Vec4::splat(r.shear.z),
         );
-        let (az, bz, cz) = (rel(0, kz), rel(1, kz), rel(2, kz));
-        let ax = rel(0, kx) - sx * az;
-        let ay = rel(0, ky) - sy * az;
-        let bx = rel(1, kx) - sx * bz;
-        let by = rel(1, ky) - sy * bz;
-        let cx = rel(2, kx) - sx * cz;
-        let cy = rel(2, ky) - sy * cz;
+        let (az, bz, cz) = (rel(0, 2), rel(1, 2), rel(2, 2));
+        let ax = rel(0, 0) - sx * az;
+        let ay = rel(0, 1) - sy * az;
+        let bx = rel(1, 0) - sx * bz;
+        let by = rel(1, 1) - sy * bz;
+        let cx = rel(2, 0) - sx * cz;
+        let cy = rel(2, 1) - sy * cz;
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
@@ -139,20 +139,21 @@ impl Tri4 {
             _mm256_storeu_ps, _mm256_sub_ps, _mm256_xor_ps, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
             _CMP_LT_OQ,
         };
-        let [kx, ky, kz] = crate::shapes::PERMS[r.perm];
-        let o = r.origin.to_array();
+        let axes = crate::shapes::PERMS[r.perm];
+        let o = r.origin_k;
         // SAFETY: the caller ensures AVX; each load reads one aligned `Vec4` of a pack (a
         // pack is 32-byte aligned and its vectors sit at multiples of 16 bytes).
         unsafe {
             // Macros, not closures: a closure is compiled apart, without AVX.
+            // Vertex `$i`'s coordinate on sheared axis `$k`, less the origin's.
             macro_rules! rel {
-                ($i:expr, $axis:expr) => {
+                ($i:expr, $k:expr) => {
                     _mm256_sub_ps(
                         _mm256_set_m128(
-                            _mm_load_ps(b.v[$i][$axis].as_ref().as_ptr()),
-                            _mm_load_ps(a.v[$i][$axis].as_ref().as_ptr()),
+                            _mm_load_ps(b.v[$i][axes[$k]].as_ref().as_ptr()),
+                            _mm_load_ps(a.v[$i][axes[$k]].as_ref().as_ptr()),
                         ),
-                        _mm256_set1_ps(o[$axis]),
+                        _mm256_set1_ps(o[$k]),
                     )
                 };
             }
@@ -171,13 +172,13 @@ impl Tri4 {
                 _mm256_set1_ps(r.shear.y),
                 _mm256_set1_ps(r.shear.z),
             );
-            let (az, bz, cz) = (rel!(0, kz), rel!(1, kz), rel!(2, kz));
-            let ax = sub!(rel!(0, kx), mul!(sx, az));
-            let ay = sub!(rel!(0, ky), mul!(sy, az));
-            let bx = sub!(rel!(1, kx), mul!(sx, bz));
-            let by = sub!(rel!(1, ky), mul!(sy, bz));
-            let cx = sub!(rel!(2, kx), mul!(sx, cz));
-            let cy = sub!(rel!(2, ky), mul!(sy, cz));
+            let (az, bz, cz) = (rel!(0, 2), rel!(1, 2), rel!(2, 2));
+            let ax = sub!(rel!(0, 0), mul!(sx, az));
+            let ay = sub!(rel!(0, 1), mul!(sy, az));
+            let bx = sub!(rel!(1, 0), mul!(sx, bz));
+            let by = sub!(rel!(1, 1), mul!(sy, bz));
+            let cx = sub!(rel!(2, 0), mul!(sx, cz));
+            let cy = sub!(rel!(2, 1), mul!(sy, cz));
             let u = sub!(mul!(cx, by), mul!(cy, bx));
             let v = sub!(mul!(ax, cy), mul!(ay, cx));
             let w = sub!(mul!(bx, ay), mul!(by, ax));
