@@ -116,23 +116,9 @@ pub(crate) use queries::{closest_avx2, closest_avx512, occluded_avx2, occluded_a
 mod queries {
     use super::{Flat, Lanes, MAX_VERTICES, SEVERAL};
     use crate::bvh::Hit;
-    use crate::lanes::{enters, sphere, triangle, widen, Group, Nearest};
+    use crate::lanes::{enters, sphere, triangle, widen, Group, Inverse, Nearest};
     use crate::simd::{Avx2, Avx512, Simd};
     use prism_math::Ray;
-
-    /// `1 / dir` of a group's rays, as the slab tests take it.
-    #[inline(always)]
-    unsafe fn inverse<S: Simd>(g: &Group<S>) -> [S::F; 3] {
-        // SAFETY: the caller runs on `S`'s instruction set.
-        unsafe {
-            let one = S::splat(1.0);
-            [
-                S::div(one, g.dir[0]),
-                S::div(one, g.dir[1]),
-                S::div(one, g.dir[2]),
-            ]
-        }
-    }
 
     /// Lanes that enter one of `flat.inner` with an entry in `[tmin, tmax]`, and per lane
     /// the one it enters ([`Lanes::inner`]).
@@ -140,7 +126,7 @@ mod queries {
     unsafe fn need<S: Simd>(
         flat: &Flat,
         g: &Group<S>,
-        inv: &[S::F; 3],
+        inv: &Inverse<S>,
         tmin: S::F,
         tmax: S::F,
     ) -> (u16, [u32; 16]) {
@@ -172,7 +158,7 @@ mod queries {
     unsafe fn live<S: Simd>(
         flat: &Flat,
         g: &Group<S>,
-        inv: &[S::F; 3],
+        inv: &Inverse<S>,
         tmin: S::F,
         tmax: S::F,
     ) -> u32 {
@@ -234,7 +220,7 @@ mod queries {
             let zero = S::splat(0.0);
             let mut near = Nearest::<S>::none(hi);
             let mut defer = S::none();
-            let inv = inverse(&g);
+            let inv = Inverse::<S>::new(&g);
             let live = live(flat, &g, &inv, lo, widen::<S>(hi));
             let mut prepared = Prepared::<S>::new();
             prepared.fill(flat, &g);
@@ -281,7 +267,7 @@ mod queries {
             let lo = S::splat(tmin);
             let hi = S::load(&ends);
             let (mut blocked, mut defer) = (S::none(), S::none());
-            let inv = inverse(&g);
+            let inv = Inverse::<S>::new(&g);
             let live = live(flat, &g, &inv, lo, hi);
             let mut prepared = Prepared::<S>::new();
             prepared.fill(flat, &g);

@@ -218,12 +218,44 @@ unsafe fn dot<S: Simd>(a: &[S::F; 3], b: &[S::F; 3]) -> S::F {
     }
 }
 
+/// `1 / dir` of a group's rays as the slab tests take it, as `node8::SlabRay` holds it:
+/// for the near slabs, and widened by [`FAR_WIDEN`] for the far ones.
+pub(crate) struct Inverse<S: Simd> {
+    near: [S::F; 3],
+    far: [S::F; 3],
+}
+
+impl<S: Simd> Inverse<S> {
+    /// The inverse directions of group `g`.
+    #[inline(always)]
+    pub(crate) unsafe fn new(g: &Group<S>) -> Inverse<S> {
+        // SAFETY: the caller runs on `S`'s instruction set.
+        unsafe {
+            let one = S::splat(1.0);
+            let near = [
+                S::div(one, g.dir[0]),
+                S::div(one, g.dir[1]),
+                S::div(one, g.dir[2]),
+            ];
+            let widen = S::splat(FAR_WIDEN);
+            let far = [
+                S::mul(near[0], widen),
+                S::mul(near[1], widen),
+                S::mul(near[2], widen),
+            ];
+            Inverse { near, far }
+        }
+    }
+}
+
 /// The slab test of the tree's nodes (`node8`) on lanes: each lane's entry distance into
-/// `b`, and the lanes entering it with an entry in `[tmin, tmax]`.
+/// `b`, and the lanes entering it with an entry in `[tmin, tmax]`. The same distances as
+/// the node test's, and the same answer: the node test compares the entry with each far
+/// distance that is not NaN and with `tmax`, this test with their minimum.
 #[inline(always)]
 pub(crate) unsafe fn enters<S: Simd>(
     g: &Group<S>,
-    inv: &[S::F; 3],
+    inv: &Inverse<S>,
     b: &Aabb,
     tmin: S::F,
     tmax: S::F,
@@ -231,17 +263,16 @@ pub(crate) unsafe fn enters<S: Simd>(
     // SAFETY: the caller runs on `S`'s instruction set.
     unsafe {
         let mut near = tmin;
-        let mut far = S::splat(f32::INFINITY);
-        for (a, &inv) in inv.iter().enumerate() {
+        let mut far = tmax;
+        for a in 0..3 {
             // Lanes whose direction is negative on this axis meet the upper plane first.
             let (lo, hi) = (S::splat(b.min[a]), S::splat(b.max[a]));
-            let first = S::mul(S::sub(S::select_sign(inv, lo, hi), g.origin[a]), inv);
-            let last = S::mul(S::sub(S::select_sign(inv, hi, lo), g.origin[a]), inv);
+            let first = S::sub(S::select_sign(inv.near[a], lo, hi), g.origin[a]);
+            let last = S::sub(S::select_sign(inv.near[a], hi, lo), g.origin[a]);
             // The slab value first: a NaN (a ray in the slab's plane) drops out.
-            near = S::max(first, near);
-            far = S::min(last, far);
+            near = S::max(S::mul(first, inv.near[a]), near);
+            far = S::min(S::mul(last, inv.far[a]), far);
         }
-        let far = S::min(S::mul(far, S::splat(FAR_WIDEN)), tmax);
         (near, S::le(near, far))
     }
 }
@@ -343,5 +374,103 @@ impl<S: Simd> Nearest<S> {
             self.prim = S::select_i(nearer, self.prim, S::splat_i(prim as i32));
             self.found = S::or(self.found, nearer);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::node8::{hit_sse, Node8, SlabRay};
+    use crate::shapes::RayPre;
+    use crate::simd::Avx2;
+    use prism_math::{Pcg32, Vec3};
+
+    /// [`enters`] for up to eight rays and one box on AVX2: each lane's entry, and the
+    /// lanes entering.
+    ///
+    /// # Safety
+    /// The processor must support AVX2.
+    #[target_feature(enable = "avx2")]
+    unsafe fn enters_avx2(rays: &[Ray], b: &Aabb, tmax: f32) -> ([f32; 16], u16) {
+        // SAFETY: compiled for AVX2, which the caller guarantees.
+        unsafe {
+            let g = Group::<Avx2>::new(rays);
+            let inv = Inverse::new(&g);
+            let (near, enter) = enters(&g, &inv, b, Avx2::splat(0.0), Avx2::splat(tmax));
+            let mut out = [0.0; 16];
+            Avx2::store(near, &mut out);
+            (out, Avx2::bits(enter))
+        }
+    }
+
+    /// Property: the lanes' slab test enters exactly the children the node test
+    /// (`node8::hit_sse`, which the one-ray walks run) enters, with entries equal to its
+    /// own, on boxes with corners on a small integer grid and rays from grid points along
+    /// axes (slab distances of 0 * inf = NaN), through box faces, and in random directions.
+    #[test]
+    fn lane_slab_test_equals_the_node_test() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let mut rng = Pcg32::new(8, 1);
+        let mut entered = 0;
+        for k in 0..4000 {
+            let mut grid = || (rng.next_u32() % 7) as f32 - 3.0;
+            let mut n = Node8::empty();
+            let boxes: Vec<Aabb> = (0..8)
+                .map(|_| {
+                    let a = Vec3::new(grid(), grid(), grid());
+                    let b = Vec3::new(grid(), grid(), grid());
+                    Aabb {
+                        min: a.min(b),
+                        max: a.max(b),
+                    }
+                })
+                .collect();
+            for (slot, b) in boxes.iter().enumerate() {
+                n.set(slot, *b, slot as u32);
+            }
+            let rays: Vec<Ray> = (0..8)
+                .map(|i| {
+                    let origin = Vec3::new(grid(), grid(), grid());
+                    let dir = match (k + i) % 4 {
+                        0 => [Vec3::X, -Vec3::Y, Vec3::Z, -Vec3::X][i % 4],
+                        1 => Vec3::new(grid(), grid(), grid() + 0.5),
+                        2 => Vec3::new(grid() + 0.37, grid() - 0.21, grid() + 0.05),
+                        // At a box's corner, missed or met by a few ulps: where the far
+                        // slabs' rounding decides.
+                        _ => {
+                            let b = &boxes[i];
+                            let corner = Vec3::new(b.max.x, b.min.y, b.max.z);
+                            let ulps = (grid() * 2.0) * f32::EPSILON;
+                            (corner - origin) * (1.0 + ulps) + Vec3::new(0.0, ulps, 0.0)
+                        }
+                    };
+                    Ray::new(origin + Vec3::splat(0.123), dir)
+                })
+                .collect();
+            let tmax = if k % 5 == 0 { 2.5 } else { f32::INFINITY };
+            let lanes: Vec<_> = boxes
+                .iter()
+                // SAFETY: AVX2 was detected above.
+                .map(|b| unsafe { enters_avx2(&rays, b, tmax) })
+                .collect();
+            for (i, ray) in rays.iter().enumerate() {
+                let (near, mask) = hit_sse(&n, &SlabRay::new(&RayPre::new(ray)), 0.0, tmax);
+                for (slot, (lane_near, lane_mask)) in lanes.iter().enumerate() {
+                    let enters = lane_mask >> i & 1 == 1;
+                    assert_eq!(
+                        enters,
+                        mask >> slot & 1 == 1,
+                        "case {k} ray {i} slot {slot}"
+                    );
+                    if enters {
+                        assert_eq!(lane_near[i], near[slot], "case {k} ray {i} slot {slot}");
+                        entered += 1;
+                    }
+                }
+            }
+        }
+        assert!(entered > 20_000, "{entered} children entered");
     }
 }

@@ -11,7 +11,7 @@
 use prism_math::Ray;
 
 use crate::bvh::{Bvh, Hit, LEAF, STACK};
-use crate::lanes::{enters, sphere, triangle, widen, Group, Nearest};
+use crate::lanes::{enters, sphere, triangle, widen, Group, Inverse, Nearest};
 use crate::simd::{Avx2, Avx512, Simd};
 
 /// True if `rays` are worth walking as one packet: as many as the lanes, one origin (to the
@@ -56,12 +56,7 @@ unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16
     // SAFETY (all below): the caller runs on `S`'s instruction set.
     unsafe {
         let g = Group::<S>::new(q.rays);
-        let one = S::splat(1.0);
-        let inv = [
-            S::div(one, g.dir[0]),
-            S::div(one, g.dir[1]),
-            S::div(one, g.dir[2]),
-        ];
+        let inv = Inverse::<S>::new(&g);
         let (lo, hi) = (S::splat(q.tmin), S::load(&q.ends));
         let zero = S::splat(0.0);
         let mut best = Nearest::<S>::none(hi);
