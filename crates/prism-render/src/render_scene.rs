@@ -296,10 +296,10 @@ impl RenderScene {
     ) {
         out.clear();
         // The hits land anywhere in the scene's tables: start loading a later hit's
-        // primitive record, and a nearer one's vertices, while this one is computed, so that
-        // the cache misses overlap.
+        // primitive record while this one is computed, so that the cache misses overlap.
+        // Its vertices and normals are not prefetched: that costs more than the misses it
+        // hides.
         const RECORD_AHEAD: usize = 8;
-        const VERTICES_AHEAD: usize = 4;
         out.extend(
             rays.iter()
                 .zip(hits.iter())
@@ -308,35 +308,9 @@ impl RenderScene {
                     if let Some(Some(h)) = hits.get(i + RECORD_AHEAD) {
                         prism_math::prefetch(&self.prims[h.prim as usize]);
                     }
-                    if let Some(Some(h)) = hits.get(i + VERTICES_AHEAD) {
-                        self.prefetch_vertices(h.prim);
-                    }
                     hit.map(|h| self.interaction(ray, h))
                 }),
         );
-    }
-
-    /// Starts loading the vertex data a hit on primitive `prim` will read.
-    #[inline(always)]
-    fn prefetch_vertices(&self, prim: u32) {
-        if let Prim::Mesh {
-            mesh, tri, corners, ..
-        } = self.prims[prim as usize]
-        {
-            let m = &self.meshes[mesh as usize];
-            for i in corners {
-                prism_math::prefetch(m.positions.as_ptr().wrapping_add(i as usize));
-            }
-            match &m.shading {
-                Shading::Smooth(n) => {
-                    for i in corners {
-                        prism_math::prefetch(n.as_ptr().wrapping_add(i as usize));
-                    }
-                }
-                Shading::Corners(n) => prism_math::prefetch(n.as_ptr().wrapping_add(tri as usize)),
-                Shading::Flat => {}
-            }
-        }
     }
 
     /// The closest surface along the ray, with its shading data.
