@@ -61,9 +61,10 @@ impl Tri4 {
         tmin: f32,
         tmax: f32,
     ) -> Option<(f32, usize, f32, f32)> {
-        let [kx, ky, kz] = crate::shapes::PERMS[r.perm];
+        let axes = crate::shapes::PERMS[r.perm];
         let o = r.origin_k;
-        let rel = |i: usize, k: usize| self.v[i][[kx, ky, kz][k]] - Vec4::splat(o[k]);
+        // Vertex `i`'s coordinate on sheared axis `k`, less the origin's.
+        let rel = |i: usize, k: usize| self.v[i][axes[k]] - Vec4::splat(o[k]);
         let (sx, sy, sz) = (
             Vec4::splat(r.shear.x),
             Vec4::splat(r.shear.y),
