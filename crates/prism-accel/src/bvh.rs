@@ -880,7 +880,7 @@ impl Bvh {
                     continue;
                 }
                 if mask != 0 {
-                    node_ref = self.descend::<false>(n, &near, mask, &mut stack, &mut sp);
+                    node_ref = self.descend::<true>(n, &near, mask, &mut stack, &mut sp);
                     continue;
                 }
             }
@@ -895,11 +895,12 @@ impl Bvh {
     /// nearest first (the lower slot first of equals), pushes all but the nearest onto
     /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
     /// told apart and ordered by selects rather than branches (one is pushed and popped
-    /// again at once: `*sp` does not move). The next child on the stack is prefetched, and
-    /// with `NEAREST` the nearest too: worth it when another walk's step comes between
-    /// ([`Bvh::walk_pairs`]), not in a lone walk, whose next loads are the nearest's.
+    /// again at once: `*sp` does not move). With `PREFETCH`, the next child on the stack is
+    /// prefetched: worth it in a lone walk ([`Bvh::intersect_with`]), not in the paired
+    /// walks of batches ([`Bvh::walk_pairs`]), which overlap their misses already and
+    /// render 2-7% faster without it.
     #[inline(always)]
-    fn descend<const NEAREST: bool>(
+    fn descend<const PREFETCH: bool>(
         &self,
         n: &Node8,
         near: &[f32; 8],
@@ -919,10 +920,9 @@ impl Bvh {
             let (a, b) = if swap { (last, first) } else { (first, last) };
             stack.push(*sp, (n.child[b], near[b]));
             *sp += usize::from(rest != 0);
-            if NEAREST {
-                self.prefetch(n.child[a]);
+            if PREFETCH {
+                self.prefetch(n.child[b]);
             }
-            self.prefetch(n.child[b]);
             return n.child[a];
         }
         let i = mask.trailing_zeros() as usize;
@@ -945,11 +945,10 @@ impl Bvh {
             stack.push(*sp, hits[k]);
             *sp += 1;
         }
-        if NEAREST {
-            self.prefetch(hits[0].0);
+        if PREFETCH {
+            // The second nearest is likely visited next after the nearest's subtree.
+            self.prefetch(hits[1].0);
         }
-        // The second nearest is likely visited next after the nearest's subtree.
-        self.prefetch(hits[1].0);
         hits[0].0
     }
 
@@ -1562,12 +1561,10 @@ impl Bvh {
                     mask &= !start.skip;
                 }
                 if mask != 0 {
+                    // No prefetch of the next child on the stack: shadow rays come in
+                    // batches, whose walks render faster without it.
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    if mask != 0 {
-                        // The last child pushed is the next visited after `i`'s subtree.
-                        self.prefetch(n.child[31 - mask.leading_zeros() as usize]);
-                    }
                     while mask != 0 {
                         let k = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
@@ -1729,7 +1726,7 @@ impl Walk {
                 mask &= !skip;
             }
             if mask != 0 {
-                self.node = bvh.descend::<true>(n, &near, mask, stack, &mut self.sp);
+                self.node = bvh.descend::<false>(n, &near, mask, stack, &mut self.sp);
                 return true;
             }
         }
