@@ -261,11 +261,14 @@ mod queries {
         // SAFETY: the caller runs on `S`'s instruction set.
         unsafe {
             let g = Group::<S>::new(rays);
-            let mut ends = [tmax[0]; 16];
-            let n = tmax.len().min(S::W);
-            ends[..n].copy_from_slice(&tmax[..n]);
             let lo = S::splat(tmin);
-            let hi = S::load(&ends);
+            let hi = if tmax.len() >= S::W {
+                S::load(tmax)
+            } else {
+                let mut ends = [tmax[0]; 16];
+                ends[..tmax.len()].copy_from_slice(tmax);
+                S::load(&ends)
+            };
             let (mut blocked, mut defer) = (S::none(), S::none());
             let inv = Inverse::<S>::new(&g);
             let live = live(flat, &g, &inv, lo, hi);

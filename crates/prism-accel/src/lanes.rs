@@ -32,9 +32,16 @@ impl<S: Simd> Group<S> {
     /// operations.
     #[inline(always)]
     pub(crate) unsafe fn new(rays: &[Ray]) -> Group<S> {
-        let mut padded = [rays[0]; 16];
-        let n = rays.len().min(S::W);
-        padded[..n].copy_from_slice(&rays[..n]);
+        // A full group is read in place; a short one is padded, in a copy.
+        let padded: [Ray; 16];
+        let rays = if rays.len() >= S::W {
+            rays
+        } else {
+            let mut copy = [rays[0]; 16];
+            copy[..rays.len()].copy_from_slice(rays);
+            padded = copy;
+            &padded[..]
+        };
         let (o, d) = (
             std::mem::offset_of!(Ray, origin) / 4,
             std::mem::offset_of!(Ray, dir) / 4,
@@ -44,14 +51,14 @@ impl<S: Simd> Group<S> {
             // No closures here: a closure is not compiled for `S`'s instruction set, and
             // the operations it calls would not be inlined into it.
             let origin = [
-                S::ray_field(&padded, o),
-                S::ray_field(&padded, o + 1),
-                S::ray_field(&padded, o + 2),
+                S::ray_field(rays, o),
+                S::ray_field(rays, o + 1),
+                S::ray_field(rays, o + 2),
             ];
             let dir = [
-                S::ray_field(&padded, d),
-                S::ray_field(&padded, d + 1),
-                S::ray_field(&padded, d + 2),
+                S::ray_field(rays, d),
+                S::ray_field(rays, d + 1),
+                S::ray_field(rays, d + 2),
             ];
             let abs = [S::abs(dir[0]), S::abs(dir[1]), S::abs(dir[2])];
             // The dominant axis kz (ties to the lower axis), and whether the ray runs
