@@ -11,7 +11,7 @@ use crate::flat::{Flat, Lanes, FLAT_MAX};
 use crate::node8::{self, widen, Node8, SlabRay};
 #[cfg(target_arch = "x86_64")]
 use crate::packet::Query;
-use crate::shapes::{intersect_sphere, RayPre, Sphere};
+use crate::shapes::{intersect_sphere, Limit, RayPre, Sphere};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512, Simd};
 use crate::tri4::Tri4;
@@ -709,9 +709,10 @@ impl Bvh {
             .collect()
     }
 
-    /// Tests a leaf's primitives, narrowing `tmax` to the nearest hit; with `any`, stops at
-    /// the first hit. With `AVX`, its packs are tested two at a time
-    /// ([`Tri4::intersect_pair_avx`]), which finds the same hits.
+    /// Tests a leaf's primitives, moving `end` to each hit it admits (the first by distance,
+    /// then primitive number, is kept); with `any`, stops at the first. With `AVX`, its
+    /// packs are tested two at a time ([`Tri4::intersect_pair_avx`]), which finds the same
+    /// hits.
     #[inline(always)]
     fn leaf<const AVX: bool>(
         &self,
@@ -719,7 +720,7 @@ impl Bvh {
         pre: &RayPre,
         ray: &Ray,
         tmin: f32,
-        tmax: &mut f32,
+        end: &mut Limit,
         any: bool,
     ) -> Option<Hit> {
         let rec = self.leaf_rec(r);
@@ -734,38 +735,34 @@ impl Bvh {
                     packs = tail;
                     // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
                     // their callers enter after detecting it.
-                    let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *tmax) };
+                    let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *end) };
                     (found, b)
                 }
                 _ => {
                     packs = rest;
-                    (a.intersect(pre, tmin, *tmax), a)
+                    (a.intersect(pre, tmin, *end), a)
                 }
             };
             if let Some((t, lane, b1, b2)) = found {
-                *tmax = t;
                 let pack = if lane < 4 { a } else { second };
-                best = Some(Hit {
-                    t,
-                    prim: pack.prim[lane % 4],
-                    b1,
-                    b2,
-                });
+                let prim = pack.prim[lane % 4];
+                *end = Limit { t, prim };
+                best = Some(Hit { t, prim, b1, b2 });
                 if any {
                     return best;
                 }
             }
         }
         if rec.spheres != 0 {
-            if let Some(h) = self.leaf_spheres(&rec, ray, tmin, tmax, any) {
+            if let Some(h) = self.leaf_spheres(&rec, ray, tmin, end, any) {
                 return Some(h);
             }
         }
         best
     }
 
-    /// [`Bvh::leaf`]'s test of a leaf's spheres: the nearest hit below `tmax`, narrowing it
-    /// (with `any`, the first hit). Never inlined: inlined, its per-ray values would be
+    /// [`Bvh::leaf`]'s test of a leaf's spheres: the first hit `end` admits, moving `end` to
+    /// it (with `any`, the first hit). Never inlined: inlined, its per-ray values would be
     /// computed at the start of every walk, spheres or not.
     #[inline(never)]
     fn leaf_spheres(
@@ -773,15 +770,17 @@ impl Bvh {
         rec: &LeafRec,
         ray: &Ray,
         tmin: f32,
-        tmax: &mut f32,
+        end: &mut Limit,
         any: bool,
     ) -> Option<Hit> {
         let mut best = None;
         let s0 = rec.sphere_start as usize;
         for &p in &self.leaf_spheres[s0..s0 + rec.spheres as usize] {
             let s = &self.spheres[(p - self.triangle_count) as usize];
-            if let Some(t) = intersect_sphere(ray, s, tmin, *tmax) {
-                *tmax = t;
+            // Hits up to `end.t` itself, which `end` then judges.
+            let found = intersect_sphere(ray, s, tmin, end.t.next_up());
+            if let Some(t) = found.filter(|&t| end.admits(t, p)) {
+                *end = Limit { t, prim: p };
                 best = Some(Hit {
                     t,
                     prim: p,
@@ -796,7 +795,8 @@ impl Bvh {
         best
     }
 
-    /// The closest hit with `tmin < t < tmax`.
+    /// The closest hit with `tmin < t < tmax`; of primitives at one distance, the one with the
+    /// lowest number (so the hit does not depend on the hierarchy's shape).
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
         if self.nodes.is_empty() {
@@ -844,7 +844,8 @@ impl Bvh {
         self.intersect_with::<true>(ray, tmin, tmax, Start::ROOT)
     }
 
-    /// The closest hit with `tmin < t < tmax`, in the part of the tree `start` names.
+    /// The closest hit with `tmin < t < tmax` (the lowest primitive number of equals), in the
+    /// part of the tree `start` names.
     #[inline(always)]
     fn intersect_with<const AVX: bool>(
         &self,
@@ -857,15 +858,15 @@ impl Bvh {
         // stays in registers (a `Walk`, stepped from outside, lives in memory).
         let pre = RayPre::new(ray);
         let slab = SlabRay::new(&pre);
-        let (mut tmax, mut reach, mut best) = (tmax, widen(tmax), None);
+        let (mut end, mut reach, mut best) = (Limit::end(tmax), widen(tmax), None);
         let mut stack = Stack::new();
         let mut sp = 0;
         let mut node_ref = start.node;
         loop {
             if node_ref & LEAF != 0 {
-                if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut tmax, false) {
+                if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut end, false) {
                     best = Some(h);
-                    reach = widen(tmax);
+                    reach = widen(end.t);
                 }
             } else {
                 let n = self.node(node_ref);
@@ -1176,7 +1177,8 @@ impl Bvh {
         for ((&(i, ..), all), h) in jobs.iter().zip(whole).zip(found) {
             hits[i] = match h {
                 _ if all => h,
-                // Two primitives at one distance: the tree's order decides.
+                // Two primitives at one distance: the walk over the whole tree decides, by
+                // primitive number.
                 Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
                     self.intersect_with::<true>(&rays[i], tmin, tmax, Start::ROOT)
                 }
@@ -1547,9 +1549,9 @@ impl Bvh {
         let mut node_ref = start.node;
         loop {
             if node_ref & LEAF != 0 {
-                let mut t = tmax;
+                let mut end = Limit::end(tmax);
                 if self
-                    .leaf::<AVX>(node_ref, &r, ray, tmin, &mut t, true)
+                    .leaf::<AVX>(node_ref, &r, ray, tmin, &mut end, true)
                     .is_some()
                 {
                     return true;
@@ -1657,8 +1659,8 @@ struct Walk {
     pre: RayPre,
     slab: SlabRay,
     best: Option<Hit>,
-    tmax: f32,
-    /// `widen(tmax)`: children entered no farther than this are visited.
+    end: Limit,
+    /// `widen(end.t)`: children entered no farther than this are visited.
     reach: f32,
     sp: usize,
     /// The node or leaf the next step visits.
@@ -1674,7 +1676,7 @@ impl Walk {
             slab: SlabRay::new(&pre),
             pre,
             best: None,
-            tmax,
+            end: Limit::end(tmax),
             reach: widen(tmax),
             sp: 0,
             node: start,
@@ -1688,7 +1690,7 @@ impl Walk {
         self.pre = RayPre::new(ray);
         self.slab = SlabRay::new(&self.pre);
         self.best = None;
-        self.tmax = tmax;
+        self.end = Limit::end(tmax);
         self.reach = widen(tmax);
         self.sp = 0;
         self.node = start;
@@ -1714,10 +1716,9 @@ impl Walk {
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
-            if let Some(h) = bvh.leaf::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.tmax, false)
-            {
+            if let Some(h) = bvh.leaf::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.end, false) {
                 self.best = Some(h);
-                self.reach = widen(self.tmax);
+                self.reach = widen(self.end.t);
             }
         } else {
             let n = bvh.node(node_ref);

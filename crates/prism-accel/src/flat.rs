@@ -7,7 +7,7 @@
 //! The only branches are per group of rays: a leaf whose box no ray of the group enters (by
 //! the walk's own root test) is skipped, as the walk skips it. A lane that meets an edge
 //! function of exactly zero (which the one-ray test settles in double precision) or two
-//! primitives at the same nearest distance (where the hierarchy's visiting order decides)
+//! primitives at the same nearest distance (which the hierarchy settles by primitive number)
 //! is left to the hierarchy.
 
 use prism_math::{Aabb, Vec3};

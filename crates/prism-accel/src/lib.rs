@@ -18,7 +18,9 @@
 //! - [`Bvh::intersect`] finds the closest hit, going on to the nearest child entered and
 //!   stacking the others; [`Bvh::occluded`] stops at the first hit, for shadow rays. A child
 //!   is entered when its entry is no farther than the nearest hit found so far, moved up
-//!   past the tests' rounding, so walks in any order find the same nearest hit.
+//!   past the tests' rounding, so walks in any order find the same nearest hit; of two
+//!   primitives at one distance the lower-numbered is taken. The hit is therefore a pure
+//!   function of the ray and the primitives, whatever the hierarchy's shape.
 //! - [`Bvh::intersect_batch`] and [`Bvh::occluded_batch`] answer many rays in one call. On
 //!   processors with AVX-512 (AVX2), when the root's leaves hold at most 24 primitives (a
 //!   Cornell box's walls, or all of a small scene), they test sixteen (eight) rays at once

@@ -167,7 +167,8 @@ pub(crate) const FAR_WIDEN: f32 = 1.0 + 2.0 * 3.0 * f32::EPSILON;
 /// `t` moved up by 1/1024 of its size and by the smallest normal float: past a distance by
 /// far more than the slab and triangle tests' rounding (subnormal distances included).
 /// Walks enter every child whose entry is no farther than the nearest hit so widened, so a
-/// hit a few ulps short of its box's computed entry is never lost, whatever order the
+/// hit a few ulps short of its box's computed entry is never lost, nor one at the nearest
+/// distance itself (which may come first by its primitive number), whatever order the
 /// children are visited in: walks in any order find the same nearest hit.
 #[inline(always)]
 pub(crate) fn widen(t: f32) -> f32 {

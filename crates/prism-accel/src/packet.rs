@@ -4,9 +4,9 @@
 //! each leaf's triangles likewise, with the one-ray tests' operations on each lane
 //! (`lanes`). A child is entered by the lanes that enter its box no farther than their
 //! nearest hit, widened as the one-ray walk widens it, so both walks meet the same nearest
-//! hit. A lane whose answer depends on the one-ray walk's visiting order (two primitives at
-//! one distance) or on its double-precision edge test (an edge function of exactly zero) is
-//! left to that walk.
+//! hit. A lane whose answer depends on the one-ray walk's choice by primitive number (two
+//! primitives at one distance) or on its double-precision edge test (an edge function of
+//! exactly zero) is left to that walk.
 
 use prism_math::Ray;
 

@@ -4,7 +4,7 @@
 use prism_math::glam::Vec4;
 use prism_math::Vec3;
 
-use crate::shapes::{intersect_triangle, RayPre};
+use crate::shapes::{intersect_triangle, Limit, RayPre};
 
 /// Four triangles in structure-of-arrays form: `v[i][axis]` holds coordinate `axis` of
 /// vertex `i` of the four triangles. Unused lanes hold NaN vertices, which fail every
@@ -53,13 +53,14 @@ impl Tri4 {
         [x.as_ref()[lane], y.as_ref()[lane], z.as_ref()[lane]]
     }
 
-    /// The nearest hit among the four with `tmin < t < tmax`: `(t, lane, b1, b2)`.
+    /// The first hit among the four with `tmin < t` that `end` admits, by distance, then
+    /// primitive number: `(t, lane, b1, b2)`.
     #[inline(always)]
     pub(crate) fn intersect(
         &self,
         r: &RayPre,
         tmin: f32,
-        tmax: f32,
+        end: Limit,
     ) -> Option<(f32, usize, f32, f32)> {
         let axes = crate::shapes::PERMS[r.perm];
         let o = r.origin_k;
@@ -85,7 +86,7 @@ impl Tri4 {
         if any_zero.any() {
             // An edge function is exactly zero in single precision: decide these lanes with
             // the scalar test, which recomputes them in double precision.
-            return self.scalar(r, tmin, tmax);
+            return self.scalar(r, tmin, end);
         }
         // No edge function is zero here, so a lane is inside its triangle when its edge
         // functions are all negative or all positive: when they share a sign bit. Most packs
@@ -103,12 +104,15 @@ impl Tri4 {
         }
         let det = u + v + w;
         let t = sz * (u * az + v * bz + w * cz) * (Vec4::ONE / det);
-        let mask = inside & (t.cmpgt(Vec4::splat(tmin)) & t.cmplt(Vec4::splat(tmax))).bitmask();
+        let mask = inside & (t.cmpgt(Vec4::splat(tmin)) & t.cmple(Vec4::splat(end.t))).bitmask();
         if mask == 0 {
             return None;
         }
         let ta = t.to_array();
-        let best = nearest_lane(mask, &ta);
+        let best = nearest_lane(mask, &ta, |lane| self.prim[lane]);
+        if !end.admits(ta[best], self.prim[best]) {
+            return None;
+        }
         let inv = 1.0 / det.to_array()[best];
         Some((
             ta[best],
@@ -118,10 +122,10 @@ impl Tri4 {
         ))
     }
 
-    /// The nearest hit among the eight triangles of packs `a` and `b` with `tmin < t < tmax`,
-    /// `(t, lane, b1, b2)` with lanes 0..4 in `a` and 4..8 in `b`: [`Tri4::intersect`]'s
-    /// operations on 256-bit AVX lanes, so the same hit as testing `a` and then `b` below
-    /// `a`'s hit (the nearest, the first lane of equals), at about the cost of one pack.
+    /// The first hit among the eight triangles of packs `a` and `b` with `tmin < t` that
+    /// `end` admits, `(t, lane, b1, b2)` with lanes 0..4 in `a` and 4..8 in `b`:
+    /// [`Tri4::intersect`]'s operations on 256-bit AVX lanes, so the same hit as testing `a`
+    /// and then `b` up to `a`'s hit, at about the cost of one pack.
     ///
     /// # Safety
     /// The processor must support AVX.
@@ -132,13 +136,13 @@ impl Tri4 {
         b: &Tri4,
         r: &RayPre,
         tmin: f32,
-        tmax: f32,
+        end: Limit,
     ) -> Option<(f32, usize, f32, f32)> {
         use std::arch::x86_64::{
             _mm256_add_ps, _mm256_and_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_movemask_ps,
             _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_set_m128, _mm256_setzero_ps,
             _mm256_storeu_ps, _mm256_sub_ps, _mm256_xor_ps, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
-            _CMP_LT_OQ,
+            _CMP_LE_OQ,
         };
         let axes = crate::shapes::PERMS[r.perm];
         let o = r.origin_k;
@@ -198,8 +202,11 @@ impl Tri4 {
             }
             if _mm256_movemask_ps(sign!(_CMP_EQ_OQ)) != 0 {
                 // An edge function is exactly zero: the packs one by one, as they decide it.
-                let first = a.intersect(r, tmin, tmax);
-                let below = first.map_or(tmax, |h| h.0);
+                let first = a.intersect(r, tmin, end);
+                let below = first.map_or(end, |h| Limit {
+                    t: h.0,
+                    prim: a.prim[h.1],
+                });
                 return match b.intersect(r, tmin, below) {
                     Some((t, lane, b1, b2)) => Some((t, 4 + lane, b1, b2)),
                     None => first,
@@ -216,7 +223,7 @@ impl Tri4 {
             let t = mul!(mul!(sz, dist), _mm256_div_ps(_mm256_set1_ps(1.0), det));
             let within = _mm256_and_ps(
                 _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(tmin)),
-                _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(tmax)),
+                _mm256_cmp_ps::<_CMP_LE_OQ>(t, _mm256_set1_ps(end.t)),
             );
             let mask = inside & _mm256_movemask_ps(within) as u32;
             if mask == 0 {
@@ -224,7 +231,17 @@ impl Tri4 {
             }
             let mut ta = [0f32; 8];
             _mm256_storeu_ps(ta.as_mut_ptr(), t);
-            let best = nearest_lane(mask, &ta);
+            let prim = |lane: usize| {
+                if lane < 4 {
+                    a.prim[lane]
+                } else {
+                    b.prim[lane - 4]
+                }
+            };
+            let best = nearest_lane(mask, &ta, prim);
+            if !end.admits(ta[best], prim(best)) {
+                return None;
+            }
             let (mut va, mut wa, mut da) = ([0f32; 8], [0f32; 8], [0f32; 8]);
             _mm256_storeu_ps(va.as_mut_ptr(), v);
             _mm256_storeu_ps(wa.as_mut_ptr(), w);
@@ -234,10 +251,11 @@ impl Tri4 {
         }
     }
 
-    fn scalar(&self, r: &RayPre, tmin: f32, mut tmax: f32) -> Option<(f32, usize, f32, f32)> {
+    /// [`Tri4::intersect`] lane by lane with the scalar test (`shapes::intersect_triangle`).
+    fn scalar(&self, r: &RayPre, tmin: f32, mut end: Limit) -> Option<(f32, usize, f32, f32)> {
         let mut best = None;
-        for lane in 0..4 {
-            if self.prim[lane] == u32::MAX {
+        for (lane, &prim) in self.prim.iter().enumerate() {
+            if prim == u32::MAX {
                 continue;
             }
             let tri = [
@@ -245,8 +263,10 @@ impl Tri4 {
                 self.vertex(lane, 1),
                 self.vertex(lane, 2),
             ];
-            if let Some((t, b1, b2)) = intersect_triangle(r, &tri, tmin, tmax) {
-                tmax = t;
+            // Hits up to `end.t` itself, which `end` then judges.
+            let found = intersect_triangle(r, &tri, tmin, end.t.next_up());
+            if let Some((t, b1, b2)) = found.filter(|h| end.admits(h.0, prim)) {
+                end = Limit { t, prim };
                 best = Some((t, lane, b1, b2));
             }
         }
@@ -254,16 +274,15 @@ impl Tri4 {
     }
 }
 
-/// The lane of `mask` (not empty) with the smallest `t`, the lowest of equals: the one a
-/// scan of the lanes in order keeps.
+/// The lane of `mask` (not empty) first by `t`, then by primitive number `prim`.
 #[inline(always)]
-fn nearest_lane(mut mask: u32, t: &[f32]) -> usize {
+fn nearest_lane(mut mask: u32, t: &[f32], prim: impl Fn(usize) -> u32) -> usize {
     let mut best = mask.trailing_zeros() as usize;
     mask &= mask - 1;
     while mask != 0 {
         let lane = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        if t[lane] < t[best] {
+        if t[lane] < t[best] || (t[lane] == t[best] && prim(lane) < prim(best)) {
             best = lane;
         }
     }
@@ -278,17 +297,18 @@ mod tests {
     /// Oracle: the scalar watertight test lane by lane ([`Tri4::scalar`], which calls
     /// `shapes::intersect_triangle`). The lane test finds the same hit, on small integer
     /// coordinates (edge functions exactly zero, ties, triangles of zero area) and with
-    /// unused lanes.
+    /// unused lanes; primitive numbers run against the lanes, so that ties are decided by
+    /// number, not lane; and with limits at a hit's own distance.
     #[test]
     fn pack_test_equals_the_scalar_test_lane_by_lane() {
         let mut rng = Pcg32::new(5, 7);
         let coord = |rng: &mut Pcg32| (rng.next_u32() % 5) as f32 - 2.0;
-        let (mut hits, mut vector) = (0, 0);
+        let (mut hits, mut vector, mut at_limit) = (0, 0, 0);
         for k in 0..40_000 {
             let tris: Vec<_> = (0..1 + k % 4)
                 .map(|p| {
                     let mut v = || Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
-                    ([v(), v(), v()], p as u32)
+                    ([v(), v(), v()], 10 - 3 * p as u32)
                 })
                 .collect();
             let pack = Tri4::new(&tris);
@@ -301,21 +321,32 @@ mod tests {
             }
             let pre = RayPre::new(&Ray::new(o, d));
             let tmax = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
-            let want = pack.scalar(&pre, 0.0, tmax);
-            assert_eq!(pack.intersect(&pre, 0.0, tmax), want, "case {k}");
+            let end = Limit::end(tmax);
+            let want = pack.scalar(&pre, 0.0, end);
+            assert_eq!(pack.intersect(&pre, 0.0, end), want, "case {k}");
             hits += usize::from(want.is_some());
             vector += usize::from(jitter != 0.0 && want.is_some());
+            // A limit at the hit's own distance admits the hits there on lower numbers.
+            if let Some((t, lane, ..)) = want {
+                for prim in [0, 1, pack.prim[lane], pack.prim[lane] + 1, 11] {
+                    let end = Limit { t, prim };
+                    let want = pack.scalar(&pre, 0.0, end);
+                    assert_eq!(pack.intersect(&pre, 0.0, end), want, "case {k} {prim}");
+                    assert!(want.is_none_or(|h| h.0 == t && pack.prim[h.1] < prim));
+                    at_limit += usize::from(want.is_some());
+                }
+            }
         }
         assert!(
-            hits > 1500 && vector > 800,
-            "{hits} hits, {vector} off the grid"
+            hits > 1500 && vector > 800 && at_limit > 1000,
+            "{hits} hits, {vector} off the grid, {at_limit} at a limit"
         );
     }
 
     /// Property: the 8-wide pair test returns exactly what testing the two packs one after
     /// the other returns, including rays through shared edges and vertices (small integer
-    /// coordinates make edge functions exactly zero and distances tie) and packs with
-    /// unused lanes.
+    /// coordinates make edge functions exactly zero and distances tie, decided by primitive
+    /// numbers that interleave the packs') and packs with unused lanes.
     #[test]
     fn pair_test_equals_the_packs_one_by_one() {
         #[cfg(target_arch = "x86_64")]
@@ -330,8 +361,8 @@ mod tests {
                 };
                 let na = 1 + k % 4;
                 let nb = 1 + (k / 4) % 4;
-                let a: Vec<_> = (0..na).map(|p| tri(&mut rng, p as u32)).collect();
-                let b: Vec<_> = (0..nb).map(|p| tri(&mut rng, 4 + p as u32)).collect();
+                let a: Vec<_> = (0..na).map(|p| tri(&mut rng, 8 - 2 * p as u32)).collect();
+                let b: Vec<_> = (0..nb).map(|p| tri(&mut rng, 7 - 2 * p as u32)).collect();
                 let (a, b) = (Tri4::new(&a), Tri4::new(&b));
                 let o = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng)) * 1.5;
                 let d = Vec3::new(coord(&mut rng), coord(&mut rng), coord(&mut rng));
@@ -339,14 +370,18 @@ mod tests {
                     continue;
                 }
                 let pre = RayPre::new(&Ray::new(o, d));
-                let tmax = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
-                let first = a.intersect(&pre, 0.0, tmax);
-                let seq = match b.intersect(&pre, 0.0, first.map_or(tmax, |h| h.0)) {
+                let end = Limit::end(if k % 3 == 0 { 2.0 } else { f32::INFINITY });
+                let first = a.intersect(&pre, 0.0, end);
+                let below = first.map_or(end, |h| Limit {
+                    t: h.0,
+                    prim: a.prim[h.1],
+                });
+                let seq = match b.intersect(&pre, 0.0, below) {
                     Some((t, lane, b1, b2)) => Some((t, 4 + lane, b1, b2)),
                     None => first,
                 };
                 // SAFETY: AVX was detected above.
-                let pair = unsafe { Tri4::intersect_pair_avx(&a, &b, &pre, 0.0, tmax) };
+                let pair = unsafe { Tri4::intersect_pair_avx(&a, &b, &pre, 0.0, end) };
                 assert_eq!(pair, seq, "case {k}");
                 hits += usize::from(seq.is_some());
                 ties += usize::from(first.is_some_and(|f| seq.is_some_and(|s| s.0 == f.0)));
