@@ -255,10 +255,11 @@ impl<S: Simd> Inverse<S> {
     }
 }
 
-/// The slab test of the tree's nodes (`node8`) on lanes: each lane's entry distance into
-/// `b`, and the lanes entering it with an entry in `[tmin, tmax]`. The same distances as
-/// the node test's, and the same answer: the node test compares the entry with each far
-/// distance that is not NaN and with `tmax`, this test with their minimum.
+/// The unfused slab test of the tree's nodes (`node8::hit_sse`) on lanes: each lane's entry
+/// distance into `b`, and the lanes entering it with an entry in `[tmin, tmax]`. The same
+/// distances as that test's, and the same answer (it compares the entry with each far
+/// distance that is not NaN and with `tmax`, this test with their minimum): never shorter
+/// than the exact interval, so no lane skips a box it meets.
 #[inline(always)]
 pub(crate) unsafe fn enters<S: Simd>(
     g: &Group<S>,
@@ -410,8 +411,8 @@ mod tests {
         }
     }
 
-    /// Property: the lanes' slab test enters exactly the children the node test
-    /// (`node8::hit_sse`, which the one-ray walks run) enters, with entries equal to its
+    /// Property: the lanes' slab test enters exactly the children the unfused node test
+    /// (`node8::hit_sse`, which the one-ray walks run without AVX2) enters, with entries equal to its
     /// own, on boxes with corners on a small integer grid and rays from grid points along
     /// axes (slab distances of 0 * inf = NaN), through box faces, and in random directions.
     #[test]

@@ -1,7 +1,9 @@
-//! The 8-wide BVH node and the ray-box test of its eight children: with 256-bit AVX
-//! instructions when the processor has them, else as two 4-wide SSE halves. Both compute the
-//! same operations in the same order, so they enter the same children with the same
-//! distances and traversal is identical either way.
+//! The 8-wide BVH node and the ray-box test of its eight children: with 256-bit AVX2 and FMA
+//! instructions when the processor has them, else as two 4-wide SSE halves. The two measure
+//! slab distances in different roundings (the AVX2 test fuses a multiply and an add), both
+//! never shorter than the exact interval, so each enters every child the ray meets; the
+//! walks' hits do not depend on which children they enter or in what order (the closest
+//! hit is the first by distance, then primitive number), so they are the same either way.
 
 use prism_math::glam::{Vec3A, Vec4};
 use prism_math::{Aabb, Vec3};
@@ -71,16 +73,23 @@ impl Node8 {
 /// A ray prepared for slab tests, `t = (p - origin) * inv_dir`: for each axis, the plane of
 /// a box the ray meets first and the other one, as byte offsets of their rows in
 /// `Node8::bounds` ([`SlabRay::near`], [`SlabRay::far`]). Far slabs are measured with
-/// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`].
+/// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`]. The fused test ([`hit_avx`]) measures
+/// `t = p * inv_dir + off_near` (far: `p * inv_far + off_far`) in one rounding instead.
 pub(crate) struct SlabRay {
     origin: [f32; 3],
     inv_dir: [f32; 3],
     inv_far: [f32; 3],
+    /// `-origin * inv_dir`, moved down past its rounding (see [`SlabRay::new`]).
+    off_near: [f32; 3],
+    /// `-origin * inv_far`, moved up past its rounding.
+    off_far: [f32; 3],
     /// The row of [`PLANES`] for the ray's direction signs.
     planes: &'static [usize; 6],
     /// The origin and `inv_dir` are finite and no `inv_dir` is zero: no slab distance is
     /// NaN.
     plain: bool,
+    /// `plain`, and the offsets are finite: the fused test applies.
+    fused: bool,
 }
 
 /// For each set of axes a ray runs down (bit `axis` set), the byte offsets of the near
@@ -103,19 +112,42 @@ static PLANES: [[usize; 6]; 8] = {
 };
 
 impl SlabRay {
+    /// The slab values of ray `r`.
+    ///
+    /// The fused test's offsets: `a = origin * inv` is rounded by at most half an ulp (and
+    /// an absolute 2^-150 if subnormal), so `a + |a| * OFFSET_SLACK + MIN_POSITIVE`, rounded,
+    /// is at least the exact product (the slack, eight times the rounding, covers both
+    /// roundings; `MIN_POSITIVE` the subnormal case). Its negation `off_near` is then at
+    /// most `-origin * inv` exactly, and `p * inv + off_near` at most the exact
+    /// `(p - origin) * inv`: one rounding of that sum is no larger than one rounding of the
+    /// exact distance, within Ize's margin ([`FAR_WIDEN`]) as the unfused test is.
+    /// Likewise `off_far` is at least `-origin * inv_far`, and far distances are never
+    /// shorter.
     #[inline(always)]
     pub(crate) fn new(r: &RayPre) -> SlabRay {
         // SIMD tests rather than glam's `Vec3` ones, which test component by component with
         // branches.
         let down = r.inv_dir.is_negative_bitmask() as usize & 7;
-        let (o, inv) = (Vec3A::from(r.origin).abs(), Vec3A::from(r.inv_dir).abs());
+        let (origin, inv_dir) = (Vec3A::from(r.origin), Vec3A::from(r.inv_dir));
+        let inv_far = inv_dir * FAR_WIDEN;
+        let (o, inv) = (origin.abs(), inv_dir.abs());
+        let plain =
+            (o.cmplt(Vec3A::INFINITY) & inv.cmplt(Vec3A::INFINITY) & inv.cmpgt(Vec3A::ZERO)).all();
+        let slack = |a: Vec3A| a.abs() * OFFSET_SLACK + Vec3A::splat(f32::MIN_POSITIVE);
+        let (a, af) = (origin * inv_dir, origin * inv_far);
+        let off_near = -(a + slack(a));
+        let off_far = slack(af) - af;
+        let finite =
+            (off_near.abs().cmplt(Vec3A::INFINITY) & off_far.abs().cmplt(Vec3A::INFINITY)).all();
         SlabRay {
             origin: r.origin.to_array(),
             inv_dir: r.inv_dir.to_array(),
-            inv_far: (r.inv_dir * FAR_WIDEN).to_array(),
+            inv_far: inv_far.to_array(),
+            off_near: off_near.to_array(),
+            off_far: off_far.to_array(),
             planes: &PLANES[down],
-            plain: (o.cmplt(Vec3A::INFINITY) & inv.cmplt(Vec3A::INFINITY) & inv.cmpgt(Vec3A::ZERO))
-                .all(),
+            plain,
+            fused: plain && finite,
         }
     }
 
@@ -131,6 +163,9 @@ impl SlabRay {
         self.planes[3 + axis]
     }
 }
+
+/// The fused test's slack on `origin * inv_dir`: eight times its rounding (2^-21).
+const OFFSET_SLACK: f32 = 1.0 / 2_097_152.0;
 
 /// Bytes in one plane's row of `Node8::bounds`.
 const PLANE_BYTES: usize = std::mem::size_of::<[Vec4; 2]>();
@@ -219,19 +254,24 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
     (near_out, mask & n.used)
 }
 
-/// [`hit_sse`] with 256-bit AVX instructions: the same operations in the same order (the
-/// comparison "not greater than" is `_CMP_NGT_UQ`, true for NaN).
-/// Inlined into the callers compiled for AVX (a `target_feature` function could not be
-/// inlined always, and a call per node costs a tenth of the traversal).
+/// [`hit_sse`] with 256-bit AVX instructions (the comparison "not greater than" is
+/// `_CMP_NGT_UQ`, true for NaN), for a ray of [`SlabRay::fused`] with each slab distance
+/// one fused multiply-add, `p * inv + off`: one dependent step fewer on the path every node
+/// waits on. Its distances are never shorter than the exact interval (see [`SlabRay::new`]),
+/// but may differ from [`hit_sse`]'s by a rounding: other rays take [`hit_sse`]'s
+/// operations in its order. Inlined into the callers compiled for AVX2 and FMA (a
+/// `target_feature` function could not be inlined always, and a call per node costs a
+/// tenth of the traversal).
 ///
 /// # Safety
-/// The processor must support AVX.
+/// The processor must support AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
     use std::arch::x86_64::{
-        _mm256_and_ps, _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
+        _mm256_and_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
+        _CMP_LE_OQ, _CMP_NGT_UQ,
     };
     // SAFETY: `SlabRay::new` makes every plane offset that of one of the node's rows: 32
     // bytes at a 32-byte aligned offset of a 64-byte aligned node, as `_mm256_load_ps`
@@ -250,6 +290,42 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
                     _mm256_set1_ps(r.$inv[$axis]),
                 )
             };
+        }
+        if r.fused {
+            macro_rules! f {
+                ($plane:expr, $axis:expr, $inv:ident, $off:ident) => {
+                    _mm256_fmadd_ps(
+                        _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
+                        _mm256_set1_ps(r.$inv[$axis]),
+                        _mm256_set1_ps(r.$off[$axis]),
+                    )
+                };
+            }
+            macro_rules! near {
+                ($axis:expr) => {
+                    f!(r.near($axis), $axis, inv_dir, off_near)
+                };
+            }
+            let near = _mm256_max_ps(
+                _mm256_max_ps(near!(0), near!(1)),
+                _mm256_max_ps(near!(2), _mm256_set1_ps(tmin)),
+            );
+            macro_rules! before {
+                ($axis:expr) => {
+                    _mm256_cmp_ps::<_CMP_NGT_UQ>(near, f!(r.far($axis), $axis, inv_far, off_far))
+                };
+            }
+            let m = _mm256_and_ps(
+                _mm256_and_ps(before!(0), before!(1)),
+                _mm256_and_ps(
+                    before!(2),
+                    _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
+                ),
+            );
+            let mask = _mm256_movemask_ps(m) as u32;
+            let mut near_out = [0f32; 8];
+            _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+            return (near_out, mask & n.used);
         }
         let near = if r.plain {
             _mm256_max_ps(
@@ -323,11 +399,86 @@ mod tests {
         (near_out, mask)
     }
 
-    /// Property: the SSE and AVX tests enter exactly the children the scalar interval test
-    /// enters, with the same entry distances, on boxes with corners on a small integer grid
-    /// and rays from grid points along axes (slab distances of 0 * inf = NaN), on box faces,
-    /// and in random directions (with no NaN distance, whose entries are combined in
-    /// another order).
+    /// [`hit_avx`] where the processor has AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    fn avx_test(n: &Node8, slab: &SlabRay, tmax: f32) -> Option<([f32; 8], u32)> {
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn run(n: &Node8, slab: &SlabRay, tmax: f32) -> ([f32; 8], u32) {
+            // SAFETY: compiled for AVX2 and FMA, which the caller detected.
+            unsafe { hit_avx(n, slab, 0.0, tmax) }
+        }
+        let has = std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        // SAFETY: AVX2 and FMA were detected.
+        has.then(|| unsafe { run(n, slab, tmax) })
+    }
+
+    /// The interval test in double precision, with `1 / dir` exact to its rounding: the
+    /// children a ray meets, and its entry distance into each.
+    fn exact(n: &Node8, ray: &Ray, tmax: f32) -> ([f64; 8], u32) {
+        let (mut near_out, mut mask) = ([0f64; 8], 0);
+        for (slot, out) in near_out.iter_mut().enumerate() {
+            let b = n.child_box(slot);
+            let (mut near, mut far) = (0f64, f64::from(tmax));
+            for axis in 0..3 {
+                let (o, d) = (f64::from(ray.origin[axis]), f64::from(ray.dir[axis]));
+                let (lo, hi) = (f64::from(b.min[axis]), f64::from(b.max[axis]));
+                if d == 0.0 {
+                    if o < lo || o > hi {
+                        far = -1.0;
+                    }
+                    continue;
+                }
+                let (t1, t2) = ((lo - o) / d, (hi - o) / d);
+                near = near.max(t1.min(t2));
+                far = far.min(t1.max(t2));
+            }
+            *out = near;
+            if near <= far && n.slot_used(slot) {
+                mask |= 1 << slot;
+            }
+        }
+        (near_out, mask)
+    }
+
+    /// The fused test against the exact one: it enters every child the ray meets, with an
+    /// entry no later than the exact one (up to `1 / dir`'s rounding), and it enters
+    /// children the ray misses only when it passes within a rounding of them (checked by
+    /// counting, in the callers).
+    fn fused_checks(
+        n: &Node8,
+        ray: &Ray,
+        tmax: f32,
+        got: ([f32; 8], u32),
+        want: &([f32; 8], u32),
+        k: usize,
+    ) {
+        let (exact_near, exact_mask) = exact(n, ray, tmax);
+        assert_eq!(
+            exact_mask & !got.1,
+            0,
+            "case {k}: a child met is not entered"
+        );
+        for slot in (0..8).filter(|s| got.1 & exact_mask & (1 << s) != 0) {
+            let (e, g) = (exact_near[slot], f64::from(got.0[slot]));
+            assert!(
+                g <= e + e.abs() * 1e-6 + 1e-30,
+                "case {k} slot {slot}: {g} after {e}"
+            );
+            let w = f64::from(want.0[slot]);
+            assert!(
+                (g - w).abs() <= w.abs() * 1e-5 + 1e-5,
+                "case {k} slot {slot}: {g} vs {w}"
+            );
+        }
+    }
+
+    /// Property: the SSE test (and the AVX one, unfused) enters exactly the children the
+    /// scalar interval test enters, with the same entry distances, on boxes with corners on
+    /// a small integer grid and rays from grid points along axes (slab distances of
+    /// 0 * inf = NaN), on box faces, and in random directions (with no NaN distance, whose
+    /// entries are combined in another order). The fused AVX test enters every child the
+    /// double-precision interval test enters ([`fused_checks`]).
     #[test]
     fn node_tests_match_the_scalar_interval_test() {
         let mut rng = Pcg32::new(3, 9);
@@ -371,11 +522,13 @@ mod tests {
                 }
             }
             #[cfg(target_arch = "x86_64")]
-            if std::arch::is_x86_feature_detected!("avx") {
-                // SAFETY: AVX was detected.
-                let avx = unsafe { hit_avx(&n, &slab, 0.0, tmax) };
-                assert_eq!(avx.1, sse.1, "case {k}");
-                assert_eq!(avx.0.map(f32::to_bits), sse.0.map(f32::to_bits), "case {k}");
+            if let Some(avx) = avx_test(&n, &slab, tmax) {
+                if slab.fused {
+                    fused_checks(&n, &ray, tmax, avx, &want, k);
+                } else {
+                    assert_eq!(avx.1, sse.1, "case {k}");
+                    assert_eq!(avx.0.map(f32::to_bits), sse.0.map(f32::to_bits), "case {k}");
+                }
             }
             entered += want.1.count_ones();
         }
@@ -383,6 +536,70 @@ mod tests {
         assert!(
             (5000..15_000).contains(&plain),
             "{plain} rays with no NaN distance"
+        );
+    }
+
+    /// Property: the fused test enters every child the double-precision interval test
+    /// enters, on boxes and rays of random floats (no grid), with origins near the boxes
+    /// and far from them (where `origin * inv` is large against the distances, so its
+    /// rounding matters), and enters few others.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn fused_test_enters_every_child_the_ray_meets() {
+        let mut rng = Pcg32::new(17, 2);
+        // Per distance of the origins: children met, entered but not met, by the unfused test.
+        let (mut met, mut extra, mut sse_extra) = ([0usize; 3], [0usize; 3], [0usize; 3]);
+        let mut fused = 0;
+        for k in 0..30_000 {
+            let mut f = |s: f32| (rng.next_f32() * 2.0 - 1.0) * s;
+            let mut n = Node8::empty();
+            for slot in 0..8 {
+                let c = Vec3::new(f(4.0), f(4.0), f(4.0));
+                let e = Vec3::new(f(1.0).abs(), f(1.0).abs(), f(1.0).abs());
+                n.set(
+                    slot,
+                    Aabb {
+                        min: c - e,
+                        max: c + e,
+                    },
+                    slot as u32,
+                );
+            }
+            let far = [1.0, 1e3, 1e6][k % 3];
+            let origin = Vec3::new(f(far), f(far), f(far));
+            // Aimed at a box's centre, offset by up to a box's size.
+            let target = n.child_box(k % 8).centroid() + Vec3::new(f(1.5), f(1.5), f(1.5));
+            let ray = Ray::new(origin, target - origin);
+            let slab = SlabRay::new(&RayPre::new(&ray));
+            let tmax = if k % 4 == 0 {
+                (target - origin).length() / ray.dir.length()
+            } else {
+                f32::INFINITY
+            };
+            let Some(got) = avx_test(&n, &slab, tmax) else {
+                return;
+            };
+            if !slab.fused {
+                continue;
+            }
+            fused += 1;
+            let want = hit_sse(&n, &slab, 0.0, tmax);
+            fused_checks(&n, &ray, tmax, got, &want, k);
+            let exact_mask = exact(&n, &ray, tmax).1;
+            let class = k % 3;
+            met[class] += exact_mask.count_ones() as usize;
+            extra[class] += (got.1 & !exact_mask).count_ones() as usize;
+            sse_extra[class] += (want.1 & !exact_mask).count_ones() as usize;
+        }
+        assert!(
+            fused > 29_000 && met.iter().all(|&m| m > 1000),
+            "{fused} fused rays, {met:?} children met"
+        );
+        // Near the boxes, next to no extra child; a million box sizes away (where the
+        // origin's own rounding is a sixteenth of a box), a few times the unfused test's.
+        assert!(
+            (extra[0] + extra[1]) * 100 <= met[0] + met[1] && extra[2] <= 4 * sse_extra[2],
+            "{extra:?} children entered but not met, of {met:?} (unfused {sse_extra:?})"
         );
     }
 }

@@ -12,7 +12,7 @@ pub enum Isa {
     Sse,
     /// AVX (256-bit floating-point vectors).
     Avx,
-    /// AVX2 (256-bit integer vectors and gathers).
+    /// AVX2 (256-bit integer vectors and gathers) and FMA.
     Avx2,
     /// AVX-512 F, DQ and VL.
     Avx512,
@@ -82,7 +82,7 @@ impl Isa {
             if has!("avx512f") && has!("avx512dq") && has!("avx512vl") {
                 return Isa::Avx512;
             }
-            if has!("avx2") {
+            if has!("avx2") && has!("fma") {
                 return Isa::Avx2;
             }
             if has!("avx") {
