@@ -607,14 +607,27 @@ impl Bvh {
         self.triangle_count
     }
 
-    /// Entry distances of the ray into a node's eight child boxes, and which it enters.
+    /// Entry distances of the ray into a node's eight child boxes, and which it enters: with
+    /// `AVX`, by the fused test if `FUSED` (which the caller sets only for a
+    /// [`SlabRay::fused`] ray), else by the unfused one.
     #[inline(always)]
-    fn node_hit<const AVX: bool>(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+    fn node_hit<const AVX: bool, const FUSED: bool>(
+        n: &Node8,
+        r: &SlabRay,
+        tmin: f32,
+        tmax: f32,
+    ) -> ([f32; 8], u32) {
         #[cfg(target_arch = "x86_64")]
         if AVX {
-            // SAFETY: `AVX` is true only in the traversals `intersect` and `occluded` call
-            // after detecting AVX.
-            return unsafe { node8::hit_avx(n, r, tmin, tmax) };
+            // SAFETY: `AVX` is true only in the traversals compiled for AVX2 and FMA, which
+            // their callers enter after detecting them; `FUSED` only for a fused ray.
+            return unsafe {
+                if FUSED {
+                    node8::hit_fused(n, r, tmin, tmax)
+                } else {
+                    node8::hit_avx(n, r, tmin, tmax)
+                }
+            };
         }
         node8::hit_sse(n, r, tmin, tmax)
     }
@@ -724,7 +737,8 @@ impl Bvh {
         any: bool,
     ) -> Option<Hit> {
         let rec = self.leaf_rec(r);
-        let mut best = None;
+        // The hit so far is `end` with these barycentric weights (none: `end` is as given).
+        let mut weights = None;
         let p0 = rec.pack_start as usize;
         let mut packs = &self.packs[p0..p0 + rec.packs as usize];
         while let [a, rest @ ..] = packs {
@@ -745,20 +759,27 @@ impl Bvh {
             };
             if let Some((t, lane, b1, b2)) = found {
                 let pack = if lane < 4 { a } else { second };
-                let prim = pack.prim[lane % 4];
-                *end = Limit { t, prim };
-                best = Some(Hit { t, prim, b1, b2 });
+                *end = Limit {
+                    t,
+                    prim: pack.prim[lane % 4],
+                };
+                weights = Some((b1, b2));
                 if any {
-                    return best;
+                    break;
                 }
             }
         }
-        if rec.spheres != 0 {
+        if rec.spheres != 0 && !(any && weights.is_some()) {
             if let Some(h) = self.leaf_spheres(&rec, ray, tmin, end, any) {
                 return Some(h);
             }
         }
-        best
+        weights.map(|(b1, b2)| Hit {
+            t: end.t,
+            prim: end.prim,
+            b1,
+            b2,
+        })
     }
 
     /// [`Bvh::leaf`]'s test of a leaf's spheres: the first hit `end` admits, moving `end` to
@@ -854,23 +875,41 @@ impl Bvh {
         tmax: f32,
         start: Start,
     ) -> Option<Hit> {
-        // `Walk::step`'s walk, written as one loop over local variables, so that its state
-        // stays in registers (a `Walk`, stepped from outside, lives in memory).
         let pre = RayPre::new(ray);
         let slab = SlabRay::new(&pre);
+        // One loop per node test, so that each keeps only its own per-ray values live.
+        if AVX && slab.fused() {
+            self.walk_one::<AVX, true>(ray, (&pre, &slab), tmin, tmax, start)
+        } else {
+            self.walk_one::<AVX, false>(ray, (&pre, &slab), tmin, tmax, start)
+        }
+    }
+
+    /// [`Bvh::intersect_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
+    #[inline(always)]
+    fn walk_one<const AVX: bool, const FUSED: bool>(
+        &self,
+        ray: &Ray,
+        (pre, slab): (&RayPre, &SlabRay),
+        tmin: f32,
+        tmax: f32,
+        start: Start,
+    ) -> Option<Hit> {
+        // `Walk::step`'s walk, written as one loop over local variables, so that its state
+        // stays in registers (a `Walk`, stepped from outside, lives in memory).
         let (mut end, mut reach, mut best) = (Limit::end(tmax), widen(tmax), None);
         let mut stack = Stack::new();
         let mut sp = 0;
         let mut node_ref = start.node;
         loop {
             if node_ref & LEAF != 0 {
-                if let Some(h) = self.leaf::<AVX>(node_ref, &pre, ray, tmin, &mut end, false) {
+                if let Some(h) = self.leaf::<AVX>(node_ref, pre, ray, tmin, &mut end, false) {
                     best = Some(h);
                     reach = widen(end.t);
                 }
             } else {
                 let n = self.node(node_ref);
-                let (near, mut mask) = Bvh::node_hit::<AVX>(n, &slab, tmin, reach);
+                let (near, mut mask) = Bvh::node_hit::<AVX, FUSED>(n, slab, tmin, reach);
                 if node_ref == 0 {
                     mask &= !start.skip;
                 }
@@ -1544,6 +1583,23 @@ impl Bvh {
     ) -> bool {
         let r = RayPre::new(ray);
         let slab = SlabRay::new(&r);
+        if AVX && slab.fused() {
+            self.occluded_one::<AVX, true>(ray, (&r, &slab), tmin, tmax, start)
+        } else {
+            self.occluded_one::<AVX, false>(ray, (&r, &slab), tmin, tmax, start)
+        }
+    }
+
+    /// [`Bvh::occluded_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
+    #[inline(always)]
+    fn occluded_one<const AVX: bool, const FUSED: bool>(
+        &self,
+        ray: &Ray,
+        (r, slab): (&RayPre, &SlabRay),
+        tmin: f32,
+        tmax: f32,
+        start: Start,
+    ) -> bool {
         let mut stack = Stack::<u32>::new();
         let mut sp = 0usize;
         let mut node_ref = start.node;
@@ -1551,14 +1607,14 @@ impl Bvh {
             if node_ref & LEAF != 0 {
                 let mut end = Limit::end(tmax);
                 if self
-                    .leaf::<AVX>(node_ref, &r, ray, tmin, &mut end, true)
+                    .leaf::<AVX>(node_ref, r, ray, tmin, &mut end, true)
                     .is_some()
                 {
                     return true;
                 }
             } else {
                 let n = self.node(node_ref);
-                let (_, mut mask) = Self::node_hit::<AVX>(n, &slab, tmin, tmax);
+                let (_, mut mask) = Self::node_hit::<AVX, FUSED>(n, slab, tmin, tmax);
                 if node_ref == 0 {
                     mask &= !start.skip;
                 }
@@ -1722,7 +1778,11 @@ impl Walk {
             }
         } else {
             let n = bvh.node(node_ref);
-            let (near, mut mask) = Bvh::node_hit::<AVX>(n, &self.slab, tmin, self.reach);
+            let (near, mut mask) = if AVX && self.slab.fused() {
+                Bvh::node_hit::<AVX, true>(n, &self.slab, tmin, self.reach)
+            } else {
+                Bvh::node_hit::<AVX, false>(n, &self.slab, tmin, self.reach)
+            };
             if node_ref == 0 {
                 mask &= !skip;
             }

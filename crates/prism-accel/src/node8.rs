@@ -73,7 +73,7 @@ impl Node8 {
 /// A ray prepared for slab tests, `t = (p - origin) * inv_dir`: for each axis, the plane of
 /// a box the ray meets first and the other one, as byte offsets of their rows in
 /// `Node8::bounds` ([`SlabRay::near`], [`SlabRay::far`]). Far slabs are measured with
-/// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`]. The fused test ([`hit_avx`]) measures
+/// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`]. The fused test ([`hit_fused`]) measures
 /// `t = p * inv_dir + off_near` (far: `p * inv_far + off_far`) in one rounding instead.
 pub(crate) struct SlabRay {
     origin: [f32; 3],
@@ -149,6 +149,12 @@ impl SlabRay {
             plain,
             fused: plain && finite,
         }
+    }
+
+    /// True if the fused test ([`hit_fused`]) applies to the ray.
+    #[inline(always)]
+    pub(crate) fn fused(&self) -> bool {
+        self.fused
     }
 
     /// The byte offset of the row of the plane on `axis` the ray meets first.
@@ -254,24 +260,20 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
     (near_out, mask & n.used)
 }
 
-/// [`hit_sse`] with 256-bit AVX instructions (the comparison "not greater than" is
-/// `_CMP_NGT_UQ`, true for NaN), for a ray of [`SlabRay::fused`] with each slab distance
-/// one fused multiply-add, `p * inv + off`: one dependent step fewer on the path every node
-/// waits on. Its distances are never shorter than the exact interval (see [`SlabRay::new`]),
-/// but may differ from [`hit_sse`]'s by a rounding: other rays take [`hit_sse`]'s
-/// operations in its order. Inlined into the callers compiled for AVX2 and FMA (a
+/// [`hit_sse`] with 256-bit AVX instructions: the same operations in the same order (the
+/// comparison "not greater than" is `_CMP_NGT_UQ`, true for NaN), for rays that are not
+/// [`SlabRay::fused`]. Inlined into the callers compiled for AVX2 and FMA (a
 /// `target_feature` function could not be inlined always, and a call per node costs a
 /// tenth of the traversal).
 ///
 /// # Safety
-/// The processor must support AVX2 and FMA.
+/// The processor must support AVX.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
     use std::arch::x86_64::{
-        _mm256_and_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps,
-        _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps,
-        _CMP_LE_OQ, _CMP_NGT_UQ,
+        _mm256_and_ps, _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps,
+        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
     };
     // SAFETY: `SlabRay::new` makes every plane offset that of one of the node's rows: 32
     // bytes at a 32-byte aligned offset of a 64-byte aligned node, as `_mm256_load_ps`
@@ -290,42 +292,6 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
                     _mm256_set1_ps(r.$inv[$axis]),
                 )
             };
-        }
-        if r.fused {
-            macro_rules! f {
-                ($plane:expr, $axis:expr, $inv:ident, $off:ident) => {
-                    _mm256_fmadd_ps(
-                        _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
-                        _mm256_set1_ps(r.$inv[$axis]),
-                        _mm256_set1_ps(r.$off[$axis]),
-                    )
-                };
-            }
-            macro_rules! near {
-                ($axis:expr) => {
-                    f!(r.near($axis), $axis, inv_dir, off_near)
-                };
-            }
-            let near = _mm256_max_ps(
-                _mm256_max_ps(near!(0), near!(1)),
-                _mm256_max_ps(near!(2), _mm256_set1_ps(tmin)),
-            );
-            macro_rules! before {
-                ($axis:expr) => {
-                    _mm256_cmp_ps::<_CMP_NGT_UQ>(near, f!(r.far($axis), $axis, inv_far, off_far))
-                };
-            }
-            let m = _mm256_and_ps(
-                _mm256_and_ps(before!(0), before!(1)),
-                _mm256_and_ps(
-                    before!(2),
-                    _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
-                ),
-            );
-            let mask = _mm256_movemask_ps(m) as u32;
-            let mut near_out = [0f32; 8];
-            _mm256_storeu_ps(near_out.as_mut_ptr(), near);
-            return (near_out, mask & n.used);
         }
         let near = if r.plain {
             _mm256_max_ps(
@@ -350,6 +316,61 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
             _mm256_and_ps(before!(r.far(0), 0), before!(r.far(1), 1)),
             _mm256_and_ps(
                 before!(r.far(2), 2),
+                _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
+            ),
+        );
+        let mask = _mm256_movemask_ps(m) as u32;
+        let mut near_out = [0f32; 8];
+        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
+        (near_out, mask & n.used)
+    }
+}
+
+/// The node test for a ray of [`SlabRay::fused`], on 256-bit AVX lanes: each slab distance
+/// one fused multiply-add, `p * inv + off`, one dependent step fewer on the path every
+/// node waits on than [`hit_avx`]. Its distances are never shorter than the exact interval
+/// (see [`SlabRay::new`]), but may differ from [`hit_avx`]'s by a rounding. No distance is
+/// NaN for such a ray, so the near distances are taken in pairs. Inlined as [`hit_avx`].
+///
+/// # Safety
+/// The processor must support AVX2 and FMA, and the ray must be [`SlabRay::fused`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn hit_fused(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
+    use std::arch::x86_64::{
+        _mm256_and_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps,
+        _mm256_movemask_ps, _mm256_set1_ps, _mm256_storeu_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
+    };
+    debug_assert!(r.fused);
+    // SAFETY: as in `hit_avx`; the caller ensures FMA.
+    unsafe {
+        macro_rules! f {
+            ($plane:expr, $axis:expr, $inv:ident, $off:ident) => {
+                _mm256_fmadd_ps(
+                    _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
+                    _mm256_set1_ps(r.$inv[$axis]),
+                    _mm256_set1_ps(r.$off[$axis]),
+                )
+            };
+        }
+        macro_rules! near {
+            ($axis:expr) => {
+                f!(r.near($axis), $axis, inv_dir, off_near)
+            };
+        }
+        let near = _mm256_max_ps(
+            _mm256_max_ps(near!(0), near!(1)),
+            _mm256_max_ps(near!(2), _mm256_set1_ps(tmin)),
+        );
+        macro_rules! before {
+            ($axis:expr) => {
+                _mm256_cmp_ps::<_CMP_NGT_UQ>(near, f!(r.far($axis), $axis, inv_far, off_far))
+            };
+        }
+        let m = _mm256_and_ps(
+            _mm256_and_ps(before!(0), before!(1)),
+            _mm256_and_ps(
+                before!(2),
                 _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
             ),
         );
@@ -399,13 +420,21 @@ mod tests {
         (near_out, mask)
     }
 
-    /// [`hit_avx`] where the processor has AVX2 and FMA.
+    /// The AVX test the walks take for `slab` ([`hit_fused`] or [`hit_avx`]) where the
+    /// processor has AVX2 and FMA.
     #[cfg(target_arch = "x86_64")]
     fn avx_test(n: &Node8, slab: &SlabRay, tmax: f32) -> Option<([f32; 8], u32)> {
         #[target_feature(enable = "avx2,fma")]
         unsafe fn run(n: &Node8, slab: &SlabRay, tmax: f32) -> ([f32; 8], u32) {
-            // SAFETY: compiled for AVX2 and FMA, which the caller detected.
-            unsafe { hit_avx(n, slab, 0.0, tmax) }
+            // SAFETY: compiled for AVX2 and FMA, which the caller detected; the fused test
+            // only for a fused ray.
+            unsafe {
+                if slab.fused() {
+                    hit_fused(n, slab, 0.0, tmax)
+                } else {
+                    hit_avx(n, slab, 0.0, tmax)
+                }
+            }
         }
         let has = std::arch::is_x86_feature_detected!("avx2")
             && std::arch::is_x86_feature_detected!("fma");
