@@ -298,6 +298,8 @@ fn bvh_and_brute_force_give_identical_images() {
         (Preset::Spheres, 64),
         (Preset::CubeTextured, 64),
         (Preset::Cube, 200),
+        (Preset::Cube, 96),
+        (Preset::Custom, 96),
         (Preset::SingleTriangle, 64),
     ] {
         let scene = preset.load(&[]).unwrap();
