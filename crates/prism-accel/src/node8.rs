@@ -330,7 +330,9 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
 /// one fused multiply-add, `p * inv + off`, one dependent step fewer on the path every
 /// node waits on than [`hit_avx`]. Its distances are never shorter than the exact interval
 /// (see [`SlabRay::new`]), but may differ from [`hit_avx`]'s by a rounding. No distance is
-/// NaN for such a ray, so the near distances are taken in pairs. Inlined as [`hit_avx`].
+/// NaN for such a ray, so the near distances are taken in pairs, and the far ones too: the
+/// entry is compared once, with the least of the far distances and `tmax` (a NaN `tmax`
+/// enters nothing, as in [`hit_avx`]). Inlined as [`hit_avx`].
 ///
 /// An unused slot's empty box (minima `+inf`, maxima `-inf`) is never entered, so the
 /// test leaves out the `used` mask (one dependent step fewer): with a finite non-zero
@@ -342,8 +344,8 @@ pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([
 #[inline(always)]
 pub(crate) unsafe fn hit_fused(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
     use std::arch::x86_64::{
-        _mm256_and_ps, _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps,
-        _mm256_movemask_ps, _mm256_set1_ps, _mm256_storeu_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
+        _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_set1_ps, _mm256_storeu_ps, _CMP_LE_OQ,
     };
     debug_assert!(r.fused);
     // SAFETY: as in `hit_avx`; the caller ensures FMA.
@@ -366,19 +368,17 @@ pub(crate) unsafe fn hit_fused(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> 
             _mm256_max_ps(near!(0), near!(1)),
             _mm256_max_ps(near!(2), _mm256_set1_ps(tmin)),
         );
-        macro_rules! before {
+        macro_rules! far {
             ($axis:expr) => {
-                _mm256_cmp_ps::<_CMP_NGT_UQ>(near, f!(r.far($axis), $axis, inv_far, off_far))
+                f!(r.far($axis), $axis, inv_far, off_far)
             };
         }
-        let m = _mm256_and_ps(
-            _mm256_and_ps(before!(0), before!(1)),
-            _mm256_and_ps(
-                before!(2),
-                _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
-            ),
+        // The exit, taken while the entry is computed: one comparison waits on the entry.
+        let exit = _mm256_min_ps(
+            _mm256_min_ps(far!(0), far!(1)),
+            _mm256_min_ps(far!(2), _mm256_set1_ps(tmax)),
         );
-        let mask = _mm256_movemask_ps(m) as u32;
+        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, exit)) as u32;
         let mut near_out = [0f32; 8];
         _mm256_storeu_ps(near_out.as_mut_ptr(), near);
         (near_out, mask)
