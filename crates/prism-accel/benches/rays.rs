@@ -13,7 +13,9 @@
 //!
 //! The mesh is `PRISM_RAYS_MESH` (.obj, .ply or .dae), by default the staged bunny
 //! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
-//! Each figure is the median of 5 runs. `PRISM_RAYS_QUICK=1` traces each set once on one
+//! Each figure is the median of 5 runs. `Mrays/cpu-s` divides the rays by the CPU time the
+//! tracing threads spent in their chunks (as the Embree script's figure of that name does):
+//! per-core speed, less hurt than `Mrays/s` by other work on a busy machine. `PRISM_RAYS_QUICK=1` traces each set once on one
 //! thread, for instruction counts under `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a
 //! comma-separated list such as `primary,random-batch`) traces only the sets named.
 
@@ -45,19 +47,44 @@ fn load(path: &Path) -> Vec<[Vec3; 3]> {
         .collect()
 }
 
+/// CPU time the calling thread has used so far (zero where the platform has no such clock).
+fn thread_cpu() -> Duration {
+    #[cfg(unix)]
+    {
+        let mut ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: `ts` is a valid `timespec` for the call to fill.
+        if unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0 {
+            return Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32);
+        }
+    }
+    Duration::ZERO
+}
+
+/// One timed trace: wall time, the CPU time the tracing threads spent in their chunks, and
+/// the fraction of rays that hit.
+struct Run {
+    wall: Duration,
+    cpu: Duration,
+    hit: f64,
+}
+
 /// Traces `rays` on `threads` threads in chunks of 4096: one ray per call
 /// ([`Bvh::intersect`]), or, with `batch`, a chunk per call ([`Bvh::intersect_batch`]).
-fn trace(bvh: &Bvh, rays: &[Ray], threads: usize, batch: bool) -> (Duration, f64) {
+fn trace(bvh: &Bvh, rays: &[Ray], threads: usize, batch: bool) -> Run {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool");
     pool.install(|| {
         let t = Instant::now();
-        let hits: usize = rays
+        let (hits, cpu) = rays
             .par_chunks(4096)
             .map(|c| {
-                if batch {
+                let cpu = thread_cpu();
+                let hits = if batch {
                     let mut hits = vec![None; c.len()];
                     bvh.intersect_batch(c, 0.0, f32::INFINITY, &mut hits);
                     hits.iter().filter(|h| h.is_some()).count()
@@ -65,10 +92,15 @@ fn trace(bvh: &Bvh, rays: &[Ray], threads: usize, batch: bool) -> (Duration, f64
                     c.iter()
                         .filter(|r| bvh.intersect(r, 0.0, f32::INFINITY).is_some())
                         .count()
-                }
+                };
+                (hits, thread_cpu().saturating_sub(cpu))
             })
-            .sum();
-        (t.elapsed(), hits as f64 / rays.len() as f64)
+            .reduce(|| (0, Duration::ZERO), |a, b| (a.0 + b.0, a.1 + b.1));
+        Run {
+            wall: t.elapsed(),
+            cpu,
+            hit: hits as f64 / rays.len() as f64,
+        }
     })
 }
 
@@ -162,13 +194,19 @@ fn main() {
             if !quick {
                 trace(&bvh, &rays[..10_000], threads, batch);
             }
-            let runs: Vec<(Duration, f64)> = (0..n_runs)
+            let runs: Vec<Run> = (0..n_runs)
                 .map(|_| trace(&bvh, rays, threads, batch))
                 .collect();
-            let hit = runs[0].1;
-            let med = median(runs.iter().map(|r| r.0).collect());
+            let hit = runs[0].hit;
+            let med = median(runs.iter().map(|r| r.wall).collect());
+            let cpu = median(runs.iter().map(|r| r.cpu).collect());
+            let per_cpu = if cpu.is_zero() {
+                "-".to_string()
+            } else {
+                format!("{:.2}", rays.len() as f64 / cpu.as_secs_f64() / 1e6)
+            };
             println!(
-                "{kind:13} threads={threads} rays={} hit={hit:.3} median={:.1} ms Mrays/s={:.2}",
+                "{kind:13} threads={threads} rays={} hit={hit:.3} median={:.1} ms Mrays/s={:.2} Mrays/cpu-s={per_cpu}",
                 rays.len(),
                 med.as_secs_f64() * 1e3,
                 rays.len() as f64 / med.as_secs_f64() / 1e6
