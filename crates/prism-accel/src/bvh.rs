@@ -875,8 +875,7 @@ impl Bvh {
         tmax: f32,
         start: Start,
     ) -> Option<Hit> {
-        let pre = RayPre::new(ray);
-        let slab = SlabRay::new(&pre);
+        let (pre, slab) = set_up::<AVX>(ray);
         // One loop per node test, so that each keeps only its own per-ray values live.
         if AVX && slab.fused() {
             self.walk_one::<AVX, true>(ray, (&pre, &slab), tmin, tmax, start)
@@ -1581,8 +1580,7 @@ impl Bvh {
         tmax: f32,
         start: Start,
     ) -> bool {
-        let r = RayPre::new(ray);
-        let slab = SlabRay::new(&r);
+        let (r, slab) = set_up::<AVX>(ray);
         if AVX && slab.fused() {
             self.occluded_one::<AVX, true>(ray, (&r, &slab), tmin, tmax, start)
         } else {
@@ -1799,6 +1797,23 @@ impl Walk {
             None => false,
         }
     }
+}
+
+/// The ray's per-ray values for the leaves and the node tests: with `AVX` (in walks
+/// compiled for AVX2), by [`RayPre::new_avx`], which gives the same values as
+/// [`RayPre::new`], and the slab values from its registers.
+#[inline(always)]
+fn set_up<const AVX: bool>(ray: &Ray) -> (RayPre, SlabRay) {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
+        // enter after detecting it.
+        let (pre, origin, inv_dir) = unsafe { RayPre::new_avx(ray) };
+        return (pre, SlabRay::from_vectors(origin, inv_dir));
+    }
+    let pre = RayPre::new(ray);
+    let slab = SlabRay::new(&pre);
+    (pre, slab)
 }
 
 /// Pops the nearest pending child that may still hold a closer hit (one entered no farther

@@ -125,10 +125,15 @@ impl SlabRay {
     /// shorter.
     #[inline(always)]
     pub(crate) fn new(r: &RayPre) -> SlabRay {
+        SlabRay::from_vectors(Vec3A::from(r.origin), Vec3A::from(r.inv_dir))
+    }
+
+    /// [`SlabRay::new`] from the ray's origin and `1 / dir` (as [`RayPre`] holds them).
+    #[inline(always)]
+    pub(crate) fn from_vectors(origin: Vec3A, inv_dir: Vec3A) -> SlabRay {
         // SIMD tests rather than glam's `Vec3` ones, which test component by component with
         // branches.
-        let down = r.inv_dir.is_negative_bitmask() as usize & 7;
-        let (origin, inv_dir) = (Vec3A::from(r.origin), Vec3A::from(r.inv_dir));
+        let down = inv_dir.is_negative_bitmask() as usize & 7;
         let inv_far = inv_dir * FAR_WIDEN;
         let (o, inv) = (origin.abs(), inv_dir.abs());
         let plain =
@@ -140,8 +145,8 @@ impl SlabRay {
         let finite =
             (off_near.abs().cmplt(Vec3A::INFINITY) & off_far.abs().cmplt(Vec3A::INFINITY)).all();
         SlabRay {
-            origin: r.origin.to_array(),
-            inv_dir: r.inv_dir.to_array(),
+            origin: Vec3::from(origin).to_array(),
+            inv_dir: Vec3::from(inv_dir).to_array(),
             inv_far: inv_far.to_array(),
             off_near: off_near.to_array(),
             off_far: off_far.to_array(),
