@@ -1026,8 +1026,8 @@ impl Bvh {
             }
             return;
         }
-        let mut a = Slot::start(rays, &job, 0);
-        let mut b = Slot::start(rays, &job, 1);
+        let mut a = Slot::start::<AVX>(rays, &job, 0);
+        let mut b = Slot::start::<AVX>(rays, &job, 1);
         let mut next = 2;
         let (walks, out) = ((rays, tmin, (n, &job)), hits);
         while self.pair_step::<AVX>(walks, out, &mut a, &mut b, &mut next)
@@ -1065,7 +1065,7 @@ impl Bvh {
             return false;
         }
         let (ray, tmax, start) = job(*next);
-        slot.walk.reset(&rays[ray], tmax, start.node);
+        slot.walk.reset::<AVX>(&rays[ray], tmax, start.node);
         (slot.ray, slot.skip, slot.query) = (ray, start.skip, *next);
         *next += 1;
         true
@@ -1694,10 +1694,14 @@ struct Slot {
 impl Slot {
     /// The slot walking query `k` of `job`.
     #[inline(always)]
-    fn start(rays: &[Ray], job: &impl Fn(usize) -> (usize, f32, Start), k: usize) -> Slot {
+    fn start<const AVX: bool>(
+        rays: &[Ray],
+        job: &impl Fn(usize) -> (usize, f32, Start),
+        k: usize,
+    ) -> Slot {
         let (ray, tmax, start) = job(k);
         Slot {
-            walk: Walk::new(&rays[ray], tmax, start.node),
+            walk: Walk::new::<AVX>(&rays[ray], tmax, start.node),
             stack: Stack::new(),
             ray,
             skip: start.skip,
@@ -1724,10 +1728,10 @@ struct Walk {
 impl Walk {
     /// A walk of `ray` up to `tmax`, starting at node `start`.
     #[inline(always)]
-    fn new(ray: &Ray, tmax: f32, start: u32) -> Walk {
-        let pre = RayPre::new(ray);
+    fn new<const AVX: bool>(ray: &Ray, tmax: f32, start: u32) -> Walk {
+        let (pre, slab) = set_up::<AVX>(ray);
         Walk {
-            slab: SlabRay::new(&pre),
+            slab,
             pre,
             best: None,
             end: Limit::end(tmax),
@@ -1740,9 +1744,8 @@ impl Walk {
     /// Starts the walk over, for `ray` up to `tmax` from node `start` (the stack's memory
     /// is kept).
     #[inline(always)]
-    fn reset(&mut self, ray: &Ray, tmax: f32, start: u32) {
-        self.pre = RayPre::new(ray);
-        self.slab = SlabRay::new(&self.pre);
+    fn reset<const AVX: bool>(&mut self, ray: &Ray, tmax: f32, start: u32) {
+        (self.pre, self.slab) = set_up::<AVX>(ray);
         self.best = None;
         self.end = Limit::end(tmax);
         self.reach = widen(tmax);
