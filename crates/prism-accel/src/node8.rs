@@ -577,16 +577,22 @@ mod tests {
         );
     }
 
-    /// Property: the fused test enters every child the double-precision interval test
-    /// enters, on boxes and rays of random floats (no grid), with origins near the boxes
-    /// and far from them (where `origin * inv` is large against the distances, so its
-    /// rounding matters), and enters few others.
-    #[cfg(target_arch = "x86_64")]
     /// Property: the fused test, which skips the `used` mask, enters no unused slot, for
     /// every fused ray (origins and directions from tiny to huge, every sign) and every
     /// query interval, whatever the used slots hold.
+    #[cfg(target_arch = "x86_64")]
     #[test]
     fn fused_test_never_enters_an_unused_slot() {
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn run(n: &Node8, s: &SlabRay, tmin: f32, tmax: f32) -> u32 {
+            // SAFETY: compiled for AVX2 and FMA, which the caller detected; the ray is fused.
+            unsafe { hit_fused(n, s, tmin, tmax).1 }
+        }
+        if !(std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma"))
+        {
+            return;
+        }
         let mut rng = Pcg32::new(23, 5);
         let mut fused = 0;
         for k in 0..20_000 {
@@ -615,18 +621,7 @@ mod tests {
             }
             fused += 1;
             for (tmin, tmax) in [(0.0, f32::INFINITY), (-f32::MAX, f32::MAX), (0.0, 1.0)] {
-                // SAFETY: AVX2 and FMA are detected first; the ray is fused.
-                if !(std::arch::is_x86_feature_detected!("avx2")
-                    && std::arch::is_x86_feature_detected!("fma"))
-                {
-                    return;
-                }
-                #[target_feature(enable = "avx2,fma")]
-                unsafe fn run(n: &Node8, s: &SlabRay, tmin: f32, tmax: f32) -> u32 {
-                    // SAFETY: compiled for AVX2 and FMA; the ray is fused.
-                    unsafe { hit_fused(n, s, tmin, tmax).1 }
-                }
-                // SAFETY: as above.
+                // SAFETY: AVX2 and FMA were detected; the ray is fused.
                 let mask = unsafe { run(&n, &slab, tmin, tmax) };
                 assert_eq!(mask & !used, 0, "case {k}: unused slot entered ({ray:?})");
             }
@@ -634,6 +629,11 @@ mod tests {
         assert!(fused > 15_000, "{fused} fused rays");
     }
 
+    /// Property: the fused test enters every child the double-precision interval test
+    /// enters, on boxes and rays of random floats (no grid), with origins near the boxes
+    /// and far from them (where `origin * inv` is large against the distances, so its
+    /// rounding matters), and enters few others.
+    #[cfg(target_arch = "x86_64")]
     #[test]
     fn fused_test_enters_every_child_the_ray_meets() {
         let mut rng = Pcg32::new(17, 2);
