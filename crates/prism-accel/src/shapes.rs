@@ -118,8 +118,8 @@ impl RayPre {
 
     /// [`RayPre::new`] with AVX's in-register permutes instead of indexing arrays by the
     /// ray's axes (which round-trips each value through memory): the same values, bit for
-    /// bit, in about a third of the instructions. Also returns the origin and `inv_dir` as
-    /// vectors, for the slab set-up to take from registers rather than reload.
+    /// bit, in fewer instructions. Also returns the origin and `inv_dir` as vectors, for the
+    /// slab set-up to take from registers rather than reload.
     ///
     /// # Safety
     /// The processor must support AVX.
