@@ -15,8 +15,9 @@
 //! (`pathtracer/dae/sky/bunny.dae`). Threads: 1 and 2 (rayon, rays in chunks of 4096).
 //! Each figure is the median of 5 runs. `Mrays/cpu-s` divides the rays by the CPU time the
 //! tracing threads spent in their chunks (as the Embree script's figure of that name does):
-//! per-core speed, less hurt than `Mrays/s` by other work on a busy machine. `PRISM_RAYS_QUICK=1` traces each set once on one
-//! thread, for instruction counts under `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a
+//! per-core speed, less hurt than `Mrays/s` by other work on a busy machine.
+//! `PRISM_RAYS_QUICK=1` traces each set once on one thread, for instruction counts under
+//! `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a
 //! comma-separated list such as `primary,random-batch`) traces only the sets named.
 
 use std::path::{Path, PathBuf};

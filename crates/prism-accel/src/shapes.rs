@@ -86,16 +86,21 @@ static PERM_LANES: [[i32; 4]; 6] = {
     t
 };
 
+/// The axis of the largest of `a` (absolute direction components), ties going to the lower
+/// axis; without branches.
+#[inline(always)]
+fn dominant_axis(a: [f32; 3]) -> usize {
+    let x_wins = (a[0] >= a[1]) & (a[0] >= a[2]);
+    usize::from(!x_wins) * (2 - usize::from(a[1] >= a[2]))
+}
+
 impl RayPre {
     /// Precomputes the shear that maps the ray to the +z axis.
     #[must_use]
     #[inline]
     pub fn new(ray: &Ray) -> RayPre {
         let d = ray.dir;
-        let a = d.abs();
-        // The dominant axis, without branches (ties go to the lower axis).
-        let x_wins = (a.x >= a.y) & (a.x >= a.z);
-        let kz = usize::from(!x_wins) * (2 - usize::from(a.y >= a.z));
+        let kz = dominant_axis(d.abs().to_array());
         let da = d.to_array();
         // Keep the winding: swap kx and ky when the dominant component is negative.
         let perm = 2 * kz + usize::from(da[kz] < 0.0);
@@ -131,11 +136,9 @@ impl RayPre {
             __m128, _mm_blend_ps, _mm_loadu_si128, _mm_mul_ps, _mm_permute_ps, _mm_permutevar_ps,
         };
         let (d, o) = (Vec3A::from(ray.dir), Vec3A::from(ray.origin));
-        let a = d.abs();
-        // As in `new`: the dominant axis, ties to the lower one, and the sign of its
-        // component (`< 0`, so a negative zero counts as positive).
-        let x_wins = (a.x >= a.y) & (a.x >= a.z);
-        let kz = usize::from(!x_wins) * (2 - usize::from(a.y >= a.z));
+        // As in `new`: the dominant axis and the sign of its component (`< 0`, so a
+        // negative zero counts as positive).
+        let kz = dominant_axis(d.abs().to_array());
         let perm = 2 * kz + ((d.cmplt(Vec3A::ZERO).bitmask() as usize >> kz) & 1);
         let inv = d.recip();
         // SAFETY: the caller ensures AVX (which includes SSE4.1's blend); the load reads
