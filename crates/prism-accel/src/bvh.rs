@@ -14,7 +14,7 @@ use crate::packet::Query;
 use crate::shapes::{intersect_sphere, Limit, RayPre, Sphere};
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{Avx2, Avx512, Simd};
-use crate::tri4::Tri4;
+use crate::tri4::{EdgeOnZero, Tri4};
 
 /// A leaf: `packs` triangle packs from `pack_start`, `spheres` spheres from `sphere_start`.
 #[derive(Clone, Copy, Debug, Default)]
@@ -782,6 +782,64 @@ impl Bvh {
         })
     }
 
+    /// [`Bvh::leaf`] without calling any function, so that a walk's loop around it keeps
+    /// its per-ray values in registers (a call would clobber them): the leaf's packs by the
+    /// lane tests alone. [`SlowLeaf`] if the leaf holds spheres or a lane test met an edge
+    /// function of exactly zero; `end` is then as given, for [`Bvh::leaf`] to decide the
+    /// leaf.
+    #[inline(always)]
+    fn leaf_fast<const AVX: bool>(
+        &self,
+        r: u32,
+        pre: &RayPre,
+        tmin: f32,
+        end: &mut Limit,
+        any: bool,
+    ) -> Result<Option<Hit>, SlowLeaf> {
+        let rec = self.leaf_rec(r);
+        if rec.spheres != 0 {
+            return Err(SlowLeaf);
+        }
+        let mut e = *end;
+        let mut weights = None;
+        let p0 = rec.pack_start as usize;
+        let mut packs = &self.packs[p0..p0 + rec.packs as usize];
+        while let [a, rest @ ..] = packs {
+            let (found, second) = match rest {
+                #[cfg(target_arch = "x86_64")]
+                [b, tail @ ..] if AVX => {
+                    packs = tail;
+                    // SAFETY: as in `Bvh::leaf`.
+                    let found = unsafe { Tri4::intersect_pair_fast(a, b, pre, tmin, e) };
+                    (found, b)
+                }
+                _ => {
+                    packs = rest;
+                    (a.intersect_fast(pre, tmin, e), a)
+                }
+            };
+            let found = found.map_err(|EdgeOnZero| SlowLeaf)?;
+            if let Some((t, lane, b1, b2)) = found {
+                let pack = if lane < 4 { a } else { second };
+                e = Limit {
+                    t,
+                    prim: pack.prim[lane % 4],
+                };
+                weights = Some((b1, b2));
+                if any {
+                    break;
+                }
+            }
+        }
+        *end = e;
+        Ok(weights.map(|(b1, b2)| Hit {
+            t: e.t,
+            prim: e.prim,
+            b1,
+            b2,
+        }))
+    }
+
     /// [`Bvh::leaf`]'s test of a leaf's spheres: the first hit `end` admits, moving `end` to
     /// it (with `any`, the first hit). Never inlined: inlined, its per-ray values would be
     /// computed at the start of every walk, spheres or not.
@@ -901,27 +959,43 @@ impl Bvh {
         let mut sp = 0;
         let mut node_ref = start.node;
         loop {
-            if node_ref & LEAF != 0 {
-                if let Some(h) = self.leaf::<AVX>(node_ref, pre, ray, tmin, &mut end, false) {
-                    best = Some(h);
-                    reach = widen(end.t);
+            // The walk up to a leaf that needs `Bvh::leaf`, which calls functions: tested
+            // after this loop, so that no call clobbers the registers it keeps.
+            let slow = loop {
+                if node_ref & LEAF != 0 {
+                    match self.leaf_fast::<AVX>(node_ref, pre, tmin, &mut end, false) {
+                        Ok(Some(h)) => {
+                            best = Some(h);
+                            reach = widen(end.t);
+                        }
+                        Ok(None) => {}
+                        Err(SlowLeaf) => break node_ref,
+                    }
+                } else {
+                    let n = self.node(node_ref);
+                    let (near, mut mask) = Bvh::node_hit::<AVX, FUSED>(n, slab, tmin, reach);
+                    if node_ref == 0 {
+                        mask &= !start.skip;
+                    }
+                    if mask != 0 && mask & mask.wrapping_sub(1) == 0 {
+                        // One child entered: go on to it without the stack (its loads follow
+                        // at once, so it is not prefetched).
+                        node_ref = n.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    if mask != 0 {
+                        node_ref = self.descend::<true>(n, &near, mask, &mut stack, &mut sp);
+                        continue;
+                    }
                 }
-            } else {
-                let n = self.node(node_ref);
-                let (near, mut mask) = Bvh::node_hit::<AVX, FUSED>(n, slab, tmin, reach);
-                if node_ref == 0 {
-                    mask &= !start.skip;
+                match pop(&stack, &mut sp, reach) {
+                    Some(next) => node_ref = next,
+                    None => return best,
                 }
-                if mask != 0 && mask & mask.wrapping_sub(1) == 0 {
-                    // One child entered: go on to it without the stack (its loads follow at
-                    // once, so it is not prefetched).
-                    node_ref = n.child[mask.trailing_zeros() as usize];
-                    continue;
-                }
-                if mask != 0 {
-                    node_ref = self.descend::<true>(n, &near, mask, &mut stack, &mut sp);
-                    continue;
-                }
+            };
+            if let Some(h) = self.leaf::<AVX>(slow, pre, ray, tmin, &mut end, false) {
+                best = Some(h);
+                reach = widen(end.t);
             }
             match pop(&stack, &mut sp, reach) {
                 Some(next) => node_ref = next,
@@ -1602,34 +1676,48 @@ impl Bvh {
         let mut sp = 0usize;
         let mut node_ref = start.node;
         loop {
-            if node_ref & LEAF != 0 {
-                let mut end = Limit::end(tmax);
-                if self
-                    .leaf::<AVX>(node_ref, r, ray, tmin, &mut end, true)
-                    .is_some()
-                {
-                    return true;
-                }
-            } else {
-                let n = self.node(node_ref);
-                let (_, mut mask) = Self::node_hit::<AVX, FUSED>(n, slab, tmin, tmax);
-                if node_ref == 0 {
-                    mask &= !start.skip;
-                }
-                if mask != 0 {
-                    // No prefetch of the next child on the stack: shadow rays come in
-                    // batches, whose walks render faster without it.
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    while mask != 0 {
-                        let k = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        stack.push(sp, n.child[k]);
-                        sp += 1;
+            // The walk up to a leaf that needs `Bvh::leaf`, tested after this loop (as in
+            // `Bvh::walk_one`).
+            let slow = loop {
+                if node_ref & LEAF != 0 {
+                    match self.leaf_fast::<AVX>(node_ref, r, tmin, &mut Limit::end(tmax), true) {
+                        Ok(Some(_)) => return true,
+                        Ok(None) => {}
+                        Err(SlowLeaf) => break node_ref,
                     }
-                    node_ref = n.child[i];
-                    continue;
+                } else {
+                    let n = self.node(node_ref);
+                    let (_, mut mask) = Self::node_hit::<AVX, FUSED>(n, slab, tmin, tmax);
+                    if node_ref == 0 {
+                        mask &= !start.skip;
+                    }
+                    if mask != 0 {
+                        // No prefetch of the next child on the stack: shadow rays come in
+                        // batches, whose walks render faster without it.
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        while mask != 0 {
+                            let k = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            stack.push(sp, n.child[k]);
+                            sp += 1;
+                        }
+                        node_ref = n.child[i];
+                        continue;
+                    }
                 }
+                if sp == 0 {
+                    return false;
+                }
+                sp -= 1;
+                node_ref = stack.get(sp);
+            };
+            let mut end = Limit::end(tmax);
+            if self
+                .leaf::<AVX>(slow, r, ray, tmin, &mut end, true)
+                .is_some()
+            {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -1639,6 +1727,9 @@ impl Bvh {
         }
     }
 }
+
+/// A leaf that [`Bvh::leaf_fast`] leaves to [`Bvh::leaf`].
+struct SlowLeaf;
 
 /// Where a one-ray walk starts: at node `node`, and if that is the root, with the root's
 /// children in the slots of `skip` left out.
@@ -2280,6 +2371,100 @@ mod tests {
             }
             assert!(hits > 2000, "{hits} hits");
         }
+    }
+
+    /// Property: the call-free leaf test answers exactly as the full one (hit, and the end
+    /// it moves to) or defers the leaf, and defers only a leaf with spheres or one where a
+    /// pack's lane test meets an edge function of exactly zero. Small integer coordinates
+    /// make such edges common; both occur here, as do hits, for closest and any hits, with
+    /// and without AVX.
+    #[test]
+    fn call_free_leaf_test_equals_the_full_one_or_defers() {
+        let mut rng = Pcg32::new(13, 4);
+        let mut c = || (rng.next_u32() % 9) as f32 - 4.0;
+        let tris: Vec<[Vec3; 3]> = (0..400)
+            .map(|_| {
+                let a = Vec3::new(c(), c(), c());
+                [
+                    a,
+                    a + Vec3::new(c(), c(), 1.0),
+                    a + Vec3::new(1.0, c(), c()),
+                ]
+            })
+            .collect();
+        let spheres = [Sphere {
+            center: Vec3::new(0.5, 0.5, 0.5),
+            radius: 0.75,
+        }];
+        let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
+        let leaves: Vec<u32> = bvh
+            .nodes
+            .iter()
+            .flat_map(|n| (0..8).filter(|&s| n.slot_used(s)).map(|s| n.child[s]))
+            .filter(|&r| r & LEAF != 0)
+            .collect();
+        let zero_edge = |r: u32, pre: &RayPre| {
+            let rec = bvh.leaf_rec(r);
+            let p0 = rec.pack_start as usize;
+            bvh.packs[p0..p0 + rec.packs as usize].iter().any(|p| {
+                p.intersect_fast(pre, 0.0, Limit::end(f32::INFINITY))
+                    .is_err()
+            })
+        };
+        let (mut same, mut deferred, mut hits) = (0, 0, 0);
+        for k in 0..3000 {
+            let o =
+                Vec3::new(c(), c(), c()) * 1.5 + Vec3::splat(if k % 2 == 0 { 0.0 } else { 0.3 });
+            let d = Vec3::new(c(), c(), c());
+            if d == Vec3::ZERO {
+                continue;
+            }
+            let ray = Ray::new(o, d);
+            let pre = RayPre::new(&ray);
+            for &r in &leaves {
+                for any in [false, true] {
+                    let end0 = Limit::end(if k % 3 == 0 { 3.0 } else { f32::INFINITY });
+                    // The full test on the same instruction set (with AVX it tests packs in
+                    // pairs, which may find another first hit when `any`).
+                    let check =
+                        |fast: Result<Option<Hit>, SlowLeaf>, end_fast: Limit, avx: bool| {
+                            let mut end = end0;
+                            let full = if avx {
+                                bvh.leaf::<true>(r, &pre, &ray, 0.0, &mut end, any)
+                            } else {
+                                bvh.leaf::<false>(r, &pre, &ray, 0.0, &mut end, any)
+                            };
+                            match fast {
+                                Ok(h) => {
+                                    assert_eq!(h, full, "ray {k} leaf {r:#x}");
+                                    assert_eq!((end_fast.t, end_fast.prim), (end.t, end.prim));
+                                    (1, 0, usize::from(h.is_some()))
+                                }
+                                Err(SlowLeaf) => {
+                                    assert!(bvh.leaf_rec(r).spheres != 0 || zero_edge(r, &pre));
+                                    assert_eq!((end_fast.t, end_fast.prim), (end0.t, end0.prim));
+                                    (0, 1, 0)
+                                }
+                            }
+                        };
+                    let mut end = end0;
+                    let fast = bvh.leaf_fast::<false>(r, &pre, 0.0, &mut end, any);
+                    let (s, d, h) = check(fast, end, false);
+                    (same, deferred, hits) = (same + s, deferred + d, hits + h);
+                    #[cfg(target_arch = "x86_64")]
+                    if std::arch::is_x86_feature_detected!("avx2") {
+                        let mut end = end0;
+                        // SAFETY (of the AVX tests): AVX2 was detected above.
+                        let fast = bvh.leaf_fast::<true>(r, &pre, 0.0, &mut end, any);
+                        check(fast, end, true);
+                    }
+                }
+            }
+        }
+        assert!(
+            same > 10_000 && deferred > 1000 && hits > 1000,
+            "{same} answered, {deferred} deferred, {hits} hits"
+        );
     }
 
     /// Every set of at most `max` descendants of `n` (itself included) that holds each of

@@ -6,6 +6,10 @@ use prism_math::Vec3;
 
 use crate::shapes::{intersect_triangle, Limit, RayPre};
 
+/// A lane test met an edge function of exactly zero, which only the scalar test decides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct EdgeOnZero;
+
 /// Four triangles in structure-of-arrays form: `v[i][axis]` holds coordinate `axis` of
 /// vertex `i` of the four triangles. Unused lanes hold NaN vertices, which fail every
 /// comparison of the test, so they never hit.
@@ -62,6 +66,20 @@ impl Tri4 {
         tmin: f32,
         end: Limit,
     ) -> Option<(f32, usize, f32, f32)> {
+        self.intersect_fast(r, tmin, end)
+            .unwrap_or_else(|EdgeOnZero| self.scalar(r, tmin, end))
+    }
+
+    /// [`Tri4::intersect`] when no edge function of a lane is exactly zero; else
+    /// [`EdgeOnZero`], and the lanes are for the scalar test to decide. It calls no
+    /// function, so a walk's loop that uses it keeps its per-ray values in registers.
+    #[inline(always)]
+    pub(crate) fn intersect_fast(
+        &self,
+        r: &RayPre,
+        tmin: f32,
+        end: Limit,
+    ) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
         let axes = crate::shapes::PERMS[r.perm];
         let o = r.origin_k;
         // Vertex `i`'s coordinate on sheared axis `k`, less the origin's.
@@ -84,9 +102,9 @@ impl Tri4 {
         let zero = Vec4::ZERO;
         let any_zero = u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero);
         if any_zero.any() {
-            // An edge function is exactly zero in single precision: decide these lanes with
-            // the scalar test, which recomputes them in double precision.
-            return self.scalar(r, tmin, end);
+            // An edge function is exactly zero in single precision: these lanes are for the
+            // scalar test, which recomputes them in double precision.
+            return Err(EdgeOnZero);
         }
         // No edge function is zero here, so a lane is inside its triangle when its edge
         // functions are all negative or all positive: when they share a sign bit. Most packs
@@ -100,26 +118,26 @@ impl Tri4 {
         );
         let inside = !((su ^ sv) | (su ^ sw)) & 0xf;
         if inside == 0 {
-            return None;
+            return Ok(None);
         }
         let det = u + v + w;
         let t = sz * (u * az + v * bz + w * cz) * (Vec4::ONE / det);
         let mask = inside & (t.cmpgt(Vec4::splat(tmin)) & t.cmple(Vec4::splat(end.t))).bitmask();
         if mask == 0 {
-            return None;
+            return Ok(None);
         }
         let ta = t.to_array();
         let best = nearest_lane(mask, &ta, |lane| self.prim[lane]);
         if !end.admits(ta[best], self.prim[best]) {
-            return None;
+            return Ok(None);
         }
         let inv = 1.0 / det.to_array()[best];
-        Some((
+        Ok(Some((
             ta[best],
             best,
             v.to_array()[best] * inv,
             w.to_array()[best] * inv,
-        ))
+        )))
     }
 
     /// The first hit among the eight triangles of packs `a` and `b` with `tmin < t` that
@@ -138,6 +156,35 @@ impl Tri4 {
         tmin: f32,
         end: Limit,
     ) -> Option<(f32, usize, f32, f32)> {
+        // SAFETY: the caller ensures AVX.
+        unsafe { Tri4::intersect_pair_fast(a, b, r, tmin, end) }.unwrap_or_else(|EdgeOnZero| {
+            // The packs one by one, as they decide it.
+            let first = a.intersect(r, tmin, end);
+            let below = first.map_or(end, |h| Limit {
+                t: h.0,
+                prim: a.prim[h.1],
+            });
+            match b.intersect(r, tmin, below) {
+                Some((t, lane, b1, b2)) => Some((t, 4 + lane, b1, b2)),
+                None => first,
+            }
+        })
+    }
+
+    /// [`Tri4::intersect_pair_avx`] when no edge function of a lane is exactly zero; else
+    /// [`EdgeOnZero`]. It calls no function.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(crate) unsafe fn intersect_pair_fast(
+        a: &Tri4,
+        b: &Tri4,
+        r: &RayPre,
+        tmin: f32,
+        end: Limit,
+    ) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
         use std::arch::x86_64::{
             _mm256_add_ps, _mm256_and_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_movemask_ps,
             _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_set_m128, _mm256_setzero_ps,
@@ -201,22 +248,14 @@ impl Tri4 {
                 };
             }
             if _mm256_movemask_ps(sign!(_CMP_EQ_OQ)) != 0 {
-                // An edge function is exactly zero: the packs one by one, as they decide it.
-                let first = a.intersect(r, tmin, end);
-                let below = first.map_or(end, |h| Limit {
-                    t: h.0,
-                    prim: a.prim[h.1],
-                });
-                return match b.intersect(r, tmin, below) {
-                    Some((t, lane, b1, b2)) => Some((t, 4 + lane, b1, b2)),
-                    None => first,
-                };
+                // An edge function is exactly zero.
+                return Err(EdgeOnZero);
             }
             // No edge function is zero: a lane is inside when the three share a sign bit.
             let differ = _mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w));
             let inside = !_mm256_movemask_ps(differ) as u32 & 0xff;
             if inside == 0 {
-                return None;
+                return Ok(None);
             }
             let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
             let dist = _mm256_add_ps(_mm256_add_ps(mul!(u, az), mul!(v, bz)), mul!(w, cz));
@@ -227,7 +266,7 @@ impl Tri4 {
             );
             let mask = inside & _mm256_movemask_ps(within) as u32;
             if mask == 0 {
-                return None;
+                return Ok(None);
             }
             let mut ta = [0f32; 8];
             _mm256_storeu_ps(ta.as_mut_ptr(), t);
@@ -240,14 +279,14 @@ impl Tri4 {
             };
             let best = nearest_lane(mask, &ta, prim);
             if !end.admits(ta[best], prim(best)) {
-                return None;
+                return Ok(None);
             }
             let (mut va, mut wa, mut da) = ([0f32; 8], [0f32; 8], [0f32; 8]);
             _mm256_storeu_ps(va.as_mut_ptr(), v);
             _mm256_storeu_ps(wa.as_mut_ptr(), w);
             _mm256_storeu_ps(da.as_mut_ptr(), det);
             let inv = 1.0 / da[best];
-            Some((ta[best], best, va[best] * inv, wa[best] * inv))
+            Ok(Some((ta[best], best, va[best] * inv, wa[best] * inv)))
         }
     }
 
