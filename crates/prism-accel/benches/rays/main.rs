@@ -17,8 +17,18 @@
 //! tracing threads spent in their chunks (as the Embree script's figure of that name does):
 //! per-core speed, less hurt than `Mrays/s` by other work on a busy machine.
 //! `PRISM_RAYS_QUICK=1` traces each set once on one thread, for instruction counts under
-//! `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a
-//! comma-separated list such as `primary,random-batch`) traces only the sets named.
+//! `valgrind --tool=callgrind`. `PRISM_RAYS_SETS` (a comma-separated list such as
+//! `primary,random-batch`) traces only the sets named.
+//!
+//! `PRISM_EMBREE=<path to libembree4.so>` instead traces the one-ray sets with prism and
+//! with that Embree library side by side in this process (`side_by_side`: chunks of the
+//! two alternating on each thread, three passes, on 1 and 2 threads), and prints prism's
+//! speed over Embree's by the CPU time each spent, and how their hits compare. Embree's
+//! scene is built with its defaults, as `embree_rays.py` builds it through `embreex`, and
+//! is traced with `rtcIntersect1` directly: no binding's per-ray copying counts against
+//! it, as it does in the script's figures.
+
+mod embree;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -184,6 +194,24 @@ fn main() {
             std::process::exit(2);
         }
     }
+    if let Ok(lib) = std::env::var("PRISM_EMBREE") {
+        let Some(emb) = embree::Embree::new(&lib, &tris) else {
+            std::process::exit(2);
+        };
+        for (kind, rays, batch) in sets {
+            if batch
+                || only
+                    .as_deref()
+                    .is_some_and(|o| !o.split(',').any(|k| k == kind))
+            {
+                continue;
+            }
+            for &threads in thread_counts {
+                side_by_side(&bvh, &emb, kind, rays, threads, if quick { 1 } else { 3 });
+            }
+        }
+        return;
+    }
     for (kind, rays, batch) in sets {
         if only
             .as_deref()
@@ -214,4 +242,117 @@ fn main() {
             );
         }
     }
+}
+
+/// What one side-by-side chunk or run measured: each side's thread CPU time, and how the
+/// hits compare (rays both hit, rays one side alone hits, rays both hit at distances more
+/// than 1e-4 apart relative to prism's).
+#[derive(Clone, Copy, Default)]
+struct Tally {
+    prism: f64,
+    embree: f64,
+    both: usize,
+    prism_only: usize,
+    embree_only: usize,
+    apart: usize,
+}
+
+impl Tally {
+    fn add(self, o: Tally) -> Tally {
+        Tally {
+            prism: self.prism + o.prism,
+            embree: self.embree + o.embree,
+            both: self.both + o.both,
+            prism_only: self.prism_only + o.prism_only,
+            embree_only: self.embree_only + o.embree_only,
+            apart: self.apart + o.apart,
+        }
+    }
+}
+
+/// Traces `rays` with prism and with Embree in chunks of 1024, each chunk by the two back
+/// to back on one thread (which first alternates from chunk to chunk and pass to pass),
+/// `passes` times over on `threads` threads, and prints prism's speed divided by Embree's:
+/// the ratio of the thread CPU time each spent, whole and per pass. Load on the machine
+/// slows both alike, so the ratio holds to a percent or two where separate runs differ by
+/// tens of percent.
+fn side_by_side(
+    bvh: &Bvh,
+    emb: &embree::Embree,
+    kind: &str,
+    rays: &[Ray],
+    threads: usize,
+    passes: usize,
+) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    let chunk = |i: usize, c: &[Ray], pass: usize| {
+        let prism = || {
+            let t0 = thread_cpu();
+            let hits: Vec<Option<f32>> = c
+                .iter()
+                .map(|r| bvh.intersect(r, 0.0, f32::INFINITY).map(|h| h.t))
+                .collect();
+            ((thread_cpu() - t0).as_secs_f64(), hits)
+        };
+        let embree = || {
+            let t0 = thread_cpu();
+            let hits: Vec<Option<f32>> = c.iter().map(|r| emb.intersect(r)).collect();
+            ((thread_cpu() - t0).as_secs_f64(), hits)
+        };
+        let ((tp, hp), (te, he)) = if (i + pass).is_multiple_of(2) {
+            let p = prism();
+            (p, embree())
+        } else {
+            let e = embree();
+            (prism(), e)
+        };
+        let mut t = Tally {
+            prism: tp,
+            embree: te,
+            ..Tally::default()
+        };
+        for (p, e) in hp.iter().zip(&he) {
+            match (p, e) {
+                (Some(p), Some(e)) => {
+                    t.both += 1;
+                    t.apart += usize::from((p - e).abs() > 1e-4 * p.abs());
+                }
+                (Some(_), None) => t.prism_only += 1,
+                (None, Some(_)) => t.embree_only += 1,
+                (None, None) => {}
+            }
+        }
+        t
+    };
+    let runs: Vec<Tally> = (0..passes)
+        .map(|pass| {
+            pool.install(|| {
+                rays.par_chunks(1024)
+                    .enumerate()
+                    .map(|(i, c)| chunk(i, c, pass))
+                    .reduce(Tally::default, Tally::add)
+            })
+        })
+        .collect();
+    let mut ratios: Vec<f64> = runs.iter().map(|t| t.embree / t.prism).collect();
+    ratios.sort_by(f64::total_cmp);
+    let all = runs.iter().copied().fold(Tally::default(), Tally::add);
+    let n = (rays.len() * passes) as f64;
+    let last = runs[runs.len() - 1];
+    println!(
+        "{kind:13} threads={threads} prism/Embree speed {:.3} (passes {:.3}-{:.3}); \
+         prism {:.2} Embree {:.2} Mrays/cpu-s; hits: both {} (apart {}), prism only {}, Embree only {}",
+        all.embree / all.prism,
+        ratios[0],
+        ratios[ratios.len() - 1],
+        n / all.prism / 1e6,
+        n / all.embree / 1e6,
+        last.both,
+        last.apart,
+        last.prism_only,
+        last.embree_only
+    );
 }
