@@ -843,7 +843,7 @@ impl Bvh {
     /// [`Bvh::leaf`], compiled apart and marked cold: the paired walks' test of a leaf
     /// [`Bvh::leaf_fast`] leaves to it. Inlined, the calls it makes would sit in their loop
     /// and clobber the registers it keeps (on the 56k-triangle bunny, random rays in
-    /// batches trace 5% faster with it apart).
+    /// batches trace 5% faster by `leaf_fast` and this than by `leaf` inlined).
     #[inline(never)]
     #[cold]
     fn leaf_apart<const AVX: bool>(
@@ -2504,8 +2504,8 @@ mod tests {
                     (same, deferred, hits) = (same + s, deferred + d, hits + h);
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
+                        // The `AVX` code paths, on a processor with AVX2 (detected above).
                         let mut end = end0;
-                        // SAFETY (of the AVX tests): AVX2 was detected above.
                         let fast = bvh.leaf_fast::<true>(r, &pre, 0.0, &mut end, any);
                         check(fast, end, true);
                     }
