@@ -737,38 +737,9 @@ impl Bvh {
         any: bool,
     ) -> Option<Hit> {
         let rec = self.leaf_rec(r);
-        // The hit so far is `end` with these barycentric weights (none: `end` is as given).
-        let mut weights = None;
-        let p0 = rec.pack_start as usize;
-        let mut packs = &self.packs[p0..p0 + rec.packs as usize];
-        while let [a, rest @ ..] = packs {
-            // The pack of lanes 4..8 (the first again when tested alone).
-            let (found, second) = match rest {
-                #[cfg(target_arch = "x86_64")]
-                [b, tail @ ..] if AVX => {
-                    packs = tail;
-                    // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
-                    // their callers enter after detecting it.
-                    let found = unsafe { Tri4::intersect_pair_avx(a, b, pre, tmin, *end) };
-                    (found, b)
-                }
-                _ => {
-                    packs = rest;
-                    (a.intersect(pre, tmin, *end), a)
-                }
-            };
-            if let Some((t, lane, b1, b2)) = found {
-                let pack = if lane < 4 { a } else { second };
-                *end = Limit {
-                    t,
-                    prim: pack.prim[lane % 4],
-                };
-                weights = Some((b1, b2));
-                if any {
-                    break;
-                }
-            }
-        }
+        let weights = self
+            .leaf_packs::<AVX, false>(&rec, pre, tmin, end, any)
+            .unwrap_or_else(|SlowLeaf| unreachable!("only the deferring test defers a leaf"));
         if rec.spheres != 0 && !(any && weights.is_some()) {
             if let Some(h) = self.leaf_spheres(&rec, ray, tmin, end, any) {
                 return Some(h);
@@ -800,22 +771,58 @@ impl Bvh {
         if rec.spheres != 0 {
             return Err(SlowLeaf);
         }
+        let weights = self.leaf_packs::<AVX, true>(&rec, pre, tmin, end, any)?;
+        Ok(weights.map(|(b1, b2)| Hit {
+            t: end.t,
+            prim: end.prim,
+            b1,
+            b2,
+        }))
+    }
+
+    /// The triangle packs of leaf `rec`, as [`Bvh::leaf`] tests them: moves `end` to each
+    /// hit it admits (with `any`, to the first), and returns the barycentric weights of the
+    /// last (none: `end` is as given). With `DEFER`, by the lane tests alone, which call no
+    /// function, and [`SlowLeaf`] with `end` as given if one meets an edge function of
+    /// exactly zero; without, never [`SlowLeaf`].
+    #[inline(always)]
+    fn leaf_packs<const AVX: bool, const DEFER: bool>(
+        &self,
+        rec: &LeafRec,
+        pre: &RayPre,
+        tmin: f32,
+        end: &mut Limit,
+        any: bool,
+    ) -> Result<Option<(f32, f32)>, SlowLeaf> {
         let mut e = *end;
         let mut weights = None;
         let p0 = rec.pack_start as usize;
         let mut packs = &self.packs[p0..p0 + rec.packs as usize];
         while let [a, rest @ ..] = packs {
+            // The pack of lanes 4..8 (the first again when tested alone).
             let (found, second) = match rest {
                 #[cfg(target_arch = "x86_64")]
                 [b, tail @ ..] if AVX => {
                     packs = tail;
-                    // SAFETY: as in `Bvh::leaf`.
-                    let found = unsafe { Tri4::intersect_pair_fast(a, b, pre, tmin, e) };
+                    // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
+                    // their callers enter after detecting it.
+                    let found = unsafe {
+                        if DEFER {
+                            Tri4::intersect_pair_fast(a, b, pre, tmin, e)
+                        } else {
+                            Ok(Tri4::intersect_pair_avx(a, b, pre, tmin, e))
+                        }
+                    };
                     (found, b)
                 }
                 _ => {
                     packs = rest;
-                    (a.intersect_fast(pre, tmin, e), a)
+                    let found = if DEFER {
+                        a.intersect_fast(pre, tmin, e)
+                    } else {
+                        Ok(a.intersect(pre, tmin, e))
+                    };
+                    (found, a)
                 }
             };
             let found = found.map_err(|EdgeOnZero| SlowLeaf)?;
@@ -832,12 +839,7 @@ impl Bvh {
             }
         }
         *end = e;
-        Ok(weights.map(|(b1, b2)| Hit {
-            t: e.t,
-            prim: e.prim,
-            b1,
-            b2,
-        }))
+        Ok(weights)
     }
 
     /// [`Bvh::leaf`], compiled apart and marked cold: the paired walks' test of a leaf
