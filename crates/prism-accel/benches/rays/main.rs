@@ -194,7 +194,12 @@ fn main() {
             std::process::exit(2);
         }
     }
-    if let Ok(lib) = std::env::var("PRISM_EMBREE") {
+    // An empty value is no value, as for `PRISM_RAYS_SETS` (`dlopen("")` would open this
+    // program itself).
+    if let Some(lib) = std::env::var("PRISM_EMBREE")
+        .ok()
+        .filter(|l| !l.trim().is_empty())
+    {
         let Some(emb) = embree::Embree::new(&lib, &tris) else {
             std::process::exit(2);
         };
