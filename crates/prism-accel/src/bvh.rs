@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::flat::{Flat, Lanes, FLAT_MAX};
 use crate::node8::{self, widen, Node8, SlabRay};
+use crate::order::Pending;
 #[cfg(target_arch = "x86_64")]
 use crate::packet::Query;
 use crate::shapes::{intersect_sphere, Limit, RayPre, Sphere};
@@ -1030,7 +1031,7 @@ impl Bvh {
                         continue;
                     }
                     if mask != 0 {
-                        node_ref = self.descend::<true>(n, &near, mask, &mut stack, &mut sp);
+                        node_ref = self.descend::<AVX, true>(n, &near, mask, &mut stack, &mut sp);
                         continue;
                     }
                 }
@@ -1054,17 +1055,20 @@ impl Bvh {
     /// nearest first (the lower slot first of equals), pushes all but the nearest onto
     /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
     /// told apart and ordered by selects rather than branches (one is pushed and popped
-    /// again at once: `*sp` does not move). With `PREFETCH`, the next child on the stack is
+    /// again at once: `*sp` does not move). More are sorted, with `AVX` by a sorting
+    /// network without branches ([`crate::order::sort_entered_avx2`], which orders entries less
+    /// than 8 ulps apart by slot), else one by one. Any order finds the same hit (see
+    /// [`widen`]). With `PREFETCH`, the next child on the stack is
     /// prefetched: worth it in a lone walk ([`Bvh::intersect_with`]), not in the paired
     /// walks of batches ([`Bvh::walk_pairs`]), which overlap their misses already and
     /// render 2-7% faster without it.
     #[inline(always)]
-    fn descend<const PREFETCH: bool>(
+    fn descend<const AVX: bool, const PREFETCH: bool>(
         &self,
         n: &Node8,
         near: &[f32; 8],
         mut mask: u32,
-        stack: &mut Stack<(u32, f32)>,
+        stack: &mut Stack<Pending>,
         sp: &mut usize,
     ) -> u32 {
         // The entered children but the lowest slot's: none when one is entered. (Bit
@@ -1077,12 +1081,31 @@ impl Bvh {
             let last = 31 - mask.leading_zeros() as usize;
             let swap = near[last] < near[first];
             let (a, b) = if swap { (last, first) } else { (first, last) };
-            stack.push(*sp, (n.child[b], near[b]));
+            stack.push(
+                *sp,
+                Pending {
+                    node: n.child[b],
+                    t_near: near[b],
+                },
+            );
             *sp += usize::from(rest != 0);
             if PREFETCH {
                 self.prefetch(n.child[b]);
             }
             return n.child[a];
+        }
+        #[cfg(target_arch = "x86_64")]
+        if AVX {
+            // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
+            // enter after detecting it; three or more children are entered, none with a
+            // NaN entry (the node tests enter no such child).
+            let (nearest, second, pushed) =
+                unsafe { crate::order::sort_entered_avx2(near, &n.child, mask, stack.eight(*sp)) };
+            *sp += pushed;
+            if PREFETCH {
+                self.prefetch(second);
+            }
+            return nearest;
         }
         let i = mask.trailing_zeros() as usize;
         mask &= mask - 1;
@@ -1101,7 +1124,8 @@ impl Bvh {
             count += 1;
         }
         for k in (1..count).rev() {
-            stack.push(*sp, hits[k]);
+            let (node, t_near) = hits[k];
+            stack.push(*sp, Pending { node, t_near });
             *sp += 1;
         }
         if PREFETCH {
@@ -1810,6 +1834,14 @@ impl<T: Copy> Stack<T> {
         self.items[i] = std::mem::MaybeUninit::new(v);
     }
 
+    /// Slots `i..i + 8`, to be written at once. A walk's stack holds at most seven
+    /// children per level above the node it is at, so past the deepest node's pushes it
+    /// has room for these eight ([`STACK`]).
+    #[inline(always)]
+    fn eight(&mut self, i: usize) -> &mut [std::mem::MaybeUninit<T>; 8] {
+        (&mut self.items[i..i + 8]).try_into().expect("eight slots")
+    }
+
     #[inline(always)]
     fn get(&self, i: usize) -> T {
         // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
@@ -1822,7 +1854,7 @@ impl<T: Copy> Stack<T> {
 /// slots `skip` left out.
 struct Slot {
     walk: Walk,
-    stack: Stack<(u32, f32)>,
+    stack: Stack<Pending>,
     ray: usize,
     skip: u32,
     query: usize,
@@ -1906,7 +1938,7 @@ impl Walk {
         ray: &Ray,
         tmin: f32,
         skip: u32,
-        stack: &mut Stack<(u32, f32)>,
+        stack: &mut Stack<Pending>,
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
@@ -1932,7 +1964,7 @@ impl Walk {
                 mask &= !skip;
             }
             if mask != 0 {
-                self.node = bvh.descend::<false>(n, &near, mask, stack, &mut self.sp);
+                self.node = bvh.descend::<AVX, false>(n, &near, mask, stack, &mut self.sp);
                 return true;
             }
         }
@@ -1966,12 +1998,12 @@ fn set_up<const AVX: bool>(ray: &Ray) -> (RayPre, SlabRay) {
 /// Pops the nearest pending child that may still hold a closer hit (one entered no farther
 /// than `reach`), dropping those that cannot.
 #[inline(always)]
-fn pop(stack: &Stack<(u32, f32)>, sp: &mut usize, reach: f32) -> Option<u32> {
+fn pop(stack: &Stack<Pending>, sp: &mut usize, reach: f32) -> Option<u32> {
     while *sp > 0 {
         *sp -= 1;
-        let (next, t_near) = stack.get(*sp);
-        if t_near <= reach {
-            return Some(next);
+        let p = stack.get(*sp);
+        if p.t_near <= reach {
+            return Some(p.node);
         }
     }
     None

@@ -41,6 +41,7 @@ mod inspect;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 mod node8;
+mod order;
 #[cfg(target_arch = "x86_64")]
 mod packet;
 mod shapes;
