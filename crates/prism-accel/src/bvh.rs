@@ -798,7 +798,12 @@ impl Bvh {
         let mut e = *end;
         let mut weights = None;
         let p0 = rec.pack_start as usize;
-        let mut packs = &self.packs[p0..p0 + rec.packs as usize];
+        let range = p0..p0 + rec.packs as usize;
+        debug_assert!(range.end <= self.packs.len());
+        // SAFETY: `rec` is the record of a leaf reference the tree holds: its packs were
+        // placed by `Bvh::plan_leaf` and every placed pack is filled by
+        // `Bvh::pack_leaves`; packs are never removed.
+        let mut packs = unsafe { self.packs.get_unchecked(range) };
         while let [a, rest @ ..] = packs {
             // The pack of lanes 4..8 (the first again when tested alone).
             let (found, second) = match rest {

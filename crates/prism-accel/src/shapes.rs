@@ -64,7 +64,7 @@ pub struct RayPre {
 }
 
 /// The axes `(kx, ky, kz)` of each permutation used by the watertight test.
-pub(crate) const PERMS: [[usize; 3]; 6] = [
+pub(crate) static PERMS: [[usize; 3]; 6] = [
     [1, 2, 0],
     [2, 1, 0],
     [2, 0, 1],
@@ -161,6 +161,16 @@ impl RayPre {
             };
             (pre, o, inv)
         }
+    }
+
+    /// The axes `(kx, ky, kz)` of the ray's permutation, `PERMS[perm]`, without a bounds
+    /// check.
+    #[inline(always)]
+    pub(crate) fn axes(&self) -> &'static [usize; 3] {
+        debug_assert!(self.perm < PERMS.len());
+        // SAFETY: `perm` is `2 * kz + sign` with `kz < 3` (`RayPre::new`, `new_avx`), below
+        // six.
+        unsafe { PERMS.get_unchecked(self.perm) }
     }
 
     /// `v` with its axes reordered to `(kx, ky, kz)`.

@@ -80,7 +80,7 @@ impl Tri4 {
         tmin: f32,
         end: Limit,
     ) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
-        let axes = crate::shapes::PERMS[r.perm];
+        let axes = r.axes();
         let o = r.origin_k;
         // Vertex `i`'s coordinate on sheared axis `k`, less the origin's.
         let rel = |i: usize, k: usize| self.v[i][axes[k]] - Vec4::splat(o[k]);
@@ -191,7 +191,7 @@ impl Tri4 {
             _mm256_storeu_ps, _mm256_sub_ps, _mm256_xor_ps, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
             _CMP_LE_OQ,
         };
-        let axes = crate::shapes::PERMS[r.perm];
+        let axes = r.axes();
         let o = r.origin_k;
         // SAFETY: the caller ensures AVX; each load reads one aligned `Vec4` of a pack (a
         // pack is 32-byte aligned and its vectors sit at multiples of 16 bytes).
