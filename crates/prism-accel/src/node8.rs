@@ -135,15 +135,16 @@ impl SlabRay {
         // branches.
         let down = inv_dir.is_negative_bitmask() as usize & 7;
         let inv_far = inv_dir * FAR_WIDEN;
-        let (o, inv) = (origin.abs(), inv_dir.abs());
-        let plain =
-            (o.cmplt(Vec3A::INFINITY) & inv.cmplt(Vec3A::INFINITY) & inv.cmpgt(Vec3A::ZERO)).all();
+        let plain = ((zero_if_finite(origin) + zero_if_finite(inv_dir)).cmpeq(Vec3A::ZERO)
+            & inv_dir.cmpne(Vec3A::ZERO))
+        .all();
         let slack = |a: Vec3A| a.abs() * OFFSET_SLACK + Vec3A::splat(f32::MIN_POSITIVE);
         let (a, af) = (origin * inv_dir, origin * inv_far);
         let off_near = -(a + slack(a));
         let off_far = slack(af) - af;
-        let finite =
-            (off_near.abs().cmplt(Vec3A::INFINITY) & off_far.abs().cmplt(Vec3A::INFINITY)).all();
+        let finite = (zero_if_finite(off_near) + zero_if_finite(off_far))
+            .cmpeq(Vec3A::ZERO)
+            .all();
         SlabRay {
             origin: Vec3::from(origin).to_array(),
             inv_dir: Vec3::from(inv_dir).to_array(),
@@ -173,6 +174,15 @@ impl SlabRay {
     fn far(&self, axis: usize) -> usize {
         self.planes[3 + axis]
     }
+}
+
+/// `v - v`: zero in each finite lane, NaN in an infinite or NaN one, so a sum of these is
+/// zero exactly where every term is finite (one instruction, where comparing absolute
+/// values with infinity takes three).
+#[inline(always)]
+#[allow(clippy::eq_op)]
+fn zero_if_finite(v: Vec3A) -> Vec3A {
+    v - v
 }
 
 /// The fused test's slack on `origin * inv_dir`: eight times its rounding (2^-21).

@@ -53,8 +53,6 @@ impl Limit {
 pub struct RayPre {
     /// The ray's origin.
     pub origin: Vec3,
-    /// The ray's direction.
-    pub dir: Vec3,
     /// `1 / dir`, for slab tests.
     pub inv_dir: Vec3,
     pub(crate) perm: usize,
@@ -110,7 +108,6 @@ impl RayPre {
         let inv_z = inv_dir.to_array()[kz];
         RayPre {
             origin: ray.origin,
-            dir: d,
             inv_dir,
             perm,
             shear: Vec3::new(da[kx] * inv_z, da[ky] * inv_z, inv_z),
@@ -153,7 +150,6 @@ impl RayPre {
             let origin_k = _mm_permutevar_ps(__m128::from(o), lanes);
             let pre = RayPre {
                 origin: ray.origin,
-                dir: ray.dir,
                 inv_dir: Vec3::from(inv),
                 perm,
                 shear: Vec3::from(Vec3A::from(shear)),
@@ -323,7 +319,6 @@ mod tests {
             let v = |v: Vec3| v.to_array().map(f32::to_bits);
             (
                 v(p.origin),
-                v(p.dir),
                 v(p.inv_dir),
                 p.perm,
                 v(p.shear),
