@@ -1036,7 +1036,7 @@ impl Bvh {
                         continue;
                     }
                     if mask != 0 {
-                        node_ref = self.descend::<AVX, true>(n, &near, mask, &mut stack, &mut sp);
+                        node_ref = self.descend::<false, true>(n, &near, mask, &mut stack, &mut sp);
                         continue;
                     }
                 }
@@ -1060,15 +1060,18 @@ impl Bvh {
     /// nearest first (the lower slot first of equals), pushes all but the nearest onto
     /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
     /// told apart and ordered by selects rather than branches (one is pushed and popped
-    /// again at once: `*sp` does not move). More are sorted, with `AVX` by a sorting
-    /// network without branches ([`crate::order::sort_entered_avx2`], which orders entries less
-    /// than 8 ulps apart by slot), else one by one. Any order finds the same hit (see
-    /// [`widen`]). With `PREFETCH`, the next child on the stack is
-    /// prefetched: worth it in a lone walk ([`Bvh::intersect_with`]), not in the paired
+    /// again at once: `*sp` does not move). More are sorted one by one, or with `NETWORK`
+    /// (only in walks compiled for AVX2) by a sorting network without branches
+    /// ([`crate::order::sort_entered_avx2`], which orders entries less than 8 ulps apart
+    /// by slot): faster for the paired walks of batches, whose rays are incoherent
+    /// (random rays in batches 3.3% faster), slower for a lone walk, whose branches are
+    /// predicted for coherent rays (primary rays 2.2% slower, random ones 2.1% faster).
+    /// Any order finds the same hit (see [`widen`]). With `PREFETCH`, the next child on
+    /// the stack is prefetched: worth it in a lone walk ([`Bvh::intersect_with`]), not in the paired
     /// walks of batches ([`Bvh::walk_pairs`]), which overlap their misses already and
     /// render 2-7% faster without it.
     #[inline(always)]
-    fn descend<const AVX: bool, const PREFETCH: bool>(
+    fn descend<const NETWORK: bool, const PREFETCH: bool>(
         &self,
         n: &Node8,
         near: &[f32; 8],
@@ -1100,10 +1103,10 @@ impl Bvh {
             return n.child[a];
         }
         #[cfg(target_arch = "x86_64")]
-        if AVX {
-            // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
-            // enter after detecting it; three or more children are entered, none with a
-            // NaN entry (the node tests enter no such child).
+        if NETWORK {
+            // SAFETY: `NETWORK` is true only in the walks compiled for AVX2, which their
+            // callers enter after detecting it; three or more children are entered, none
+            // with a NaN entry (the node tests enter no such child).
             let (nearest, second, pushed) =
                 unsafe { crate::order::sort_entered_avx2(near, &n.child, mask, stack.eight(*sp)) };
             *sp += pushed;
@@ -1157,9 +1160,10 @@ impl Bvh {
     /// `rays`), its end and where its walk starts, and writes query k's hit to
     /// `hits[k]`. Two walks go on at once, a step of one then a step of the other: each
     /// step waits on memory (a node, a leaf's triangles) that the other's step is computed
-    /// under. Each walk is the one [`Bvh::intersect_with`] takes, so the hits are the same;
-    /// its children are chosen by selects (`Walk::step`), as the rays of a batch are mostly
-    /// incoherent.
+    /// under. Each walk is the one [`Bvh::intersect_with`] takes (but for the order of
+    /// children entered less than 8 ulps apart, see [`Bvh::descend`]), so the hits are the
+    /// same; its children are chosen by selects (`Walk::step`) and sorted without branches
+    /// on AVX2, as the rays of a batch are mostly incoherent.
     #[inline(always)]
     fn walk_pairs<const AVX: bool>(
         &self,
@@ -1886,7 +1890,7 @@ impl Slot {
 
 /// One ray's closest-hit walk through the tree, a node or leaf per [`Walk::step`], for
 /// [`Bvh::walk_pairs`], which alternates two; its traversal stack is kept apart. A lone walk
-/// is [`Bvh::intersect_with`]'s loop, the same steps.
+/// is [`Bvh::intersect_with`]'s loop, the same steps (see [`Bvh::walk_pairs`]).
 struct Walk {
     pre: RayPre,
     slab: SlabRay,
@@ -1935,7 +1939,8 @@ impl Walk {
     /// One or two children entered are told apart and ordered by selects instead of
     /// branches ([`Bvh::descend`]): for incoherent rays, whose branches the processor cannot
     /// predict, that is faster (the one-ray walk, mostly coherent, branches on one child).
-    /// The children visited and their order are the same either way.
+    /// The children visited are the same either way, in the same order but for children
+    /// entered less than 8 ulps apart ([`Bvh::descend`]).
     #[inline(always)]
     fn step<const AVX: bool>(
         &mut self,
