@@ -1045,10 +1045,14 @@ impl Bvh {
                     None => return best,
                 }
             };
-            if let Some(h) = self.leaf::<AVX>(slow, pre, ray, tmin, &mut end, false) {
+            // A copy of the end for the full test, which takes it by reference: the end
+            // itself is never borrowed past the call-free test, so it stays in registers.
+            let mut e = end;
+            if let Some(h) = self.leaf::<AVX>(slow, pre, ray, tmin, &mut e, false) {
                 best = Some(h);
-                reach = widen(end.t);
+                reach = widen(e.t);
             }
+            end = e;
             match pop(&stack, &mut sp, reach) {
                 Some(next) => node_ref = next,
                 None => return best,
@@ -1853,9 +1857,11 @@ impl<T: Copy> Stack<T> {
 
     #[inline(always)]
     fn get(&self, i: usize) -> T {
+        debug_assert!(i < STACK);
         // SAFETY: the traversals read slot i only after pushing it (the stack pointer never
-        // passes the highest slot written), so it holds an initialized value.
-        unsafe { self.items[i].assume_init() }
+        // passes the highest slot written), so it lies in the stack (`push` and `eight`
+        // check their slots) and holds an initialized value.
+        unsafe { self.items.get_unchecked(i).assume_init() }
     }
 }
 
