@@ -1036,7 +1036,7 @@ impl Bvh {
                         continue;
                     }
                     if mask != 0 {
-                        node_ref = self.descend::<false, true>(n, &near, mask, &mut stack, &mut sp);
+                        node_ref = self.descend::<true, AVX>(n, &near, mask, &mut stack, &mut sp);
                         continue;
                     }
                 }
@@ -1062,20 +1062,24 @@ impl Bvh {
 
     /// Orders the children of `n` entered (`mask`, not empty) by their entries `near`,
     /// nearest first (the lower slot first of equals), pushes all but the nearest onto
-    /// `stack` at `*sp`, farthest first, and returns the nearest. One or two children are
-    /// told apart and ordered by selects rather than branches (one is pushed and popped
-    /// again at once: `*sp` does not move). More are sorted one by one, or with `NETWORK`
-    /// (only in walks compiled for AVX2) by a sorting network without branches
-    /// ([`crate::order::sort_entered_avx2`], which orders entries less than 8 ulps apart
-    /// by slot): faster for the paired walks of batches, whose rays are incoherent
-    /// (random rays in batches 3.3% faster), slower for a lone walk, whose branches are
-    /// predicted for coherent rays (primary rays 2.2% slower, random ones 2.1% faster).
-    /// Any order finds the same hit (see [`widen`]). With `PREFETCH`, the next child on
-    /// the stack is prefetched: worth it in a lone walk ([`Bvh::intersect_with`]), not in the paired
-    /// walks of batches ([`Bvh::walk_pairs`]), which overlap their misses already and
-    /// render 2-7% faster without it.
+    /// `stack` at `*sp`, farthest first, and returns the nearest. Any order finds the same
+    /// hit (see [`widen`]); the two kinds of walk order children in the ways that are
+    /// fastest for their rays (in-process A/B on the 56k-triangle bunny, 5 passes):
+    /// - `LONE`, a lone walk ([`Bvh::intersect_with`]), whose rays are mostly coherent
+    ///   and its branches predicted: two children by a branch (primary rays 3.5% faster
+    ///   than by selects), more one by one (a sorting network made them 2.2% slower); the
+    ///   next child on the stack is prefetched (random rays 3.7% faster, primary rays 1.9%
+    ///   slower than without).
+    /// - Else the paired walks of batches ([`Bvh::walk_pairs`]), whose rays are
+    ///   incoherent: one or two children are told apart and ordered by selects (one is
+    ///   pushed and popped again at once: `*sp` does not move); more, with `AVX` (walks
+    ///   compiled for AVX2), by a sorting network without branches
+    ///   ([`crate::order::sort_entered_avx2`], which orders entries less than 8 ulps
+    ///   apart by slot; random rays 3.3% faster), else one by one. Nothing is
+    ///   prefetched: these walks overlap their misses already, and render 2-7% faster
+    ///   without.
     #[inline(always)]
-    fn descend<const NETWORK: bool, const PREFETCH: bool>(
+    fn descend<const LONE: bool, const AVX: bool>(
         &self,
         n: &Node8,
         near: &[f32; 8],
@@ -1091,6 +1095,34 @@ impl Bvh {
             // below orders them.
             let first = mask.trailing_zeros() as usize;
             let last = 31 - mask.leading_zeros() as usize;
+            if LONE {
+                debug_assert!(rest != 0, "a lone walk goes on to a lone child itself");
+                let (a, b) = (n.child[first], n.child[last]);
+                let (ta, tb) = (near[first], near[last]);
+                // Each arm pushes and returns, so that this stays a branch.
+                if tb < ta {
+                    stack.push(
+                        *sp,
+                        Pending {
+                            node: a,
+                            t_near: ta,
+                        },
+                    );
+                    *sp += 1;
+                    self.prefetch(a);
+                    return b;
+                }
+                stack.push(
+                    *sp,
+                    Pending {
+                        node: b,
+                        t_near: tb,
+                    },
+                );
+                *sp += 1;
+                self.prefetch(b);
+                return a;
+            }
             let swap = near[last] < near[first];
             let (a, b) = if swap { (last, first) } else { (first, last) };
             stack.push(
@@ -1101,22 +1133,16 @@ impl Bvh {
                 },
             );
             *sp += usize::from(rest != 0);
-            if PREFETCH {
-                self.prefetch(n.child[b]);
-            }
             return n.child[a];
         }
         #[cfg(target_arch = "x86_64")]
-        if NETWORK {
-            // SAFETY: `NETWORK` is true only in the walks compiled for AVX2, which their
-            // callers enter after detecting it; three or more children are entered, none
-            // with a NaN entry (the node tests enter no such child).
-            let (nearest, second, pushed) =
+        if AVX && !LONE {
+            // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
+            // enter after detecting it; three or more children are entered, none with a
+            // NaN entry (the node tests enter no such child).
+            let (nearest, pushed) =
                 unsafe { crate::order::sort_entered_avx2(near, &n.child, mask, stack.eight(*sp)) };
             *sp += pushed;
-            if PREFETCH {
-                self.prefetch(second);
-            }
             return nearest;
         }
         let i = mask.trailing_zeros() as usize;
@@ -1140,7 +1166,7 @@ impl Bvh {
             stack.push(*sp, Pending { node, t_near });
             *sp += 1;
         }
-        if PREFETCH {
+        if LONE {
             // The second nearest is likely visited next after the nearest's subtree.
             self.prefetch(hits[1].0);
         }
@@ -1980,7 +2006,7 @@ impl Walk {
                 mask &= !skip;
             }
             if mask != 0 {
-                self.node = bvh.descend::<AVX, false>(n, &near, mask, stack, &mut self.sp);
+                self.node = bvh.descend::<false, AVX>(n, &near, mask, stack, &mut self.sp);
                 return true;
             }
         }

@@ -49,7 +49,7 @@ const fn max_lanes(k: i32, j: i32) -> i32 {
 /// orders as the floats do, the three lowest replaced by the slot, so entries less than
 /// 8 ulps apart are ordered by slot), and writes them to `out`, the nearest last: the
 /// first `n - 1` of the `n` children are the ones to push, in order, and the rest of `out`
-/// is scratch. Returns the nearest child, the second nearest and `n - 1`.
+/// is scratch. Returns the nearest child and `n - 1`.
 /// No branch: a bitonic sorting network of six steps on the eight lanes, the children
 /// not entered keyed below every entered one.
 ///
@@ -63,7 +63,7 @@ pub(crate) unsafe fn sort_entered_avx2(
     child: &[u32; 8],
     mask: u32,
     out: &mut [std::mem::MaybeUninit<Pending>; 8],
-) -> (u32, u32, usize) {
+) -> (u32, usize) {
     use std::arch::x86_64::{
         __m256i, _mm256_and_si256, _mm256_blend_epi32, _mm256_blendv_epi8, _mm256_castps_si256,
         _mm256_castsi256_si128, _mm256_cmpeq_epi32, _mm256_loadu_ps, _mm256_loadu_si256,
@@ -118,11 +118,9 @@ pub(crate) unsafe fn sort_entered_avx2(
         _mm256_storeu_si256(dst, _mm256_permute2x128_si256::<0x20>(lo, hi));
         _mm256_storeu_si256(dst.add(1), _mm256_permute2x128_si256::<0x31>(lo, hi));
         let pushed = usize::from(BITS_SET[(mask & 0xff) as usize]) - 1;
-        let lane = |i: usize| {
-            let at = _mm256_permutevar8x32_epi32(kids, _mm256_set1_epi32(i as i32));
-            _mm_cvtsi128_si32(_mm256_castsi256_si128(at)) as u32
-        };
-        (lane(pushed), lane(pushed - 1), pushed)
+        let at = _mm256_permutevar8x32_epi32(kids, _mm256_set1_epi32(pushed as i32));
+        let nearest = _mm_cvtsi128_si32(_mm256_castsi256_si128(at)) as u32;
+        (nearest, pushed)
     }
 }
 
@@ -214,8 +212,7 @@ mod tests {
                 t_near: 0.0,
             }); 8];
             // SAFETY: AVX2 was detected; no entry is NaN.
-            let (nearest, second, pushed) =
-                unsafe { sort_entered_avx2(&near, &child, mask, &mut out) };
+            let (nearest, pushed) = unsafe { sort_entered_avx2(&near, &child, mask, &mut out) };
             assert_eq!(pushed, want.len() - 1);
             for (i, &s) in want.iter().enumerate() {
                 // SAFETY: the network wrote all eight.
@@ -224,7 +221,6 @@ mod tests {
                 assert_eq!(got.t_near.to_bits(), near[s].to_bits());
             }
             assert_eq!(nearest, child[want[pushed]]);
-            assert_eq!(second, child[want[pushed - 1]]);
         }
     }
 }
