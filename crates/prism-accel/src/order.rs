@@ -45,13 +45,13 @@ const fn max_lanes(k: i32, j: i32) -> i32 {
 }
 
 /// Orders the children of `mask` (at least three of the eight slots) by their entries
-/// `near`, farthest first (descending by a key: the entry's bits as an integer that
-/// orders as the floats do, the three lowest replaced by the slot, so entries less than
-/// 8 ulps apart are ordered by slot), and writes them to `out`, the nearest last: the
-/// first `n - 1` of the `n` children are the ones to push, in order, and the rest of `out`
-/// is scratch. Returns the nearest child and `n - 1`.
-/// No branch: a bitonic sorting network of six steps on the eight lanes, the children
-/// not entered keyed below every entered one.
+/// `near`, farthest first, and writes them to `out`, the nearest last: the first `n - 1`
+/// of the `n` children are the ones to push, in order, and the rest of `out` is scratch.
+/// Returns the nearest child and `n - 1`. The order is descending by a key: the entry's
+/// bits as an integer that orders as the floats do, the three lowest replaced by the
+/// slot, so entries that differ only in those bits (less than 8 ulps apart) are ordered
+/// by slot. No branch: a bitonic sorting network of six steps on the eight lanes, the
+/// children not entered keyed below every entered one.
 ///
 /// # Safety
 /// The processor must support AVX2. No entered slot's entry may be NaN (the node tests
@@ -128,11 +128,11 @@ pub(crate) unsafe fn sort_entered_avx2(
 mod tests {
     use super::*;
 
-    /// The order key of entry distance `t` in slot `slot`: the float's bits as an integer that
-    /// orders as the floats do (a negative float's other bits flipped), its three lowest bits
-    /// replaced by the slot. Keys of distances more than 8 ulps apart order as the distances
-    /// do; closer ones (a tie among them) by slot. [`sort_entered_avx2`] computes these keys
-    /// on lanes.
+    /// The order key of entry distance `t` in slot `slot`: the float's bits as an integer
+    /// that orders as the floats do (a negative float's other bits flipped), its three
+    /// lowest bits replaced by the slot. Keys of distances 8 ulps apart or more order as
+    /// the distances do; closer ones may be ordered by slot instead. [`sort_entered_avx2`]
+    /// computes these keys on lanes.
     fn key(t: f32, slot: usize) -> i32 {
         let bits = t.to_bits() as i32;
         let ordered = bits ^ ((bits >> 31) as u32 >> 1) as i32;
