@@ -739,7 +739,7 @@ impl Bvh {
     ) -> Option<Hit> {
         let rec = self.leaf_rec(r);
         let weights = self
-            .leaf_packs::<AVX, false>(&rec, pre, tmin, end, any)
+            .leaf_packs::<AVX, false, false>(&rec, pre, tmin, end, any)
             .unwrap_or_else(|SlowLeaf| unreachable!("only the deferring test defers a leaf"));
         if rec.spheres != 0 && !(any && weights.is_some()) {
             if let Some(h) = self.leaf_spheres(&rec, ray, tmin, end, any) {
@@ -760,7 +760,7 @@ impl Bvh {
     /// function of exactly zero; `end` is then as given, for [`Bvh::leaf`] to decide the
     /// leaf.
     #[inline(always)]
-    fn leaf_fast<const AVX: bool>(
+    fn leaf_fast<const AVX: bool, const WIDE: bool>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -772,7 +772,7 @@ impl Bvh {
         if rec.spheres != 0 {
             return Err(SlowLeaf);
         }
-        let weights = self.leaf_packs::<AVX, true>(&rec, pre, tmin, end, any)?;
+        let weights = self.leaf_packs::<AVX, WIDE, true>(&rec, pre, tmin, end, any)?;
         Ok(weights.map(|(b1, b2)| Hit {
             t: end.t,
             prim: end.prim,
@@ -785,9 +785,12 @@ impl Bvh {
     /// hit it admits (with `any`, to the first), and returns the barycentric weights of the
     /// last (none: `end` is as given). With `DEFER`, by the lane tests alone, which call no
     /// function, and [`SlowLeaf`] with `end` as given if one meets an edge function of
-    /// exactly zero; without, never [`SlowLeaf`].
+    /// exactly zero; without, never [`SlowLeaf`]. With `WIDE` (walks compiled for
+    /// AVX-512) and `DEFER`, a leaf of three or four packs is one test on sixteen lanes
+    /// ([`Tri4::intersect_four_fast`]), which finds the same closest hit (and, with `any`,
+    /// a hit if there is one).
     #[inline(always)]
-    fn leaf_packs<const AVX: bool, const DEFER: bool>(
+    fn leaf_packs<const AVX: bool, const WIDE: bool, const DEFER: bool>(
         &self,
         rec: &LeafRec,
         pre: &RayPre,
@@ -804,6 +807,28 @@ impl Bvh {
         // placed by `Bvh::plan_leaf` and every placed pack is filled by
         // `Bvh::pack_leaves`; packs are never removed.
         let mut packs = unsafe { self.packs.get_unchecked(range) };
+        #[cfg(target_arch = "x86_64")]
+        if WIDE && DEFER && (3..=4).contains(&packs.len()) {
+            // Four packs, or three with the third named again in the last lanes, which
+            // `valid` leaves out: chosen without a branch, which would be mispredicted on
+            // incoherent rays. (Leaves of more, which only primitives that cannot be
+            // separated make, are tested by the loop below.)
+            let n = packs.len();
+            let four = [&packs[0], &packs[1], &packs[2], &packs[n - 1]];
+            let valid = 0xffff >> (16 - 4 * n);
+            // SAFETY: `WIDE` is true only in the walks compiled for AVX-512 (F, DQ and VL),
+            // which their callers enter after detecting it.
+            let found = unsafe { Tri4::intersect_four_fast(four, valid, pre, tmin, e) }
+                .map_err(|EdgeOnZero| SlowLeaf)?;
+            let Some((t, lane, b1, b2)) = found else {
+                return Ok(None);
+            };
+            *end = Limit {
+                t,
+                prim: four[lane / 4].prim[lane % 4],
+            };
+            return Ok(Some((b1, b2)));
+        }
         while let [a, rest @ ..] = packs {
             // The pack of lanes 4..8 (the first again when tested alone).
             let (found, second) = match rest {
@@ -951,18 +976,19 @@ impl Bvh {
     /// stack of kilobytes) would be set up at every call, whichever walk the call takes.
     #[inline(never)]
     fn intersect_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<false>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<false, false>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX-512VL: the same 256-bit operations, with twice
-    /// the registers.
+    /// the registers, and leaves of three or four packs tested on sixteen lanes
+    /// (`leaf_packs`' `WIDE`).
     ///
     /// # Safety
     /// The processor must support AVX-512VL.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn intersect_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<true, true>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX2 and FMA.
@@ -972,13 +998,13 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<true, false>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// The closest hit with `tmin < t < tmax` (the lowest primitive number of equals), in the
     /// part of the tree `start` names.
     #[inline(always)]
-    fn intersect_with<const AVX: bool>(
+    fn intersect_with<const AVX: bool, const WIDE: bool>(
         &self,
         ray: &Ray,
         tmin: f32,
@@ -988,15 +1014,15 @@ impl Bvh {
         let (pre, slab) = set_up::<AVX>(ray);
         // One loop per node test, so that each keeps only its own per-ray values live.
         if AVX && slab.fused() {
-            self.walk_one::<AVX, true>(ray, (&pre, &slab), tmin, tmax, start)
+            self.walk_one::<AVX, WIDE, true>(ray, (&pre, &slab), tmin, tmax, start)
         } else {
-            self.walk_one::<AVX, false>(ray, (&pre, &slab), tmin, tmax, start)
+            self.walk_one::<AVX, WIDE, false>(ray, (&pre, &slab), tmin, tmax, start)
         }
     }
 
     /// [`Bvh::intersect_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
     #[inline(always)]
-    fn walk_one<const AVX: bool, const FUSED: bool>(
+    fn walk_one<const AVX: bool, const WIDE: bool, const FUSED: bool>(
         &self,
         ray: &Ray,
         (pre, slab): (&RayPre, &SlabRay),
@@ -1015,7 +1041,7 @@ impl Bvh {
             // after this loop, so that no call clobbers the registers it keeps.
             let slow = loop {
                 if node_ref & LEAF != 0 {
-                    match self.leaf_fast::<AVX>(node_ref, pre, tmin, &mut end, false) {
+                    match self.leaf_fast::<AVX, WIDE>(node_ref, pre, tmin, &mut end, false) {
                         Ok(Some(h)) => {
                             best = Some(h);
                             reach = widen(end.t);
@@ -1206,14 +1232,14 @@ impl Bvh {
     /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
     /// at once ([`Bvh::walk_pairs`]).
     #[inline(always)]
-    fn intersect_pairs<const AVX: bool>(
+    fn intersect_pairs<const AVX: bool, const WIDE: bool>(
         &self,
         rays: &[Ray],
         tmin: f32,
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.walk_pairs::<AVX>(rays, tmin, (rays.len(), |k| (k, tmax, Start::ROOT)), hits);
+        self.walk_pairs::<AVX, WIDE>(rays, tmin, (rays.len(), |k| (k, tmax, Start::ROOT)), hits);
     }
 
     /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
@@ -1225,7 +1251,7 @@ impl Bvh {
     /// same; its children are chosen by selects (`Walk::step`) and sorted without branches
     /// on AVX2, as the rays of a batch are mostly incoherent.
     #[inline(always)]
-    fn walk_pairs<const AVX: bool>(
+    fn walk_pairs<const AVX: bool, const WIDE: bool>(
         &self,
         rays: &[Ray],
         tmin: f32,
@@ -1235,7 +1261,7 @@ impl Bvh {
         if n < 2 {
             for (k, hit) in hits.iter_mut().enumerate().take(n) {
                 let (i, tmax, start) = job(k);
-                *hit = self.intersect_with::<AVX>(&rays[i], tmin, tmax, start);
+                *hit = self.intersect_with::<AVX, WIDE>(&rays[i], tmin, tmax, start);
             }
             return;
         }
@@ -1243,8 +1269,8 @@ impl Bvh {
         let mut b = Slot::start::<AVX>(rays, &job, 1);
         let mut next = 2;
         let (walks, out) = ((rays, tmin, (n, &job)), hits);
-        while self.pair_step::<AVX>(walks, out, &mut a, &mut b, &mut next)
-            && self.pair_step::<AVX>(walks, out, &mut b, &mut a, &mut next)
+        while self.pair_step::<AVX, WIDE>(walks, out, &mut a, &mut b, &mut next)
+            && self.pair_step::<AVX, WIDE>(walks, out, &mut b, &mut a, &mut next)
         {}
     }
 
@@ -1253,7 +1279,7 @@ impl Bvh {
     /// is finished, and the answer is false: all are done.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
-    fn pair_step<const AVX: bool>(
+    fn pair_step<const AVX: bool, const WIDE: bool>(
         &self,
         (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, Start))),
         hits: &mut [Option<Hit>],
@@ -1263,17 +1289,19 @@ impl Bvh {
     ) -> bool {
         if slot
             .walk
-            .step::<AVX>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
+            .step::<AVX, WIDE>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
         {
             return true;
         }
         hits[slot.query] = slot.walk.best;
         if *next == n {
-            while other
-                .walk
-                .step::<AVX>(self, &rays[other.ray], tmin, other.skip, &mut other.stack)
-            {
-            }
+            while other.walk.step::<AVX, WIDE>(
+                self,
+                &rays[other.ray],
+                tmin,
+                other.skip,
+                &mut other.stack,
+            ) {}
             hits[other.query] = other.walk.best;
             return false;
         }
@@ -1344,7 +1372,7 @@ impl Bvh {
     /// pairs.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_with(
+    fn intersect_batch_with<const WIDE: bool>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1358,7 +1386,12 @@ impl Bvh {
         while i + width <= rays.len() {
             let group = &rays[i..i + width];
             if crate::packet::coherent(group, width) {
-                self.intersect_pairs::<true>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
+                self.intersect_pairs::<true, WIDE>(
+                    &rays[loose..i],
+                    tmin,
+                    tmax,
+                    &mut hits[loose..i],
+                );
                 let query = Query {
                     rays: group,
                     tmin,
@@ -1371,13 +1404,13 @@ impl Bvh {
                     let lane = defer.trailing_zeros() as usize;
                     defer &= defer - 1;
                     hits[i + lane] =
-                        self.intersect_with::<true>(&group[lane], tmin, tmax, Start::ROOT);
+                        self.intersect_with::<true, WIDE>(&group[lane], tmin, tmax, Start::ROOT);
                 }
                 loose = i + width;
             }
             i += width;
         }
-        self.intersect_pairs::<true>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
+        self.intersect_pairs::<true, WIDE>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
     }
 
     /// [`Bvh::intersect_batch`] through the root's list ([`Flat`]): `width` rays at a time
@@ -1386,7 +1419,7 @@ impl Bvh {
     /// rays or more enter, else ray by ray. Inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn intersect_batch_list(
+    fn intersect_batch_list<const WIDE: bool>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1404,7 +1437,7 @@ impl Bvh {
             let lanes = closest(rays, hits);
             let tree = lanes.need & !lanes.defer;
             if 2 * tree.count_ones() as usize >= width && crate::packet::coherent(rays, width) {
-                self.list_packet(rays, (tmin, tmax), hits, (flat, lanes), &packet);
+                self.list_packet::<WIDE>(rays, (tmin, tmax), hits, (flat, lanes), &packet);
                 continue;
             }
             // The list's hits stand, but in the lanes that must consult the tree.
@@ -1424,14 +1457,14 @@ impl Bvh {
             }
         }
         let mut found = vec![None; jobs.len()];
-        self.walk_pairs::<true>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
+        self.walk_pairs::<true, WIDE>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
         for ((&(i, ..), all), h) in jobs.iter().zip(whole).zip(found) {
             hits[i] = match h {
                 _ if all => h,
                 // Two primitives at one distance: the walk over the whole tree decides, by
                 // primitive number.
                 Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
-                    self.intersect_with::<true>(&rays[i], tmin, tmax, Start::ROOT)
+                    self.intersect_with::<true, WIDE>(&rays[i], tmin, tmax, Start::ROOT)
                 }
                 Some(h) => Some(h),
                 None => hits[i],
@@ -1445,7 +1478,7 @@ impl Bvh {
     /// the list meet one distance, take the one-ray walk over the whole tree.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn list_packet(
+    fn list_packet<const WIDE: bool>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -1476,7 +1509,7 @@ impl Bvh {
                 || (tree & bit != 0
                     && found[lane].is_some_and(|h| list[lane].is_some_and(|n| n.t == h.t)));
             if whole {
-                *hit = self.intersect_with::<true>(&rays[lane], tmin, tmax, Start::ROOT);
+                *hit = self.intersect_with::<true, WIDE>(&rays[lane], tmin, tmax, Start::ROOT);
             } else if tree & bit != 0 && found[lane].is_some() {
                 *hit = found[lane];
             }
@@ -1497,7 +1530,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(
+        self.intersect_batch_list::<true>(
             rays,
             (tmin, tmax),
             hits,
@@ -1522,7 +1555,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list(
+        self.intersect_batch_list::<false>(
             rays,
             (tmin, tmax),
             hits,
@@ -1536,7 +1569,7 @@ impl Bvh {
     /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_list`].
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn occluded_batch_list(
+    fn occluded_batch_list<const WIDE: bool>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, &[f32]),
@@ -1553,9 +1586,9 @@ impl Bvh {
                 *b = if lanes.blocked & bit != 0 {
                     true
                 } else if lanes.defer & bit != 0 {
-                    self.occluded_with::<true>(ray, tmin, end, Start::ROOT)
+                    self.occluded_with::<true, WIDE>(ray, tmin, end, Start::ROOT)
                 } else if lanes.need & bit != 0 {
-                    self.occluded_with::<true>(ray, tmin, end, flat.start(lanes.inner[lane]))
+                    self.occluded_with::<true, WIDE>(ray, tmin, end, flat.start(lanes.inner[lane]))
                 } else {
                     false
                 };
@@ -1577,7 +1610,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
+        self.occluded_batch_list::<true>(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
             // SAFETY: the processor has AVX-512F.
             unsafe { crate::flat::occluded_avx512(flat, r, tmin, e) }
         });
@@ -1597,14 +1630,15 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
+        self.occluded_batch_list::<false>(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
             // SAFETY: the processor has AVX2.
             unsafe { crate::flat::occluded_avx2(flat, r, tmin, e) }
         });
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX-512VL: the same 256-bit operations, with
-    /// one-instruction broadcasts and twice the registers.
+    /// one-instruction broadcasts and twice the registers, and leaves of three or four packs
+    /// tested on sixteen lanes.
     ///
     /// # Safety
     /// The processor must support AVX-512VL.
@@ -1617,7 +1651,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
+        self.intersect_batch_with::<true>(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
             // SAFETY: the processor has AVX-512VL, hence AVX-512F.
             unsafe { crate::packet::closest_avx512(self, q, h) }
         });
@@ -1636,7 +1670,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
+        self.intersect_batch_with::<false>(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
             // SAFETY: the processor has AVX2.
             unsafe { crate::packet::closest_avx2(self, q, h) }
         });
@@ -1699,13 +1733,20 @@ impl Bvh {
     /// The loop of [`Bvh::occluded_batch`], inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn occluded_batch_with(&self, rays: &[Ray], tmin: f32, tmax: &[f32], blocked: &mut [bool]) {
+    fn occluded_batch_with<const WIDE: bool>(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &[f32],
+        blocked: &mut [bool],
+    ) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true>(ray, tmin, t, Start::ROOT);
+            *b = self.occluded_with::<true, WIDE>(ray, tmin, t, Start::ROOT);
         }
     }
 
-    /// [`Bvh::occluded_batch`] compiled for AVX-512VL.
+    /// [`Bvh::occluded_batch`] compiled for AVX-512VL (leaves of three or four packs on
+    /// sixteen lanes).
     ///
     /// # Safety
     /// The processor must support AVX-512VL.
@@ -1718,7 +1759,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with(rays, tmin, tmax, blocked);
+        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX2.
@@ -1734,7 +1775,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with(rays, tmin, tmax, blocked);
+        self.occluded_batch_with::<false>(rays, tmin, tmax, blocked);
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
@@ -1760,17 +1801,18 @@ impl Bvh {
     /// [`Bvh::occluded`] without AVX, never inlined (as [`Bvh::intersect_sse`]).
     #[inline(never)]
     fn occluded_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<false>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<false, false>(ray, tmin, tmax, Start::ROOT)
     }
 
-    /// [`Bvh::occluded`] compiled for AVX-512VL.
+    /// [`Bvh::occluded`] compiled for AVX-512VL (leaves of three or four packs on sixteen
+    /// lanes).
     ///
     /// # Safety
     /// The processor must support AVX-512VL.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     unsafe fn occluded_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<true, true>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::occluded`] compiled for AVX2 and FMA.
@@ -1780,13 +1822,13 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<true, false>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax`, in the part of the tree
     /// `start` names.
     #[inline(always)]
-    fn occluded_with<const AVX: bool>(
+    fn occluded_with<const AVX: bool, const WIDE: bool>(
         &self,
         ray: &Ray,
         tmin: f32,
@@ -1795,15 +1837,15 @@ impl Bvh {
     ) -> bool {
         let (r, slab) = set_up::<AVX>(ray);
         if AVX && slab.fused() {
-            self.occluded_one::<AVX, true>(ray, (&r, &slab), tmin, tmax, start)
+            self.occluded_one::<AVX, WIDE, true>(ray, (&r, &slab), tmin, tmax, start)
         } else {
-            self.occluded_one::<AVX, false>(ray, (&r, &slab), tmin, tmax, start)
+            self.occluded_one::<AVX, WIDE, false>(ray, (&r, &slab), tmin, tmax, start)
         }
     }
 
     /// [`Bvh::occluded_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
     #[inline(always)]
-    fn occluded_one<const AVX: bool, const FUSED: bool>(
+    fn occluded_one<const AVX: bool, const WIDE: bool, const FUSED: bool>(
         &self,
         ray: &Ray,
         (r, slab): (&RayPre, &SlabRay),
@@ -1819,7 +1861,13 @@ impl Bvh {
             // `Bvh::walk_one`).
             let slow = loop {
                 if node_ref & LEAF != 0 {
-                    match self.leaf_fast::<AVX>(node_ref, r, tmin, &mut Limit::end(tmax), true) {
+                    match self.leaf_fast::<AVX, WIDE>(
+                        node_ref,
+                        r,
+                        tmin,
+                        &mut Limit::end(tmax),
+                        true,
+                    ) {
                         Ok(Some(_)) => return true,
                         Ok(None) => {}
                         Err(SlowLeaf) => break node_ref,
@@ -2004,7 +2052,7 @@ impl Walk {
     /// The children visited are the same either way, in the same order but for children
     /// entered less than 8 ulps apart ([`Bvh::descend`]).
     #[inline(always)]
-    fn step<const AVX: bool>(
+    fn step<const AVX: bool, const WIDE: bool>(
         &mut self,
         bvh: &Bvh,
         ray: &Ray,
@@ -2014,13 +2062,13 @@ impl Walk {
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
-            let found = match bvh.leaf_fast::<AVX>(node_ref, &self.pre, tmin, &mut self.end, false)
-            {
-                Ok(found) => found,
-                Err(SlowLeaf) => {
-                    bvh.leaf_apart::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.end, false)
-                }
-            };
+            let found =
+                match bvh.leaf_fast::<AVX, WIDE>(node_ref, &self.pre, tmin, &mut self.end, false) {
+                    Ok(found) => found,
+                    Err(SlowLeaf) => {
+                        bvh.leaf_apart::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.end, false)
+                    }
+                };
             if let Some(h) = found {
                 self.best = Some(h);
                 self.reach = widen(self.end.t);
@@ -2519,11 +2567,14 @@ mod tests {
                 let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
                 assert_eq!(
                     avx,
-                    bvh.intersect_with::<false>(&ray, 0.0, f32::INFINITY, Start::ROOT)
+                    bvh.intersect_with::<false, false>(&ray, 0.0, f32::INFINITY, Start::ROOT)
                 );
                 // SAFETY: as above.
                 let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
-                assert_eq!(occ, bvh.occluded_with::<false>(&ray, 0.0, 5.0, Start::ROOT));
+                assert_eq!(
+                    occ,
+                    bvh.occluded_with::<false, false>(&ray, 0.0, 5.0, Start::ROOT)
+                );
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");
@@ -2534,7 +2585,8 @@ mod tests {
     /// it moves to) or defers the leaf, and defers only a leaf with spheres or one where a
     /// pack's lane test meets an edge function of exactly zero. Small integer coordinates
     /// make such edges common; both occur here, as do hits, for closest and any hits, with
-    /// and without AVX.
+    /// and without AVX, and on AVX-512's sixteen lanes (where, with `any`, the answer may
+    /// be another of the leaf's hits than the full test's first).
     #[test]
     fn call_free_leaf_test_equals_the_full_one_or_defers() {
         let mut rng = Pcg32::new(13, 4);
@@ -2568,7 +2620,11 @@ mod tests {
                     .is_err()
             })
         };
-        let (mut same, mut deferred, mut hits) = (0, 0, 0);
+        let (mut same, mut deferred, mut hits, mut wide) = (0, 0, 0, 0);
+        #[cfg(target_arch = "x86_64")]
+        let wide_paths = std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512vl");
         for k in 0..3000 {
             let o =
                 Vec3::new(c(), c(), c()) * 1.5 + Vec3::splat(if k % 2 == 0 { 0.0 } else { 0.3 });
@@ -2605,15 +2661,33 @@ mod tests {
                             }
                         };
                     let mut end = end0;
-                    let fast = bvh.leaf_fast::<false>(r, &pre, 0.0, &mut end, any);
+                    let fast = bvh.leaf_fast::<false, false>(r, &pre, 0.0, &mut end, any);
                     let (s, d, h) = check(fast, end, false);
                     (same, deferred, hits) = (same + s, deferred + d, hits + h);
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
                         // The `AVX` code paths, on a processor with AVX2 (detected above).
                         let mut end = end0;
-                        let fast = bvh.leaf_fast::<true>(r, &pre, 0.0, &mut end, any);
+                        let fast = bvh.leaf_fast::<true, false>(r, &pre, 0.0, &mut end, any);
                         check(fast, end, true);
+                    }
+                    #[cfg(target_arch = "x86_64")]
+                    if wide_paths {
+                        // The `WIDE` code paths, which test three or four packs on sixteen
+                        // lanes: with `any`, a hit of the leaf's, perhaps not the full
+                        // test's first one.
+                        let mut end = end0;
+                        let fast = bvh.leaf_fast::<true, true>(r, &pre, 0.0, &mut end, any);
+                        if any && matches!(fast, Ok(Some(_))) {
+                            let mut all = end0;
+                            let first = bvh.leaf::<true>(r, &pre, &ray, 0.0, &mut all, false);
+                            assert!(first.is_some(), "ray {k} leaf {r:#x}");
+                            assert!(end.t >= all.t && end.t <= end0.t);
+                            wide += 1;
+                        } else {
+                            let (s, ..) = check(fast, end, true);
+                            wide += s;
+                        }
                     }
                 }
             }
@@ -2621,6 +2695,11 @@ mod tests {
         assert!(
             same > 10_000 && deferred > 1000 && hits > 1000,
             "{same} answered, {deferred} deferred, {hits} hits"
+        );
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            !wide_paths || wide > 10_000,
+            "{wide} answered on sixteen lanes"
         );
     }
 
