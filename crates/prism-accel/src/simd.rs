@@ -1,5 +1,5 @@
-//! [`Simd`], the vector operations the list's queries (`flat`) are written in, once, for
-//! two register widths: sixteen lanes of AVX-512 ([`Avx512`]) and eight of AVX2 ([`Avx2`]).
+//! [`Simd`], the vector operations the list's queries (`flat`) and the packs' lane test
+//! (`tri4`) are written in, once, for two register widths: sixteen lanes of AVX-512 ([`Avx512`]) and eight of AVX2 ([`Avx2`]).
 //! Each operation is the same IEEE arithmetic on every width, so both give the same bits.
 
 use std::arch::x86_64::*;
@@ -18,6 +18,8 @@ pub(crate) trait Simd {
     type I: Copy;
     /// A lane mask.
     type M: Copy;
+    /// `W` floats: a vector's lanes in memory.
+    type Floats: Default + AsRef<[f32]> + AsMut<[f32]>;
 
     /// Every lane `x`.
     unsafe fn splat(x: f32) -> Self::F;
@@ -56,6 +58,9 @@ pub(crate) trait Simd {
     unsafe fn cmp_and<const P: i32>(m: Self::M, a: Self::F, b: Self::F) -> Self::M;
     /// The lanes of `m` where `a`, `b` and `c` have the same sign bit.
     unsafe fn same_sign(m: Self::M, a: Self::F, b: Self::F, c: Self::F) -> Self::M;
+    /// The lanes where `a`, `b` and `c` do not all have the same sign bit, as bits (lane 0
+    /// lowest): [`Simd::same_sign`]'s complement, straight to bits.
+    unsafe fn sign_differs(a: Self::F, b: Self::F, c: Self::F) -> u16;
     /// `b` in the lanes of `m`, `a` in the others.
     unsafe fn select(m: Self::M, a: Self::F, b: Self::F) -> Self::F;
     /// `b` in the lanes of `m`, `a` in the others.
@@ -104,6 +109,7 @@ impl Simd for Avx512 {
     type F = __m512;
     type I = __m512i;
     type M = __mmask16;
+    type Floats = [f32; 16];
 
     #[inline(always)]
     unsafe fn splat(x: f32) -> __m512 {
@@ -179,6 +185,12 @@ impl Simd for Avx512 {
         // `(a ^ b) | (a ^ c)`: every bit but those where the three agree.
         let differ = _mm512_ternarylogic_epi32::<0x7e>(a, b, c);
         _mm512_mask_testn_epi32_mask(m, differ, _mm512_set1_epi32(i32::MIN))
+    }
+    #[inline(always)]
+    unsafe fn sign_differs(a: __m512, b: __m512, c: __m512) -> u16 {
+        let [a, b, c] = [a, b, c].map(|x| _mm512_castps_si512(x));
+        let differ = _mm512_ternarylogic_epi32::<0x7e>(a, b, c);
+        _mm512_test_epi32_mask(differ, _mm512_set1_epi32(i32::MIN))
     }
     #[inline(always)]
     unsafe fn select(m: __mmask16, a: __m512, b: __m512) -> __m512 {
@@ -271,6 +283,7 @@ impl Simd for Avx2 {
     type F = __m256;
     type I = __m256i;
     type M = __m256;
+    type Floats = [f32; 8];
 
     #[inline(always)]
     unsafe fn splat(x: f32) -> __m256 {
@@ -326,6 +339,10 @@ impl Simd for Avx2 {
         // Every bit of a lane set where the sign bits differ.
         let differ = _mm256_srai_epi32::<31>(_mm256_castps_si256(differ));
         _mm256_andnot_ps(_mm256_castsi256_ps(differ), m)
+    }
+    #[inline(always)]
+    unsafe fn sign_differs(a: __m256, b: __m256, c: __m256) -> u16 {
+        _mm256_movemask_ps(_mm256_or_ps(_mm256_xor_ps(a, b), _mm256_xor_ps(a, c))) as u16
     }
     #[inline(always)]
     unsafe fn le(a: __m256, b: __m256) -> __m256 {

@@ -5,6 +5,8 @@ use prism_math::glam::Vec4;
 use prism_math::Vec3;
 
 use crate::shapes::{intersect_triangle, Limit, RayPre};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{Avx2, Avx512, Simd};
 
 /// A lane test met an edge function of exactly zero, which only the scalar test decides.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -146,7 +148,7 @@ impl Tri4 {
     /// and then `b` up to `a`'s hit, at about the cost of one pack.
     ///
     /// # Safety
-    /// The processor must support AVX.
+    /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) unsafe fn intersect_pair_avx(
@@ -156,7 +158,7 @@ impl Tri4 {
         tmin: f32,
         end: Limit,
     ) -> Option<(f32, usize, f32, f32)> {
-        // SAFETY: the caller ensures AVX.
+        // SAFETY: the caller ensures AVX2.
         unsafe { Tri4::intersect_pair_fast(a, b, r, tmin, end) }.unwrap_or_else(|EdgeOnZero| {
             // The packs one by one, as they decide it.
             let first = a.intersect(r, tmin, end);
@@ -175,7 +177,7 @@ impl Tri4 {
     /// [`EdgeOnZero`]. It calls no function.
     ///
     /// # Safety
-    /// The processor must support AVX.
+    /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) unsafe fn intersect_pair_fast(
@@ -185,15 +187,10 @@ impl Tri4 {
         tmin: f32,
         end: Limit,
     ) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
-        use std::arch::x86_64::{
-            _mm256_add_ps, _mm256_and_ps, _mm256_cmp_ps, _mm256_div_ps, _mm256_movemask_ps,
-            _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_set_m128, _mm256_setzero_ps,
-            _mm256_storeu_ps, _mm256_sub_ps, _mm256_xor_ps, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
-            _CMP_LE_OQ,
-        };
+        use std::arch::x86_64::{_mm256_set1_ps, _mm256_set_m128, _mm256_sub_ps, _mm_load_ps};
         let axes = r.axes();
         let o = r.origin_k;
-        // SAFETY: the caller ensures AVX; each load reads one aligned `Vec4` of a pack (a
+        // SAFETY: the caller ensures AVX2; each load reads one aligned `Vec4` of a pack (a
         // pack is 32-byte aligned and its vectors sit at multiples of 16 bytes).
         unsafe {
             // Macros, not closures: a closure is compiled apart, without AVX.
@@ -209,67 +206,11 @@ impl Tri4 {
                     )
                 };
             }
-            macro_rules! sub {
-                ($x:expr, $y:expr) => {
-                    _mm256_sub_ps($x, $y)
-                };
-            }
-            macro_rules! mul {
-                ($x:expr, $y:expr) => {
-                    _mm256_mul_ps($x, $y)
-                };
-            }
-            let (sx, sy, sz) = (
-                _mm256_set1_ps(r.shear.x),
-                _mm256_set1_ps(r.shear.y),
-                _mm256_set1_ps(r.shear.z),
-            );
-            let (az, bz, cz) = (rel!(0, 2), rel!(1, 2), rel!(2, 2));
-            let ax = sub!(rel!(0, 0), mul!(sx, az));
-            let ay = sub!(rel!(0, 1), mul!(sy, az));
-            let bx = sub!(rel!(1, 0), mul!(sx, bz));
-            let by = sub!(rel!(1, 1), mul!(sy, bz));
-            let cx = sub!(rel!(2, 0), mul!(sx, cz));
-            let cy = sub!(rel!(2, 1), mul!(sy, cz));
-            let u = sub!(mul!(cx, by), mul!(cy, bx));
-            let v = sub!(mul!(ax, cy), mul!(ay, cx));
-            let w = sub!(mul!(bx, ay), mul!(by, ax));
-            let zero = _mm256_setzero_ps();
-            // Lanes where `$cmp` holds for any of the three edge functions.
-            macro_rules! sign {
-                ($cmp:ident) => {
-                    _mm256_or_ps(
-                        _mm256_or_ps(
-                            _mm256_cmp_ps::<$cmp>(u, zero),
-                            _mm256_cmp_ps::<$cmp>(v, zero),
-                        ),
-                        _mm256_cmp_ps::<$cmp>(w, zero),
-                    )
-                };
-            }
-            if _mm256_movemask_ps(sign!(_CMP_EQ_OQ)) != 0 {
-                // An edge function is exactly zero.
-                return Err(EdgeOnZero);
-            }
-            // No edge function is zero: a lane is inside when the three share a sign bit.
-            let differ = _mm256_or_ps(_mm256_xor_ps(u, v), _mm256_xor_ps(u, w));
-            let inside = !_mm256_movemask_ps(differ) as u32 & 0xff;
-            if inside == 0 {
-                return Ok(None);
-            }
-            let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-            let dist = _mm256_add_ps(_mm256_add_ps(mul!(u, az), mul!(v, bz)), mul!(w, cz));
-            let t = mul!(mul!(sz, dist), _mm256_div_ps(_mm256_set1_ps(1.0), det));
-            let within = _mm256_and_ps(
-                _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(tmin)),
-                _mm256_cmp_ps::<_CMP_LE_OQ>(t, _mm256_set1_ps(end.t)),
-            );
-            let mask = inside & _mm256_movemask_ps(within) as u32;
-            if mask == 0 {
-                return Ok(None);
-            }
-            let mut ta = [0f32; 8];
-            _mm256_storeu_ps(ta.as_mut_ptr(), t);
+            let rel = [
+                [rel!(0, 0), rel!(0, 1), rel!(0, 2)],
+                [rel!(1, 0), rel!(1, 1), rel!(1, 2)],
+                [rel!(2, 0), rel!(2, 1), rel!(2, 2)],
+            ];
             let prim = |lane: usize| {
                 if lane < 4 {
                     a.prim[lane]
@@ -277,22 +218,13 @@ impl Tri4 {
                     b.prim[lane - 4]
                 }
             };
-            let best = nearest_lane(mask, &ta, prim);
-            if !end.admits(ta[best], prim(best)) {
-                return Ok(None);
-            }
-            let (mut va, mut wa, mut da) = ([0f32; 8], [0f32; 8], [0f32; 8]);
-            _mm256_storeu_ps(va.as_mut_ptr(), v);
-            _mm256_storeu_ps(wa.as_mut_ptr(), w);
-            _mm256_storeu_ps(da.as_mut_ptr(), det);
-            let inv = 1.0 / da[best];
-            Ok(Some((ta[best], best, va[best] * inv, wa[best] * inv)))
+            lanes_fast::<Avx2>(rel, r, 0xff, (tmin, end), prim)
         }
     }
 
     /// [`Tri4::intersect_pair_fast`] over the sixteen lanes of four packs at once with
     /// 512-bit AVX-512 vectors: lanes `4k..4k + 4` are pack `k`'s, and only the lanes of
-    /// `valid` may hit (a leaf of three packs names its first again as the fourth). The same
+    /// `valid` may hit (a leaf of three packs names its third again as the fourth). The same
     /// operations lane by lane, so the same hit as testing the packs one after another.
     ///
     /// # Safety
@@ -301,98 +233,42 @@ impl Tri4 {
     #[inline(always)]
     pub(crate) unsafe fn intersect_four_fast(
         packs: [&Tri4; 4],
-        valid: u32,
+        valid: u16,
         r: &RayPre,
         tmin: f32,
         end: Limit,
     ) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
         use std::arch::x86_64::{
-            _mm512_add_ps, _mm512_castps128_ps512, _mm512_castps_si512, _mm512_cmp_ps_mask,
-            _mm512_cmplt_epi32_mask, _mm512_div_ps, _mm512_insertf32x4, _mm512_mul_ps,
-            _mm512_or_si512, _mm512_set1_ps, _mm512_setzero_ps, _mm512_setzero_si512,
-            _mm512_storeu_ps, _mm512_sub_ps, _mm512_xor_si512, _mm_load_ps, _CMP_EQ_OQ, _CMP_GT_OQ,
-            _CMP_LE_OQ,
+            _mm512_castps128_ps512, _mm512_insertf32x4, _mm512_set1_ps, _mm512_sub_ps, _mm_load_ps,
         };
         let axes = r.axes();
         let o = r.origin_k;
         // SAFETY: the caller ensures AVX-512F; each load reads one aligned `Vec4` of a pack.
         unsafe {
+            // Vertex `$i`'s coordinate on sheared axis `$k`, less the origin's (a macro, as
+            // in `intersect_pair_fast`).
             macro_rules! rel {
                 ($i:expr, $k:expr) => {{
-                    let ax = axes[$k];
-                    let q = |p: usize| _mm_load_ps(packs[p].v[$i][ax].as_ref().as_ptr());
-                    let mut x = _mm512_castps128_ps512(q(0));
-                    x = _mm512_insertf32x4::<1>(x, q(1));
-                    x = _mm512_insertf32x4::<2>(x, q(2));
-                    x = _mm512_insertf32x4::<3>(x, q(3));
+                    let axis = axes[$k];
+                    macro_rules! quarter {
+                        ($p:expr) => {
+                            _mm_load_ps(packs[$p].v[$i][axis].as_ref().as_ptr())
+                        };
+                    }
+                    let mut x = _mm512_castps128_ps512(quarter!(0));
+                    x = _mm512_insertf32x4::<1>(x, quarter!(1));
+                    x = _mm512_insertf32x4::<2>(x, quarter!(2));
+                    x = _mm512_insertf32x4::<3>(x, quarter!(3));
                     _mm512_sub_ps(x, _mm512_set1_ps(o[$k]))
                 }};
             }
-            macro_rules! sub {
-                ($x:expr, $y:expr) => {
-                    _mm512_sub_ps($x, $y)
-                };
-            }
-            macro_rules! mul {
-                ($x:expr, $y:expr) => {
-                    _mm512_mul_ps($x, $y)
-                };
-            }
-            let (sx, sy, sz) = (
-                _mm512_set1_ps(r.shear.x),
-                _mm512_set1_ps(r.shear.y),
-                _mm512_set1_ps(r.shear.z),
-            );
-            let (az, bz, cz) = (rel!(0, 2), rel!(1, 2), rel!(2, 2));
-            let ax = sub!(rel!(0, 0), mul!(sx, az));
-            let ay = sub!(rel!(0, 1), mul!(sy, az));
-            let bx = sub!(rel!(1, 0), mul!(sx, bz));
-            let by = sub!(rel!(1, 1), mul!(sy, bz));
-            let cx = sub!(rel!(2, 0), mul!(sx, cz));
-            let cy = sub!(rel!(2, 1), mul!(sy, cz));
-            let u = sub!(mul!(cx, by), mul!(cy, bx));
-            let v = sub!(mul!(ax, cy), mul!(ay, cx));
-            let w = sub!(mul!(bx, ay), mul!(by, ax));
-            let zero = _mm512_setzero_ps();
-            let on_zero = _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(u, zero)
-                | _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(v, zero)
-                | _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(w, zero);
-            if u32::from(on_zero) & valid != 0 {
-                return Err(EdgeOnZero);
-            }
-            let (ui, vi, wi) = (
-                _mm512_castps_si512(u),
-                _mm512_castps_si512(v),
-                _mm512_castps_si512(w),
-            );
-            let differ = _mm512_or_si512(_mm512_xor_si512(ui, vi), _mm512_xor_si512(ui, wi));
-            let inside =
-                !u32::from(_mm512_cmplt_epi32_mask(differ, _mm512_setzero_si512())) & valid;
-            if inside == 0 {
-                return Ok(None);
-            }
-            let det = _mm512_add_ps(_mm512_add_ps(u, v), w);
-            let dist = _mm512_add_ps(_mm512_add_ps(mul!(u, az), mul!(v, bz)), mul!(w, cz));
-            let t = mul!(mul!(sz, dist), _mm512_div_ps(_mm512_set1_ps(1.0), det));
-            let within = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, _mm512_set1_ps(tmin))
-                & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, _mm512_set1_ps(end.t));
-            let mask = inside & u32::from(within);
-            if mask == 0 {
-                return Ok(None);
-            }
-            let mut ta = [0f32; 16];
-            _mm512_storeu_ps(ta.as_mut_ptr(), t);
+            let rel = [
+                [rel!(0, 0), rel!(0, 1), rel!(0, 2)],
+                [rel!(1, 0), rel!(1, 1), rel!(1, 2)],
+                [rel!(2, 0), rel!(2, 1), rel!(2, 2)],
+            ];
             let prim = |lane: usize| packs[lane / 4].prim[lane % 4];
-            let best = nearest_lane(mask, &ta, prim);
-            if !end.admits(ta[best], prim(best)) {
-                return Ok(None);
-            }
-            let (mut va, mut wa, mut da) = ([0f32; 16], [0f32; 16], [0f32; 16]);
-            _mm512_storeu_ps(va.as_mut_ptr(), v);
-            _mm512_storeu_ps(wa.as_mut_ptr(), w);
-            _mm512_storeu_ps(da.as_mut_ptr(), det);
-            let inv = 1.0 / da[best];
-            Ok(Some((ta[best], best, va[best] * inv, wa[best] * inv)))
+            lanes_fast::<Avx512>(rel, r, valid, (tmin, end), prim)
         }
     }
 
@@ -419,6 +295,82 @@ impl Tri4 {
     }
 }
 
+/// [`Tri4::intersect`]'s operations on the lanes of `S`, four lanes per pack: the first
+/// hit with `tmin < t` that `end` admits among the lanes of `valid`, `(t, lane, b1, b2)`, or
+/// [`EdgeOnZero`] if an edge function of one of those lanes is exactly zero. `rel[i][k]`
+/// holds vertex `i`'s coordinates on the ray's sheared axis `k`, less the origin's; `prim`
+/// gives a lane's primitive number. It calls no function.
+///
+/// # Safety
+/// The processor must support `S`'s instruction set.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn lanes_fast<S: Simd>(
+    rel: [[S::F; 3]; 3],
+    r: &RayPre,
+    valid: u16,
+    (tmin, end): (f32, Limit),
+    prim: impl Fn(usize) -> u32,
+) -> Result<Option<(f32, usize, f32, f32)>, EdgeOnZero> {
+    // SAFETY: the caller ensures `S`'s instruction set.
+    unsafe {
+        let (sub, mul) = (S::sub, S::mul);
+        let (sx, sy, sz) = (
+            S::splat(r.shear.x),
+            S::splat(r.shear.y),
+            S::splat(r.shear.z),
+        );
+        let [[ax, ay, az], [bx, by, bz], [cx, cy, cz]] = rel;
+        let (ax, ay) = (sub(ax, mul(sx, az)), sub(ay, mul(sy, az)));
+        let (bx, by) = (sub(bx, mul(sx, bz)), sub(by, mul(sy, bz)));
+        let (cx, cy) = (sub(cx, mul(sx, cz)), sub(cy, mul(sy, cz)));
+        let u = sub(mul(cx, by), mul(cy, bx));
+        let v = sub(mul(ax, cy), mul(ay, cx));
+        let w = sub(mul(bx, ay), mul(by, ax));
+        let zero = S::splat(0.0);
+        let on_zero = S::or(S::or(S::eq(u, zero), S::eq(v, zero)), S::eq(w, zero));
+        if S::bits(on_zero) & valid != 0 {
+            return Err(EdgeOnZero);
+        }
+        // No edge function is zero: a lane is inside when the three share a sign bit. Most
+        // tests have no such lane and stop before the division. The sum `det` of three
+        // numbers of one sign, none zero, is not zero. A lane with a NaN edge function may
+        // pass, but then its `t` is NaN and fails both comparisons with the ends.
+        let inside = !S::sign_differs(u, v, w) & valid;
+        if inside == 0 {
+            return Ok(None);
+        }
+        let det = S::add(S::add(u, v), w);
+        let dist = S::add(S::add(mul(u, az), mul(v, bz)), mul(w, cz));
+        let t = mul(mul(sz, dist), S::div(S::splat(1.0), det));
+        let within = S::and(S::gt(t, S::splat(tmin)), S::le(t, S::splat(end.t)));
+        let mask = u32::from(inside & S::bits(within));
+        if mask == 0 {
+            return Ok(None);
+        }
+        // Lanes in memory, each array exactly as wide as the vectors, so that the store
+        // fills it (a zeroed remainder would cost stores).
+        let lanes = |x: S::F| {
+            let mut a = S::Floats::default();
+            S::store(x, a.as_mut());
+            a
+        };
+        let ta = lanes(t);
+        let ta = ta.as_ref();
+        let best = nearest_lane(mask, ta, &prim);
+        if !end.admits(ta[best], prim(best)) {
+            return Ok(None);
+        }
+        let inv = 1.0 / lanes(det).as_ref()[best];
+        Ok(Some((
+            ta[best],
+            best,
+            lanes(v).as_ref()[best] * inv,
+            lanes(w).as_ref()[best] * inv,
+        )))
+    }
+}
+
 /// The lane of `mask` (not empty) first by `t`, then by primitive number `prim`.
 #[inline(always)]
 fn nearest_lane(mut mask: u32, t: &[f32], prim: impl Fn(usize) -> u32) -> usize {
@@ -439,6 +391,17 @@ mod tests {
     use super::*;
     use prism_math::{Pcg32, Ray};
 
+    /// A ray from and along small integer coordinates (the origin's scaled by 1.5), moved off
+    /// the grid for odd `k` so that most lane tests there take the vector path; `None` for a
+    /// zero direction.
+    fn grid_ray(rng: &mut Pcg32, k: usize) -> Option<RayPre> {
+        let coord = |rng: &mut Pcg32| (rng.next_u32() % 5) as f32 - 2.0;
+        let jitter = if k.is_multiple_of(2) { 0.0 } else { 0.173 };
+        let o = Vec3::new(coord(rng) + jitter, coord(rng), coord(rng)) * 1.5;
+        let d = Vec3::new(coord(rng), coord(rng) - jitter, coord(rng));
+        (d != Vec3::ZERO).then(|| RayPre::new(&Ray::new(o, d)))
+    }
+
     /// Oracle: the scalar watertight test lane by lane ([`Tri4::scalar`], which calls
     /// `shapes::intersect_triangle`). The lane test finds the same hit, on small integer
     /// coordinates (edge functions exactly zero, ties, triangles of zero area) and with
@@ -457,20 +420,16 @@ mod tests {
                 })
                 .collect();
             let pack = Tri4::new(&tris);
-            // Off the grid half the time, so that most packs take the vector path.
-            let jitter = if k % 2 == 0 { 0.0 } else { 0.173 };
-            let o = Vec3::new(coord(&mut rng) + jitter, coord(&mut rng), coord(&mut rng)) * 1.5;
-            let d = Vec3::new(coord(&mut rng), coord(&mut rng) - jitter, coord(&mut rng));
-            if d == Vec3::ZERO {
+            let Some(pre) = grid_ray(&mut rng, k) else {
                 continue;
-            }
-            let pre = RayPre::new(&Ray::new(o, d));
+            };
+            let jitter = k % 2;
             let tmax = if k % 3 == 0 { 2.0 } else { f32::INFINITY };
             let end = Limit::end(tmax);
             let want = pack.scalar(&pre, 0.0, end);
             assert_eq!(pack.intersect(&pre, 0.0, end), want, "case {k}");
             hits += usize::from(want.is_some());
-            vector += usize::from(jitter != 0.0 && want.is_some());
+            vector += usize::from(jitter != 0 && want.is_some());
             // A limit at the hit's own distance admits the hits there on lower numbers.
             if let Some((t, lane, ..)) = want {
                 for prim in [0, 1, pack.prim[lane], pack.prim[lane] + 1, 11] {
@@ -520,13 +479,9 @@ mod tests {
                     tris[n - 1][0].0 = tris[0][0].0;
                 }
                 let packs: Vec<Tri4> = tris.iter().map(|t| Tri4::new(t)).collect();
-                let jitter = if k % 2 == 0 { 0.0 } else { 0.173 };
-                let o = Vec3::new(coord(&mut rng) + jitter, coord(&mut rng), coord(&mut rng)) * 1.5;
-                let d = Vec3::new(coord(&mut rng), coord(&mut rng) - jitter, coord(&mut rng));
-                if d == Vec3::ZERO {
+                let Some(pre) = grid_ray(&mut rng, k) else {
                     continue;
-                }
-                let pre = RayPre::new(&Ray::new(o, d));
+                };
                 let end = Limit::end(if k % 3 == 0 { 2.0 } else { f32::INFINITY });
                 let mut seq = None;
                 let mut below = end;
@@ -577,7 +532,7 @@ mod tests {
     #[test]
     fn pair_test_equals_the_packs_one_by_one() {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx") {
+        if std::arch::is_x86_feature_detected!("avx2") {
             let mut rng = Pcg32::new(11, 3);
             let coord = |rng: &mut Pcg32| (rng.next_u32() % 5) as f32 - 2.0;
             let (mut hits, mut ties) = (0, 0);
@@ -607,7 +562,7 @@ mod tests {
                     Some((t, lane, b1, b2)) => Some((t, 4 + lane, b1, b2)),
                     None => first,
                 };
-                // SAFETY: AVX was detected above.
+                // SAFETY: AVX2 was detected above.
                 let pair = unsafe { Tri4::intersect_pair_avx(&a, &b, &pre, 0.0, end) };
                 assert_eq!(pair, seq, "case {k}");
                 hits += usize::from(seq.is_some());
