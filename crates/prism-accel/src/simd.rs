@@ -1,5 +1,6 @@
 //! [`Simd`], the vector operations the list's queries (`flat`) and the packs' lane test
-//! (`tri4`) are written in, once, for two register widths: sixteen lanes of AVX-512 ([`Avx512`]) and eight of AVX2 ([`Avx2`]).
+//! (`tri4`) are written in, once, for two register widths: sixteen lanes of AVX-512
+//! ([`Avx512`]) and eight of AVX2 ([`Avx2`]).
 //! Each operation is the same IEEE arithmetic on every width, so both give the same bits.
 
 use std::arch::x86_64::*;
