@@ -54,7 +54,9 @@ pub fn run(a: &BezierArgs) -> Result<()> {
         }
         _ => return Err(UserError(format!("{name}: expected a .bzc or .bez file")).into()),
     };
-    let text = std::fs::read_to_string(&a.input).map_err(|e| UserError(format!("{name}: {e}")))?;
+    crate::output::check_distinct(&[("the input", &a.input)], &[("--output", &a.output)])?;
+    let text = prism_math::limits::read_input_text(&a.input, prism_mesh::MAX_MESH_FILE_BYTES)
+        .map_err(|e| UserError(format!("{name}: {e}")))?;
     match curve_format {
         Some(format) => {
             if !(0.0..=1.0).contains(&a.t) {

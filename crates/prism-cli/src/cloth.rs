@@ -130,6 +130,15 @@ pub fn run(a: &ClothArgs) -> Result<()> {
             .into());
         }
     }
+    let mut outputs = Vec::new();
+    outputs.extend(
+        a.output
+            .as_deref()
+            .filter(|_| frames_dir.is_none())
+            .map(|p| ("--output", p)),
+    );
+    outputs.extend(a.obj.as_deref().map(|p| ("--obj", p)));
+    crate::output::check_distinct(&[("the scene", &a.scene)], &outputs)?;
     let shader = match a.shader {
         ShaderArg::Normal => Shader::Normal,
         ShaderArg::Wireframe => Shader::Wireframe,

@@ -296,6 +296,14 @@ pub fn run(a: &MeshArgs) -> Result<()> {
     };
     if let Some(output) = output {
         crate::output::mesh_output(output, "--output")?;
+        let input = match &a.command {
+            MeshCommand::Info { input, .. }
+            | MeshCommand::Normals { input, .. }
+            | MeshCommand::Convert { input, .. }
+            | MeshCommand::Subdivide { input, .. } => input,
+            MeshCommand::Split(e) | MeshCommand::Flip(e) | MeshCommand::Collapse(e) => &e.input,
+        };
+        crate::output::check_distinct(&[("the mesh", input)], &[("--output", output)])?;
     }
     let strict = a.strict;
     match &a.command {

@@ -2,7 +2,7 @@
 //! folder are checked before any work starts. prism does not create a missing folder (as
 //! resvg does not): a mistyped path is an error, not a new directory.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use prism_scene::MeshFormat;
@@ -45,12 +45,18 @@ pub fn extension(path: &Path) -> String {
 
 /// Checks a rendered picture's outputs before any work: the picture (`--output`: .png, .jpg
 /// or .exr), the linear copy (`--exr`) and the sample-count heat map (`--heatmap`: .png or
-/// .jpg); returns the picture's and the heat map's formats.
+/// .jpg), each a file of its own that is none of `inputs`; returns the picture's and the
+/// heat map's formats.
 pub fn picture_outputs(
     output: &Path,
     exr: Option<&Path>,
     heatmap: Option<&Path>,
+    inputs: &[(&str, &Path)],
 ) -> Result<(ImageFormat, Option<ImageFormat>)> {
+    let mut outputs = vec![("--output", output)];
+    outputs.extend(exr.map(|p| ("--exr", p)));
+    outputs.extend(heatmap.map(|p| ("--heatmap", p)));
+    check_distinct(inputs, &outputs)?;
     let format = image_output(
         output,
         "--output",
@@ -141,6 +147,55 @@ pub fn check_folder(path: &Path, flag: &str) -> Result<()> {
         ))
         .into()),
     }
+}
+
+/// Where `path` leads: the file's device and inode when it exists (hard links and symbolic
+/// links alike lead to one file), else its canonical folder joined with its name.
+#[derive(PartialEq, Eq)]
+enum FileIdentity {
+    Inode(u64, u64),
+    Path(PathBuf),
+}
+
+fn identity(path: &Path) -> FileIdentity {
+    use std::os::unix::fs::MetadataExt;
+    if let Ok(meta) = std::fs::metadata(path) {
+        return FileIdentity::Inode(meta.dev(), meta.ino());
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let dir = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    FileIdentity::Path(dir.join(path.file_name().unwrap_or_default()))
+}
+
+/// Checks, before any work, that no output names an input or another output of the same
+/// command (compared as files: links and other spellings of a path count); each pair is
+/// `(flag or role, path)`, a role such as `the scene`.
+pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Result<()> {
+    let ids: Vec<FileIdentity> = outputs.iter().map(|(_, p)| identity(p)).collect();
+    for (i, (flag, path)) in outputs.iter().enumerate() {
+        for (role, input) in inputs {
+            if identity(input) == ids[i] {
+                return Err(UserError(format!(
+                    "{flag} {}: it names {role} {}, an input (prism never writes over an input)",
+                    path.display(),
+                    input.display()
+                ))
+                .into());
+            }
+        }
+        if let Some(((other, _), _)) = outputs[..i].iter().zip(&ids).find(|(_, id)| **id == ids[i])
+        {
+            return Err(UserError(format!(
+                "{flag} {}: it names the same file as {other}",
+                path.display()
+            ))
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// Writes an 8-bit picture as PNG, JPEG or BMP, atomically.

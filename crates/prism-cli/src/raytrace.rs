@@ -267,6 +267,16 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             return Err(UserError("--debug-ply: it needs --debug-pixel X,Y".into()).into());
         }
     }
+    let mut outputs = vec![("--output", a.output.as_path())];
+    outputs.extend(a.exr.as_deref().map(|p| ("--exr", p)));
+    outputs.extend(a.debug_ply.as_deref().map(|p| ("--debug-ply", p)));
+    let scene = Path::new(&a.scene);
+    let inputs: Vec<(&str, &Path)> = if scene.is_file() {
+        vec![("the scene", scene)]
+    } else {
+        Vec::new()
+    };
+    crate::output::check_distinct(&inputs, &outputs)?;
     if a.debug_camera.is_some() && a.debug_pixel.is_none() {
         eprintln!("prism: warning: --debug-camera has no effect: it applies to --debug-pixel");
     }

@@ -324,8 +324,11 @@ const MAX_SIDE: u32 = 16384;
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
     use crate::output::ImageFormat;
+    let mut inputs = Vec::new();
+    inputs.extend(a.scene.as_deref().map(|p| ("the scene", p)));
+    inputs.extend(a.envmap.as_deref().map(|p| ("--envmap", p)));
     let (format, heatmap_format) =
-        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref())?;
+        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref(), &inputs)?;
     if let Some(map) = &a.envmap {
         if crate::output::extension(map) != "exr" {
             return Err(UserError(format!(

@@ -162,12 +162,8 @@ fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
 pub fn read_shade_mesh(path: &Path) -> Result<ShadeMesh> {
     let user = |m: String| anyhow::Error::from(UserError(m));
     if crate::output::extension(path) == "obj" {
-        let meta = std::fs::metadata(path).map_err(|e| user(format!("{}: {e}", path.display())))?;
-        if meta.len() > 1 << 30 {
-            return Err(user(format!("{}: over the 1 GiB limit", path.display())));
-        }
-        let text =
-            std::fs::read_to_string(path).map_err(|e| user(format!("{}: {e}", path.display())))?;
+        let text = prism_math::limits::read_input_text(path, prism_mesh::MAX_MESH_FILE_BYTES)
+            .map_err(|e| user(format!("{}: {e}", path.display())))?;
         ShadeMesh::from_obj(&text, &path.display().to_string()).map_err(|e| user(e.to_string()))
     } else {
         let (mesh, warnings) = prism_scene::read_mesh(path).map_err(|e| user(e.to_string()))?;
@@ -185,6 +181,11 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         "--output",
         &[ImageFormat::Png, ImageFormat::Bmp, ImageFormat::Jpeg],
     )?;
+    let mut inputs = vec![("the mesh", a.mesh.as_path())];
+    inputs.extend(a.texture.as_deref().map(|p| ("--texture", p)));
+    inputs.extend(a.height_map.as_deref().map(|p| ("--height-map", p)));
+    inputs.extend(a.cubemap.as_deref().map(|p| ("--cubemap", p)));
+    crate::output::check_distinct(&inputs, &[("--output", &a.output)])?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(UserError(format!(

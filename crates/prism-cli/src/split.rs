@@ -117,8 +117,9 @@ pub struct MergeArgs {
 /// Runs `prism merge`.
 pub fn run(a: &MergeArgs) -> Result<()> {
     let t0 = Instant::now();
+    let inputs: Vec<(&str, &Path)> = a.parts.iter().map(|p| ("the part", p.as_path())).collect();
     let (format, heatmap_format) =
-        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref())?;
+        crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref(), &inputs)?;
     let mut parts = Vec::with_capacity(a.parts.len());
     for path in &a.parts {
         parts.push(PartFile::open(path).map_err(|e| UserError(e.to_string()))?);

@@ -223,6 +223,7 @@ pub fn run(a: &SvgArgs) -> Result<()> {
             "--output",
             &[ImageFormat::Png, ImageFormat::Jpeg],
         )?;
+        crate::output::check_distinct(&[("the SVG", &a.input)], &[("--output", &a.output)])?;
         return render_one(&a.input, &a.output, format, a, view).map(warn);
     }
     let mut files = Vec::new();

@@ -106,23 +106,7 @@ pub fn read_scene(path: &Path, overrides: &[String]) -> Result<ClothScene, Cloth
         path: name.clone(),
         message: e.to_string(),
     };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(ClothError::Io {
-            path: name,
-            message: "expected a regular file".into(),
-        });
-    }
-    if meta.len() > MAX_SCENE_BYTES {
-        return Err(ClothError::Io {
-            path: name,
-            message: format!(
-                "{} bytes is over the {MAX_SCENE_BYTES}-byte limit",
-                meta.len()
-            ),
-        });
-    }
-    let text = std::fs::read_to_string(path).map_err(io)?;
+    let text = prism_math::limits::read_input_text(path, MAX_SCENE_BYTES).map_err(io)?;
     parse_scene(&text, &name, overrides)
 }
 

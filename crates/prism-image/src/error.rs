@@ -21,8 +21,8 @@ pub enum ImageError {
         /// What the decoder expected and found.
         message: String,
     },
-    /// The image is larger than [`crate::MAX_IMAGE_PIXELS`] or has a zero dimension.
-    #[error("{what}: image size {width}x{height} is outside 1..={max} pixels")]
+    /// The image has a zero dimension.
+    #[error("{what}: image size {width}x{height} is empty")]
     BadSize {
         /// The file name, or a description of the in-memory source.
         what: String,
@@ -30,8 +30,20 @@ pub enum ImageError {
         width: u64,
         /// Height in pixels.
         height: u64,
-        /// The limit that was exceeded.
-        max: u64,
+    },
+    /// The decoded image would be larger than one image's memory budget
+    /// ([`prism_math::limits::image_budget`]); nothing was allocated for it.
+    #[error("{what}: a {width}x{height} image {source}")]
+    OverBudget {
+        /// The file name, or a description of the in-memory source.
+        what: String,
+        /// Width in pixels.
+        width: u64,
+        /// Height in pixels.
+        height: u64,
+        /// What it needs and the budget.
+        #[source]
+        source: prism_math::limits::OverBudget,
     },
     /// Encoding failed.
     #[error("encoding {format}: {message}")]

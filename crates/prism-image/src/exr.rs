@@ -7,7 +7,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::io::{check_size, decode_err, read_bytes};
+use crate::io::{check_size, decode_err, read_bytes, DEFLATE_MAX_RATIO};
 use crate::{write_atomic, Image, ImageError, RgbImage};
 use prism_math::Rgb;
 
@@ -316,22 +316,35 @@ fn unzip(block: &[u8], expected: usize, what: &str) -> Result<Vec<u8>, ImageErro
 }
 
 /// Decodes an OpenEXR file's R, G and B channels (see the module's subset); a missing
-/// channel reads as 0. `what` names the source in errors.
+/// channel reads as 0, and a file with none of the three but a luminance channel `Y` reads
+/// as grey (R = G = B = Y), as OpenEXR's RGBA interface reads it. `what` names the source
+/// in errors.
 ///
 /// # Errors
 /// [`ImageError::Decode`] for anything outside the subset or malformed (naming what), or
-/// [`ImageError::BadSize`] for an image over [`crate::MAX_IMAGE_PIXELS`].
+/// [`ImageError::OverBudget`] for an image over the image budget (all its channels, 4 bytes
+/// a sample).
 pub fn decode_exr(data: &[u8], what: &str) -> Result<RgbImage, ImageError> {
     let layers = decode_exr_layers(data, what)?;
     let (w, h) = (layers.width, layers.height);
-    let value = |name: &str, i: usize| match layers.channel(name) {
+    let grey = ["R", "G", "B"].iter().all(|c| layers.channel(c).is_none());
+    let pick = |name: &'static str| match (grey, layers.channel(name)) {
+        (true, _) => layers.channel("Y"),
+        (false, c) => c,
+    };
+    let planes = [pick("R"), pick("G"), pick("B")];
+    let value = |plane: Option<&ExrSamples>, i: usize| match plane {
         Some(ExrSamples::Float(v)) => v[i],
         Some(ExrSamples::Uint(v)) => v[i] as f32,
         None => 0.0,
     };
     Ok(Image::from_fn(w, h, |x, y| {
         let i = y as usize * w as usize + x as usize;
-        Rgb::new(value("R", i), value("G", i), value("B", i))
+        Rgb::new(
+            value(planes[0], i),
+            value(planes[1], i),
+            value(planes[2], i),
+        )
     }))
 }
 
@@ -425,8 +438,7 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
     if w <= 0 || h <= 0 {
         return Err(decode_err(what, format!("dataWindow is empty ({w}x{h})")));
     }
-    check_size(what, w as u64, h as u64)?;
-    let (w, h) = (w as usize, h as usize);
+    let (w, h) = (w as u64, h as u64);
     let lines_per_block = match compression {
         Some(0) | Some(2) => 1,
         Some(3) => 16,
@@ -452,7 +464,7 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
     // Channels are stored in name order; each has 2 (half) or 4 (uint, float) bytes a sample.
     channels.sort();
     let mut layout = Vec::new();
-    let mut line_bytes = 0usize;
+    let mut line_bytes = 0u64;
     for (name, ty) in &channels {
         let size = match ty {
             0 | 2 => 4,
@@ -464,17 +476,20 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
                 ))
             }
         };
-        layout.push((*ty, line_bytes));
-        line_bytes += size * w;
+        layout.push((*ty, line_bytes as usize));
+        line_bytes = line_bytes.saturating_add(size * w);
     }
-    // zlib expands at most about 1032 to 1: a file too small for its pixels is refused
-    // before they are allocated (by this reader or by a caller that read only the header).
-    if (data.len() as u64).saturating_mul(1032) < (h as u64).saturating_mul(line_bytes as u64) {
-        return Err(decode_err(
-            what,
-            format!("{w}x{h} pixels cannot fit in {} bytes", data.len()),
-        ));
-    }
+    // Every channel decodes to 4 bytes a sample. Stored, the scanlines take at least their
+    // size over zlib's greatest expansion: a file too small for its pixels is refused before
+    // they are allocated (by this reader or by a caller that read only the header).
+    let stored = h.saturating_mul(line_bytes);
+    let needed = match compression {
+        Some(0) => stored,
+        _ => stored.div_ceil(DEFLATE_MAX_RATIO),
+    };
+    let samples = 4 * channels.len() as u64;
+    check_size(what, (w, h), samples, needed, data.len())?;
+    let (w, h, line_bytes) = (w as usize, h as usize, line_bytes as usize);
     if !pixels {
         return Ok(ExrLayers {
             width: w as u32,
@@ -683,6 +698,57 @@ mod tests {
         ] {
             assert_eq!(e.to_string(), "mem: expected at least one channel");
         }
+    }
+
+    /// A luminance-only file (channel `Y`, as OpenEXR's RGBA interface writes grey) reads
+    /// as grey; a file with any of R, G, B reads its missing ones as 0.
+    #[test]
+    fn luminance_only_files_read_as_grey() {
+        let n = 6;
+        let y: Vec<f32> = (0..n).map(|i| i as f32 * 0.5 + 0.25).collect();
+        let grey = ExrLayers {
+            width: 3,
+            height: 2,
+            channels: vec![("Y".into(), ExrSamples::Float(y.clone()))],
+            attributes: Vec::new(),
+        };
+        let im = decode_exr(&encode_exr_layers(&grey), "grey.exr").unwrap();
+        for (i, p) in im.pixels().iter().enumerate() {
+            assert_eq!(*p, Rgb::new(y[i], y[i], y[i]));
+        }
+        let mut red = grey.clone();
+        red.channels
+            .push(("R".into(), ExrSamples::Float(vec![2.0; n])));
+        let im = decode_exr(&encode_exr_layers(&red), "red.exr").unwrap();
+        assert!(im.pixels().iter().all(|p| *p == Rgb::new(2.0, 0.0, 0.0)));
+    }
+
+    /// Many channels over a modest window are refused by the image budget (every channel
+    /// decodes to 4 bytes a sample), before their planes are allocated.
+    #[test]
+    fn channels_count_against_the_image_budget() {
+        let channels = (0..2000)
+            .map(|i| (format!("c{i:04}"), ExrSamples::Float(vec![0.0])))
+            .collect();
+        let wide = ExrLayers {
+            width: 1,
+            height: 1,
+            channels,
+            attributes: Vec::new(),
+        };
+        let mut bytes = encode_exr_layers(&wide);
+        // Widen the data window in place to 256 x 512: 2000 channels need 1000 MiB.
+        let at = bytes
+            .windows(10)
+            .position(|w| w == b"dataWindow")
+            .expect("a data window")
+            + 11
+            + 6
+            + 4;
+        bytes[at + 8..at + 12].copy_from_slice(&255i32.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&511i32.to_le_bytes());
+        let e = decode_exr_header(&bytes, "many.exr").unwrap_err();
+        assert!(matches!(e, ImageError::OverBudget { .. }), "{e}");
     }
 
     /// Oracle: what the writer wrote reads back exactly.

@@ -6,9 +6,6 @@ use std::path::{Path, PathBuf};
 
 use crate::{ImageError, Rgb8Image, Rgba8Image};
 
-/// The largest image, in pixels, that the readers accept (256 megapixels).
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
-
 pub(crate) fn decode_err(what: &str, message: impl ToString) -> ImageError {
     ImageError::Decode {
         what: what.to_string(),
@@ -16,17 +13,43 @@ pub(crate) fn decode_err(what: &str, message: impl ToString) -> ImageError {
     }
 }
 
-pub(crate) fn check_size(what: &str, width: u64, height: u64) -> Result<(), ImageError> {
-    if width == 0 || height == 0 || width * height > MAX_IMAGE_PIXELS {
+/// Checks a header's size before anything is allocated for its pixels: both sides at least
+/// 1, the decoded image (`bytes_per_pixel` bytes a pixel, all channels) within one image's
+/// memory budget ([`prism_math::limits::image_budget`]), and `needed_bytes`, the fewest
+/// bytes a file of that size must hold, within the `file_bytes` it has.
+pub(crate) fn check_size(
+    what: &str,
+    (width, height): (u64, u64),
+    bytes_per_pixel: u64,
+    needed_bytes: u64,
+    file_bytes: usize,
+) -> Result<(), ImageError> {
+    if width == 0 || height == 0 {
         return Err(ImageError::BadSize {
             what: what.to_string(),
             width,
             height,
-            max: MAX_IMAGE_PIXELS,
         });
+    }
+    let bytes = width.saturating_mul(height).saturating_mul(bytes_per_pixel);
+    prism_math::limits::check_image_memory(bytes).map_err(|source| ImageError::OverBudget {
+        what: what.to_string(),
+        width,
+        height,
+        source,
+    })?;
+    if needed_bytes > file_bytes as u64 {
+        return Err(decode_err(
+            what,
+            format!("{width}x{height} pixels cannot fit in {file_bytes} bytes"),
+        ));
     }
     Ok(())
 }
+
+/// The most bytes zlib's deflate can expand one compressed byte to: a length-258 copy coded
+/// in two bits.
+pub(crate) const DEFLATE_MAX_RATIO: u64 = 1032;
 
 /// Decodes a PNG of any colour type and bit depth to straight-alpha RGBA8.
 ///
@@ -34,17 +57,25 @@ pub(crate) fn check_size(what: &str, width: u64, height: u64) -> Result<(), Imag
 /// channel becomes 255. `what` names the source in errors.
 ///
 /// # Errors
-/// [`ImageError::Decode`] for a malformed or truncated file, [`ImageError::BadSize`] for an
-/// empty or oversized image.
+/// [`ImageError::Decode`] for a malformed or truncated file, or one too short for the
+/// pixels its header claims; [`ImageError::BadSize`] for an empty image;
+/// [`ImageError::OverBudget`] for one over the image budget.
 pub fn decode_png(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
-    let mut decoder = png::Decoder::new(bytes);
+    let budget = usize::try_from(prism_math::limits::image_budget()).unwrap_or(usize::MAX);
+    let mut decoder = png::Decoder::new_with_limits(bytes, png::Limits { bytes: budget });
     decoder.set_transformations(png::Transformations::normalize_to_color8());
-    let mut reader = decoder.read_info().map_err(|e| decode_err(what, e))?;
-    let (w, h) = {
-        let info = reader.info();
-        (info.width, info.height)
+    // The header alone is read first: its size is checked before the decoder allocates.
+    let (w, h, stream) = {
+        let info = decoder
+            .read_header_info()
+            .map_err(|e| decode_err(what, e))?;
+        let row = (u64::from(info.width) * info.bits_per_pixel() as u64).div_ceil(8) + 1;
+        (info.width, info.height, row * u64::from(info.height))
     };
-    check_size(what, u64::from(w), u64::from(h))?;
+    // The filtered scanlines inflate from at most the whole file.
+    let needed = stream.div_ceil(DEFLATE_MAX_RATIO);
+    check_size(what, (u64::from(w), u64::from(h)), 8, needed, bytes.len())?;
+    let mut reader = decoder.read_info().map_err(|e| decode_err(what, e))?;
     let mut buf = vec![0u8; reader.output_buffer_size()];
     let frame = reader
         .next_frame(&mut buf)
@@ -79,14 +110,24 @@ pub fn decode_png(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
 /// Decodes a baseline or progressive JPEG to RGBA8 (alpha 255).
 ///
 /// # Errors
-/// [`ImageError::Decode`] for malformed data or an unsupported pixel format.
+/// [`ImageError::Decode`] for malformed data, an unsupported pixel format, or a file too
+/// short for the pixels its header claims; [`ImageError::BadSize`] for an empty image;
+/// [`ImageError::OverBudget`] for one over the image budget.
 pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
     let mut decoder = jpeg_decoder::Decoder::new(bytes);
     decoder.read_info().map_err(|e| decode_err(what, e))?;
     let info = decoder
         .info()
         .ok_or_else(|| decode_err(what, "missing JPEG header"))?;
-    check_size(what, u64::from(info.width), u64::from(info.height))?;
+    let (w, h) = (u64::from(info.width), u64::from(info.height));
+    // Every 8x8 block of the full-resolution component takes at least one bit (its DC
+    // code), so a file of n bytes holds at most 8n blocks.
+    let needed = (w.div_ceil(8) * h.div_ceil(8)).div_ceil(8);
+    // The decoder's planes (up to 4 bytes a pixel), then the RGBA copy.
+    check_size(what, (w, h), 8, needed, bytes.len())?;
+    decoder.set_max_decoding_buffer_size(
+        usize::try_from(prism_math::limits::image_budget()).unwrap_or(usize::MAX),
+    );
     let data = decoder.decode().map_err(|e| decode_err(what, e))?;
     let n = usize::from(info.width) * usize::from(info.height);
     let pixels: Vec<[u8; 4]> = match info.pixel_format {
@@ -124,25 +165,12 @@ pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
 /// The largest image file the readers open, in bytes (1 GiB).
 pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
 
+/// Reads an image file: a regular file of at most [`MAX_IMAGE_FILE_BYTES`].
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, ImageError> {
-    let io = |source| ImageError::Io {
+    prism_math::limits::read_input(path, MAX_IMAGE_FILE_BYTES).map_err(|source| ImageError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(decode_err(
-            &path.display().to_string(),
-            "expected a regular file",
-        ));
-    }
-    if meta.len() > MAX_IMAGE_FILE_BYTES {
-        return Err(decode_err(
-            &path.display().to_string(),
-            format!("file is larger than the limit of {MAX_IMAGE_FILE_BYTES} bytes"),
-        ));
-    }
-    std::fs::read(path).map_err(io)
+    })
 }
 
 /// Reads a PNG file as RGBA8.
@@ -470,5 +498,91 @@ mod tests {
         let back = decode_jpeg(&bytes, "mem").unwrap().to_rgb8();
         let stats = crate::compare_rgb8(&im, &back).unwrap();
         assert!(stats.mean_abs_error < 2.0, "{stats:?}");
+    }
+
+    /// A PNG chunk with its CRC (ISO 3309, bit by bit: the independent oracle is the png
+    /// crate, which checks it).
+    fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+        let mut crc = !0u32;
+        for &b in kind.iter().chain(data) {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xedb8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        out.extend_from_slice(kind);
+        out.extend_from_slice(data);
+        out.extend_from_slice(&(!crc).to_be_bytes());
+        out
+    }
+
+    /// A PNG whose header claims `width` x `height` 8-bit RGB over `idat`.
+    fn png_claiming(width: u32, height: u32, depth: u8, colour: u8, idat: &[u8]) -> Vec<u8> {
+        let mut ihdr = width.to_be_bytes().to_vec();
+        ihdr.extend_from_slice(&height.to_be_bytes());
+        ihdr.extend_from_slice(&[depth, colour, 0, 0, 0]);
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend(chunk(b"IHDR", &ihdr));
+        png.extend(chunk(b"IDAT", idat));
+        png.extend(chunk(b"IEND", &[]));
+        png
+    }
+
+    /// A short PNG claiming 4096 x 65535 pixels is refused by what its bytes can hold
+    /// (deflate expands at most 1032 to 1), before any pixel is allocated.
+    #[test]
+    fn png_claiming_more_than_its_bytes_hold_is_refused() {
+        let z = miniz_oxide::deflate::compress_to_vec_zlib(&[0; 64], 6);
+        let png = png_claiming(4096, 65535 / 16, 8, 2, &z);
+        let e = decode_png(&png, "small.png").unwrap_err().to_string();
+        assert!(
+            e.contains("small.png: 4096x4095 pixels cannot fit in"),
+            "{e}"
+        );
+    }
+
+    /// A 16384 x 16384 one-bit PNG is small on disk (its rows deflate well) but decodes to
+    /// 1 GiB of RGBA: refused by the image budget, naming the file, the size and the budget.
+    #[test]
+    fn png_over_the_image_budget_is_refused() {
+        let rows = vec![0u8; (1 + 16384 / 8) * 16384];
+        let z = miniz_oxide::deflate::compress_to_vec_zlib(&rows, 1);
+        assert!(z.len() < 1 << 20, "{} bytes", z.len());
+        let png = png_claiming(16384, 16384, 1, 0, &z);
+        let e = decode_png(&png, "big.png").unwrap_err();
+        assert!(matches!(e, ImageError::OverBudget { .. }), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "big.png: a 16384x16384 image needs 2 GiB of memory, over the budget of 512 MiB \
+             (--max-memory raises it)"
+        );
+    }
+
+    /// A real JPEG with its frame header patched to claim 4096 x 65535 pixels (the sweep's
+    /// 634-byte file): refused before decoding, by its size and by the budget.
+    #[test]
+    fn jpeg_claiming_a_huge_frame_is_refused() {
+        let im = Image::from_fn(16, 16, |x, y| [(x * 9) as u8, (y * 9) as u8, 77]);
+        let mut bytes = encode_jpeg(&im).unwrap();
+        let sof = bytes
+            .windows(2)
+            .position(|w| w == [0xff, 0xc0])
+            .expect("a baseline frame header");
+        // Marker, length (2), precision (1), then height and width, big-endian.
+        bytes[sof + 5..sof + 7].copy_from_slice(&65535u16.to_be_bytes());
+        bytes[sof + 7..sof + 9].copy_from_slice(&4096u16.to_be_bytes());
+        let e = decode_jpeg(&bytes, "huge.jpg").unwrap_err();
+        assert!(matches!(e, ImageError::OverBudget { .. }), "{e}");
+        // Within the budget but not within the file: 1024 x 1024 needs 16384 blocks, at
+        // least 2048 bytes.
+        bytes[sof + 5..sof + 7].copy_from_slice(&1024u16.to_be_bytes());
+        bytes[sof + 7..sof + 9].copy_from_slice(&1024u16.to_be_bytes());
+        let e = decode_jpeg(&bytes, "huge.jpg").unwrap_err().to_string();
+        assert!(e.contains("1024x1024 pixels cannot fit in"), "{e}");
     }
 }

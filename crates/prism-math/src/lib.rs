@@ -1,8 +1,8 @@
 //! Floor-0 maths shared by every prism crate: a glam re-export, linear RGB colours, rays,
 //! boxes and frames, exact (order-independent) sums of floats, 4x4 transforms named destination-from-source, sixteen-lane numbers for
 //! SIMD kernels, warps with their densities, deterministic random numbers, and line numbers
-//! of byte offsets for the readers' error messages, a cache prefetch hint, and the
-//! instruction sets the kernels may use.
+//! of byte offsets for the readers' error messages, a cache prefetch hint, the
+//! instruction sets the kernels may use, and the resource limits every reader shares.
 #![warn(missing_docs)]
 
 mod cache;
@@ -12,6 +12,7 @@ mod exact;
 mod geometry;
 mod isa;
 pub mod lanes;
+pub mod limits;
 mod random;
 mod text;
 mod transform;

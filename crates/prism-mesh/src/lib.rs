@@ -33,3 +33,6 @@ pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};
 pub use polymesh::PolyMesh;
 pub use repair::SplitVertex;
 pub use shapes::icosahedron;
+
+/// The largest mesh file (OBJ or PLY) the readers open: 1 GiB.
+pub const MAX_MESH_FILE_BYTES: u64 = 1 << 30;

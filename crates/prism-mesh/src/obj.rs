@@ -7,7 +7,7 @@ use std::path::Path;
 
 use prism_math::glam::DVec3;
 
-use crate::{MeshError, PolyMesh};
+use crate::{MeshError, PolyMesh, MAX_MESH_FILE_BYTES};
 
 /// Parses OBJ text; `file` names the source in errors.
 ///
@@ -76,10 +76,13 @@ pub fn parse_obj(text: &str, file: &str) -> Result<PolyMesh, MeshError> {
 /// [`MeshError::Io`] if unreadable, else as [`parse_obj`].
 pub fn read_obj(path: &Path) -> Result<PolyMesh, MeshError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
-        path: name.clone(),
-        source,
-    })?;
+    let text =
+        prism_math::limits::read_input_text(path, MAX_MESH_FILE_BYTES).map_err(|source| {
+            MeshError::Io {
+                path: name.clone(),
+                source,
+            }
+        })?;
     parse_obj(&text, &name)
 }
 

@@ -398,10 +398,12 @@ impl PartFile {
     /// [`PartError::Image`] if it cannot be read or is not an OpenEXR file prism reads, else
     /// as [`PartHeader::from_exr`].
     pub fn open(path: &Path) -> Result<PartFile, PartError> {
-        let bytes = std::fs::read(path).map_err(|source| ImageError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let limit = prism_image::MAX_IMAGE_FILE_BYTES;
+        let bytes =
+            prism_math::limits::read_input(path, limit).map_err(|source| ImageError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
         let layers = prism_image::decode_exr_header(&bytes, &path.display().to_string())?;
         Ok(PartFile {
             path: path.to_path_buf(),

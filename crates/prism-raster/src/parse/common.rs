@@ -17,11 +17,12 @@ pub const MAX_USE_ELEMENTS: usize = 1_000_000;
 /// Most gradients a gradient's `href` chain may hold (itself included).
 pub const MAX_HREF_CHAIN: usize = 16;
 
-/// A reader error with its location, shown as `file:line: element: message`.
+/// A reader error with its location, shown as `file:line: element: message` (or `file: message`
+/// for the whole file).
 #[derive(Clone, Debug, thiserror::Error)]
 pub enum SvgError {
     /// The file cannot be read.
-    #[error("{file}:0: file: {source}")]
+    #[error("{file}: {source}")]
     Io {
         /// The file.
         file: String,
@@ -30,7 +31,7 @@ pub enum SvgError {
         source: Arc<std::io::Error>,
     },
     /// The file is not UTF-8 text.
-    #[error("{file}:0: file: expected UTF-8 text: {source}")]
+    #[error("{file}: expected UTF-8 text: {source}")]
     Encoding {
         /// The file.
         file: String,
@@ -39,7 +40,7 @@ pub enum SvgError {
         source: std::str::Utf8Error,
     },
     /// The file is larger than [`MAX_SVG_BYTES`].
-    #[error("{file}:0: file: file is larger than the limit of {limit} bytes")]
+    #[error("{file}: the file is larger than the limit of {limit} bytes")]
     FileTooLarge {
         /// The file.
         file: String,

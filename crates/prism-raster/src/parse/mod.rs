@@ -314,14 +314,7 @@ pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
         file: name.clone(),
         source: Arc::new(e),
     };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if meta.len() > MAX_SVG_BYTES {
-        return Err(SvgError::FileTooLarge {
-            file: name,
-            limit: MAX_SVG_BYTES,
-        });
-    }
-    let bytes = std::fs::read(path).map_err(io)?;
+    let bytes = prism_math::limits::read_input(path, MAX_SVG_BYTES).map_err(io)?;
     let text = String::from_utf8(bytes).map_err(|e| SvgError::Encoding {
         file: name.clone(),
         source: e.utf8_error(),

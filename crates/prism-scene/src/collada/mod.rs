@@ -279,8 +279,8 @@ impl Collada {
 /// Reads a COLLADA file.
 ///
 /// # Errors
-/// [`SceneError::Io`], [`SceneError::NotAFile`] or [`SceneError::TooLarge`] (over
-/// [`MAX_COLLADA_BYTES`]); otherwise as
+/// [`SceneError::Io`] for a file that cannot be read, is not a regular file or is over
+/// [`MAX_COLLADA_BYTES`]; otherwise as
 /// [`parse_collada`].
 pub fn read_collada(path: &Path) -> Result<Collada, SceneError> {
     let name = path.display().to_string();
@@ -288,18 +288,7 @@ pub fn read_collada(path: &Path) -> Result<Collada, SceneError> {
         path: name.clone(),
         source: std::sync::Arc::new(e),
     };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(SceneError::NotAFile { path: name });
-    }
-    if meta.len() > MAX_COLLADA_BYTES {
-        return Err(SceneError::TooLarge {
-            path: name,
-            bytes: meta.len(),
-            limit: MAX_COLLADA_BYTES,
-        });
-    }
-    let text = std::fs::read_to_string(path).map_err(io)?;
+    let text = prism_math::limits::read_input_text(path, MAX_COLLADA_BYTES).map_err(io)?;
     parse_collada(&text, &name)
 }
 

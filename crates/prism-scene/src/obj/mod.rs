@@ -38,25 +38,12 @@ pub fn read_obj_scene(path: &Path, normalize: bool) -> Result<Scene, SceneError>
     parse_obj_scene(&text, &path.display().to_string(), &companions, normalize)
 }
 
-/// Reads a file of at most [`MAX_OBJ_BYTES`].
+/// Reads a regular file of at most [`MAX_OBJ_BYTES`].
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
-    let name = path.display().to_string();
-    let io = |e: std::io::Error| SceneError::Io {
-        path: name.clone(),
+    prism_math::limits::read_input(path, MAX_OBJ_BYTES).map_err(|e| SceneError::Io {
+        path: path.display().to_string(),
         source: Arc::new(e),
-    };
-    let meta = std::fs::metadata(path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(SceneError::NotAFile { path: name });
-    }
-    if meta.len() > MAX_OBJ_BYTES {
-        return Err(SceneError::TooLarge {
-            path: name,
-            bytes: meta.len(),
-            limit: MAX_OBJ_BYTES,
-        });
-    }
-    std::fs::read(path).map_err(io)
+    })
 }
 
 /// Reads a text file of at most [`MAX_OBJ_BYTES`].
