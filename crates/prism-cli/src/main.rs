@@ -8,6 +8,7 @@ mod output;
 mod progress;
 mod raytrace;
 mod render;
+mod resources;
 mod shade;
 mod split;
 mod svg;
@@ -21,6 +22,11 @@ use clap::{Parser, Subcommand};
 #[derive(Parser)]
 #[command(name = "prism", version, about, long_about = None)]
 struct Cli {
+    /// The memory budget: the most one film, frame or buffer sized by an input may take (a
+    /// quarter of it for each decoded image), such as 4G or 512M; larger requests are
+    /// refused before they are allocated.
+    #[arg(long, global = true, value_name = "SIZE", default_value = "2G", value_parser = resources::parse_bytes)]
+    max_memory: u64,
     #[command(subcommand)]
     command: Command,
 }
@@ -89,6 +95,7 @@ fn main() -> ExitCode {
             };
         }
     };
+    prism_math::limits::set_memory_budget(cli.max_memory);
     let result = match cli.command {
         Command::Svg(a) => svg::run(&a),
         Command::Bezier(a) => bezier::run(&a),

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use prism_image::Bloom;
 use prism_math::Rgb;
@@ -356,6 +356,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         ))
         .into());
     }
+    crate::resources::check_frame("--resolution", w, h, prism_render::film_bytes(w, h))?;
     if let Some((_, parts)) = a.tile {
         crate::split::check_tile_count(parts, w, h)?;
     }
@@ -431,13 +432,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         },
         seed: a.seed,
     };
-    let pool = {
-        let mut b = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = a.threads {
-            b = b.num_threads(t.max(1));
-        }
-        b.build().context("starting worker threads")?
-    };
+    let pool = crate::resources::pool(a.threads)?;
     let n = loaded.cameras.len();
     let mut written = Vec::new();
     let mut counts = prism_render::RayCounts::default();

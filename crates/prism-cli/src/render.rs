@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_render::{
     render, render_share_profiled, Integrator, Part, RenderOptions, RenderScene, Share,
@@ -321,6 +321,9 @@ fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Res
 /// Largest image side.
 const MAX_SIDE: u32 = 16384;
 
+/// Most samples of each light at a shading point.
+const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
+
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
     use crate::output::ImageFormat;
@@ -345,6 +348,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(UserError(format!(
             "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
+        ))
+        .into());
+    }
+    crate::resources::check_frame("--resolution", w, h, prism_render::film_bytes(w, h))?;
+    if a.light_samples == 0 || a.light_samples > MAX_LIGHT_SAMPLES {
+        return Err(UserError(format!(
+            "--light-samples: expected 1 to {MAX_LIGHT_SAMPLES}, found {}",
+            a.light_samples
         ))
         .into());
     }
@@ -457,13 +468,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         seed: a.seed,
         ..RenderOptions::default()
     };
-    let pool = {
-        let mut b = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = a.threads {
-            b = b.num_threads(t.max(1));
-        }
-        b.build().context("starting worker threads")?
-    };
+    let pool = crate::resources::pool(a.threads)?;
     if let Some(share) = share {
         let tiles = prism_render::tiles(w, h);
         let pixels: u64 = tiles

@@ -131,6 +131,19 @@ impl Share {
     }
 }
 
+/// The most bytes a `width x height` render's film holds at once, whatever the integrator
+/// (path or Whitted): the pixel sums twice (the tiles' results and the image they are
+/// gathered into), each pixel's place in its tile, and three colour images made from the
+/// sums (the mean, bloom's layer, the output). A caller checks it against the memory
+/// budget before rendering.
+#[must_use]
+pub fn film_bytes(width: u32, height: u32) -> u64 {
+    let per_pixel = 2 * std::mem::size_of::<PixelSum>()
+        + std::mem::size_of::<(u32, u32)>()
+        + 3 * std::mem::size_of::<Rgb>();
+    u64::from(width) * u64::from(height) * per_pixel as u64
+}
+
 /// Renders the scene. `progress` is called with the number of samples taken so far after
 /// each tile (from worker threads). The image is the same whatever the thread count.
 pub fn render(

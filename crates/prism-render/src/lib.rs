@@ -29,8 +29,8 @@ pub use bsdf::{Bsdf, BsdfSample};
 pub use camera::{OrbitView, Perspective};
 pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use film::{
-    render, render_share, render_share_except, render_share_profiled, tile_count, tile_of, tiles,
-    PixelSum, RenderOptions, Rendered, Share, TILE,
+    film_bytes, render, render_share, render_share_except, render_share_profiled, tile_count,
+    tile_of, tiles, PixelSum, RenderOptions, Rendered, Share, TILE,
 };
 pub use integrators::whitted::{
     parallelogram_color, parallelogram_grid, phong, DebugRay, PixelSampler, RayCounts, RayKind,

@@ -5,7 +5,7 @@
 
 mod mtl;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -123,7 +123,13 @@ pub fn parse_obj_scene(
     let mut uvs: Vec<Vec2> = Vec::new();
     let mut normals: Vec<Vec3> = Vec::new();
     let mut libs: Vec<mtl::MtlMaterial> = Vec::new();
+    // Each material's index by name, the last definition winning (as a search from the end).
+    let mut by_name: HashMap<String, usize> = HashMap::new();
     let mut lib_files: Vec<String> = Vec::new();
+    let mut lib_names: HashSet<&str> = HashSet::new();
+    // Faces are stored as corners: their count is checked against the memory budget.
+    let most_triangles = prism_math::limits::memory_budget() / size_of::<[Corner; 3]>() as u64;
+    let mut triangle_count = 0u64;
     let mut runs: Vec<Run> = Vec::new();
     let mut current: Option<usize> = None;
     // A shape boundary (`o`, `g`) or a material change starts a new run.
@@ -156,6 +162,10 @@ pub fn parse_obj_scene(
             }
             "mtllib" => {
                 for name in content[key.len()..].split_whitespace() {
+                    // Each library is read once, however often it is named.
+                    if !lib_names.insert(name) {
+                        continue;
+                    }
                     let bytes = companions(name).map_err(|e| {
                         err(format!("mtllib: cannot read the material library: {e}"))
                     })?;
@@ -167,14 +177,16 @@ pub fn parse_obj_scene(
                         .to_string();
                     let text = String::from_utf8(bytes)
                         .map_err(|_| err(format!("mtllib {name}: expected UTF-8 text")))?;
-                    libs.extend(parse_mtl(&text, &what)?);
+                    for m in parse_mtl(&text, &what)? {
+                        by_name.insert(m.name.clone(), libs.len());
+                        libs.push(m);
+                    }
                     lib_files.push(name.to_string());
                 }
             }
             "usemtl" => {
                 let name = content[key.len()..].trim();
-                let found = libs.iter().rposition(|m| m.name == name);
-                let Some(found) = found else {
+                let Some(&found) = by_name.get(name) else {
                     return Err(err(if lib_files.is_empty() {
                         format!("usemtl {name}: no material library was named before it")
                     } else {
@@ -213,6 +225,12 @@ pub fn parse_obj_scene(
                     });
                     new_run = false;
                 }
+                triangle_count += corners.len() as u64 - 2;
+                if triangle_count > most_triangles {
+                    let need = triangle_count * size_of::<[Corner; 3]>() as u64;
+                    let over = prism_math::limits::check_memory(need).expect_err("over the budget");
+                    return Err(err(format!("f: the faces {over}")));
+                }
                 let run = runs.last_mut().expect("a run was just ensured");
                 // A fan from the first corner: a quad becomes (0 1 2) and (0 2 3).
                 for i in 1..corners.len() - 1 {
@@ -226,6 +244,7 @@ pub fn parse_obj_scene(
     let mut scene = Scene::new(OrbitCamera::default().to_camera(1.0));
     // Materials in the order they are first used; faces without one share the default.
     let mut material_slot: HashMap<Option<usize>, usize> = HashMap::new();
+    let mut textures = TextureCache::new();
     for run in &runs {
         if run.triangles.is_empty() {
             continue;
@@ -244,7 +263,10 @@ pub fn parse_obj_scene(
                         },
                         "(none)".to_string(),
                     ),
-                    Some(i) => (to_material(&libs[i], companions)?, libs[i].name.clone()),
+                    Some(i) => (
+                        to_material(&libs[i], companions, &mut textures)?,
+                        libs[i].name.clone(),
+                    ),
                 };
                 scene.materials.push(m);
                 scene.material_names.push(name);
@@ -280,14 +302,19 @@ fn corner(w: &str, positions: &[Vec3], uvs: &[Vec2], normals: &[Vec3]) -> Result
     let v = index(parts.next().unwrap_or(""), positions.len(), "vertex")?;
     // A file with no `vt` (no `vn`) at all gets (0, 0) (the geometric normal) wherever a
     // corner names one, as the template does.
+    // A file with no `vt` (no `vn`) still names a number there.
+    let number = |s: &str, what: &str| match s.parse::<i64>() {
+        Ok(i) if i != 0 => Ok(None),
+        _ => Err(format!("f: expected a {what} index, found {w:?}")),
+    };
     let vt = match parts.next() {
         None | Some("") => None,
-        Some(_) if uvs.is_empty() => None,
+        Some(s) if uvs.is_empty() => number(s, "texture coordinate")?,
         Some(s) => Some(index(s, uvs.len(), "texture coordinate")?),
     };
     let vn = match parts.next() {
         None | Some("") => None,
-        Some(_) if normals.is_empty() => None,
+        Some(s) if normals.is_empty() => number(s, "normal")?,
         Some(s) => Some(index(s, normals.len(), "normal")?),
     };
     if parts.next().is_some() {
@@ -298,10 +325,21 @@ fn corner(w: &str, positions: &[Vec3], uvs: &[Vec2], normals: &[Vec3]) -> Result
     Ok(Corner { v, vt, vn })
 }
 
-/// A Phong material from an MTL entry, its texture loaded.
-fn to_material(m: &mtl::MtlMaterial, companions: &Companions<'_>) -> Result<Material, SceneError> {
+/// Textures decoded so far, by their name in the MTL file: each is read and decoded once.
+type TextureCache = HashMap<String, Arc<prism_image::RgbImage>>;
+
+/// A Phong material from an MTL entry, its texture loaded (once, through `textures`).
+fn to_material(
+    m: &mtl::MtlMaterial,
+    companions: &Companions<'_>,
+    textures: &mut TextureCache,
+) -> Result<Material, SceneError> {
     let kd_texture = match &m.kd_map {
         None => None,
+        Some((name, _)) if textures.contains_key(name) => Some(MaterialTexture {
+            path: name.clone(),
+            image: Arc::clone(&textures[name]),
+        }),
         Some((name, line)) => {
             let located = |message: String| SceneError::Line {
                 file: m.file.clone(),
@@ -316,9 +354,11 @@ fn to_material(m: &mtl::MtlMaterial, companions: &Companions<'_>) -> Result<Mate
             })?;
             let image = crate::texture_file::decode_texture(&bytes, name)
                 .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
+            let image = Arc::new(image);
+            textures.insert(name.clone(), Arc::clone(&image));
             Some(MaterialTexture {
                 path: name.clone(),
-                image: Arc::new(image),
+                image,
             })
         }
     };

@@ -179,3 +179,96 @@ fn malformed_input_is_located() {
         "{e}"
     );
 }
+
+/// Fan-out: a library named 10,000 times on one line and again on another is read once;
+/// a texture two materials share is read and decoded once, and both hold the same image;
+/// `usemtl` finds the last definition of a name (as a search from the end would).
+#[test]
+fn libraries_and_textures_are_read_once() {
+    let reads = std::cell::RefCell::new(Vec::new());
+    let png = prism_image::encode_png(&prism_image::Image::new(2, 2, [200, 10, 10])).unwrap();
+    let files = |name: &str| -> Result<Vec<u8>, SceneError> {
+        reads.borrow_mut().push(name.to_string());
+        match name {
+            "m.mtl" => Ok(
+                b"newmtl a\nKd 1 0 0\nmap_Kd t.png\nnewmtl b\nmap_Kd t.png\n\
+                            newmtl a\nKd 0 0 1\n"
+                    .to_vec(),
+            ),
+            "t.png" => Ok(png.clone()),
+            _ => no_files(name),
+        }
+    };
+    let obj = format!(
+        "mtllib {}\nmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n\
+         usemtl a\nf 1 2 3\nusemtl b\nf 1 2 3\nusemtl a\nf 3 2 1\n",
+        ["m.mtl"; 10_000].join(" ")
+    );
+    let s = parse_obj_scene(&obj, "fan.obj", &files, false).unwrap();
+    assert_eq!(*reads.borrow(), ["m.mtl", "t.png"]);
+    assert_eq!(s.material_names, ["a", "b"]);
+    match &s.materials[0] {
+        Material::Phong { kd, kd_texture, .. } => {
+            assert_eq!(*kd, Rgb::new(0.0, 0.0, 1.0), "the last `a` wins");
+            assert!(kd_texture.is_none());
+        }
+        m => panic!("{m:?}"),
+    }
+    match &s.materials[1] {
+        Material::Phong {
+            kd_texture: Some(t),
+            ..
+        } => assert_eq!(t.image.width(), 2),
+        m => panic!("{m:?}"),
+    }
+}
+
+/// Lookup by name is a hash: 100,000 materials, each used once, parse in well under the
+/// time a search per `usemtl` would take (about 5 * 10^9 comparisons).
+#[test]
+fn many_materials_are_looked_up_by_hash() {
+    let n = 100_000;
+    let mut mtl = String::new();
+    let mut obj = String::from("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for i in 0..n {
+        mtl.push_str(&format!("newmtl m{i}\nKd 0.5 0.5 0.5\n"));
+        obj.push_str(&format!("usemtl m{}\nf 1 2 3\n", n - 1 - i));
+    }
+    let mtl: &'static str = Box::leak(mtl.into_boxed_str());
+    let s = parse_obj_scene(&obj, "many.obj", &lib(mtl), false).unwrap();
+    assert_eq!(s.materials.len(), n);
+    assert_eq!(s.material_names[0], format!("m{}", n - 1));
+}
+
+/// A corner naming a texture coordinate or normal that is not a number is an error even
+/// in a file without any `vt` or `vn` (where a number there reads as none).
+#[test]
+fn corners_name_numbers_even_without_uvs() {
+    let ok = parse_obj_scene(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/2 3/3\n",
+        "ok.obj",
+        &no_files,
+        false,
+    );
+    assert!(ok.is_ok());
+    for (face, what) in [
+        ("f 1/a 2 3", "texture coordinate"),
+        ("f 1//x 2 3", "normal"),
+        ("f 1/0 2 3", "texture coordinate"),
+    ] {
+        let text = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{face}\n");
+        let e = parse_obj_scene(&text, "bad.obj", &no_files, false)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            format!(
+                "bad.obj:4: f: expected a {what} index, found {:?}",
+                &face[2..face
+                    .find(' ')
+                    .map_or(face.len(), |_| face[2..].find(' ').unwrap() + 2)]
+            ),
+            "{face}"
+        );
+    }
+}
