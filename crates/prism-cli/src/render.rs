@@ -393,16 +393,20 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     scene.camera.lens = thin_lens(a, &scene.camera)?;
     if let Some(path) = &a.envmap {
         let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
-        // Radiance is finite and non-negative: a NaN or negative texel would make a wrong
-        // picture (the renderer drops non-finite samples), so it is refused by position.
+        // Radiance is finite, non-negative and within what a sample may carry: a NaN, a
+        // negative texel or one of 2^55 or more would make a wrong picture (the renderer
+        // counts such samples as black), so it is refused by position.
+        let limit = prism_math::ExactSum::LIMIT;
+        let within = |v: f32| (0.0..limit).contains(&v);
         if let Some(i) = map
             .pixels()
             .iter()
-            .position(|p| !(p.is_finite() && p.r >= 0.0 && p.g >= 0.0 && p.b >= 0.0))
+            .position(|p| !(within(p.r) && within(p.g) && within(p.b)))
         {
             let (x, y) = (i as u32 % map.width(), i as u32 / map.width());
             return Err(UserError(format!(
-                "--envmap {}: texel ({x}, {y}) is {:?}; expected finite, non-negative radiance",
+                "--envmap {}: texel ({x}, {y}) is {:?}; expected finite, non-negative radiance \
+                 below 2^55",
                 path.display(),
                 map.get(x, y)
             ))

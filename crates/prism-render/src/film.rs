@@ -325,14 +325,26 @@ impl PixelSum {
         self.n < most && !self.converged
     }
 
-    /// Adds the sums of another share of this pixel's samples.
-    pub fn merge(&mut self, other: &PixelSum) {
-        for (s, o) in self.sum.iter_mut().zip(other.sum) {
-            *s += o;
+    /// Adds the sums of another share of this pixel's samples; false, leaving `self` as it
+    /// was, if an exact sum or the sample count would overflow (no render reaches that: only
+    /// crafted parts do).
+    #[must_use]
+    pub fn merge(&mut self, other: &PixelSum) -> bool {
+        let mut sum = self.sum;
+        for (s, o) in sum.iter_mut().zip(other.sum) {
+            match s.0.checked_add(o.0) {
+                Some(v) => s.0 = v,
+                None => return false,
+            }
         }
+        let Some(n) = self.n.checked_add(other.n) else {
+            return false;
+        };
+        self.sum = sum;
+        self.n = n;
         self.moment1 += other.moment1;
         self.moment2 += other.moment2;
-        self.n += other.n;
+        true
     }
 
     /// The mean radiance (black without samples).

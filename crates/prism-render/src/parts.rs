@@ -95,6 +95,19 @@ pub enum PartError {
     /// No part was given.
     #[error("no part files given")]
     NoParts,
+    /// The merged image's sums would be larger than the memory budget.
+    #[error("{file}: a {width}x{height} render {source}")]
+    OverBudget {
+        /// The first part, which gives the size.
+        file: PathBuf,
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// What the sums need and the budget.
+        #[source]
+        source: prism_math::limits::OverBudget,
+    },
 }
 
 /// What a part is a share of: the render's identity (every setting that changes pixels, by
@@ -465,6 +478,9 @@ pub fn merge_order(
             .chain(&p.identity)
             .map(|(k, _)| k.as_str())
             .collect();
+        // The kind of render first: parts of another renderer differ in many settings, and
+        // the kind says why.
+        let keys = std::iter::once("kind").chain(keys.into_iter().filter(|&k| k != "kind"));
         for k in keys {
             let (a, b) = (first.setting(k), p.setting(k));
             if a != b {
@@ -541,19 +557,35 @@ pub fn merge(files: &[PartFile], allow_missing: bool) -> Result<Merged, PartErro
         setting("width").unwrap_or(0),
         setting("height").unwrap_or(0),
     );
+    let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
+    prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
+        file: files[0].path.clone(),
+        width: w,
+        height: h,
+        source,
+    })?;
     let mut sums = Image::new(w, h, PixelSum::default());
     for i in order {
         let file = &files[i];
         let layers = file.layers()?;
         // Straight from the channels into the sums: no second image per part.
+        let mut overflow = None;
         each_pixel(&layers, &file.header, &file.path, |x, y, add| {
             let acc = &mut sums.pixels_mut()[(y * w + x) as usize];
             if acc.n == 0 {
                 *acc = add;
-            } else {
-                acc.merge(&add);
+            } else if !acc.merge(&add) && overflow.is_none() {
+                overflow = Some((x, y));
             }
         })?;
+        if let Some((x, y)) = overflow {
+            return Err(PartError::Corrupt {
+                file: file.path.clone(),
+                x,
+                y,
+                why: "has sums that overflow when added to the other parts'".to_string(),
+            });
+        }
     }
     Ok(Merged {
         identity: first.identity.clone(),

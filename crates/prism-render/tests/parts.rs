@@ -188,3 +188,44 @@ fn part_data_must_fit_the_share() {
         ));
     }
 }
+
+/// Two crafted parts, each valid alone, whose exact sums overflow 128 bits when added: the
+/// merge refuses them, naming the part and the pixel, rather than wrapping to a negative
+/// radiance.
+#[test]
+fn sums_that_overflow_are_refused() {
+    let opts = RenderOptions {
+        width: 2,
+        height: 1,
+        spp: 2,
+        ..RenderOptions::default()
+    };
+    let dir = std::env::temp_dir().join(format!("prism-overflow-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut parts = Vec::new();
+    for samples in [0..1, 1..2] {
+        let start = samples.start;
+        let share = Share {
+            part: 0,
+            parts: 1,
+            samples,
+        };
+        let mut sums = prism_image::Image::new(2, 1, prism_render::PixelSum::default());
+        for p in sums.pixels_mut() {
+            p.n = 1;
+            p.sum = [prism_math::ExactSum(i128::MAX / 2 + 1); 3];
+        }
+        let file = dir.join(format!("o{start}.exr"));
+        Part::new(identity(&opts), share, sums)
+            .write(&file)
+            .unwrap();
+        parts.push(PartFile::open(&file).unwrap());
+    }
+    let e = merge(&parts, false).unwrap_err();
+    assert!(
+        matches!(&e, PartError::Corrupt { file, x: 0, y: 0, .. } if file.ends_with("o1.exr")),
+        "{e}"
+    );
+    assert!(e.to_string().contains("overflow"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
