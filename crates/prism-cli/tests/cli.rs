@@ -4,6 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "cli/bounded.rs"]
+mod bounded;
+
 fn prism() -> Command {
     Command::new(env!("CARGO_BIN_EXE_prism"))
 }

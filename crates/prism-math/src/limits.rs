@@ -93,10 +93,12 @@ pub fn format_bytes(bytes: u64) -> String {
         value /= 1024.0;
         unit += 1;
     }
-    if value.fract() == 0.0 || value >= 100.0 {
+    // One decimal, left out when it is 0 or the value is 100 or more.
+    let tenths = (value * 10.0).round() / 10.0;
+    if tenths.fract() == 0.0 || value >= 100.0 {
         format!("{value:.0} {}", UNITS[unit])
     } else {
-        format!("{value:.1} {}", UNITS[unit])
+        format!("{tenths:.1} {}", UNITS[unit])
     }
 }
 
@@ -230,6 +232,7 @@ mod tests {
         assert_eq!(format_bytes(512), "512 B");
         assert_eq!(format_bytes(256 << 20), "256 MiB");
         assert_eq!(format_bytes(3 << 29), "1.5 GiB");
+        assert_eq!(format_bytes((2 << 30) - (1 << 16)), "2 GiB");
         assert_eq!(format_bytes(u64::MAX), "16384 PiB");
     }
 }
