@@ -93,14 +93,31 @@ struct ClipVertex {
     v: Varyings,
 }
 
-/// A vertex in window coordinates (x right, y down, z in [0, 1]) with `1/w`.
+/// A vertex in window coordinates (x right, y down) with `1/w` and its reversed depth
+/// `rz = 1 - z`: 1 at the near plane, 0 at the far plane.
+///
+/// Window depth `z` crowds against 1 far from the eye (at 270 units, `1 - z` is 4e-5, and
+/// a float near 1 resolves 6e-8 of it, half a unit of distance): a mesh of large
+/// coordinates seen from afar lost its depth order to rounding. `1 - z` is the same
+/// order reversed, and as a float it resolves those small values finely; it is computed
+/// from `w` in double precision (`n (f - w) / ((f - n) w)`, the perspective's closed
+/// form), not as a difference of nearly equal numbers. The test is OpenGL's LESS on `z`,
+/// that is GREATER on `rz`.
 #[derive(Clone, Copy, Debug)]
 struct ScreenVertex {
     x: f32,
     y: f32,
-    z: f32,
+    rz: f32,
     inv_w: f32,
     v: Varyings,
+}
+
+/// `1 - z` of window depth `z` for clip `w` (the eye-space distance along the view) under
+/// the [`NEAR`] and [`FAR`] perspective.
+#[inline]
+fn reversed_depth(w: f32) -> f32 {
+    let (n, f, w) = (f64::from(NEAR), f64::from(FAR), f64::from(w));
+    (n * (f - w) / ((f - n) * w)) as f32
 }
 
 /// A convex polygon of at most 9 corners: a triangle clipped by two planes.
@@ -213,7 +230,7 @@ fn screen_triangles<'a>(
         ScreenVertex {
             x: (c.clip[0] * inv_w + 1.0) * 0.5 * w,
             y: (1.0 - c.clip[1] * inv_w) * 0.5 * h,
-            z: (c.clip[2] * inv_w + 1.0) * 0.5,
+            rz: reversed_depth(c.clip[3]),
             inv_w,
             v: c.v,
         }
@@ -596,12 +613,13 @@ struct Band {
 }
 
 impl Band {
-    /// Clears depth (to 1, the far plane: LESS passes below it) and the visible triangle;
+    /// Clears depth (to 0, the far plane in reversed depth: the test passes above it) and
+    /// the visible triangle;
     /// weights and colours are written before they are read.
     fn clear(&mut self, len: usize, k: u32, row_len: usize) {
         let padded = len + LANES;
         self.depth.clear();
-        self.depth.resize(padded, 1.0);
+        self.depth.resize(padded, 0.0);
         self.prim.clear();
         self.prim.resize(padded, NONE);
         for b in &mut self.bary {
@@ -729,12 +747,12 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
                         e[1] * set.inv_area,
                         e[2] * set.inv_area,
                     ];
-                    let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
+                    let rz = l[0] * a.rz + l[1] * b.rz + l[2] * c.rz;
                     let s = row + j;
                     let depth = F16::load(&buf.depth[s..]);
-                    // LESS: a NaN depth never passes.
-                    let pass = inside & z.lt(depth);
-                    F16::select(pass, z, depth).store(&mut buf.depth[s..]);
+                    // LESS on z, GREATER on 1 - z: a NaN depth never passes.
+                    let pass = inside & depth.lt(rz);
+                    F16::select(pass, rz, depth).store(&mut buf.depth[s..]);
                     for (corner, weights) in l.iter().zip(&mut buf.bary) {
                         let old = F16::load(&weights[s..]);
                         F16::select(pass, *corner, old).store(&mut weights[s..]);
@@ -838,14 +856,15 @@ fn raster_wire(t: [&ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, h
                     continue;
                 }
                 let l = e.map(|v| v * set.inv_area);
-                let z = l[0] * a.z + l[1] * b.z + l[2] * c.z;
+                let rz = l[0] * a.rz + l[1] * b.rz + l[2] * c.rz;
                 // Distance in pixels to the nearest edge.
                 let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
                 let s = row + j;
-                if !near_edge || z > buf.depth[s] + 1e-4 {
+                // Behind what is drawn by more than the bias (1e-4 of window depth).
+                if !near_edge || rz < buf.depth[s] - 1e-4 {
                     continue;
                 }
-                buf.depth[s] = z;
+                buf.depth[s] = rz;
                 (buf.color[0][s], buf.color[1][s], buf.color[2][s]) = (color.r, color.g, color.b);
             }
         }

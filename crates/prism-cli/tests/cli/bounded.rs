@@ -188,7 +188,7 @@ fn small_files_claiming_gigabytes_are_refused() {
         "--max-memory 64M",
         &o,
         "t.png: a 2048x2048 image needs 32 MiB of memory, over the budget of 16 MiB",
-        &[out.clone()],
+        std::slice::from_ref(&out),
     );
     let o = bounded(
         &dir,
@@ -303,21 +303,21 @@ fn flags_are_bounded() {
         "render -l",
         &o,
         "--light-samples: expected 1 to 65536, found 4294967295",
-        &[out.clone()],
+        std::slice::from_ref(&out),
     );
     let o = bounded(&dir, &["raytrace", "-r", "16384", "16384", "-o", "out.png"]);
     refused(
         "raytrace -r",
         &o,
         "--resolution 16384 16384: the image needs 51 GiB of memory, over the budget of 2 GiB (--max-memory raises it)",
-        &[out.clone()],
+        std::slice::from_ref(&out),
     );
     let o = bounded(&dir, &["render", "-r", "8192", "8192", "-o", "out.png"]);
     refused(
         "render -r",
         &o,
         "--resolution 8192 8192: the image needs",
-        &[out.clone()],
+        std::slice::from_ref(&out),
     );
     let o = prism()
         .current_dir(&*dir)
