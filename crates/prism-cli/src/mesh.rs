@@ -112,9 +112,6 @@ enum MeshCommand {
     },
 }
 
-/// Most faces `prism mesh subdivide` will produce (about 18 GB as a halfedge mesh).
-const MAX_SUBDIVIDED_FACES: u64 = 1 << 28;
-
 /// Reads a mesh by its extension (prism-scene's table of formats), printing the reader's
 /// warnings.
 fn read(path: &Path) -> Result<PolyMesh> {
@@ -405,16 +402,13 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             let mut p = load(input, strict)?;
             let read_time = t.elapsed();
             // Refuse before allocating what cannot fit: every level makes 4 faces of one.
-            let out_faces = (p.face_count() as u128) << (2 * u128::from((*levels).min(40)));
-            if out_faces > MAX_SUBDIVIDED_FACES as u128 {
-                return Err(UserError(format!(
-                    "{}: {} levels of {} faces would make {out_faces} faces; the limit is {MAX_SUBDIVIDED_FACES}",
+            prism_mesh::check_subdivision(p.face_count(), *levels).map_err(|e| {
+                UserError(format!(
+                    "{}: {levels} levels of {} faces: {e}",
                     input.display(),
-                    levels,
                     p.face_count()
                 ))
-                .into());
-            }
+            })?;
             // Progress in output faces, so the ETA weighs each level by its work.
             let bar = crate::progress::bar(
                 (1..=*levels)

@@ -39,6 +39,15 @@ pub enum MeshError {
         /// What is wrong.
         message: String,
     },
+    /// The result would be larger than the memory budget.
+    #[error("making {faces} faces {source}")]
+    OverBudget {
+        /// Faces the result would have.
+        faces: u64,
+        /// What they need and the budget.
+        #[source]
+        source: prism_math::limits::OverBudget,
+    },
     /// An operation needs triangles.
     #[error("face {face} has {sides} sides; this operation needs triangles")]
     NotTriangles {

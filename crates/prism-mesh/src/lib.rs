@@ -26,7 +26,9 @@ pub use error::MeshError;
 pub use halfedge::{
     EdgeId, FaceId, HalfedgeId, HalfedgeMesh, TopologyError, ValidationError, VertexId,
 };
-pub use loop_subdivision::{loop_subdivide, LoopWeights};
+pub use loop_subdivision::{
+    check_subdivision, loop_subdivide, subdivided_size, LoopWeights, BYTES_PER_FACE,
+};
 pub use normals::vertex_normals_area_weighted;
 pub use obj::{parse_obj, read_obj, write_obj};
 pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};

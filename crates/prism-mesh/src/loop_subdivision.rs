@@ -41,13 +41,38 @@ impl LoopWeights {
     }
 }
 
+/// Bytes a subdivided triangle mesh takes, a face: as a halfedge mesh, three halfedges of
+/// four indices, half a vertex (a position and an index) and the face's index; and, while
+/// it is made, as a polygon mesh, its start and three indices and half a position.
+pub const BYTES_PER_FACE: u64 = (3 * 16 + (24 + 4) / 2 + 4) + (4 + 12 + 24 / 2);
+
+/// Faces and bytes ([`BYTES_PER_FACE`] a face) of `faces` triangles after `levels` of Loop
+/// subdivision, each of which makes four faces of one (saturating).
+#[must_use]
+pub fn subdivided_size(faces: usize, levels: u32) -> (u64, u64) {
+    let out = (faces as u64).saturating_mul(1u64.checked_shl(2 * levels).unwrap_or(u64::MAX));
+    (out, out.saturating_mul(BYTES_PER_FACE))
+}
+
+/// Checks `levels` of Loop subdivision of `faces` triangles against the memory budget.
+///
+/// # Errors
+/// [`MeshError::OverBudget`] with the faces the result would have.
+pub fn check_subdivision(faces: usize, levels: u32) -> Result<(), MeshError> {
+    let (faces, bytes) = subdivided_size(faces, levels);
+    prism_math::limits::check_memory(bytes)
+        .map_err(|source| MeshError::OverBudget { faces, source })
+}
+
 /// One level of Loop subdivision. Old vertices keep their indices (repositioned); the new
 /// vertex of edge `e` gets index `V + e`; face `f` becomes faces `4f .. 4f + 3`: the three
 /// corner triangles (in the order of the face's vertices), then the middle one.
 ///
 /// # Errors
-/// [`MeshError::NotTriangles`] if a face is not a triangle.
+/// [`MeshError::NotTriangles`] if a face is not a triangle; [`MeshError::OverBudget`] if
+/// the result would be larger than the memory budget (checked before it is allocated).
 pub fn loop_subdivide(mesh: &HalfedgeMesh, weights: LoopWeights) -> Result<PolyMesh, MeshError> {
+    check_subdivision(mesh.face_count(), 1)?;
     for f in 0..mesh.face_count() {
         let sides = mesh.face_halfedges(FaceId(f as u32)).count();
         if sides != 3 {
@@ -211,5 +236,27 @@ mod tests {
         assert_eq!(LoopWeights::Warren.beta(6), 1.0 / 16.0);
         // Loop's weights equal 1/16 for the regular valence 6 as well.
         assert!((LoopWeights::Loop.beta(6) - 1.0 / 16.0).abs() < 1e-15);
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+
+    /// Closed form: each level makes four faces of one; a count past 64 bits saturates
+    /// rather than wrapping to a small number, and is refused.
+    #[test]
+    fn subdivision_sizes_are_checked_before_subdividing() {
+        assert_eq!(subdivided_size(20, 0), (20, 20 * BYTES_PER_FACE));
+        assert_eq!(subdivided_size(20, 3), (20 * 64, 20 * 64 * BYTES_PER_FACE));
+        assert_eq!(subdivided_size(5856, 40).0, u64::MAX);
+        assert!(check_subdivision(20, 3).is_ok());
+        let e = check_subdivision(5856, 9).unwrap_err().to_string();
+        assert!(
+            e.starts_with("making 1535115264 faces needs 134 GiB of memory"),
+            "{e}"
+        );
+        let ico = HalfedgeMesh::from_polymesh(&crate::icosahedron()).unwrap();
+        assert!(loop_subdivide(&ico, LoopWeights::Warren).is_ok());
     }
 }

@@ -1,7 +1,7 @@
 //! [`MeshMode`]: MeshEdit's controls on a halfedge mesh: orbit (drag), zoom (wheel) and pan
 //! (arrows); the vertex, edge or face under the cursor highlighted; `F` flip, `S` split,
 //! `C` collapse the highlighted edge, `U` one level of Loop subdivision, `N` smooth or flat
-//! normals, `W` wireframe, `Ctrl+Z` undo, `Ctrl+S` save as `NAME-edited.obj`. An operation
+//! normals, `W` wireframe, `Ctrl+Z` undo, `Ctrl+S` save as `NAME-edited.obj` (or `-2`, `-3`, ... if taken). An operation
 //! the mesh cannot take says why on the status line and changes nothing.
 
 use std::path::{Path, PathBuf};
@@ -203,7 +203,15 @@ impl MeshMode {
             .path
             .file_stem()
             .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
-        let out = self.path.with_file_name(format!("{stem}-edited.obj"));
+        // A new file each time, never over an earlier one: NAME-edited.obj, then
+        // NAME-edited-2.obj, ...
+        let out = (1..)
+            .map(|n| match n {
+                1 => self.path.with_file_name(format!("{stem}-edited.obj")),
+                n => self.path.with_file_name(format!("{stem}-edited-{n}.obj")),
+            })
+            .find(|p| std::fs::symlink_metadata(p).is_err())
+            .expect("a free name");
         let poly = self.mesh.to_polymesh();
         let written = prism_image::write_atomic(&out, |w| {
             prism_mesh::write_obj(&poly, w).map_err(|source| prism_image::ImageError::Io {
@@ -261,7 +269,7 @@ impl Mode for MeshMode {
             ("N", "smooth / flat normals"),
             ("W", "wireframe on / off"),
             ("Ctrl+Z", "undo"),
-            ("Ctrl+S", "save as NAME-edited.obj"),
+            ("Ctrl+S", "save as NAME-edited.obj (-2, -3, ... if taken)"),
             ("drag", "orbit"),
             ("wheel", "zoom"),
             ("arrows", "pan"),

@@ -140,4 +140,14 @@ fn wireframe_normals_and_save() {
     );
     let back = prism_mesh::read_obj(&saved).unwrap();
     assert_eq!(back, mesh(OCTAHEDRON).to_polymesh());
+    // Saving again never writes over the earlier file.
+    std::fs::write(&saved, "kept").unwrap();
+    v.input(key('s', true));
+    let second = dir.join("oct-edited-2.obj");
+    assert_eq!(
+        v.message(),
+        Some(format!("saved {}", second.display()).as_str())
+    );
+    assert_eq!(std::fs::read_to_string(&saved).unwrap(), "kept");
+    assert!(prism_mesh::read_obj(&second).is_ok());
 }

@@ -229,7 +229,7 @@ pub fn parse_obj_scene(
                 if triangle_count > most_triangles {
                     let need = triangle_count * size_of::<[Corner; 3]>() as u64;
                     let over = prism_math::limits::check_memory(need).expect_err("over the budget");
-                    return Err(err(format!("f: the faces {over}")));
+                    return Err(err(format!("f: storing the faces {over}")));
                 }
                 let run = runs.last_mut().expect("a run was just ensured");
                 // A fan from the first corner: a quad becomes (0 1 2) and (0 2 3).
