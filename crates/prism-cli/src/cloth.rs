@@ -1,7 +1,7 @@
 //! `prism cloth`: the course's ClothSim scenes simulated exactly, written as OBJ and drawn
 //! through prism-shade with the course app's camera.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -272,6 +272,13 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         }
         (None, None) => run_frames(&mut |_, _, _| Ok(()))?,
     }
+    // A folder holds this run's frames alone: frames of a longer earlier run go.
+    if let Some(dir) = &frames_dir {
+        remove_stale_frames(dir, "png", a.frames)?;
+    }
+    if let Some(dir) = &a.obj_sequence {
+        remove_stale_frames(dir, "obj", a.frames)?;
+    }
     let cloth = &cloth;
     if let Some(o) = &a.obj {
         let t = Instant::now();
@@ -334,4 +341,25 @@ impl<W: std::io::Write> Animation<W> {
         }
         Ok(())
     }
+}
+
+/// Removes `frame_NNNN.EXT` files in `dir` numbered `frames` or more (this run wrote
+/// `frame_0000` to `frame_{frames - 1}`), so that the folder shows this run alone.
+fn remove_stale_frames(dir: &Path, ext: &str, frames: u32) -> Result<()> {
+    let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let number = name
+            .strip_prefix("frame_")
+            .and_then(|n| n.strip_suffix(ext))
+            .and_then(|n| n.strip_suffix('.'))
+            .filter(|n| n.len() >= 4 && n.bytes().all(|b| b.is_ascii_digit()))
+            .and_then(|n| n.parse::<u64>().ok());
+        if number.is_some_and(|n| n >= u64::from(frames)) {
+            let path = entry.path();
+            std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
+        }
+    }
+    Ok(())
 }

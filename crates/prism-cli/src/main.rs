@@ -3,6 +3,7 @@
 mod bezier;
 mod cloth;
 mod demo;
+mod interrupt;
 mod mesh;
 mod output;
 mod progress;
@@ -96,6 +97,7 @@ fn main() -> ExitCode {
         }
     };
     prism_math::limits::set_memory_budget(cli.max_memory);
+    interrupt::clean_up_on_signals();
     let result = match cli.command {
         Command::Svg(a) => svg::run(&a),
         Command::Bezier(a) => bezier::run(&a),

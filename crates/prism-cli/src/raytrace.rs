@@ -162,6 +162,36 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
     path.with_file_name(format!("{stem}{suffix}"))
 }
 
+/// Checks, before any rendering, every file the run will write (each camera's picture,
+/// linear copy, ray tree, PLY and debug picture): none may name the scene or another.
+fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
+    let mut outputs: Vec<(&str, PathBuf)> = Vec::new();
+    for ci in 0..n {
+        let path = numbered(&a.output, ci, n);
+        outputs.push(("--output", path.clone()));
+        if a.tile.is_none() {
+            outputs.extend(a.exr.as_deref().map(|e| ("--exr", numbered(e, ci, n))));
+            if debug {
+                outputs.push(("--debug-pixel's ray tree", sibling(&path, ".rays.json")));
+                outputs.push(("--debug-pixel's picture", sibling(&path, ".debug.png")));
+                outputs.extend(
+                    a.debug_ply
+                        .as_deref()
+                        .map(|p| ("--debug-ply", numbered(p, ci, n))),
+                );
+            }
+        }
+    }
+    let outputs: Vec<(&str, &Path)> = outputs.iter().map(|(f, p)| (*f, p.as_path())).collect();
+    let scene = Path::new(&a.scene);
+    let inputs: Vec<(&str, &Path)> = if scene.is_file() {
+        vec![("the scene", scene)]
+    } else {
+        Vec::new()
+    };
+    crate::output::check_distinct(&inputs, &outputs)
+}
+
 /// What the command loads: the scene, its cameras, the config if any.
 pub struct Loaded {
     /// The scene.
@@ -267,16 +297,6 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             return Err(UserError("--debug-ply: it needs --debug-pixel X,Y".into()).into());
         }
     }
-    let mut outputs = vec![("--output", a.output.as_path())];
-    outputs.extend(a.exr.as_deref().map(|p| ("--exr", p)));
-    outputs.extend(a.debug_ply.as_deref().map(|p| ("--debug-ply", p)));
-    let scene = Path::new(&a.scene);
-    let inputs: Vec<(&str, &Path)> = if scene.is_file() {
-        vec![("the scene", scene)]
-    } else {
-        Vec::new()
-    };
-    crate::output::check_distinct(&inputs, &outputs)?;
     if a.debug_camera.is_some() && a.debug_pixel.is_none() {
         eprintln!("prism: warning: --debug-camera has no effect: it applies to --debug-pixel");
     }
@@ -434,6 +454,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     };
     let pool = crate::resources::pool(a.threads)?;
     let n = loaded.cameras.len();
+    check_every_output(a, n, debug_pixel.is_some())?;
     let mut written = Vec::new();
     let mut counts = prism_render::RayCounts::default();
     let mut render_time = std::time::Duration::ZERO;

@@ -378,6 +378,7 @@ pub fn write_atomic_with<E>(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "out".to_string());
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    register_temporary(&tmp, true);
     // Errors name the user's path, never the temporary file's.
     let result = (|| {
         let file = File::create(&tmp).map_err(|e| io_error(path, e))?;
@@ -390,7 +391,35 @@ pub fn write_atomic_with<E>(
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    register_temporary(&tmp, false);
     result
+}
+
+/// The temporary files being written now, by every thread.
+static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register_temporary(path: &Path, writing: bool) {
+    let mut list = TEMPORARIES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if writing {
+        list.push(path.to_path_buf());
+    } else if let Some(i) = list.iter().position(|p| p == path) {
+        list.swap_remove(i);
+    }
+}
+
+/// Removes every temporary file being written (by [`write_atomic_with`]) and holds them
+/// from being made again, for a process about to exit on a signal: no hidden `.NAME.tmp`
+/// is left behind. Every later atomic write blocks.
+pub fn remove_temporaries_before_exit() {
+    let list = TEMPORARIES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for p in list.iter() {
+        let _ = std::fs::remove_file(p);
+    }
+    std::mem::forget(list);
 }
 
 /// [`write_atomic_with`] for image files: file-system errors are [`ImageError::Io`].

@@ -550,3 +550,82 @@ fn env_maps_beyond_the_sums_or_grey_are_read_right() {
         "the grey sky renders black"
     );
 }
+
+/// Interrupted work leaves no hidden temporary: a cloth animation streaming into
+/// `.anim.gif.PID.tmp` is stopped by SIGINT (exit 130) and by SIGTERM (exit 143), and
+/// neither the temporary nor the animation remains.
+#[test]
+fn interrupted_writes_leave_no_temporaries() {
+    let dir = scratch("bounded-signals");
+    let scene = prism_testkit::shared_asset("clothsim/scene/pinned2.json");
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let mut child = prism()
+            .current_dir(&*dir)
+            .arg("cloth")
+            .arg(&scene)
+            .args(["--frames", "5000", "-r", "64", "64", "-o", "anim.gif", "-q"])
+            .spawn()
+            .unwrap();
+        let hidden = || {
+            std::fs::read_dir(&*dir)
+                .unwrap()
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+                .count()
+        };
+        let started = std::time::Instant::now();
+        while hidden() == 0 {
+            assert!(started.elapsed().as_secs() < 60, "no temporary appeared");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let killed = std::process::Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status()
+            .unwrap();
+        assert!(killed.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(code), "SIG{signal}");
+        assert_eq!(hidden(), 0, "SIG{signal}: a temporary remains");
+        assert!(!dir.join("anim.gif").exists());
+    }
+}
+
+/// A frame folder shows one run: a shorter run removes the higher-numbered frames of a
+/// longer one, and leaves every other file alone.
+#[test]
+fn frame_folders_hold_one_run() {
+    let dir = scratch("bounded-frames");
+    let scene = prism_testkit::shared_asset("clothsim/scene/pinned2.json");
+    let run = |frames: &str| {
+        let o = prism()
+            .current_dir(&*dir)
+            .arg("cloth")
+            .arg(&scene)
+            .args(["--frames", frames, "-r", "16", "16", "-o", "./", "-q"])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    };
+    let frames = || {
+        let mut names: Vec<String> = std::fs::read_dir(&*dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    run("6");
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    std::fs::write(dir.join("frame_12.png"), "not a frame of prism's").unwrap();
+    run("3");
+    assert_eq!(
+        frames(),
+        [
+            "frame_0001.png",
+            "frame_0002.png",
+            "frame_12.png",
+            "notes.txt"
+        ]
+    );
+}
