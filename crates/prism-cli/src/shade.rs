@@ -193,6 +193,13 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         ))
         .into());
     }
+    if !(a.fov_y > 0.0 && a.fov_y < 180.0) {
+        return Err(UserError(format!(
+            "--fov-y: expected a field of view strictly between 0 and 180 degrees, found {}",
+            a.fov_y
+        ))
+        .into());
+    }
     if a.samples == 0 || a.samples > 256 {
         return Err(UserError(format!("--samples: expected 1 to 256, found {}", a.samples)).into());
     }
@@ -278,9 +285,12 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
     if a.cubemap.is_some() && a.shader != ShaderArg::Mirror {
         eprintln!("prism: warning: --cubemap has no effect: it applies to --shader mirror");
     }
-    let (lo, hi) = mesh
-        .bounds()
-        .ok_or_else(|| UserError(format!("{}: the mesh has no vertices", a.mesh.display())))?;
+    let (lo, hi) = mesh.bounds().ok_or_else(|| {
+        UserError(format!(
+            "{}: the mesh has no faces to draw",
+            a.mesh.display()
+        ))
+    })?;
     let centre = (lo + hi) * 0.5;
     let target = match &a.target {
         Some(t) => three(t, "--target")?,

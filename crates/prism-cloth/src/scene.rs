@@ -116,9 +116,49 @@ pub fn read_scene(path: &Path, overrides: &[String]) -> Result<ClothScene, Cloth
 /// A located [`ClothError`].
 pub fn parse_scene(text: &str, file: &str, overrides: &[String]) -> Result<ClothScene, ClothError> {
     let mut root = parse_json(text, file)?;
-    for o in overrides {
-        apply_override(&mut root, o)?;
+    for (i, o) in overrides.iter().enumerate() {
+        apply_override(&mut root, o, override_line(i))?;
     }
+    // A value an override set is checked as the file's are; its errors name the override,
+    // not a line of the file.
+    let overridden = |e: ClothError| match e {
+        ClothError::Parse { line, message, .. } if line >= override_line(overrides.len()) => {
+            ClothError::Override {
+                setting: overrides[(u32::MAX - line) as usize].clone(),
+                message,
+            }
+        }
+        e => e,
+    };
+    parse_checked(&root, file).map_err(overridden)
+}
+
+/// The line number standing for override `i`: counted down from the largest, where no file
+/// reaches.
+fn override_line(i: usize) -> u32 {
+    u32::MAX - u32::try_from(i).unwrap_or(u32::MAX)
+}
+
+/// Gives `json` and every value inside it the line `line` (without recursion).
+fn relabel(json: &mut Json, line: u32) {
+    let mut stack = vec![json];
+    while let Some(j) = stack.pop() {
+        j.line = line;
+        match &mut j.value {
+            JsonValue::Array(items) => stack.extend(items.iter_mut()),
+            JsonValue::Object(fields) => {
+                for (_, l, v) in fields.iter_mut() {
+                    *l = line;
+                    stack.push(v);
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Checks a scene's values, every required key present.
+fn parse_checked(root: &Json, file: &str) -> Result<ClothScene, ClothError> {
     let cx = Cx { file };
     let top = cx.object(&root, "the top level", &["cloth", "sphere", "plane"])?;
     let get = |k: &str| top.iter().find(|(n, _, _)| n == k).map(|(_, _, v)| v);
@@ -138,8 +178,9 @@ pub fn parse_scene(text: &str, file: &str, overrides: &[String]) -> Result<Cloth
     })
 }
 
-/// Replaces (or adds) the value a `KEY=VALUE` override names.
-fn apply_override(root: &mut Json, setting: &str) -> Result<(), ClothError> {
+/// Replaces (or adds) the value a `KEY=VALUE` override names, giving it (and what it holds)
+/// the line `line`.
+fn apply_override(root: &mut Json, setting: &str, line: u32) -> Result<(), ClothError> {
     let bad = |message: &str| ClothError::Override {
         setting: setting.to_string(),
         message: message.to_string(),
@@ -151,8 +192,9 @@ fn apply_override(root: &mut Json, setting: &str) -> Result<(), ClothError> {
         Some((o, k)) => (o.to_string(), k.to_string()),
         None => ("cloth".to_string(), key.trim().to_string()),
     };
-    let value =
+    let mut value =
         parse_json(value, "the value").map_err(|e| bad(&format!("expected a JSON value: {e}")))?;
+    relabel(&mut value, line);
     let JsonValue::Object(top) = &mut root.value else {
         return Err(bad("the scene is not a JSON object"));
     };
@@ -162,17 +204,12 @@ fn apply_override(root: &mut Json, setting: &str) -> Result<(), ClothError> {
     let JsonValue::Object(fields) = &mut obj.value else {
         return Err(bad(&format!("\"{object}\" is not an object")));
     };
-    let line = obj.line;
     match fields.iter_mut().find(|(n, _, _)| *n == key) {
-        Some((_, _, v)) => v.value = value.value,
-        None => fields.push((
-            key,
-            line,
-            Json {
-                value: value.value,
-                line,
-            },
-        )),
+        Some((_, l, v)) => {
+            *l = line;
+            *v = value;
+        }
+        None => fields.push((key, line, value)),
     }
     Ok(())
 }

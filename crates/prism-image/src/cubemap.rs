@@ -71,15 +71,19 @@ impl CubeMap {
         let side = faces[0].width();
         for (f, name) in faces.iter().zip(CUBE_FACES) {
             if f.width() != side || f.height() != side || side == 0 {
+                let (w, h) = (f.width(), f.height());
+                let first = CUBE_FACES[0];
+                let message = if w != h || side == 0 || name == first {
+                    format!("cube-map faces must be square and of one size: {name} is {w} x {h}")
+                } else {
+                    format!(
+                        "cube-map faces must be square and of one size: {name} is {w} x {h}, \
+                         {first} is {side} x {side}"
+                    )
+                };
                 return Err(ImageError::Decode {
                     what: name.to_string(),
-                    message: format!(
-                        "cube-map faces must be square and of one size: {} is {} x {}, {} is {side} x {side}",
-                        name,
-                        f.width(),
-                        f.height(),
-                        CUBE_FACES[0]
-                    ),
+                    message,
                 });
             }
         }

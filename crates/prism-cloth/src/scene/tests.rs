@@ -135,3 +135,25 @@ fn staged_scenes_read() {
         );
     }
 }
+
+/// A value an override sets is checked as the file's are, and its error names the
+/// override, not the line of the file where the key was.
+#[test]
+fn override_errors_name_the_override() {
+    let set = |s: &[&str]| s.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let e = parse_scene(PINNED2, "p.json", &set(&["ks=500", "ks=-1"])).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "--set ks=-1: ks: expected a spring constant from 0 to 1e12, found -1"
+    );
+    let e = parse_scene(PINNED2, "p.json", &set(&["pinned=[[0, 0], [90, 0]]"])).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("--set pinned=[[0, 0], [90, 0]]: "),
+        "{e}"
+    );
+    // A bad value in the file itself still names its line.
+    let bad = PINNED2.replace("\"ks\": 5000.0", "\"ks\": -5");
+    let e = parse_scene(&bad, "p.json", &set(&["density=15"])).unwrap_err();
+    assert!(e.to_string().starts_with("p.json:3: "), "{e}");
+}
