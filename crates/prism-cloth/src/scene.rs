@@ -160,7 +160,7 @@ fn relabel(json: &mut Json, line: u32) {
 /// Checks a scene's values, every required key present.
 fn parse_checked(root: &Json, file: &str) -> Result<ClothScene, ClothError> {
     let cx = Cx { file };
-    let top = cx.object(&root, "the top level", &["cloth", "sphere", "plane"])?;
+    let top = cx.object(root, "the top level", &["cloth", "sphere", "plane"])?;
     let get = |k: &str| top.iter().find(|(n, _, _)| n == k).map(|(_, _, v)| v);
     let cloth = get("cloth").ok_or_else(|| {
         cx.err(
