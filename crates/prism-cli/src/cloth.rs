@@ -254,18 +254,25 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                 path,
                 |out| -> Result<()> {
                     let fps = FRAMES_PER_SECOND as u16;
+                    // The encoders' failures (a full disk, say) name the file.
+                    let named = || format!("writing {}", path.display());
                     let mut enc = if gif {
-                        Animation::Gif(prism_image::GifEncoder::new(out, w, h, fps)?)
+                        Animation::Gif(
+                            prism_image::GifEncoder::new(out, w, h, fps).with_context(named)?,
+                        )
                     } else {
-                        Animation::Png(prism_image::ApngEncoder::new(out, w, h, a.frames, fps)?)
+                        Animation::Png(
+                            prism_image::ApngEncoder::new(out, w, h, a.frames, fps)
+                                .with_context(named)?,
+                        )
                     };
                     run_frames(&mut |_, img, write| {
                         let t = Instant::now();
-                        enc.push(&img)?;
+                        enc.push(&img).with_context(named)?;
                         *write += t.elapsed();
                         Ok(())
                     })?;
-                    enc.finish()
+                    enc.finish().with_context(named)
                 },
                 |p, e| anyhow::anyhow!("writing {}: {e}", p.display()),
             )?;
@@ -343,8 +350,8 @@ impl<W: std::io::Write> Animation<W> {
     }
 }
 
-/// Removes `frame_NNNN.EXT` files in `dir` numbered `frames` or more (this run wrote
-/// `frame_0000` to `frame_{frames - 1}`), so that the folder shows this run alone.
+/// Removes the `frame_NNNN.EXT` files in `dir` that this run did not write (it wrote
+/// `frame_0001` to `frame_{frames}`), so that the folder shows this run alone.
 fn remove_stale_frames(dir: &Path, ext: &str, frames: u32) -> Result<()> {
     let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
     for entry in entries.flatten() {
@@ -356,7 +363,7 @@ fn remove_stale_frames(dir: &Path, ext: &str, frames: u32) -> Result<()> {
             .and_then(|n| n.strip_suffix('.'))
             .filter(|n| n.len() >= 4 && n.bytes().all(|b| b.is_ascii_digit()))
             .and_then(|n| n.parse::<u64>().ok());
-        if number.is_some_and(|n| n >= u64::from(frames)) {
+        if number.is_some_and(|n| n == 0 || n > u64::from(frames)) {
             let path = entry.path();
             std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
         }

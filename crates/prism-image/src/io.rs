@@ -430,10 +430,22 @@ pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<File>) -> Result<(), ImageError>,
 ) -> Result<(), ImageError> {
-    write_atomic_with(path, write, |p, source| ImageError::Io {
-        path: p.to_path_buf(),
-        source,
-    })
+    // An encoder's failure (a full disk, say) names the file being written.
+    let named = |e: ImageError| match e {
+        ImageError::Encode { format, message } => ImageError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::other(format!("encoding {format}: {message}")),
+        },
+        e => e,
+    };
+    write_atomic_with(
+        path,
+        |w| write(w).map_err(named),
+        |p, source| ImageError::Io {
+            path: p.to_path_buf(),
+            source,
+        },
+    )
 }
 
 #[cfg(test)]
@@ -613,5 +625,30 @@ mod tests {
         bytes[sof + 7..sof + 9].copy_from_slice(&1024u16.to_be_bytes());
         let e = decode_jpeg(&bytes, "huge.jpg").unwrap_err().to_string();
         assert!(e.contains("1024x1024 pixels cannot fit in"), "{e}");
+    }
+
+    /// An encoder's failure while writing a file names the file (a full disk said only
+    /// "encoding PNG: ..."), and the file is not made.
+    #[test]
+    fn encoding_failures_name_the_file() {
+        let dir = std::env::temp_dir().join(format!("prism-encode-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("out.png");
+        let e = write_atomic(&path, |_| {
+            Err(ImageError::Encode {
+                format: "PNG",
+                message: "No space left on device (os error 28)".into(),
+            })
+        })
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: encoding PNG: No space left on device (os error 28)",
+                path.display()
+            )
+        );
+        assert!(!path.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

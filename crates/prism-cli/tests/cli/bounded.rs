@@ -624,6 +624,7 @@ fn frame_folders_hold_one_run() {
         [
             "frame_0001.png",
             "frame_0002.png",
+            "frame_0003.png",
             "frame_12.png",
             "notes.txt"
         ]
