@@ -630,3 +630,28 @@ fn frame_folders_hold_one_run() {
         ]
     );
 }
+
+/// A part file whose header claims 16384 x 16384 pixels (the sweep's crafted part took
+/// 5.2 GB before it was refused) is refused as it is opened, by the image budget.
+#[test]
+fn crafted_parts_are_refused_before_merging() {
+    let dir = scratch("bounded-parts");
+    let o = prism()
+        .current_dir(&*dir)
+        .args(["raytrace", "-r", "16", "16", "--tile", "0/1", "-o", "p.exr"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut bytes = std::fs::read(dir.join("p.exr")).unwrap();
+    let at = bytes.windows(10).position(|w| w == b"dataWindow").unwrap() + 21;
+    bytes[at + 8..at + 12].copy_from_slice(&16383i32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&16383i32.to_le_bytes());
+    std::fs::write(dir.join("big.exr"), bytes).unwrap();
+    let o = bounded(&dir, &["merge", "-o", "out.png", "big.exr"]);
+    refused(
+        "crafted part",
+        &o,
+        "big.exr: a 16384x16384 image needs",
+        &[dir.join("out.png")],
+    );
+}
