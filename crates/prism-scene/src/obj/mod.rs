@@ -126,7 +126,7 @@ pub fn parse_obj_scene(
     // Each material's index by name, the last definition winning (as a search from the end).
     let mut by_name: HashMap<String, usize> = HashMap::new();
     let mut lib_files: Vec<String> = Vec::new();
-    let mut lib_names: HashSet<&str> = HashSet::new();
+    let mut lib_names: HashSet<String> = HashSet::new();
     // Faces are stored as corners: their count is checked against the memory budget.
     let most_triangles = prism_math::limits::memory_budget() / size_of::<[Corner; 3]>() as u64;
     let mut triangle_count = 0u64;
@@ -162,8 +162,8 @@ pub fn parse_obj_scene(
             }
             "mtllib" => {
                 for name in content[key.len()..].split_whitespace() {
-                    // Each library is read once, however often it is named.
-                    if !lib_names.insert(name) {
+                    // Each library is read once, however often or however it is named.
+                    if !lib_names.insert(same_file_key(name)) {
                         continue;
                     }
                     let bytes = companions(name).map_err(|e| {
@@ -325,6 +325,23 @@ fn corner(w: &str, positions: &[Vec3], uvs: &[Vec2], normals: &[Vec3]) -> Result
     Ok(Corner { v, vt, vn })
 }
 
+/// A companion file's name with the spellings of one path made one (`./a//b.mtl`, `a/b.mtl`
+/// and `a/c/../b.mtl` alike), so that a file named many ways is read once.
+fn same_file_key(name: &str) -> String {
+    use std::path::Component;
+    let mut parts: Vec<String> = Vec::new();
+    for c in Path::new(name).components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if parts.last().is_some_and(|p| p != "..") => {
+                parts.pop();
+            }
+            c => parts.push(c.as_os_str().to_string_lossy().into_owned()),
+        }
+    }
+    parts.join("/")
+}
+
 /// Textures decoded so far, by their name in the MTL file: each is read and decoded once.
 type TextureCache = HashMap<String, Arc<prism_image::RgbImage>>;
 
@@ -336,9 +353,9 @@ fn to_material(
 ) -> Result<Material, SceneError> {
     let kd_texture = match &m.kd_map {
         None => None,
-        Some((name, _)) if textures.contains_key(name) => Some(MaterialTexture {
+        Some((name, _)) if textures.contains_key(&same_file_key(name)) => Some(MaterialTexture {
             path: name.clone(),
-            image: Arc::clone(&textures[name]),
+            image: Arc::clone(&textures[&same_file_key(name)]),
         }),
         Some((name, line)) => {
             let located = |message: String| SceneError::Line {
@@ -355,7 +372,7 @@ fn to_material(
             let image = crate::texture_file::decode_texture(&bytes, name)
                 .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
             let image = Arc::new(image);
-            textures.insert(name.clone(), Arc::clone(&image));
+            textures.insert(same_file_key(name), Arc::clone(&image));
             Some(MaterialTexture {
                 path: name.clone(),
                 image,
