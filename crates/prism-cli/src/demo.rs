@@ -744,17 +744,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
             .to_rgb_f32())
     };
     let tex = prism_shade::course_texture(load("texture_1.png")?);
-    let mut faces = Vec::new();
-    for name in prism_image::CUBE_FACES {
-        let path = ["png", "jpg"]
-            .iter()
-            .map(|e| format!("cube/{name}.{e}"))
-            .find(|p| textures.join(p).is_file())
-            .context("the course's cube map")?;
-        faces.push(load(&path)?);
-    }
-    let faces: [prism_image::RgbImage; 6] = faces.try_into().expect("six faces");
-    let cube = prism_image::CubeMap::new(faces)?;
+    let cube = prism_image::CubeMap::read(&textures.join("cube"))?;
     let shaders = [
         Shader::Normal,
         Shader::Diffuse,

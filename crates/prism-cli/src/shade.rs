@@ -255,23 +255,8 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         }
         ShaderArg::Mirror => {
             let dir = a.cubemap.clone().unwrap_or_else(|| staged("cube"));
-            let mut faces = Vec::new();
-            for name in prism_image::CUBE_FACES {
-                let path = ["png", "jpg", "jpeg"]
-                    .iter()
-                    .map(|e| dir.join(format!("{name}.{e}")))
-                    .find(|p| p.is_file())
-                    .ok_or_else(|| {
-                        UserError(format!(
-                            "--cubemap {}: no {name}.png or {name}.jpg",
-                            dir.display()
-                        ))
-                    })?;
-                faces.push(load_rgb(&path, "--cubemap")?);
-            }
-            let faces: [prism_image::RgbImage; 6] = faces.try_into().expect("six faces were read");
             Shader::Mirror(
-                prism_image::CubeMap::new(faces)
+                prism_image::CubeMap::read(&dir)
                     .map_err(|e| UserError(format!("--cubemap: {e}")))?,
             )
         }

@@ -62,7 +62,71 @@ pub fn cube_face(d: Vec3) -> Option<(usize, Vec2)> {
     ))
 }
 
+/// Bytes a cube-map face takes a pixel once read: linear RGB floats and their mipmaps
+/// (a third more), beside the 8-bit copy it was decoded into.
+const FACE_BYTES_PER_PIXEL: u64 = 12 + 4 + 8;
+
+/// Checks that face `name` is square, not empty, and `side` pixels a side (the first
+/// face's).
+fn check_face(name: &str, f: &RgbImage, side: u32) -> Result<(), ImageError> {
+    let (w, h) = (f.width(), f.height());
+    if w == side && h == side && side > 0 {
+        return Ok(());
+    }
+    let first = CUBE_FACES[0];
+    let message = if w != h || side == 0 || name == first {
+        format!("cube-map faces must be square and of one size: {name} is {w} x {h}")
+    } else {
+        format!(
+            "cube-map faces must be square and of one size: {name} is {w} x {h}, {first} is \
+             {side} x {side}"
+        )
+    };
+    Err(ImageError::Decode {
+        what: name.to_string(),
+        message,
+    })
+}
+
 impl CubeMap {
+    /// Reads the six faces `posx`, `negx`, ... from `dir` (each `.png`, `.jpg` or `.jpeg`,
+    /// sRGB bytes read as values in `[0, 1]`, as the course's app uploads them). The first
+    /// face's size is checked for all six against the memory budget before the other five
+    /// are read, and each face must match it.
+    ///
+    /// # Errors
+    /// [`ImageError::Decode`] naming a missing face or one of another size, or six faces
+    /// over the memory budget; a face's own read or decode error.
+    pub fn read(dir: &std::path::Path) -> Result<CubeMap, ImageError> {
+        let mut faces = Vec::with_capacity(6);
+        for name in CUBE_FACES {
+            let path = ["png", "jpg", "jpeg"]
+                .iter()
+                .map(|e| dir.join(format!("{name}.{e}")))
+                .find(|p| p.is_file())
+                .ok_or_else(|| ImageError::Decode {
+                    what: dir.display().to_string(),
+                    message: format!("no {name}.png or {name}.jpg"),
+                })?;
+            let decoded = crate::read_image(&path)?;
+            if faces.is_empty() {
+                let (w, h) = (u64::from(decoded.width()), u64::from(decoded.height()));
+                let bytes = 6 * w * h * FACE_BYTES_PER_PIXEL;
+                prism_math::limits::check_memory(bytes).map_err(|over| ImageError::Decode {
+                    what: dir.display().to_string(),
+                    message: format!("the cube map of six {w}x{h} faces {over}"),
+                })?;
+            }
+            let face = decoded.to_rgb8().to_rgb_f32();
+            // A face of another size stops the read here, not after all six.
+            let side = faces.first().map_or(face.width(), RgbImage::width);
+            check_face(name, &face, side)?;
+            faces.push(face);
+        }
+        let faces: [RgbImage; 6] = faces.try_into().expect("six faces were read");
+        CubeMap::new(faces)
+    }
+
     /// A cube map of six faces in [`CUBE_FACES`] order.
     ///
     /// # Errors
@@ -70,22 +134,7 @@ impl CubeMap {
     pub fn new(faces: [RgbImage; 6]) -> Result<CubeMap, ImageError> {
         let side = faces[0].width();
         for (f, name) in faces.iter().zip(CUBE_FACES) {
-            if f.width() != side || f.height() != side || side == 0 {
-                let (w, h) = (f.width(), f.height());
-                let first = CUBE_FACES[0];
-                let message = if w != h || side == 0 || name == first {
-                    format!("cube-map faces must be square and of one size: {name} is {w} x {h}")
-                } else {
-                    format!(
-                        "cube-map faces must be square and of one size: {name} is {w} x {h}, \
-                         {first} is {side} x {side}"
-                    )
-                };
-                return Err(ImageError::Decode {
-                    what: name.to_string(),
-                    message,
-                });
-            }
+            check_face(name, f, side)?;
         }
         Ok(CubeMap {
             faces: faces

@@ -655,3 +655,40 @@ fn crafted_parts_are_refused_before_merging() {
         &[dir.join("out.png")],
     );
 }
+
+/// Six faces of a cube map are counted together: a 4096 x 4096 first face (decodable on
+/// its own) means 2.3 GiB for six, refused before the other five are read; a face of
+/// another size is refused naming it.
+#[test]
+fn cube_maps_are_counted_whole() {
+    let dir = scratch("bounded-cube");
+    std::fs::create_dir(dir.join("cube")).unwrap();
+    let mut png = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut png, 4096, 4096);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::One);
+        let mut w = enc.write_header().unwrap();
+        w.write_image_data(&vec![0u8; 4096 / 8 * 4096]).unwrap();
+    }
+    std::fs::write(dir.join("cube/posx.png"), png).unwrap();
+    std::fs::write(dir.join("scene.obj"), TRIANGLE).unwrap();
+    std::fs::write(dir.join("m.mtl"), "newmtl m\nKd 1 0 0\n").unwrap();
+    let args = [
+        "shade",
+        "scene.obj",
+        "--shader",
+        "mirror",
+        "--cubemap",
+        "cube",
+        "-o",
+        "out.png",
+    ];
+    let o = bounded(&dir, &args);
+    refused(
+        "cube map",
+        &o,
+        "--cubemap: cube: the cube map of six 4096x4096 faces needs 2.3 GiB of memory",
+        &[dir.join("out.png")],
+    );
+}
