@@ -201,8 +201,12 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         )
         .into());
     }
-    let event_loop = EventLoop::new()
-        .map_err(|e| UserError(format!("prism view: cannot reach the display: {e}")))?;
+    let event_loop = EventLoop::new().map_err(|e| {
+        UserError(format!(
+            "prism view: cannot reach the display: {}",
+            without_source_location(&e.to_string())
+        ))
+    })?;
     let mut app = App {
         viewer,
         window: None,
@@ -212,8 +216,26 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     };
     event_loop.run_app(&mut app)?;
     match app.error {
-        Some(e) => Err(UserError(format!("prism view: {e}")).into()),
+        Some(e) => Err(UserError(format!("prism view: {}", without_source_location(&e))).into()),
         None => Ok(()),
+    }
+}
+
+/// `text` without the windowing library's note of where in its own source an OS error was
+/// raised (`os error at /.../winit-0.30/src/....rs:788: `), which says nothing to a user.
+fn without_source_location(text: &str) -> String {
+    const MARK: &str = "os error at ";
+    let Some(at) = text.find(MARK) else {
+        return text.to_string();
+    };
+    let rest = &text[at + MARK.len()..];
+    // The location ends at the first ": " after `FILE:LINE`.
+    match rest
+        .find(".rs:")
+        .and_then(|i| rest[i..].find(": ").map(|j| i + j + 2))
+    {
+        Some(end) => format!("{}{}", &text[..at], &rest[end..]),
+        None => text.to_string(),
     }
 }
 
@@ -349,5 +371,26 @@ impl ApplicationHandler for App {
             }
             _ => {}
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::without_source_location;
+
+    /// The windowing library's source location is cut from its errors; other text is kept.
+    #[test]
+    fn source_locations_are_cut() {
+        let winit = "os error at /root/.cargo/registry/src/index.crates.io-1/winit-0.30.13/src/\
+                     platform_impl/linux/mod.rs:788: Failed to open connection to X server";
+        assert_eq!(
+            without_source_location(winit),
+            "Failed to open connection to X server"
+        );
+        assert_eq!(
+            without_source_location("cannot draw: os error at a/b.rs:1: gone"),
+            "cannot draw: gone"
+        );
+        assert_eq!(without_source_location("plain"), "plain");
     }
 }
