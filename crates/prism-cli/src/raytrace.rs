@@ -135,7 +135,10 @@ fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()>
 
 /// The staged data folder, when prism runs from its source tree.
 fn staged_data() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data")
+    let dir =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data");
+    // Messages name the folder plainly, not through the crate's own folder and back.
+    std::fs::canonicalize(&dir).unwrap_or(dir)
 }
 
 /// The output path for camera `i` of `n`: the path itself for one camera, else

@@ -147,9 +147,11 @@ fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
 
 /// The staged course assets, when prism runs from its source tree.
 fn staged(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/assets/clothsim/textures")
-        .join(rel)
+        .join(rel);
+    // Messages name the file plainly, not through the crate's own folder and back.
+    std::fs::canonicalize(&path).unwrap_or(path)
 }
 
 fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
