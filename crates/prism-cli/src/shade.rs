@@ -155,8 +155,7 @@ fn staged(rel: &str) -> PathBuf {
 }
 
 fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
-    let img = prism_image::read_image(path)
-        .map_err(|e| UserError(format!("{flag} {}: {e}", path.display())))?;
+    let img = prism_image::read_image(path).map_err(|e| UserError(format!("{flag}: {e}")))?;
     Ok(img.to_rgb8().to_rgb_f32())
 }
 
