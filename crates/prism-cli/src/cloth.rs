@@ -93,6 +93,9 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         ))
         .into());
     }
+    // A frame is drawn while the one before it is written: two in flight.
+    let bytes = 2 * prism_shade::frame_bytes(w, h, 1);
+    crate::resources::check_frame("--resolution", w, h, bytes)?;
     // Where the pictures go: a folder (one per frame) or one animation (.png or .gif).
     let mut gif = false;
     let frames_dir = match &a.output {

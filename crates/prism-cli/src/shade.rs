@@ -204,6 +204,8 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
     if a.samples == 0 || a.samples > 256 {
         return Err(UserError(format!("--samples: expected 1 to 256, found {}", a.samples)).into());
     }
+    let bytes = prism_shade::frame_bytes(w, h, a.samples);
+    crate::resources::check_frame("--resolution", w, h, bytes)?;
     // Sample buffers hold 32 bytes a sample: at most 2^28 samples in all, 2^20 a row.
     let (per_row, all) = (
         u64::from(w) * u64::from(a.samples),

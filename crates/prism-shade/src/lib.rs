@@ -15,7 +15,7 @@ mod shaders;
 
 pub use error::ShadeError;
 pub use mesh::{ShadeMesh, MAX_FACE_CORNERS};
-pub use pipeline::{shade, shade_rgb8, to_bytes, ShadeOptions, View, FAR, NEAR};
+pub use pipeline::{frame_bytes, shade, shade_rgb8, to_bytes, ShadeOptions, View, FAR, NEAR};
 pub use shaders::{
     blinn_phong, bumped_normal, course_texture, fragment, height, Needs, Shader, Uniforms, Varyings,
 };

@@ -285,6 +285,19 @@ fn owns_edge(ax: f32, ay: f32, bx: f32, by: f32, area_sign: f32) -> bool {
     dy < 0.0 || (dy == 0.0 && dx > 0.0)
 }
 
+/// The most bytes [`shade_rgb8`] holds for a `width x height` frame at `samples` samples a
+/// pixel: the picture's bytes and, for each worker thread, one band's sample buffers
+/// (depth, triangle, three weights and three colour channels a sample); [`shade`]'s linear
+/// picture takes 12 bytes a pixel more. A caller checks it against the memory budget
+/// before drawing.
+#[must_use]
+pub fn frame_bytes(width: u32, height: u32, samples: u32) -> u64 {
+    let (w, h) = (u64::from(width), u64::from(height));
+    let picture = w * h * 3;
+    let band = u64::from(BAND) * w * u64::from(samples) * 32;
+    picture + band * rayon::current_num_threads() as u64
+}
+
 /// Renders `mesh` seen by `view` with `shader`: linear colours, one per pixel (the
 /// samples' mean), before clamping.
 ///

@@ -212,7 +212,11 @@ fn only_regular_files_are_read() {
 fn flags_are_bounded() {
     let dir = scratch("bounded-flags");
     let out = dir.join("out.png");
-    let cases: [(&[&str], &str); 3] = [
+    std::fs::write(dir.join("scene.obj"), TRIANGLE).unwrap();
+    std::fs::write(dir.join("m.mtl"), "newmtl m\nKd 1 0 0\n").unwrap();
+    let cloth = prism_testkit::shared_asset("clothsim/scene/pinned2.json");
+    let cloth = cloth.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
         (
             &["render", "-l", "4294967295"],
             "--light-samples: expected 1 to 65536, found 4294967295",
@@ -225,6 +229,33 @@ fn flags_are_bounded() {
         (
             &["render", "-r", "8192", "8192"],
             "--resolution 8192 8192: the image needs",
+        ),
+        (
+            &[
+                "--max-memory",
+                "512M",
+                "shade",
+                "scene.obj",
+                "-r",
+                "16384",
+                "16384",
+            ],
+            // 768 MiB of picture and one band a worker thread (a figure by machine).
+            "--resolution 16384 16384: the image needs",
+        ),
+        (
+            &[
+                "--max-memory",
+                "1G",
+                "cloth",
+                cloth,
+                "--frames",
+                "1",
+                "-r",
+                "16384",
+                "16384",
+            ],
+            "--resolution 16384 16384: the image needs",
         ),
     ];
     for (args, expect) in cases {
