@@ -100,9 +100,9 @@ struct ClipVertex {
 /// a float near 1 resolves 6e-8 of it, half a unit of distance): a mesh of large
 /// coordinates seen from afar lost its depth order to rounding. `1 - z` is the same
 /// order reversed, and as a float it resolves those small values finely; it is computed
-/// from `w` in double precision (`n (f - w) / ((f - n) w)`, the perspective's closed
-/// form), not as a difference of nearly equal numbers. The test is OpenGL's LESS on `z`,
-/// that is GREATER on `rz`.
+/// from `1/w` by the perspective's closed form, `n (f - w) / ((f - n) w) = n / (f - n) (f/w
+/// - 1)`, not as a difference of nearly equal numbers (the same two operations as `z` took).
+/// The test is OpenGL's LESS on `z`, that is GREATER on `rz`.
 #[derive(Clone, Copy, Debug)]
 struct ScreenVertex {
     x: f32,
@@ -112,12 +112,12 @@ struct ScreenVertex {
     v: Varyings,
 }
 
-/// `1 - z` of window depth `z` for clip `w` (the eye-space distance along the view) under
+/// `1 - z` of window depth `z` for `1/w` (`w` the eye-space distance along the view) under
 /// the [`NEAR`] and [`FAR`] perspective.
 #[inline]
-fn reversed_depth(w: f32) -> f32 {
-    let (n, f, w) = (f64::from(NEAR), f64::from(FAR), f64::from(w));
-    (n * (f - w) / ((f - n) * w)) as f32
+fn reversed_depth(inv_w: f32) -> f32 {
+    const SCALE: f32 = NEAR / (FAR - NEAR);
+    (FAR * inv_w - 1.0) * SCALE
 }
 
 /// A convex polygon of at most 9 corners: a triangle clipped by two planes.
@@ -230,7 +230,7 @@ fn screen_triangles<'a>(
         ScreenVertex {
             x: (c.clip[0] * inv_w + 1.0) * 0.5 * w,
             y: (1.0 - c.clip[1] * inv_w) * 0.5 * h,
-            rz: reversed_depth(c.clip[3]),
+            rz: reversed_depth(inv_w),
             inv_w,
             v: c.v,
         }
