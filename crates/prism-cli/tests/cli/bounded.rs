@@ -223,7 +223,7 @@ fn flags_are_bounded() {
         ),
         (
             &["raytrace", "-r", "16384", "16384"],
-            "--resolution 16384 16384: the image needs 51 GiB of memory, over the budget of \
+            "--resolution 16384 16384: the image needs 29 GiB of memory, over the budget of \
              2 GiB (--max-memory raises it)",
         ),
         (
