@@ -353,26 +353,26 @@ fn to_material(
 ) -> Result<Material, SceneError> {
     let kd_texture = match &m.kd_map {
         None => None,
-        Some((name, _)) if textures.contains_key(&same_file_key(name)) => Some(MaterialTexture {
-            path: name.clone(),
-            image: Arc::clone(&textures[&same_file_key(name)]),
-        }),
         Some((name, line)) => {
-            let located = |message: String| SceneError::Line {
-                file: m.file.clone(),
-                line: *line,
-                message,
+            let image = match textures.entry(same_file_key(name)) {
+                std::collections::hash_map::Entry::Occupied(e) => Arc::clone(e.get()),
+                std::collections::hash_map::Entry::Vacant(slot) => {
+                    let located = |message: String| SceneError::Line {
+                        file: m.file.clone(),
+                        line: *line,
+                        message,
+                    };
+                    let bytes = companions(name).map_err(|e| {
+                        located(format!(
+                            "material {}: map_Kd {name}: cannot read the texture: {e}",
+                            m.name
+                        ))
+                    })?;
+                    let image = crate::texture_file::decode_texture(&bytes, name)
+                        .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
+                    Arc::clone(slot.insert(Arc::new(image)))
+                }
             };
-            let bytes = companions(name).map_err(|e| {
-                located(format!(
-                    "material {}: map_Kd {name}: cannot read the texture: {e}",
-                    m.name
-                ))
-            })?;
-            let image = crate::texture_file::decode_texture(&bytes, name)
-                .map_err(|e| located(format!("material {}: map_Kd {name}: {e}", m.name)))?;
-            let image = Arc::new(image);
-            textures.insert(same_file_key(name), Arc::clone(&image));
             Some(MaterialTexture {
                 path: name.clone(),
                 image,
