@@ -72,7 +72,7 @@ def imports(module, path, mods):
     child-module paths), each resolved to the module that holds the name."""
     code = top_level_code(path)
     found = set()
-    for match in re.finditer(r"^(\s*)(?:pub(?:\([a-z]+\))?\s+)?use\s+([^;]+);", code, re.M):
+    for match in re.finditer(r"^([ \t]*)(?:pub(?:\([a-z]+\))?\s+)?use\s+([^;]+);", code, re.M):
         inline = bool(match.group(1))
         for parts in use_paths(match.group(2)):
             if inline and parts[0] != "crate":
