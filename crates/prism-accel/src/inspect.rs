@@ -3,8 +3,8 @@
 
 use prism_math::Aabb;
 
-use crate::bvh::Bvh;
-use crate::node8::Node8;
+use crate::layout::node8::Node8;
+use crate::layout::Bvh;
 
 /// A leaf of the 8-wide tree, as [`Bvh::leaf_views`] lists it.
 #[derive(Clone, Debug, PartialEq)]

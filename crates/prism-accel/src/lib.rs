@@ -34,21 +34,25 @@
 //! - [`Bvh::levels`], [`Bvh::level_boxes`] and [`Bvh::leaf_views`] show the 8-wide tree
 //!   level by level and leaf by leaf, for drawing and checking it.
 #![warn(missing_docs)]
+//!
+//! The rooms: `hit` (what a query returns), `shapes` (spheres, the one-triangle and
+//! one-sphere tests), `layout` (the hierarchy's data: 8-wide nodes, triangle packs, the
+//! root's list), `build` (SAH, collapse, leaves), `traverse` (the queries and their walks),
+//! `simd` (the only room that touches `std::arch`: the instruction-set kernels) and
+//! `inspect` (the tree level by level, for drawing). Imports go one way: `traverse` and
+//! `build` use `simd`, `layout`, `shapes` and `hit`; `simd` uses `layout`, `shapes` and
+//! `hit`.
 
-mod bvh;
-mod flat;
+mod build;
+mod hit;
 mod inspect;
-#[cfg(target_arch = "x86_64")]
-mod lanes;
-mod node8;
-mod order;
-#[cfg(target_arch = "x86_64")]
-mod packet;
+mod layout;
 mod shapes;
-#[cfg(target_arch = "x86_64")]
 mod simd;
-mod tri4;
+mod traverse;
 
-pub use bvh::{BuildOptions, Bvh, BvhStats, Hit};
+pub use build::BuildOptions;
+pub use hit::Hit;
 pub use inspect::LeafView;
+pub use layout::{Bvh, BvhStats};
 pub use shapes::{intersect_sphere, intersect_triangle, RayPre, Sphere};

@@ -1,7 +1,6 @@
 //! Primitives and their ray tests: the sphere, per-ray precomputation, the watertight
 //! ray-triangle test and the ray-sphere test.
 
-use prism_math::glam::Vec3A;
 use prism_math::{Aabb, Ray, Vec3};
 
 /// A sphere.
@@ -21,30 +20,6 @@ impl Sphere {
             min: self.center - Vec3::splat(self.radius),
             max: self.center + Vec3::splat(self.radius),
         }
-    }
-}
-
-/// Where a closest-hit walk stands: a hit counts only if it comes before `(t, prim)` in the
-/// order of distance, then primitive number. The walks keep the first hit in that order,
-/// so two primitives at one distance are decided by their numbers, not by the order the
-/// walk happens to meet them in: a ray's hit does not depend on the hierarchy's shape.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Limit {
-    pub(crate) t: f32,
-    pub(crate) prim: u32,
-}
-
-impl Limit {
-    /// A query's own end: hits before `tmax` count, none at it.
-    #[inline(always)]
-    pub(crate) fn end(tmax: f32) -> Limit {
-        Limit { t: tmax, prim: 0 }
-    }
-
-    /// True if a hit at `t` on primitive `prim` comes before this limit.
-    #[inline(always)]
-    pub(crate) fn admits(&self, t: f32, prim: u32) -> bool {
-        t < self.t || (t == self.t && prim < self.prim)
     }
 }
 
@@ -71,23 +46,10 @@ pub(crate) static PERMS: [[usize; 3]; 6] = [
     [1, 0, 2],
 ];
 
-/// [`PERMS`] as lane numbers for a variable permute, the fourth lane repeating `kz`.
-#[cfg(target_arch = "x86_64")]
-static PERM_LANES: [[i32; 4]; 6] = {
-    let mut t = [[0; 4]; 6];
-    let mut p = 0;
-    while p < 6 {
-        let [kx, ky, kz] = PERMS[p];
-        t[p] = [kx as i32, ky as i32, kz as i32, kz as i32];
-        p += 1;
-    }
-    t
-};
-
 /// The axis of the largest of `a` (absolute direction components), ties going to the lower
 /// axis; without branches.
 #[inline(always)]
-fn dominant_axis(a: [f32; 3]) -> usize {
+pub(crate) fn dominant_axis(a: [f32; 3]) -> usize {
     let x_wins = (a[0] >= a[1]) & (a[0] >= a[2]);
     usize::from(!x_wins) * (2 - usize::from(a[1] >= a[2]))
 }
@@ -115,47 +77,6 @@ impl RayPre {
                 let o = ray.origin.to_array();
                 [o[kx], o[ky], o[kz]]
             },
-        }
-    }
-
-    /// [`RayPre::new`] with AVX's in-register permutes instead of indexing arrays by the
-    /// ray's axes (which round-trips each value through memory): the same values, bit for
-    /// bit, in fewer instructions. Also returns the origin and `inv_dir` as vectors, for the
-    /// slab set-up to take from registers rather than reload.
-    ///
-    /// # Safety
-    /// The processor must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    #[must_use]
-    pub(crate) unsafe fn new_avx(ray: &Ray) -> (RayPre, Vec3A, Vec3A) {
-        use std::arch::x86_64::{
-            __m128, _mm_blend_ps, _mm_loadu_si128, _mm_mul_ps, _mm_permute_ps, _mm_permutevar_ps,
-        };
-        let (d, o) = (Vec3A::from(ray.dir), Vec3A::from(ray.origin));
-        // As in `new`: the dominant axis and the sign of its component (`< 0`, so a
-        // negative zero counts as positive).
-        let kz = dominant_axis(d.abs().to_array());
-        let perm = 2 * kz + ((d.cmplt(Vec3A::ZERO).bitmask() as usize >> kz) & 1);
-        let inv = d.recip();
-        // SAFETY: the caller ensures AVX (which includes SSE4.1's blend); the load reads
-        // one row of `PERM_LANES`.
-        unsafe {
-            let lanes = _mm_loadu_si128(PERM_LANES[perm].as_ptr().cast());
-            let inv_k = _mm_permutevar_ps(__m128::from(inv), lanes);
-            let inv_z = _mm_permute_ps::<0b10_10_10_10>(inv_k);
-            let d_k = _mm_permutevar_ps(__m128::from(d), lanes);
-            // `(d[kx] * inv_z, d[ky] * inv_z, inv_z)`.
-            let shear = _mm_blend_ps::<0b0100>(_mm_mul_ps(d_k, inv_z), inv_z);
-            let origin_k = _mm_permutevar_ps(__m128::from(o), lanes);
-            let pre = RayPre {
-                origin: ray.origin,
-                inv_dir: Vec3::from(inv),
-                perm,
-                shear: Vec3::from(Vec3A::from(shear)),
-                origin_k: Vec3A::from(origin_k).to_array(),
-            };
-            (pre, o, inv)
         }
     }
 

@@ -1,14 +1,14 @@
 //! Rays on SIMD lanes: a group of sixteen (AVX-512) or eight (AVX2) rays prepared as the
 //! one-ray tests prepare them, and the one-ray tests' operations on each lane (the
 //! watertight triangle test, the sphere test, the slab test), in their order, so that every
-//! lane computes the bits the one-ray test computes. The root's list (`flat`) and the packet
-//! walk (`packet`) are written in these.
+//! lane computes the bits the one-ray test computes. The root's list (`traverse::root_list`) and the packet
+//! walk (`traverse::packet`) are written in these.
 
 use prism_math::{Aabb, Ray};
 use std::arch::x86_64::{_CMP_EQ_OQ, _CMP_GT_OQ, _CMP_LT_OQ};
 
-use crate::bvh::Hit;
-use crate::node8::FAR_WIDEN;
+use crate::hit::Hit;
+use crate::layout::node8::FAR_WIDEN;
 use crate::shapes::Sphere;
 use crate::simd::Simd;
 
@@ -388,7 +388,7 @@ impl<S: Simd> Nearest<S> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::node8::{hit_sse, Node8, SlabRay};
+    use crate::layout::node8::{hit_sse, Node8, SlabRay};
     use crate::shapes::RayPre;
     use crate::simd::Avx2;
     use prism_math::{Pcg32, Vec3};

@@ -10,8 +10,10 @@
 
 use prism_math::Ray;
 
-use crate::bvh::{Bvh, Hit, LEAF, STACK};
-use crate::lanes::{enters, sphere, triangle, widen, Group, Inverse, Nearest};
+use super::stack::STACK;
+use crate::hit::Hit;
+use crate::layout::{Bvh, LEAF};
+use crate::simd::lanes::{enters, sphere, triangle, widen, Group, Inverse, Nearest};
 use crate::simd::{Avx2, Avx512, Simd};
 
 /// True if `rays` are worth walking as one packet: as many as the lanes, one origin (to the
@@ -28,10 +30,10 @@ pub(crate) fn coherent(rays: &[Ray], width: usize) -> bool {
 
 /// The pending children of a packet walk: a node or leaf reference, the lanes that entered
 /// it and their entry distances. Entries are written before they are read.
-struct Pending<S: Simd> {
-    node: [u32; STACK],
-    lanes: [u16; STACK],
-    near: [std::mem::MaybeUninit<S::F>; STACK],
+pub(crate) struct Pending<S: Simd> {
+    pub(crate) node: [u32; STACK],
+    pub(crate) lanes: [u16; STACK],
+    pub(crate) near: [std::mem::MaybeUninit<S::F>; STACK],
 }
 
 /// A packet walk's query: the rays (at most the lanes), their common start `tmin`, each
@@ -50,7 +52,7 @@ pub(crate) struct Query<'a> {
 /// ray, in the query's lanes) except in the lanes the returned bits name, whose answer must
 /// come from the one-ray walk.
 #[inline(always)]
-unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16 {
+pub(crate) unsafe fn closest<S: Simd>(bvh: &Bvh, q: &Query, out: &mut [Option<Hit>]) -> u16 {
     let n = q.rays.len().min(S::W);
     let real = q.lanes & if n >= 16 { u16::MAX } else { (1u16 << n) - 1 };
     // SAFETY (all below): the caller runs on `S`'s instruction set.

@@ -17,11 +17,11 @@ use crate::shapes::RayPre;
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub(crate) struct Node8 {
-    bounds: [[Vec4; 2]; 6],
+    pub(crate) bounds: [[Vec4; 2]; 6],
     pub(crate) child: [u32; 8],
     /// Bit i is set when slot i holds a child.
-    used: u32,
-    _pad: [u32; 7],
+    pub(crate) used: u32,
+    pub(crate) _pad: [u32; 7],
 }
 
 impl Node8 {
@@ -76,26 +76,26 @@ impl Node8 {
 /// `inv_far`, `inv_dir` widened by [`FAR_WIDEN`]. The fused test ([`hit_fused`]) measures
 /// `t = p * inv_dir + off_near` (far: `p * inv_far + off_far`) in one rounding instead.
 pub(crate) struct SlabRay {
-    origin: [f32; 3],
-    inv_dir: [f32; 3],
-    inv_far: [f32; 3],
+    pub(crate) origin: [f32; 3],
+    pub(crate) inv_dir: [f32; 3],
+    pub(crate) inv_far: [f32; 3],
     /// `-origin * inv_dir`, moved down past its rounding (see [`SlabRay::new`]).
-    off_near: [f32; 3],
+    pub(crate) off_near: [f32; 3],
     /// `-origin * inv_far`, moved up past its rounding.
-    off_far: [f32; 3],
+    pub(crate) off_far: [f32; 3],
     /// The row of [`PLANES`] for the ray's direction signs.
-    planes: &'static [usize; 6],
+    pub(crate) planes: &'static [usize; 6],
     /// The origin and `inv_dir` are finite and no `inv_dir` is zero: no slab distance is
     /// NaN.
-    plain: bool,
+    pub(crate) plain: bool,
     /// `plain`, and the offsets are finite: the fused test applies.
-    fused: bool,
+    pub(crate) fused: bool,
 }
 
 /// For each set of axes a ray runs down (bit `axis` set), the byte offsets of the near
 /// planes' rows of `Node8::bounds` on x, y and z, then the far planes'. Looked up rather
 /// than computed per ray: a walk keeps a reference to its row.
-static PLANES: [[usize; 6]; 8] = {
+pub(crate) static PLANES: [[usize; 6]; 8] = {
     let mut table = [[0; 6]; 8];
     let mut down = 0;
     while down < 8 {
@@ -165,13 +165,13 @@ impl SlabRay {
 
     /// The byte offset of the row of the plane on `axis` the ray meets first.
     #[inline(always)]
-    fn near(&self, axis: usize) -> usize {
+    pub(crate) fn near(&self, axis: usize) -> usize {
         self.planes[axis]
     }
 
     /// The byte offset of the row of the other plane on `axis`.
     #[inline(always)]
-    fn far(&self, axis: usize) -> usize {
+    pub(crate) fn far(&self, axis: usize) -> usize {
         self.planes[3 + axis]
     }
 }
@@ -181,15 +181,15 @@ impl SlabRay {
 /// values with infinity takes three).
 #[inline(always)]
 #[allow(clippy::eq_op)]
-fn zero_if_finite(v: Vec3A) -> Vec3A {
+pub(crate) fn zero_if_finite(v: Vec3A) -> Vec3A {
     v - v
 }
 
 /// The fused test's slack on `origin * inv_dir`: eight times its rounding (2^-21).
-const OFFSET_SLACK: f32 = 1.0 / 2_097_152.0;
+pub(crate) const OFFSET_SLACK: f32 = 1.0 / 2_097_152.0;
 
 /// Bytes in one plane's row of `Node8::bounds`.
-const PLANE_BYTES: usize = std::mem::size_of::<[Vec4; 2]>();
+pub(crate) const PLANE_BYTES: usize = std::mem::size_of::<[Vec4; 2]>();
 
 impl Node8 {
     /// The row of `bounds` at byte offset `offset`, without a bounds check.
@@ -198,7 +198,7 @@ impl Node8 {
     /// `offset` must be a multiple of [`PLANE_BYTES`] below `6 * PLANE_BYTES`, as
     /// [`SlabRay::new`] makes them.
     #[inline(always)]
-    unsafe fn plane(&self, offset: usize) -> &[Vec4; 2] {
+    pub(crate) unsafe fn plane(&self, offset: usize) -> &[Vec4; 2] {
         debug_assert!(offset.is_multiple_of(PLANE_BYTES) && offset < 6 * PLANE_BYTES);
         // SAFETY: the caller passes the offset of one of the six rows.
         unsafe {
@@ -275,134 +275,11 @@ pub(crate) fn hit_sse(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8]
     (near_out, mask & n.used)
 }
 
-/// [`hit_sse`] with 256-bit AVX instructions: the same operations in the same order (the
-/// comparison "not greater than" is `_CMP_NGT_UQ`, true for NaN), for rays that are not
-/// [`SlabRay::fused`]. Inlined into the callers compiled for AVX2 and FMA (a
-/// `target_feature` function could not be inlined always, and a call per node costs a
-/// tenth of the traversal).
-///
-/// # Safety
-/// The processor must support AVX.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) unsafe fn hit_avx(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
-    use std::arch::x86_64::{
-        _mm256_and_ps, _mm256_cmp_ps, _mm256_load_ps, _mm256_max_ps, _mm256_movemask_ps,
-        _mm256_mul_ps, _mm256_set1_ps, _mm256_storeu_ps, _mm256_sub_ps, _CMP_LE_OQ, _CMP_NGT_UQ,
-    };
-    // SAFETY: `SlabRay::new` makes every plane offset that of one of the node's rows: 32
-    // bytes at a 32-byte aligned offset of a 64-byte aligned node, as `_mm256_load_ps`
-    // requires; the store writes eight floats into an array of eight.
-    unsafe {
-        macro_rules! t {
-            ($plane:expr, $axis:expr) => {
-                t!($plane, $axis, inv_dir)
-            };
-            ($plane:expr, $axis:expr, $inv:ident) => {
-                _mm256_mul_ps(
-                    _mm256_sub_ps(
-                        _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
-                        _mm256_set1_ps(r.origin[$axis]),
-                    ),
-                    _mm256_set1_ps(r.$inv[$axis]),
-                )
-            };
-        }
-        let near = if r.plain {
-            _mm256_max_ps(
-                _mm256_max_ps(t!(r.near(0), 0), t!(r.near(1), 1)),
-                _mm256_max_ps(t!(r.near(2), 2), _mm256_set1_ps(tmin)),
-            )
-        } else {
-            _mm256_max_ps(
-                t!(r.near(2), 2),
-                _mm256_max_ps(
-                    t!(r.near(1), 1),
-                    _mm256_max_ps(t!(r.near(0), 0), _mm256_set1_ps(tmin)),
-                ),
-            )
-        };
-        macro_rules! before {
-            ($plane:expr, $axis:expr) => {
-                _mm256_cmp_ps::<_CMP_NGT_UQ>(near, t!($plane, $axis, inv_far))
-            };
-        }
-        let m = _mm256_and_ps(
-            _mm256_and_ps(before!(r.far(0), 0), before!(r.far(1), 1)),
-            _mm256_and_ps(
-                before!(r.far(2), 2),
-                _mm256_cmp_ps::<_CMP_LE_OQ>(near, _mm256_set1_ps(tmax)),
-            ),
-        );
-        let mask = _mm256_movemask_ps(m) as u32;
-        let mut near_out = [0f32; 8];
-        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
-        (near_out, mask & n.used)
-    }
-}
-
-/// The node test for a ray of [`SlabRay::fused`], on 256-bit AVX lanes: each slab distance
-/// one fused multiply-add, `p * inv + off`, one dependent step fewer on the path every
-/// node waits on than [`hit_avx`]. Its distances are never shorter than the exact interval
-/// (see [`SlabRay::new`]), but may differ from [`hit_avx`]'s by a rounding. No distance is
-/// NaN for such a ray, so the near distances are taken in pairs, and the far ones too: the
-/// entry is compared once, with the least of the far distances and `tmax` (a NaN `tmax`
-/// enters nothing, as in [`hit_avx`]). Inlined as [`hit_avx`].
-///
-/// An unused slot's empty box (minima `+inf`, maxima `-inf`) is never entered, so the
-/// test leaves out the `used` mask (one dependent step fewer): with a finite non-zero
-/// `inv` and a finite offset, each of its near distances is `+inf` and each far one `-inf`.
-///
-/// # Safety
-/// The processor must support AVX2 and FMA, and the ray must be [`SlabRay::fused`].
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-pub(crate) unsafe fn hit_fused(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32) -> ([f32; 8], u32) {
-    use std::arch::x86_64::{
-        _mm256_cmp_ps, _mm256_fmadd_ps, _mm256_load_ps, _mm256_max_ps, _mm256_min_ps,
-        _mm256_movemask_ps, _mm256_set1_ps, _mm256_storeu_ps, _CMP_LE_OQ,
-    };
-    debug_assert!(r.fused);
-    // SAFETY: as in `hit_avx`; the caller ensures FMA.
-    unsafe {
-        macro_rules! f {
-            ($plane:expr, $axis:expr, $inv:ident, $off:ident) => {
-                _mm256_fmadd_ps(
-                    _mm256_load_ps(n.plane($plane).as_ptr().cast::<f32>()),
-                    _mm256_set1_ps(r.$inv[$axis]),
-                    _mm256_set1_ps(r.$off[$axis]),
-                )
-            };
-        }
-        macro_rules! near {
-            ($axis:expr) => {
-                f!(r.near($axis), $axis, inv_dir, off_near)
-            };
-        }
-        let near = _mm256_max_ps(
-            _mm256_max_ps(near!(0), near!(1)),
-            _mm256_max_ps(near!(2), _mm256_set1_ps(tmin)),
-        );
-        macro_rules! far {
-            ($axis:expr) => {
-                f!(r.far($axis), $axis, inv_far, off_far)
-            };
-        }
-        // The exit, taken while the entry is computed: one comparison waits on the entry.
-        let exit = _mm256_min_ps(
-            _mm256_min_ps(far!(0), far!(1)),
-            _mm256_min_ps(far!(2), _mm256_set1_ps(tmax)),
-        );
-        let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, exit)) as u32;
-        let mut near_out = [0f32; 8];
-        _mm256_storeu_ps(near_out.as_mut_ptr(), near);
-        (near_out, mask)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[cfg(target_arch = "x86_64")]
+    use crate::simd::node8::{hit_avx, hit_fused};
     use prism_math::{Pcg32, Ray};
 
     /// The slab test written out per child in scalar arithmetic, as the interval

@@ -13,7 +13,7 @@ pub(crate) struct Pending {
 
 /// The number of set bits of each byte (the walks are compiled without `popcnt`).
 #[cfg(target_arch = "x86_64")]
-static BITS_SET: [u8; 256] = {
+pub(crate) static BITS_SET: [u8; 256] = {
     let mut table = [0u8; 256];
     let mut i = 0;
     while i < 256 {
@@ -26,13 +26,13 @@ static BITS_SET: [u8; 256] = {
 /// Whether lane `lane` keeps the larger of itself and lane `lane ^ j` at step `(k, j)` of
 /// a bitonic sort of eight lanes into descending order.
 #[cfg(target_arch = "x86_64")]
-const fn takes_max(lane: i32, k: i32, j: i32) -> bool {
+pub(crate) const fn takes_max(lane: i32, k: i32, j: i32) -> bool {
     ((lane & j) == 0) == ((lane & k) == 0)
 }
 
 /// The lanes of step `(k, j)` that keep the larger value, as a blend mask.
 #[cfg(target_arch = "x86_64")]
-const fn max_lanes(k: i32, j: i32) -> i32 {
+pub(crate) const fn max_lanes(k: i32, j: i32) -> i32 {
     let mut mask = 0;
     let mut lane = 0;
     while lane < 8 {
