@@ -1,10 +1,12 @@
-//! The only room that touches `std::arch`: the vector operations the lane code is written
+//! The only room that touches `std::arch`: the instruction-set [`kernel::Kernel`] a walk is
+//! compiled for, chosen by type (`kernel`), the vector operations the lane code is written
 //! in ([`Simd`], for AVX2 and AVX-512: `vector`), rays on lanes (`lanes`), and the
 //! instruction-set kernels of the walks: the 8-wide node tests (`node8`), the triangle-pack
 //! tests on 8 and 16 lanes (`tri4`), the per-ray set-up (`ray`) and the sorting network of
 //! the children entered (`order`). Each kernel computes the bits of the portable code it
 //! stands for.
 
+pub(crate) mod kernel;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod lanes;
 #[cfg(target_arch = "x86_64")]

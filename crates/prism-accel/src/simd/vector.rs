@@ -1,4 +1,4 @@
-//! [`Simd`], the vector operations the list's queries (`flat`) and the packs' lane test
+//! [`Simd`], the vector operations the root list's queries (`traverse::root_list`) and the packs' lane test
 //! (`tri4`) are written in, once, for two register widths: sixteen lanes of AVX-512
 //! ([`Avx512`]) and eight of AVX2 ([`Avx2`]).
 //! Each operation is the same IEEE arithmetic on every width, so both give the same bits.

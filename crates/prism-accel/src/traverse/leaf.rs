@@ -7,17 +7,20 @@ use crate::hit::{Hit, Limit};
 use crate::layout::tri4::{EdgeOnZero, Tri4};
 use crate::layout::{Bvh, LeafRec};
 use crate::shapes::{intersect_sphere, RayPre};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::kernel::Avx;
+use crate::simd::kernel::{Kernel, Sse};
 
 /// A leaf that [`Bvh::leaf_fast`] leaves to [`Bvh::leaf`].
 pub(crate) struct SlowLeaf;
 
 impl Bvh {
     /// Tests a leaf's primitives, moving `end` to each hit it admits (the first by distance,
-    /// then primitive number, is kept); with `any`, stops at the first. With `AVX`, its
+    /// then primitive number, is kept); with `any`, stops at the first. With an AVX [`Kernel`], its
     /// packs are tested two at a time ([`Tri4::intersect_pair_avx`]), which finds the same
     /// hits.
     #[inline(always)]
-    pub(crate) fn leaf<const AVX: bool>(
+    pub(crate) fn leaf<K: Kernel>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -28,7 +31,7 @@ impl Bvh {
     ) -> Option<Hit> {
         let rec = self.leaf_rec(r);
         let weights = self
-            .leaf_packs::<AVX, false, false>(&rec, pre, tmin, end, any)
+            .leaf_packs::<K>(&rec, pre, tmin, end, any, false)
             .unwrap_or_else(|SlowLeaf| unreachable!("only the deferring test defers a leaf"));
         if rec.spheres != 0 && !(any && weights.is_some()) {
             if let Some(h) = self.leaf_spheres(&rec, ray, tmin, end, any) {
@@ -49,7 +52,7 @@ impl Bvh {
     /// function of exactly zero; `end` is then as given, for [`Bvh::leaf`] to decide the
     /// leaf.
     #[inline(always)]
-    pub(crate) fn leaf_fast<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn leaf_fast<K: Kernel>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -61,7 +64,7 @@ impl Bvh {
         if rec.spheres != 0 {
             return Err(SlowLeaf);
         }
-        let weights = self.leaf_packs::<AVX, WIDE, true>(&rec, pre, tmin, end, any)?;
+        let weights = self.leaf_packs::<K>(&rec, pre, tmin, end, any, true)?;
         Ok(weights.map(|(b1, b2)| Hit {
             t: end.t,
             prim: end.prim,
@@ -72,20 +75,21 @@ impl Bvh {
 
     /// The triangle packs of leaf `rec`, as [`Bvh::leaf`] tests them: moves `end` to each
     /// hit it admits (with `any`, to the first), and returns the barycentric weights of the
-    /// last (none: `end` is as given). With `DEFER`, by the lane tests alone, which call no
+    /// last (none: `end` is as given). With `defer` (a constant where this is inlined), by the lane tests alone, which call no
     /// function, and [`SlowLeaf`] with `end` as given if one meets an edge function of
-    /// exactly zero; without, never [`SlowLeaf`]. With `WIDE` (walks compiled for
-    /// AVX-512) and `DEFER`, a leaf of three or four packs is one test on sixteen lanes
+    /// exactly zero; without, never [`SlowLeaf`]. With a [`Kernel::WIDE`] kernel
+    /// and `defer`, a leaf of three or four packs is one test on sixteen lanes
     /// ([`Tri4::intersect_four_fast`]), which finds the same closest hit (and, with `any`,
     /// a hit if there is one).
     #[inline(always)]
-    pub(crate) fn leaf_packs<const AVX: bool, const WIDE: bool, const DEFER: bool>(
+    pub(crate) fn leaf_packs<K: Kernel>(
         &self,
         rec: &LeafRec,
         pre: &RayPre,
         tmin: f32,
         end: &mut Limit,
         any: bool,
+        defer: bool,
     ) -> Result<Option<(f32, f32)>, SlowLeaf> {
         let mut e = *end;
         let mut weights = None;
@@ -97,7 +101,7 @@ impl Bvh {
         // `Bvh::pack_leaves`; packs are never removed.
         let mut packs = unsafe { self.packs.get_unchecked(range) };
         #[cfg(target_arch = "x86_64")]
-        if WIDE && DEFER && (3..=4).contains(&packs.len()) {
+        if K::WIDE && defer && (3..=4).contains(&packs.len()) {
             // Four packs, or three with the third named again in the last lanes, which
             // `valid` leaves out: chosen without a branch, which would be mispredicted on
             // incoherent rays. (Leaves of more, which only primitives that cannot be
@@ -105,7 +109,7 @@ impl Bvh {
             let n = packs.len();
             let four = [&packs[0], &packs[1], &packs[2], &packs[n - 1]];
             let valid = 0xffff >> (16 - 4 * n);
-            // SAFETY: `WIDE` is true only in the walks compiled for AVX-512 (F, DQ and VL),
+            // SAFETY: `K::WIDE` is true only in the walks compiled for AVX-512 (F, DQ and VL),
             // which their callers enter after detecting it.
             let found = unsafe { Tri4::intersect_four_fast(four, valid, pre, tmin, e) }
                 .map_err(|EdgeOnZero| SlowLeaf)?;
@@ -122,12 +126,12 @@ impl Bvh {
             // The pack of lanes 4..8 (the first again when tested alone).
             let (found, second) = match rest {
                 #[cfg(target_arch = "x86_64")]
-                [b, tail @ ..] if AVX => {
+                [b, tail @ ..] if K::AVX => {
                     packs = tail;
-                    // SAFETY: `AVX` is true only in the traversals compiled for AVX, which
+                    // SAFETY: `K::AVX` is true only in the traversals compiled for AVX, which
                     // their callers enter after detecting it.
                     let found = unsafe {
-                        if DEFER {
+                        if defer {
                             Tri4::intersect_pair_fast(a, b, pre, tmin, e)
                         } else {
                             Ok(Tri4::intersect_pair_avx(a, b, pre, tmin, e))
@@ -137,7 +141,7 @@ impl Bvh {
                 }
                 _ => {
                     packs = rest;
-                    let found = if DEFER {
+                    let found = if defer {
                         a.intersect_fast(pre, tmin, e)
                     } else {
                         Ok(a.intersect(pre, tmin, e))
@@ -168,7 +172,7 @@ impl Bvh {
     /// batches trace 5% faster by `leaf_fast` and this than by `leaf` inlined).
     #[inline(never)]
     #[cold]
-    pub(crate) fn leaf_apart<const AVX: bool>(
+    pub(crate) fn leaf_apart<K: Kernel>(
         &self,
         r: u32,
         pre: &RayPre,
@@ -178,12 +182,12 @@ impl Bvh {
         any: bool,
     ) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
-        if AVX {
-            // SAFETY: `AVX` is true only in the walks compiled for AVX2 and FMA (or
+        if K::AVX {
+            // SAFETY: `K::AVX` is true only in the walks compiled for AVX2 and FMA (or
             // AVX-512, which has them), which their callers enter after detecting them.
             return unsafe { self.leaf_apart_avx2(r, pre, ray, tmin, end, any) };
         }
-        self.leaf::<false>(r, pre, ray, tmin, end, any)
+        self.leaf::<Sse>(r, pre, ray, tmin, end, any)
     }
 
     /// [`Bvh::leaf_apart`] compiled for AVX2 and FMA.
@@ -203,7 +207,7 @@ impl Bvh {
         end: &mut Limit,
         any: bool,
     ) -> Option<Hit> {
-        self.leaf::<true>(r, pre, ray, tmin, end, any)
+        self.leaf::<Avx>(r, pre, ray, tmin, end, any)
     }
 
     /// [`Bvh::leaf`]'s test of a leaf's spheres: the first hit `end` admits, moving `end` to
@@ -245,6 +249,8 @@ impl Bvh {
 mod tests {
     use super::*;
     use crate::layout::LEAF;
+    #[cfg(target_arch = "x86_64")]
+    use crate::simd::kernel::Wide;
     use crate::{BuildOptions, Sphere};
     use prism_math::{Pcg32, Vec3};
 
@@ -310,9 +316,9 @@ mod tests {
                         |fast: Result<Option<Hit>, SlowLeaf>, end_fast: Limit, avx: bool| {
                             let mut end = end0;
                             let full = if avx {
-                                bvh.leaf::<true>(r, &pre, &ray, 0.0, &mut end, any)
+                                bvh.leaf::<Avx>(r, &pre, &ray, 0.0, &mut end, any)
                             } else {
-                                bvh.leaf::<false>(r, &pre, &ray, 0.0, &mut end, any)
+                                bvh.leaf::<Sse>(r, &pre, &ray, 0.0, &mut end, any)
                             };
                             match fast {
                                 Ok(h) => {
@@ -328,26 +334,26 @@ mod tests {
                             }
                         };
                     let mut end = end0;
-                    let fast = bvh.leaf_fast::<false, false>(r, &pre, 0.0, &mut end, any);
+                    let fast = bvh.leaf_fast::<Sse>(r, &pre, 0.0, &mut end, any);
                     let (s, d, h) = check(fast, end, false);
                     (same, deferred, hits) = (same + s, deferred + d, hits + h);
                     #[cfg(target_arch = "x86_64")]
                     if std::arch::is_x86_feature_detected!("avx2") {
-                        // The `AVX` code paths, on a processor with AVX2 (detected above).
+                        // The [`Avx`] code paths, on a processor with AVX2 (detected above).
                         let mut end = end0;
-                        let fast = bvh.leaf_fast::<true, false>(r, &pre, 0.0, &mut end, any);
+                        let fast = bvh.leaf_fast::<Avx>(r, &pre, 0.0, &mut end, any);
                         check(fast, end, true);
                     }
                     #[cfg(target_arch = "x86_64")]
                     if wide_paths {
-                        // The `WIDE` code paths, which test three or four packs on sixteen
+                        // The [`Wide`] code paths, which test three or four packs on sixteen
                         // lanes: with `any`, a hit of the leaf's, perhaps not the full
                         // test's first one.
                         let mut end = end0;
-                        let fast = bvh.leaf_fast::<true, true>(r, &pre, 0.0, &mut end, any);
+                        let fast = bvh.leaf_fast::<Wide>(r, &pre, 0.0, &mut end, any);
                         if any && matches!(fast, Ok(Some(_))) {
                             let mut all = end0;
-                            let first = bvh.leaf::<true>(r, &pre, &ray, 0.0, &mut all, false);
+                            let first = bvh.leaf::<Avx>(r, &pre, &ray, 0.0, &mut all, false);
                             assert!(first.is_some(), "ray {k} leaf {r:#x}");
                             assert!(end.t >= all.t && end.t <= end0.t);
                             wide += 1;

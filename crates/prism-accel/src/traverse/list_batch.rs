@@ -9,6 +9,7 @@ use super::root_list::{self, Lanes};
 use crate::hit::Hit;
 use crate::layout::root_list::RootList;
 use crate::layout::{Bvh, Start};
+use crate::simd::kernel::{Avx, Kernel, Wide};
 use crate::simd::{Avx2, Avx512, Simd};
 
 impl Bvh {
@@ -18,7 +19,7 @@ impl Bvh {
     /// rays or more enter, else ray by ray. Inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(crate) fn intersect_batch_list<const WIDE: bool>(
+    pub(crate) fn intersect_batch_list<K: Kernel>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -36,7 +37,7 @@ impl Bvh {
             let lanes = closest(rays, hits);
             let tree = lanes.need & !lanes.defer;
             if 2 * tree.count_ones() as usize >= width && packet::coherent(rays, width) {
-                self.list_packet::<WIDE>(rays, (tmin, tmax), hits, (flat, lanes), &packet);
+                self.list_packet::<K>(rays, (tmin, tmax), hits, (flat, lanes), &packet);
                 continue;
             }
             // The list's hits stand, but in the lanes that must consult the tree.
@@ -56,14 +57,14 @@ impl Bvh {
             }
         }
         let mut found = vec![None; jobs.len()];
-        self.walk_pairs::<true, WIDE>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
+        self.walk_pairs::<K>(rays, tmin, (jobs.len(), |k| jobs[k]), &mut found);
         for ((&(i, ..), all), h) in jobs.iter().zip(whole).zip(found) {
             hits[i] = match h {
                 _ if all => h,
                 // Two primitives at one distance: the walk over the whole tree decides, by
                 // primitive number.
                 Some(h) if hits[i].is_some_and(|n| n.t == h.t) => {
-                    self.intersect_with::<true, WIDE>(&rays[i], tmin, tmax, Start::ROOT)
+                    self.intersect_with::<K>(&rays[i], tmin, tmax, Start::ROOT)
                 }
                 Some(h) => Some(h),
                 None => hits[i],
@@ -77,7 +78,7 @@ impl Bvh {
     /// the list meet one distance, take the one-ray walk over the whole tree.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(crate) fn list_packet<const WIDE: bool>(
+    pub(crate) fn list_packet<K: Kernel>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -108,7 +109,7 @@ impl Bvh {
                 || (tree & bit != 0
                     && found[lane].is_some_and(|h| list[lane].is_some_and(|n| n.t == h.t)));
             if whole {
-                *hit = self.intersect_with::<true, WIDE>(&rays[lane], tmin, tmax, Start::ROOT);
+                *hit = self.intersect_with::<K>(&rays[lane], tmin, tmax, Start::ROOT);
             } else if tree & bit != 0 && found[lane].is_some() {
                 *hit = found[lane];
             }
@@ -129,7 +130,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list::<true>(
+        self.intersect_batch_list::<Wide>(
             rays,
             (tmin, tmax),
             hits,
@@ -154,7 +155,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_list::<false>(
+        self.intersect_batch_list::<Avx>(
             rays,
             (tmin, tmax),
             hits,
@@ -168,7 +169,7 @@ impl Bvh {
     /// [`Bvh::occluded_batch`] through the root's list, as [`Bvh::intersect_batch_list`].
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(crate) fn occluded_batch_list<const WIDE: bool>(
+    pub(crate) fn occluded_batch_list<K: Kernel>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, &[f32]),
@@ -185,9 +186,9 @@ impl Bvh {
                 *b = if lanes.blocked & bit != 0 {
                     true
                 } else if lanes.defer & bit != 0 {
-                    self.occluded_with::<true, WIDE>(ray, tmin, end, Start::ROOT)
+                    self.occluded_with::<K>(ray, tmin, end, Start::ROOT)
                 } else if lanes.need & bit != 0 {
-                    self.occluded_with::<true, WIDE>(ray, tmin, end, flat.start(lanes.inner[lane]))
+                    self.occluded_with::<K>(ray, tmin, end, flat.start(lanes.inner[lane]))
                 } else {
                     false
                 };
@@ -209,7 +210,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list::<true>(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
+        self.occluded_batch_list::<Wide>(rays, (tmin, tmax), blocked, (flat, Avx512::W), |r, e| {
             // SAFETY: the processor has AVX-512F.
             unsafe { root_list::occluded_avx512(flat, r, tmin, e) }
         });
@@ -229,7 +230,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_list::<false>(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
+        self.occluded_batch_list::<Avx>(rays, (tmin, tmax), blocked, (flat, Avx2::W), |r, e| {
             // SAFETY: the processor has AVX2.
             unsafe { root_list::occluded_avx2(flat, r, tmin, e) }
         });

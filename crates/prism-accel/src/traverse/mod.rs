@@ -21,6 +21,9 @@ use prism_math::{Isa, Ray};
 
 use crate::hit::Hit;
 use crate::layout::{Bvh, Start};
+#[cfg(target_arch = "x86_64")]
+use crate::simd::kernel::{Avx, Wide};
+use crate::simd::kernel::{Kernel, Sse};
 
 impl Bvh {
     /// The closest hit with `tmin < t < tmax`; of primitives at one distance, the one with the
@@ -48,19 +51,19 @@ impl Bvh {
     /// stack of kilobytes) would be set up at every call, whichever walk the call takes.
     #[inline(never)]
     pub(crate) fn intersect_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<false, false>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<Sse>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX-512VL: the same 256-bit operations, with twice
     /// the registers, and leaves of three or four packs tested on sixteen lanes
-    /// (`leaf_packs`' `WIDE`).
+    /// (the [`Wide`] kernel).
     ///
     /// # Safety
     /// The processor must support AVX-512VL.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     pub(crate) unsafe fn intersect_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true, true>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<Wide>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] compiled for AVX2 and FMA.
@@ -70,7 +73,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     pub(crate) unsafe fn intersect_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.intersect_with::<true, false>(ray, tmin, tmax, Start::ROOT)
+        self.intersect_with::<Avx>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::intersect`] for each ray of `rays` (`hits[i]` for `rays[i]`), in one call:
@@ -184,7 +187,7 @@ impl Bvh {
     /// The loop of [`Bvh::occluded_batch`], inlined into each compiled variant.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(crate) fn occluded_batch_with<const WIDE: bool>(
+    pub(crate) fn occluded_batch_with<K: Kernel>(
         &self,
         rays: &[Ray],
         tmin: f32,
@@ -192,7 +195,7 @@ impl Bvh {
         blocked: &mut [bool],
     ) {
         for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked) {
-            *b = self.occluded_with::<true, WIDE>(ray, tmin, t, Start::ROOT);
+            *b = self.occluded_with::<K>(ray, tmin, t, Start::ROOT);
         }
     }
 
@@ -210,7 +213,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<true>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with::<Wide>(rays, tmin, tmax, blocked);
     }
 
     /// [`Bvh::occluded_batch`] compiled for AVX2.
@@ -226,7 +229,7 @@ impl Bvh {
         tmax: &[f32],
         blocked: &mut [bool],
     ) {
-        self.occluded_batch_with::<false>(rays, tmin, tmax, blocked);
+        self.occluded_batch_with::<Avx>(rays, tmin, tmax, blocked);
     }
 
     /// True if anything lies along the ray with `tmin < t < tmax` (for shadow rays).
@@ -252,7 +255,7 @@ impl Bvh {
     /// [`Bvh::occluded`] without AVX, never inlined (as [`Bvh::intersect_sse`]).
     #[inline(never)]
     pub(crate) fn occluded_sse(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<false, false>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<Sse>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::occluded`] compiled for AVX-512VL (leaves of three or four packs on sixteen
@@ -263,7 +266,7 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512vl")]
     pub(crate) unsafe fn occluded_avx512(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true, true>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<Wide>(ray, tmin, tmax, Start::ROOT)
     }
 
     /// [`Bvh::occluded`] compiled for AVX2 and FMA.
@@ -273,13 +276,14 @@ impl Bvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
     pub(crate) unsafe fn occluded_avx(&self, ray: &Ray, tmin: f32, tmax: f32) -> bool {
-        self.occluded_with::<true, false>(ray, tmin, tmax, Start::ROOT)
+        self.occluded_with::<Avx>(ray, tmin, tmax, Start::ROOT)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use crate::layout::Start;
+    use crate::simd::kernel::Sse;
     use crate::{BuildOptions, Bvh, Sphere};
     use prism_math::{Pcg32, Ray, Vec3};
 
@@ -319,14 +323,11 @@ mod tests {
                 let avx = unsafe { bvh.intersect_avx(&ray, 0.0, f32::INFINITY) };
                 assert_eq!(
                     avx,
-                    bvh.intersect_with::<false, false>(&ray, 0.0, f32::INFINITY, Start::ROOT)
+                    bvh.intersect_with::<Sse>(&ray, 0.0, f32::INFINITY, Start::ROOT)
                 );
                 // SAFETY: as above.
                 let occ = unsafe { bvh.occluded_avx(&ray, 0.0, 5.0) };
-                assert_eq!(
-                    occ,
-                    bvh.occluded_with::<false, false>(&ray, 0.0, 5.0, Start::ROOT)
-                );
+                assert_eq!(occ, bvh.occluded_with::<Sse>(&ray, 0.0, 5.0, Start::ROOT));
                 hits += usize::from(avx.is_some());
             }
             assert!(hits > 2000, "{hits} hits");

@@ -2,7 +2,7 @@
 //! through the tree together, for rays such as a camera's that share an origin and head the
 //! same way. Each node's children are tested against every ray of the packet on lanes, and
 //! each leaf's triangles likewise, with the one-ray tests' operations on each lane
-//! (`lanes`). A child is entered by the lanes that enter its box no farther than their
+//! (`simd::lanes`). A child is entered by the lanes that enter its box no farther than their
 //! nearest hit, widened as the one-ray walk widens it, so both walks meet the same nearest
 //! hit. A lane whose answer depends on the one-ray walk's choice by primitive number (two
 //! primitives at one distance) or on its double-precision edge test (an edge function of

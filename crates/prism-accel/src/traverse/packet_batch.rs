@@ -6,6 +6,7 @@ use prism_math::Ray;
 use super::packet::{self, Query};
 use crate::hit::Hit;
 use crate::layout::{Bvh, Start};
+use crate::simd::kernel::{Avx, Kernel, Wide};
 use crate::simd::{Avx2, Avx512, Simd};
 
 impl Bvh {
@@ -15,7 +16,7 @@ impl Bvh {
     /// pairs.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub(crate) fn intersect_batch_with<const WIDE: bool>(
+    pub(crate) fn intersect_batch_with<K: Kernel>(
         &self,
         rays: &[Ray],
         (tmin, tmax): (f32, f32),
@@ -29,12 +30,7 @@ impl Bvh {
         while i + width <= rays.len() {
             let group = &rays[i..i + width];
             if packet::coherent(group, width) {
-                self.intersect_pairs::<true, WIDE>(
-                    &rays[loose..i],
-                    tmin,
-                    tmax,
-                    &mut hits[loose..i],
-                );
+                self.intersect_pairs::<K>(&rays[loose..i], tmin, tmax, &mut hits[loose..i]);
                 let query = Query {
                     rays: group,
                     tmin,
@@ -47,13 +43,13 @@ impl Bvh {
                     let lane = defer.trailing_zeros() as usize;
                     defer &= defer - 1;
                     hits[i + lane] =
-                        self.intersect_with::<true, WIDE>(&group[lane], tmin, tmax, Start::ROOT);
+                        self.intersect_with::<K>(&group[lane], tmin, tmax, Start::ROOT);
                 }
                 loose = i + width;
             }
             i += width;
         }
-        self.intersect_pairs::<true, WIDE>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
+        self.intersect_pairs::<K>(&rays[loose..], tmin, tmax, &mut hits[loose..]);
     }
 
     /// [`Bvh::intersect_batch`] compiled for AVX-512VL: the same 256-bit operations, with
@@ -71,7 +67,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<true>(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
+        self.intersect_batch_with::<Wide>(rays, (tmin, tmax), hits, Avx512::W, |q, h| {
             // SAFETY: the processor has AVX-512VL, hence AVX-512F.
             unsafe { packet::closest_avx512(self, q, h) }
         });
@@ -90,7 +86,7 @@ impl Bvh {
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.intersect_batch_with::<false>(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
+        self.intersect_batch_with::<Avx>(rays, (tmin, tmax), hits, Avx2::W, |q, h| {
             // SAFETY: the processor has AVX2.
             unsafe { packet::closest_avx2(self, q, h) }
         });

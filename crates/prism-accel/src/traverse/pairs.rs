@@ -4,12 +4,12 @@
 use prism_math::Ray;
 
 use super::leaf::SlowLeaf;
-use super::single::set_up;
 use super::stack::{pop, Stack};
 use crate::hit::{Hit, Limit};
 use crate::layout::node8::{widen, SlabRay};
 use crate::layout::{Bvh, Start, LEAF};
 use crate::shapes::RayPre;
+use crate::simd::kernel::Kernel;
 use crate::simd::order::Pending;
 
 /// A slot of [`Bvh::walk_pairs`]: the walk of query `query`, of ray `ray` with the root's
@@ -25,14 +25,14 @@ pub(crate) struct Slot {
 impl Slot {
     /// The slot walking query `k` of `job`.
     #[inline(always)]
-    pub(crate) fn start<const AVX: bool>(
+    pub(crate) fn start<K: Kernel>(
         rays: &[Ray],
         job: &impl Fn(usize) -> (usize, f32, Start),
         k: usize,
     ) -> Slot {
         let (ray, tmax, start) = job(k);
         Slot {
-            walk: Walk::new::<AVX>(&rays[ray], tmax, start.node),
+            walk: Walk::new::<K>(&rays[ray], tmax, start.node),
             stack: Stack::new(),
             ray,
             skip: start.skip,
@@ -59,8 +59,8 @@ pub(crate) struct Walk {
 impl Walk {
     /// A walk of `ray` up to `tmax`, starting at node `start`.
     #[inline(always)]
-    pub(crate) fn new<const AVX: bool>(ray: &Ray, tmax: f32, start: u32) -> Walk {
-        let (pre, slab) = set_up::<AVX>(ray);
+    pub(crate) fn new<K: Kernel>(ray: &Ray, tmax: f32, start: u32) -> Walk {
+        let (pre, slab) = K::set_up(ray);
         Walk {
             slab,
             pre,
@@ -75,8 +75,8 @@ impl Walk {
     /// Starts the walk over, for `ray` up to `tmax` from node `start` (the stack's memory
     /// is kept).
     #[inline(always)]
-    pub(crate) fn reset<const AVX: bool>(&mut self, ray: &Ray, tmax: f32, start: u32) {
-        (self.pre, self.slab) = set_up::<AVX>(ray);
+    pub(crate) fn reset<K: Kernel>(&mut self, ray: &Ray, tmax: f32, start: u32) {
+        (self.pre, self.slab) = K::set_up(ray);
         self.best = None;
         self.end = Limit::end(tmax);
         self.reach = widen(tmax);
@@ -95,7 +95,7 @@ impl Walk {
     /// The children visited are the same either way, in the same order but for children
     /// entered less than 8 ulps apart ([`Bvh::descend`]).
     #[inline(always)]
-    pub(crate) fn step<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn step<K: Kernel>(
         &mut self,
         bvh: &Bvh,
         ray: &Ray,
@@ -105,29 +105,28 @@ impl Walk {
     ) -> bool {
         let node_ref = self.node;
         if node_ref & LEAF != 0 {
-            let found =
-                match bvh.leaf_fast::<AVX, WIDE>(node_ref, &self.pre, tmin, &mut self.end, false) {
-                    Ok(found) => found,
-                    Err(SlowLeaf) => {
-                        bvh.leaf_apart::<AVX>(node_ref, &self.pre, ray, tmin, &mut self.end, false)
-                    }
-                };
+            let found = match bvh.leaf_fast::<K>(node_ref, &self.pre, tmin, &mut self.end, false) {
+                Ok(found) => found,
+                Err(SlowLeaf) => {
+                    bvh.leaf_apart::<K>(node_ref, &self.pre, ray, tmin, &mut self.end, false)
+                }
+            };
             if let Some(h) = found {
                 self.best = Some(h);
                 self.reach = widen(self.end.t);
             }
         } else {
             let n = bvh.node(node_ref);
-            let (near, mut mask) = if AVX && self.slab.fused() {
-                Bvh::node_hit::<AVX, true>(n, &self.slab, tmin, self.reach)
+            let (near, mut mask) = if K::AVX && self.slab.fused() {
+                K::node_hit(n, &self.slab, tmin, self.reach, true)
             } else {
-                Bvh::node_hit::<AVX, false>(n, &self.slab, tmin, self.reach)
+                K::node_hit(n, &self.slab, tmin, self.reach, false)
             };
             if node_ref == 0 {
                 mask &= !skip;
             }
             if mask != 0 {
-                self.node = bvh.descend::<false, AVX>(n, &near, mask, stack, &mut self.sp);
+                self.node = bvh.descend::<K>(n, &near, mask, stack, &mut self.sp, false);
                 return true;
             }
         }
@@ -145,14 +144,14 @@ impl Bvh {
     /// [`Bvh::intersect_with`] for each ray of `rays` over the whole tree, two rays walked
     /// at once ([`Bvh::walk_pairs`]).
     #[inline(always)]
-    pub(crate) fn intersect_pairs<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn intersect_pairs<K: Kernel>(
         &self,
         rays: &[Ray],
         tmin: f32,
         tmax: f32,
         hits: &mut [Option<Hit>],
     ) {
-        self.walk_pairs::<AVX, WIDE>(rays, tmin, (rays.len(), |k| (k, tmax, Start::ROOT)), hits);
+        self.walk_pairs::<K>(rays, tmin, (rays.len(), |k| (k, tmax, Start::ROOT)), hits);
     }
 
     /// Walks `jobs.0` closest-hit queries, `jobs.1(k)` giving query k's ray (an index into
@@ -164,7 +163,7 @@ impl Bvh {
     /// same; its children are chosen by selects (`Walk::step`) and sorted without branches
     /// on AVX2, as the rays of a batch are mostly incoherent.
     #[inline(always)]
-    pub(crate) fn walk_pairs<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn walk_pairs<K: Kernel>(
         &self,
         rays: &[Ray],
         tmin: f32,
@@ -174,16 +173,16 @@ impl Bvh {
         if n < 2 {
             for (k, hit) in hits.iter_mut().enumerate().take(n) {
                 let (i, tmax, start) = job(k);
-                *hit = self.intersect_with::<AVX, WIDE>(&rays[i], tmin, tmax, start);
+                *hit = self.intersect_with::<K>(&rays[i], tmin, tmax, start);
             }
             return;
         }
-        let mut a = Slot::start::<AVX>(rays, &job, 0);
-        let mut b = Slot::start::<AVX>(rays, &job, 1);
+        let mut a = Slot::start::<K>(rays, &job, 0);
+        let mut b = Slot::start::<K>(rays, &job, 1);
         let mut next = 2;
         let (walks, out) = ((rays, tmin, (n, &job)), hits);
-        while self.pair_step::<AVX, WIDE>(walks, out, &mut a, &mut b, &mut next)
-            && self.pair_step::<AVX, WIDE>(walks, out, &mut b, &mut a, &mut next)
+        while self.pair_step::<K>(walks, out, &mut a, &mut b, &mut next)
+            && self.pair_step::<K>(walks, out, &mut b, &mut a, &mut next)
         {}
     }
 
@@ -192,7 +191,7 @@ impl Bvh {
     /// is finished, and the answer is false: all are done.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
-    pub(crate) fn pair_step<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn pair_step<K: Kernel>(
         &self,
         (rays, tmin, (n, job)): (&[Ray], f32, (usize, &impl Fn(usize) -> (usize, f32, Start))),
         hits: &mut [Option<Hit>],
@@ -202,24 +201,21 @@ impl Bvh {
     ) -> bool {
         if slot
             .walk
-            .step::<AVX, WIDE>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
+            .step::<K>(self, &rays[slot.ray], tmin, slot.skip, &mut slot.stack)
         {
             return true;
         }
         hits[slot.query] = slot.walk.best;
         if *next == n {
-            while other.walk.step::<AVX, WIDE>(
-                self,
-                &rays[other.ray],
-                tmin,
-                other.skip,
-                &mut other.stack,
-            ) {}
+            while other
+                .walk
+                .step::<K>(self, &rays[other.ray], tmin, other.skip, &mut other.stack)
+            {}
             hits[other.query] = other.walk.best;
             return false;
         }
         let (ray, tmax, start) = job(*next);
-        slot.walk.reset::<AVX>(&rays[ray], tmax, start.node);
+        slot.walk.reset::<K>(&rays[ray], tmax, start.node);
         (slot.ray, slot.skip, slot.query) = (ray, start.skip, *next);
         *next += 1;
         true

@@ -8,67 +8,42 @@ use prism_math::Ray;
 use super::leaf::SlowLeaf;
 use super::stack::{pop, Stack};
 use crate::hit::{Hit, Limit};
-use crate::layout::node8::{self, widen, Node8, SlabRay};
+use crate::layout::node8::{widen, Node8, SlabRay};
 use crate::layout::{Bvh, Start, LEAF};
 use crate::shapes::RayPre;
-#[cfg(target_arch = "x86_64")]
-use crate::simd::node8::{hit_avx, hit_fused};
+use crate::simd::kernel::Kernel;
 use crate::simd::order::Pending;
 
 impl Bvh {
-    /// Entry distances of the ray into a node's eight child boxes, and which it enters: with
-    /// `AVX`, by the fused test if `FUSED` (which the caller sets only for a
-    /// [`SlabRay::fused`] ray), else by the unfused one.
-    #[inline(always)]
-    pub(crate) fn node_hit<const AVX: bool, const FUSED: bool>(
-        n: &Node8,
-        r: &SlabRay,
-        tmin: f32,
-        tmax: f32,
-    ) -> ([f32; 8], u32) {
-        #[cfg(target_arch = "x86_64")]
-        if AVX {
-            // SAFETY: `AVX` is true only in the traversals compiled for AVX2 and FMA, which
-            // their callers enter after detecting them; `FUSED` only for a fused ray.
-            return unsafe {
-                if FUSED {
-                    hit_fused(n, r, tmin, tmax)
-                } else {
-                    hit_avx(n, r, tmin, tmax)
-                }
-            };
-        }
-        node8::hit_sse(n, r, tmin, tmax)
-    }
-
     /// The closest hit with `tmin < t < tmax` (the lowest primitive number of equals), in the
     /// part of the tree `start` names.
     #[inline(always)]
-    pub(crate) fn intersect_with<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn intersect_with<K: Kernel>(
         &self,
         ray: &Ray,
         tmin: f32,
         tmax: f32,
         start: Start,
     ) -> Option<Hit> {
-        let (pre, slab) = set_up::<AVX>(ray);
+        let (pre, slab) = K::set_up(ray);
         // One loop per node test, so that each keeps only its own per-ray values live.
-        if AVX && slab.fused() {
-            self.walk_one::<AVX, WIDE, true>(ray, (&pre, &slab), tmin, tmax, start)
+        if K::AVX && slab.fused() {
+            self.walk_one::<K>(ray, (&pre, &slab), tmin, tmax, (start, true))
         } else {
-            self.walk_one::<AVX, WIDE, false>(ray, (&pre, &slab), tmin, tmax, start)
+            self.walk_one::<K>(ray, (&pre, &slab), tmin, tmax, (start, false))
         }
     }
 
-    /// [`Bvh::intersect_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
+    /// [`Bvh::intersect_with`]'s walk with the node test [`Kernel::node_hit`], fused if `fused` (a
+    /// constant where the walk is inlined: one loop per node test).
     #[inline(always)]
-    pub(crate) fn walk_one<const AVX: bool, const WIDE: bool, const FUSED: bool>(
+    pub(crate) fn walk_one<K: Kernel>(
         &self,
         ray: &Ray,
         (pre, slab): (&RayPre, &SlabRay),
         tmin: f32,
         tmax: f32,
-        start: Start,
+        (start, fused): (Start, bool),
     ) -> Option<Hit> {
         // `Walk::step`'s walk, written as one loop over local variables, so that its state
         // stays in registers (a `Walk`, stepped from outside, lives in memory).
@@ -81,7 +56,7 @@ impl Bvh {
             // after this loop, so that no call clobbers the registers it keeps.
             let slow = loop {
                 if node_ref & LEAF != 0 {
-                    match self.leaf_fast::<AVX, WIDE>(node_ref, pre, tmin, &mut end, false) {
+                    match self.leaf_fast::<K>(node_ref, pre, tmin, &mut end, false) {
                         Ok(Some(h)) => {
                             best = Some(h);
                             reach = widen(end.t);
@@ -91,7 +66,7 @@ impl Bvh {
                     }
                 } else {
                     let n = self.node(node_ref);
-                    let (near, mut mask) = Bvh::node_hit::<AVX, FUSED>(n, slab, tmin, reach);
+                    let (near, mut mask) = K::node_hit(n, slab, tmin, reach, fused);
                     if node_ref == 0 {
                         mask &= !start.skip;
                     }
@@ -102,7 +77,7 @@ impl Bvh {
                         continue;
                     }
                     if mask != 0 {
-                        node_ref = self.descend::<true, AVX>(n, &near, mask, &mut stack, &mut sp);
+                        node_ref = self.descend::<K>(n, &near, mask, &mut stack, &mut sp, true);
                         continue;
                     }
                 }
@@ -114,7 +89,7 @@ impl Bvh {
             // A copy of the end for the full test, which takes it by reference: the end
             // itself is never borrowed past the call-free test, so it stays in registers.
             let mut e = end;
-            if let Some(h) = self.leaf::<AVX>(slow, pre, ray, tmin, &mut e, false) {
+            if let Some(h) = self.leaf::<K>(slow, pre, ray, tmin, &mut e, false) {
                 best = Some(h);
                 reach = widen(e.t);
             }
@@ -131,7 +106,7 @@ impl Bvh {
     /// `stack` at `*sp`, farthest first, and returns the nearest. Any order finds the same
     /// hit (see [`widen`]); the two kinds of walk order children in the ways that are
     /// fastest for their rays (in-process A/B on the 56k-triangle bunny, 5 passes):
-    /// - `LONE`, a lone walk ([`Bvh::intersect_with`]), whose rays are mostly coherent
+    /// - `lone` (a constant where this is inlined), a lone walk ([`Bvh::intersect_with`]), whose rays are mostly coherent
     ///   and its branches predicted: two children by a branch (primary rays 3.5% faster
     ///   than by selects), three by three branches (primary rays 1.2% faster, random
     ///   rays 0.7%, than one by one), more one by one (a sorting network made them 2.2%
@@ -139,20 +114,21 @@ impl Bvh {
     ///   primary rays 1.9% slower than without).
     /// - Else the paired walks of batches ([`Bvh::walk_pairs`]), whose rays are
     ///   incoherent: one or two children are told apart and ordered by selects (one is
-    ///   pushed and popped again at once: `*sp` does not move); more, with `AVX` (walks
-    ///   compiled for AVX2), by a sorting network without branches
+    ///   pushed and popped again at once: `*sp` does not move); more, with an AVX
+    ///   [`Kernel`], by a sorting network without branches
     ///   ([`crate::simd::order::sort_entered_avx2`], which orders entries less than 8 ulps
     ///   apart by slot; random rays 3.3% faster), else one by one. Nothing is
     ///   prefetched: these walks overlap their misses already, and render 2-7% faster
     ///   without.
     #[inline(always)]
-    pub(crate) fn descend<const LONE: bool, const AVX: bool>(
+    pub(crate) fn descend<K: Kernel>(
         &self,
         n: &Node8,
         near: &[f32; 8],
         mut mask: u32,
         stack: &mut Stack<Pending>,
         sp: &mut usize,
+        lone: bool,
     ) -> u32 {
         // The entered children but the lowest slot's: none when one is entered. (Bit
         // tricks rather than a count: the walks are compiled without `popcnt`.)
@@ -162,7 +138,7 @@ impl Bvh {
             // below orders them.
             let first = mask.trailing_zeros() as usize;
             let last = 31 - mask.leading_zeros() as usize;
-            if LONE {
+            if lone {
                 debug_assert!(rest != 0, "a lone walk goes on to a lone child itself");
                 let (a, b) = (n.child[first], n.child[last]);
                 let (ta, tb) = (near[first], near[last]);
@@ -203,8 +179,8 @@ impl Bvh {
             return n.child[a];
         }
         #[cfg(target_arch = "x86_64")]
-        if AVX && !LONE {
-            // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
+        if K::AVX && !lone {
+            // SAFETY: `K::AVX` is true only in the walks compiled for AVX2, which their callers
             // enter after detecting it; three or more children are entered, none with a
             // NaN entry (the node tests enter no such child).
             let (nearest, pushed) = unsafe {
@@ -215,7 +191,7 @@ impl Bvh {
         }
         // The entered children but the two lowest slots'.
         let rest2 = rest & rest.wrapping_sub(1);
-        if LONE && rest2 & rest2.wrapping_sub(1) == 0 {
+        if lone && rest2 & rest2.wrapping_sub(1) == 0 {
             // Three children, the most common case past two: sorted by three predicted
             // branches, in the order of the sort below (strict comparisons keep the lower
             // slot first of equals).
@@ -263,7 +239,7 @@ impl Bvh {
             stack.push(*sp, Pending { node, t_near });
             *sp += 1;
         }
-        if LONE {
+        if lone {
             // The second nearest is likely visited next after the nearest's subtree.
             self.prefetch(hits[1].0);
         }
@@ -273,30 +249,31 @@ impl Bvh {
     /// True if anything lies along the ray with `tmin < t < tmax`, in the part of the tree
     /// `start` names.
     #[inline(always)]
-    pub(crate) fn occluded_with<const AVX: bool, const WIDE: bool>(
+    pub(crate) fn occluded_with<K: Kernel>(
         &self,
         ray: &Ray,
         tmin: f32,
         tmax: f32,
         start: Start,
     ) -> bool {
-        let (r, slab) = set_up::<AVX>(ray);
-        if AVX && slab.fused() {
-            self.occluded_one::<AVX, WIDE, true>(ray, (&r, &slab), tmin, tmax, start)
+        let (r, slab) = K::set_up(ray);
+        if K::AVX && slab.fused() {
+            self.occluded_one::<K>(ray, (&r, &slab), tmin, tmax, (start, true))
         } else {
-            self.occluded_one::<AVX, WIDE, false>(ray, (&r, &slab), tmin, tmax, start)
+            self.occluded_one::<K>(ray, (&r, &slab), tmin, tmax, (start, false))
         }
     }
 
-    /// [`Bvh::occluded_with`]'s walk with node test `node_hit::<AVX, FUSED>`.
+    /// [`Bvh::occluded_with`]'s walk with the node test [`Kernel::node_hit`], fused if `fused` (a
+    /// constant where the walk is inlined: one loop per node test).
     #[inline(always)]
-    pub(crate) fn occluded_one<const AVX: bool, const WIDE: bool, const FUSED: bool>(
+    pub(crate) fn occluded_one<K: Kernel>(
         &self,
         ray: &Ray,
         (r, slab): (&RayPre, &SlabRay),
         tmin: f32,
         tmax: f32,
-        start: Start,
+        (start, fused): (Start, bool),
     ) -> bool {
         let mut stack = Stack::<u32>::new();
         let mut sp = 0usize;
@@ -306,20 +283,14 @@ impl Bvh {
             // `Bvh::walk_one`).
             let slow = loop {
                 if node_ref & LEAF != 0 {
-                    match self.leaf_fast::<AVX, WIDE>(
-                        node_ref,
-                        r,
-                        tmin,
-                        &mut Limit::end(tmax),
-                        true,
-                    ) {
+                    match self.leaf_fast::<K>(node_ref, r, tmin, &mut Limit::end(tmax), true) {
                         Ok(Some(_)) => return true,
                         Ok(None) => {}
                         Err(SlowLeaf) => break node_ref,
                     }
                 } else {
                     let n = self.node(node_ref);
-                    let (_, mut mask) = Self::node_hit::<AVX, FUSED>(n, slab, tmin, tmax);
+                    let (_, mut mask) = K::node_hit(n, slab, tmin, tmax, fused);
                     if node_ref == 0 {
                         mask &= !start.skip;
                     }
@@ -345,10 +316,7 @@ impl Bvh {
                 node_ref = stack.get(sp);
             };
             let mut end = Limit::end(tmax);
-            if self
-                .leaf::<AVX>(slow, r, ray, tmin, &mut end, true)
-                .is_some()
-            {
+            if self.leaf::<K>(slow, r, ray, tmin, &mut end, true).is_some() {
                 return true;
             }
             if sp == 0 {
@@ -358,21 +326,4 @@ impl Bvh {
             node_ref = stack.get(sp);
         }
     }
-}
-
-/// The ray's per-ray values for the leaves and the node tests: with `AVX` (in walks
-/// compiled for AVX2), by [`RayPre::new_avx`], which gives the same values as
-/// [`RayPre::new`], and the slab values from its registers.
-#[inline(always)]
-pub(crate) fn set_up<const AVX: bool>(ray: &Ray) -> (RayPre, SlabRay) {
-    #[cfg(target_arch = "x86_64")]
-    if AVX {
-        // SAFETY: `AVX` is true only in the walks compiled for AVX2, which their callers
-        // enter after detecting it.
-        let (pre, origin, inv_dir) = unsafe { RayPre::new_avx(ray) };
-        return (pre, SlabRay::from_vectors(origin, inv_dir));
-    }
-    let pre = RayPre::new(ray);
-    let slab = SlabRay::new(&pre);
-    (pre, slab)
 }
