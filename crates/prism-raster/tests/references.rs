@@ -1,7 +1,7 @@
 //! Golden-image tests, one test per input file: the course's own reference renders
 //! (`shared/assets/rasterizer/tests/outputs/reference/`, made by the CS184 staff renderer at
 //! 1024x1024, sample rate 1, nearest pixel sampling, level 0), and resvg renders of the
-//! project's own standard-SVG suite (`tests/data/*.svg`, references made by resvg 0.49).
+//! project's own standard-SVG suite (`tests/golden/resvg/NAME.svg`, references `NAME.png` made by resvg 0.49).
 //! Images are compared in memory; a failure leaves an `expected | diff | actual` triptych
 //! under `target/test-diffs/`. Two more tests check that the lists below name every file.
 
@@ -97,16 +97,16 @@ course_goldens! {
 }
 
 fn data_dir() -> std::path::PathBuf {
-    workspace_root().join("crates/prism-raster/tests/data")
+    workspace_root().join("crates/prism-raster/tests/golden/resvg")
 }
 
-/// The standard SVG `tests/data/{stem}.svg` at 16 samples agrees with resvg 0.49's render
-/// (the oracle, made by `resvg FILE.svg resvg/FILE.png`): mean absolute channel error at most
+/// The standard SVG `tests/golden/resvg/{stem}.svg` at 16 samples agrees with resvg 0.49's render
+/// (the oracle, made by `resvg FILE.svg FILE.png`): mean absolute channel error at most
 /// 1/255 and at most 0.5% of pixels off by more than 24/255, both composited over white.
 fn resvg_golden(stem: &str) {
     let doc = read_svg(&data_dir().join(format!("{stem}.svg")), Dialect::Svg)
         .unwrap_or_else(|e| panic!("{e}"));
-    let reference = data_dir().join("resvg").join(format!("{stem}.png"));
+    let reference = data_dir().join(format!("{stem}.png"));
     let expected = prism_image::read_png(&reference).unwrap_or_else(|e| panic!("{e}"));
     let opts = RasterOptions {
         width: expected.width(),

@@ -201,32 +201,39 @@ fn flip_split_collapse_reproduce_the_course_examples() {
     );
 }
 
-/// Oracle: libigl's `per_vertex_normals` (area-weighted) on the same triangles, committed in
-/// `tests/data` (the bar is 1e-6; the two agree to about 1e-13).
+/// Oracle: libigl's `per_vertex_normals` (area-weighted) on the same triangles, committed as
+/// `tests/golden/libigl/NAME.txt` (the bar is 1e-6; the two agree to about 1e-13).
+fn normals_match_libigl(name: &str) {
+    let mesh = load(&format!("meshedit/dae/{name}.dae"));
+    let mine = prism_mesh::vertex_normals_area_weighted(&mesh);
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/libigl/{name}.txt"));
+    let theirs: Vec<DVec3> = std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            DVec3::new(v[0], v[1], v[2])
+        })
+        .collect();
+    assert_eq!(mine.len(), theirs.len(), "{name}");
+    let worst = mine
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| (*a - *b).abs().max_element())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "{name}: max difference {worst:e}");
+}
+
 #[test]
-fn area_weighted_normals_match_libigl() {
-    for name in ["teapot", "beetle"] {
-        let mesh = load(&format!("meshedit/dae/{name}.dae"));
-        let mine = prism_mesh::vertex_normals_area_weighted(&mesh);
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("tests/data/{name}_libigl_normals.txt"));
-        let theirs: Vec<DVec3> = std::fs::read_to_string(path)
-            .unwrap()
-            .lines()
-            .filter(|l| !l.starts_with('#'))
-            .map(|l| {
-                let v: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
-                DVec3::new(v[0], v[1], v[2])
-            })
-            .collect();
-        assert_eq!(mine.len(), theirs.len(), "{name}");
-        let worst = mine
-            .iter()
-            .zip(&theirs)
-            .map(|(a, b)| (*a - *b).abs().max_element())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-9, "{name}: max difference {worst:e}");
-    }
+fn teapot_normals_match_libigl() {
+    normals_match_libigl("teapot");
+}
+
+#[test]
+fn beetle_normals_match_libigl() {
+    normals_match_libigl("beetle");
 }
 
 fn scene(name: &str) -> prism_scene::Scene {
