@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-#[path = "cli/bounded.rs"]
 mod bounded;
+mod split;
 
 fn prism() -> Command {
     Command::new(env!("CARGO_BIN_EXE_prism"))
