@@ -1,4 +1,5 @@
-//! Test helpers shared by prism's crates: golden-image comparison that explains itself, and
+//! Test helpers shared by prism's crates: golden-image comparison that explains itself, a
+//! per-pixel Z-test of a render against a reference, and
 //! scratch folders that tidy up after passing tests.
 //!
 //! [`compare_golden`] decodes both PNGs, reports the identical-pixel fraction and the largest
@@ -217,6 +218,102 @@ pub fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, f64) {
     (stat, k * (1.0 - c + z * c.sqrt()).powi(3))
 }
 
+/// One pixel's estimate for [`z_test`]: its mean and the variance of that mean (a sample
+/// variance over the sample count).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// The pixel's mean.
+    pub mean: f64,
+    /// The variance of the mean.
+    pub variance: f64,
+}
+
+/// What [`z_test`] found: the smallest p-value over the pixels tested, where, and the
+/// threshold it must not fall below (the significance level over the pixels tested:
+/// Bonferroni's correction).
+#[derive(Clone, Copy, Debug)]
+pub struct ZTest {
+    /// Pixels tested (those where either estimate has a non-zero variance).
+    pub tested: usize,
+    /// The smallest two-sided p-value.
+    pub worst_p: f64,
+    /// The pixel with that p-value.
+    pub worst_pixel: usize,
+    /// `alpha / tested`.
+    pub threshold: f64,
+    /// Pixels with no variance on either side whose means differ by more than `tolerance`.
+    pub exact_mismatches: usize,
+}
+
+impl ZTest {
+    /// True if no pixel rejects the hypothesis that both estimates have one mean.
+    #[must_use]
+    pub fn passed(&self) -> bool {
+        self.worst_p >= self.threshold && self.exact_mismatches == 0
+    }
+}
+
+/// A per-pixel two-sided Z-test of `ours` against `reference` (Mitsuba's `test_renders.py`
+/// tests its renders this way): for each pixel, `z = (a - b) / sqrt(var_a + var_b)` and its
+/// p-value `erfc(|z| / sqrt 2)`; the test fails if any p-value is below `alpha` over the
+/// number of pixels tested. Pixels where neither side varies must agree to `tolerance`.
+///
+/// # Panics
+/// If the slices differ in length.
+#[must_use]
+pub fn z_test(ours: &[Estimate], reference: &[Estimate], alpha: f64, tolerance: f64) -> ZTest {
+    assert_eq!(
+        ours.len(),
+        reference.len(),
+        "one estimate per pixel on both sides"
+    );
+    let mut out = ZTest {
+        tested: 0,
+        worst_p: 1.0,
+        worst_pixel: 0,
+        threshold: alpha,
+        exact_mismatches: 0,
+    };
+    for (i, (a, b)) in ours.iter().zip(reference).enumerate() {
+        let var = a.variance + b.variance;
+        if var <= 0.0 {
+            out.exact_mismatches += usize::from((a.mean - b.mean).abs() > tolerance);
+            continue;
+        }
+        out.tested += 1;
+        let z = (a.mean - b.mean).abs() / var.sqrt();
+        let p = erfc(z / std::f64::consts::SQRT_2);
+        if p < out.worst_p {
+            out.worst_p = p;
+            out.worst_pixel = i;
+        }
+    }
+    out.threshold = alpha / out.tested.max(1) as f64;
+    out
+}
+
+/// The complementary error function, to a relative error under 1.2e-7 everywhere (the
+/// Chebyshev fit of Numerical Recipes' `erfcc`).
+#[must_use]
+pub fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -z * z - 1.265_512_23
+        + t * (1.000_023_68
+            + t * (0.374_091_96
+                + t * (0.096_784_18
+                    + t * (-0.186_288_06
+                        + t * (0.278_868_07
+                            + t * (-1.135_203_98
+                                + t * (1.488_515_87 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
+    let r = t * poly.exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
 /// Runs `f` on a rayon pool of exactly `threads` threads (for tests that an output does not
 /// depend on the thread count).
 ///
@@ -233,6 +330,63 @@ pub fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Closed form: erfc at tabulated points (Abramowitz and Stegun, table 7.1).
+    #[test]
+    fn erfc_matches_the_table() {
+        for (x, want) in [
+            (0.0, 1.0),
+            (0.5, 0.479_500_122),
+            (1.0, 0.157_299_207),
+            (2.0, 0.004_677_735),
+            (3.0, 2.209_049_7e-5),
+            (-1.0, 1.842_700_793),
+        ] {
+            let got = erfc(x);
+            assert!(
+                ((got - want) / want).abs() < 2e-7,
+                "erfc({x}) = {got}, want {want}"
+            );
+        }
+    }
+
+    /// Property: the Z-test passes two estimates of one mean (normal draws of known variance,
+    /// 10,000 pixels) and fails when one pixel's mean is moved by eight standard errors.
+    #[test]
+    fn z_test_passes_one_mean_and_catches_a_shifted_pixel() {
+        // A 64-bit linear congruential generator's top 53 bits, then Box-Muller.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let mut normal = move || {
+            let (u, v) = (uniform(), uniform());
+            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let sd: f64 = 0.1;
+        let ours: Vec<Estimate> = (0..10_000)
+            .map(|_| Estimate {
+                mean: 1.0 + sd * normal(),
+                variance: sd * sd,
+            })
+            .collect();
+        let reference = vec![
+            Estimate {
+                mean: 1.0,
+                variance: 0.0,
+            };
+            10_000
+        ];
+        let fair = z_test(&ours, &reference, 0.01, 0.0);
+        assert!(fair.passed(), "{fair:?}");
+        let mut shifted = ours.clone();
+        shifted[1234].mean = 1.0 + 8.0 * sd;
+        let caught = z_test(&shifted, &reference, 0.01, 0.0);
+        assert!(!caught.passed() && caught.worst_pixel == 1234, "{caught:?}");
+    }
 
     /// Property: a scratch folder starts empty (a failed run's leftovers gone) and is
     /// removed, with what was written in it, when it goes out of scope.
