@@ -11,41 +11,39 @@
 
 pub mod bsdf;
 mod camera;
-mod debug_output;
-mod envmap;
 mod film;
 mod integrators;
 mod interaction;
 mod lights;
-mod overlay;
 mod parts;
 mod profile;
-mod raytrace;
 mod render_scene;
 mod sampler;
-mod whitted_scene;
+pub mod whitted;
 
 pub use bsdf::{Bsdf, BsdfSample};
-pub use camera::{OrbitView, Perspective};
-pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
+pub use camera::Perspective;
 pub use film::{
     film_bytes, render, render_share, render_share_except, render_share_profiled, tile_count,
     tile_of, tiles, PixelSum, RenderOptions, Rendered, Share, TILE,
 };
-pub use integrators::whitted::{
-    parallelogram_color, parallelogram_grid, phong, DebugRay, PixelSampler, RayCounts, RayKind,
-    WhittedSettings, WhittedTracer, MISS_LENGTH, RAY_EPSILON,
-};
 pub use integrators::{radiance, Integrator};
 pub use interaction::Interaction;
+pub use lights::envmap::{direction_to_uv, uv_to_direction, EnvMap};
 pub use lights::{LightSample, MeshLight, RenderLight};
-pub use overlay::{palette, Overlay};
 pub use parts::{merge, merge_order, Merged, Part, PartError, PartFile, PartHeader};
 pub use profile::{Profile, Stage};
-pub use raytrace::{
+pub use render_scene::RenderScene;
+pub use sampler::Sampler;
+pub use whitted::camera::OrbitView;
+pub use whitted::film::{
     raytrace, raytrace_bytes, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions,
     Raytraced,
 };
-pub use render_scene::RenderScene;
-pub use sampler::Sampler;
-pub use whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
+pub use whitted::overlay::{palette, Overlay};
+pub use whitted::scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
+pub use whitted::shading::{parallelogram_color, parallelogram_grid, phong};
+pub use whitted::tracer::{
+    DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer, MISS_LENGTH,
+    RAY_EPSILON,
+};

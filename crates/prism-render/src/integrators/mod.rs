@@ -1,14 +1,12 @@
 //! The integrators: [`Integrator`] names the estimator, [`radiance`] dispatches a camera ray
 //! to it (`normals`, `direct`, `path`), and the multiple-importance-sampling weight they share;
-//! `wavefront` runs a tile's paths together, stage by stage, to the same result as `path`;
-//! `whitted` is the Delft ray tracer's recursive integrator.
+//! `wavefront` runs a tile's paths together, stage by stage, to the same result as `path`.
 
 mod direct;
 mod normals;
 mod path;
 mod smooth16;
 pub(crate) mod wavefront;
-pub mod whitted;
 
 use prism_math::{Ray, Rgb};
 
