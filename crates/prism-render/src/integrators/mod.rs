@@ -5,7 +5,6 @@
 mod direct;
 mod normals;
 mod path;
-mod smooth16;
 pub(crate) mod wavefront;
 
 use prism_math::{Ray, Rgb};

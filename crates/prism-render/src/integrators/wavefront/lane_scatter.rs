@@ -1,4 +1,4 @@
-//! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
+//! The wavefront's lane scatter stage: the step for sixteen paths at once at smooth surfaces (diffuse or rough
 //! conductor, one kind per group): shading frames, light samples with their MIS weights and
 //! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
 //! and the BSDFs' evaluation and sampling too. Area, point, directional and hemisphere
@@ -14,7 +14,7 @@ use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::warp::cosine_hemisphere_lanes;
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 
-use super::wavefront::{PathState, Shadows};
+use super::queues::{PathState, Shadows};
 use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
 use crate::film::RenderOptions;
 use crate::interaction::Interaction;
