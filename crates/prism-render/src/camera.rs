@@ -1,9 +1,11 @@
 //! [`Perspective`], the perspective camera: primary rays through image positions, from a
-//! pinhole or across a thin lens.
+//! pinhole or across a thin lens, and the camera ray a sample's first dimensions choose.
 
 use prism_math::lanes::{F16, V16};
 use prism_math::{warp, Ray, Vec2, Vec3};
 use prism_scene::Camera;
+
+use crate::sampler::Sampler;
 
 /// A perspective camera for an image of `width` x `height` pixels: a pinhole, or a thin
 /// lens focused on a plane (the course's thin-lens model).
@@ -94,6 +96,19 @@ impl Perspective {
         }
         .normalize()
     }
+}
+
+/// The camera ray through pixel `(x, y)` that a sample's first dimensions choose (the
+/// position in the pixel, then the lens point if there is a lens).
+pub(crate) fn camera_ray(camera: &Perspective, (x, y): (u32, u32), sampler: &mut Sampler) -> Ray {
+    let u = sampler.next_2d();
+    // The lens takes dimensions only when there is one: pinhole images keep their bytes.
+    let lens = if camera.has_lens() {
+        sampler.next_2d()
+    } else {
+        prism_math::Vec2::ZERO
+    };
+    camera.ray(x as f32 + u.x, y as f32 + u.y, lens)
 }
 
 #[cfg(test)]

@@ -5,8 +5,7 @@ use prism_math::lanes::{F16, LANES};
 use prism_math::{Ray, Vec3};
 
 use super::queues::PathState;
-use crate::camera::Perspective;
-use crate::film::camera_ray;
+use crate::camera::{camera_ray, Perspective};
 use crate::sampler::{lane_keys, lane_values, Sampler};
 
 /// Starts sample `n`'s path at each pixel of `active` (indices into `pixels`, whose

@@ -4,8 +4,8 @@
 use prism_math::Vec3;
 
 use super::queues::PathState;
-use crate::film::RenderOptions;
-use crate::integrators::power;
+use crate::integrators::mis::power;
+use crate::integrators::PathSettings;
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
 
@@ -13,7 +13,7 @@ use crate::render_scene::RenderScene;
 /// `hit` the surface the path scatters from next, or none if it ends there.
 pub(super) fn emit(
     scene: &RenderScene,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     p: &mut PathState,
     dir: Vec3,
     hit: &mut Option<Interaction>,
@@ -26,7 +26,7 @@ pub(super) fn emit(
 /// [`emit`]'s work: `Some(())` if the path goes on from the surface.
 fn emitted(
     scene: &RenderScene,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     p: &mut PathState,
     dir: Vec3,
     hit: Option<&Interaction>,

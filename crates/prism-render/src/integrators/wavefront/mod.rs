@@ -20,9 +20,10 @@ use self::camera::start_paths;
 use self::emission::emit;
 use self::queues::{LightTerms, PathState, Pending, Shadows};
 use self::scatter::scatter;
+use super::settings::PathSettings;
 use crate::bsdf::lanes::SmoothKind;
 use crate::camera::Perspective;
-use crate::film::{PixelSum, RenderOptions};
+use crate::film::{FilmSettings, PixelSum};
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::profile::{Laps, Profile, Stage};
@@ -57,7 +58,8 @@ struct Buffers {
 pub(crate) fn tile(
     scene: &RenderScene,
     camera: &Perspective,
-    opts: &RenderOptions,
+    film: &FilmSettings,
+    opts: &PathSettings,
     pixels: &[(u32, u32)],
     samples: &std::ops::Range<u32>,
     profile: Option<&Profile>,
@@ -66,10 +68,10 @@ pub(crate) fn tile(
     let mut active: Vec<usize> = (0..pixels.len()).collect();
     let mut radiance = vec![Rgb::BLACK; pixels.len()];
     let mut buffers = Buffers::default();
-    let width = u64::from(opts.width);
+    let width = u64::from(film.width);
     let keys: Vec<u64> = pixels
         .iter()
-        .map(|&(x, y)| Sampler::pixel_key(opts.seed, u64::from(y) * width + u64::from(x)))
+        .map(|&(x, y)| Sampler::pixel_key(film.seed, u64::from(y) * width + u64::from(x)))
         .collect();
     // Light sampling at every bounce: the sixteen-lane step applies.
     let lanes = opts
@@ -95,7 +97,7 @@ pub(crate) fn tile(
         );
         n += 1;
         active.retain(|&k| {
-            sums[k].add(radiance[k], opts);
+            sums[k].add(radiance[k], film);
             sums[k].wants_more(most)
         });
         laps.lap(Stage::Gathering);
@@ -111,7 +113,7 @@ pub(crate) fn tile(
 fn sample_pass(
     scene: &RenderScene,
     camera: &Perspective,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     pixels: (&[(u32, u32)], &[u64]),
     active: &[usize],
     n: u32,

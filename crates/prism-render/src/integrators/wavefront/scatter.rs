@@ -4,8 +4,8 @@
 use prism_math::Ray;
 
 use super::queues::{LightTerms, PathState, Pending, Shadows};
-use crate::film::RenderOptions;
 use crate::integrators::direct::light_term;
+use crate::integrators::PathSettings;
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
 
@@ -14,7 +14,7 @@ use crate::render_scene::RenderScene;
 /// the path goes on, with its next ray in `ray`.
 pub(super) fn scatter(
     scene: &RenderScene,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     (p, ray): (&mut PathState, &mut Ray),
     hit: &Interaction,
     (shadows, light_terms): (&mut Shadows, &mut Vec<LightTerms>),
