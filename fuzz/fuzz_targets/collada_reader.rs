@@ -24,14 +24,17 @@ fuzz_target!(|data: &[u8]| {
                 Ok(scene) => {
                     let triangles: usize = scene.meshes.iter().map(|m| m.triangles.len()).sum();
                     if triangles <= 4096 {
-                        let prepared = prism_render::RenderScene::new(&scene);
-                        let opts = prism_render::RenderOptions {
-                            width: 4,
-                            height: 3,
-                            spp: 1,
-                            ..prism_render::RenderOptions::default()
+                        let prepared = prism_render::render_scene::RenderScene::new(&scene);
+                        let opts = prism_render::render::RenderOptions {
+                            film: prism_render::film::FilmSettings {
+                                width: 4,
+                                height: 3,
+                                spp: 1,
+                                ..prism_render::film::FilmSettings::default()
+                            },
+                            ..prism_render::render::RenderOptions::default()
                         };
-                        let out = prism_render::render(&prepared, &opts, &|_| {});
+                        let out = prism_render::render::render(&prepared, &opts, &|_| {});
                         for p in out.image.pixels() {
                             assert!(p.is_finite() && p.r >= 0.0 && p.g >= 0.0 && p.b >= 0.0, "{p:?}");
                         }

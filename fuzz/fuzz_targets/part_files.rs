@@ -7,7 +7,7 @@ use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
 use prism_image::{decode_exr, decode_exr_header, decode_exr_layers};
-use prism_render::{Part, PartHeader};
+use prism_render::parts::{Part, PartHeader};
 
 fuzz_target!(|data: &[u8]| {
     let name = "fuzz.exr";

@@ -8,7 +8,9 @@
 
 use libfuzzer_sys::fuzz_target;
 use prism_math::{Rgb, Vec3};
-use prism_render::{raytrace, RaytraceOptions, WhittedScene, WhittedSettings};
+use prism_render::whitted::film::{raytrace, RaytraceOptions};
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{
     parse_obj_scene, parse_render_config, Features, Material, OrbitCamera, Scene, SceneError,
     Shading, TriangleMesh,

@@ -8,6 +8,9 @@ use base64::Engine;
 use clap::Args;
 use prism_image::{encode_png, Image, LevelSampling, PixelSampling};
 use prism_raster::{parse_svg, render, Dialect, RasterOptions, Source};
+use prism_render::film::FilmSettings;
+use prism_render::integrators::PathSettings;
+use prism_render::render::RenderOptions;
 
 /// Arguments of `prism demo`.
 #[derive(Args, Debug)]
@@ -27,12 +30,12 @@ pub struct DemoArgs {
 /// Path-traces a scene for the gallery and writes the PNG (and, if asked, the heat map).
 fn trace(
     scene: &prism_scene::Scene,
-    opts: &prism_render::RenderOptions,
+    opts: &RenderOptions,
     out: &std::path::Path,
     heat: Option<&std::path::Path>,
 ) -> Result<()> {
-    let prepared = prism_render::RenderScene::new(scene);
-    let r = prism_render::render(&prepared, opts, &|_| {});
+    let prepared = prism_render::render_scene::RenderScene::new(scene);
+    let r = prism_render::render::render(&prepared, opts, &|_| {});
     prism_image::write_png(out, &r.image.linear_to_srgb8())
         .with_context(|| format!("writing {}", out.display()))?;
     if let Some(h) = heat {
@@ -149,7 +152,7 @@ fn sky_map() -> prism_image::RgbImage {
     let sun = prism_math::Vec3::new(0.5, 0.7, 0.6).normalize();
     Image::from_fn(128, 64, |x, y| {
         let uv = prism_math::Vec2::new((x as f32 + 0.5) / 128.0, (y as f32 + 0.5) / 64.0);
-        let d = prism_render::uv_to_direction(uv);
+        let d = prism_render::lights::envmap::uv_to_direction(uv);
         if d.y < 0.0 {
             return prism_math::Rgb::new(0.25, 0.18, 0.12);
         }
@@ -342,11 +345,14 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     }
     // Path tracing: the Cornell box, its sample-rate heat map and its bounce decomposition.
     let cornell = prism_scene::cornell_box();
-    let base = prism_render::RenderOptions {
-        width: 256,
-        height: 192,
-        spp: 64,
-        ..prism_render::RenderOptions::default()
+    let base = RenderOptions {
+        film: FilmSettings {
+            width: 256,
+            height: 192,
+            spp: 64,
+            ..FilmSettings::default()
+        },
+        ..RenderOptions::default()
     };
     trace(&cornell, &base, &a.output.join("render_cornell.png"), None)?;
     entries.push(Entry {
@@ -357,12 +363,15 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     pb.inc(1);
     // The course's adaptive-sampling settings (2048 samples at most, checked every 64), at
     // a small size, so the map shows where the samples went.
-    let adaptive = prism_render::RenderOptions {
-        width: 128,
-        height: 96,
-        spp: 2048,
-        batch: 64,
-        adaptive: Some(0.05),
+    let adaptive = RenderOptions {
+        film: FilmSettings {
+            width: 128,
+            height: 96,
+            spp: 2048,
+            batch: 64,
+            adaptive: Some(0.05),
+            ..base.film
+        },
         ..base
     };
     trace(
@@ -390,8 +399,11 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         (3, "third bounce"),
     ] {
         let file = format!("render_bounce_{m}.png");
-        let opts = prism_render::RenderOptions {
-            only_bounce: Some(m),
+        let opts = RenderOptions {
+            path: PathSettings {
+                only_bounce: Some(m),
+                ..base.path
+            },
             ..base
         };
         trace(&cornell, &opts, &a.output.join(&file), None)?;
@@ -504,14 +516,17 @@ fn montage(panels: &[prism_image::RgbImage], cols: usize) -> prism_image::RgbIma
 /// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
 /// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
 fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
-    use prism_render::{raytrace, trace_pixel, OrbitView, Overlay, RaytraceOptions, WhittedScene};
+    use prism_render::whitted::camera::OrbitView;
+    use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
+    use prism_render::whitted::overlay::Overlay;
+    use prism_render::whitted::scene::WhittedScene;
     use prism_scene::{OrbitCamera, Preset};
     let dirs = vec![a.assets.join("delft-raytracer/data")];
     let on = prism_scene::Features::prism_defaults();
     let opts = |size: u32, features: prism_scene::Features| RaytraceOptions {
         width: size,
         height: size,
-        settings: prism_render::WhittedSettings {
+        settings: prism_render::whitted::tracer::WhittedSettings {
             features,
             light_samples: 16,
             max_depth: 3,
@@ -607,7 +622,7 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
     let mut ov = Overlay::new(img.clone(), OrbitView::new(&cam, 300, 300), &ws);
     let bvh = ws.bvh().expect("built");
     for (i, bx) in bvh.level_boxes(1).iter().enumerate() {
-        ov.aabb(bx, prism_render::palette(i));
+        ov.aabb(bx, prism_render::whitted::overlay::palette(i));
     }
     write("raytrace_bvh_level.png", &ov.image)?;
     entries.push(Entry {
@@ -637,7 +652,8 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         for r in &t.rays {
             let on_top = matches!(
                 r.kind,
-                prism_render::RayKind::Normal | prism_render::RayKind::InterpolatedNormal
+                prism_render::whitted::tracer::RayKind::Normal
+                    | prism_render::whitted::tracer::RayKind::InterpolatedNormal
             );
             ov.segment(r.origin, r.end, r.color, !on_top);
         }

@@ -8,10 +8,13 @@ use anyhow::Result;
 use clap::Args;
 use prism_image::Bloom;
 use prism_math::Rgb;
-use prism_render::{
-    raytrace, raytrace_share, trace_pixel, OrbitView, Overlay, Part, RaytraceOptions, Share,
-    WhittedScene, WhittedSettings,
-};
+use prism_render::film::Share;
+use prism_render::parts::Part;
+use prism_render::whitted::camera::OrbitView;
+use prism_render::whitted::film::{raytrace, raytrace_share, trace_pixel, RaytraceOptions};
+use prism_render::whitted::overlay::Overlay;
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
 
 use crate::output::write_text;
@@ -379,7 +382,12 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         ))
         .into());
     }
-    crate::resources::check_frame("--resolution", w, h, prism_render::raytrace_bytes(w, h))?;
+    crate::resources::check_frame(
+        "--resolution",
+        w,
+        h,
+        prism_render::whitted::film::raytrace_bytes(w, h),
+    )?;
     if let Some((_, parts)) = a.tile {
         crate::split::check_tile_count(parts, w, h)?;
     }
@@ -459,7 +467,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let n = loaded.cameras.len();
     check_every_output(a, n, debug_pixel.is_some())?;
     let mut written = Vec::new();
-    let mut counts = prism_render::RayCounts::default();
+    let mut counts = prism_render::whitted::tracer::RayCounts::default();
     let mut render_time = std::time::Duration::ZERO;
     let mut write_time = std::time::Duration::ZERO;
     if let Some((part, parts)) = a.tile {

@@ -5,9 +5,11 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use prism_render::{
-    render, render_share_profiled, Integrator, Part, RenderOptions, RenderScene, Share,
-};
+use prism_render::film::{FilmSettings, Share};
+use prism_render::integrators::{Integrator, PathSettings};
+use prism_render::parts::Part;
+use prism_render::render::{render, render_share, Job, RenderOptions};
+use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
 use crate::UserError;
@@ -184,7 +186,7 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
 /// Every setting of `opts` and `a` that changes pixels, by name, for a part file; the scene,
 /// with its camera, lens, normals and lights, is in its fingerprint.
 fn identity(scene: &prism_scene::Scene, opts: &RenderOptions) -> Vec<(String, String)> {
-    let integrator = match opts.integrator {
+    let integrator = match opts.path.integrator {
         // Both give the same bytes.
         Integrator::Path | Integrator::PathScalar => "path".to_string(),
         Integrator::Direct { hemisphere } => format!("direct hemisphere={hemisphere}"),
@@ -195,19 +197,25 @@ fn identity(scene: &prism_scene::Scene, opts: &RenderOptions) -> Vec<(String, St
         ("kind", "render".to_string()),
         ("version", env!("CARGO_PKG_VERSION").to_string()),
         ("scene", format!("{:016x}", scene.fingerprint())),
-        ("width", opts.width.to_string()),
-        ("height", opts.height.to_string()),
-        ("spp", opts.spp.to_string()),
-        ("light_samples", opts.light_samples.to_string()),
-        ("max_bounces", opts.max_bounces.to_string()),
+        ("width", opts.film.width.to_string()),
+        ("height", opts.film.height.to_string()),
+        ("spp", opts.film.spp.to_string()),
+        ("light_samples", opts.path.light_samples.to_string()),
+        ("max_bounces", opts.path.max_bounces.to_string()),
         ("integrator", integrator),
-        ("only_bounce", opt(opts.only_bounce.map(|m| m.to_string()))),
+        (
+            "only_bounce",
+            opt(opts.path.only_bounce.map(|m| m.to_string())),
+        ),
         (
             "adaptive",
-            opt(opts.adaptive.map(|t| format!("{t} batch={}", opts.batch))),
+            opt(opts
+                .film
+                .adaptive
+                .map(|t| format!("{t} batch={}", opts.film.batch))),
         ),
-        ("rr_bounces", opts.rr_bounces.to_string()),
-        ("seed", opts.seed.to_string()),
+        ("rr_bounces", opts.path.rr_bounces.to_string()),
+        ("seed", opts.film.seed.to_string()),
         ("encoding", "srgb".to_string()),
     ]
     .into_iter()
@@ -351,7 +359,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
-    crate::resources::check_frame("--resolution", w, h, prism_render::film_bytes(w, h))?;
+    crate::resources::check_frame("--resolution", w, h, prism_render::film::film_bytes(w, h))?;
     if a.light_samples == 0 || a.light_samples > MAX_LIGHT_SAMPLES {
         return Err(UserError(format!(
             "--light-samples: expected 1 to {MAX_LIGHT_SAMPLES}, found {}",
@@ -453,48 +461,51 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let prepared = RenderScene::new(&scene);
     let build = t1.elapsed();
     let options = RenderOptions {
-        width: w,
-        height: h,
-        spp: a.spp,
-        light_samples: a.light_samples.max(1),
-        max_bounces: a.max_bounces,
-        integrator: match a.integrator {
-            IntegratorArg::Path => Integrator::Path,
-            IntegratorArg::PathScalar => Integrator::PathScalar,
-            IntegratorArg::Direct => Integrator::Direct {
-                hemisphere: a.hemisphere,
-            },
-            IntegratorArg::Normals => Integrator::Normals,
+        film: FilmSettings {
+            width: w,
+            height: h,
+            spp: a.spp,
+            adaptive,
+            batch: batch.unwrap_or(DEFAULT_BATCH).max(1),
+            seed: a.seed,
         },
-        only_bounce: a.bounce,
-        adaptive,
-        batch: batch.unwrap_or(DEFAULT_BATCH).max(1),
-        seed: a.seed,
-        ..RenderOptions::default()
+        path: PathSettings {
+            light_samples: a.light_samples.max(1),
+            max_bounces: a.max_bounces,
+            integrator: match a.integrator {
+                IntegratorArg::Path => Integrator::Path,
+                IntegratorArg::PathScalar => Integrator::PathScalar,
+                IntegratorArg::Direct => Integrator::Direct {
+                    hemisphere: a.hemisphere,
+                },
+                IntegratorArg::Normals => Integrator::Normals,
+            },
+            only_bounce: a.bounce,
+            ..PathSettings::default()
+        },
     };
     let pool = crate::resources::pool(a.threads)?;
     if let Some(share) = share {
-        let tiles = prism_render::tiles(w, h);
+        let tiles = prism_render::film::tiles(w, h);
         let pixels: u64 = tiles
             .iter()
             .enumerate()
             .filter(|&(k, _)| share.has_tile(k))
             .map(|(_, &(x0, y0))| {
-                u64::from((w - x0).min(prism_render::TILE))
-                    * u64::from((h - y0).min(prism_render::TILE))
+                u64::from((w - x0).min(prism_render::film::TILE))
+                    * u64::from((h - y0).min(prism_render::film::TILE))
             })
             .sum();
         let bar = crate::progress::samples_bar(pixels * share.samples.len() as u64, a.quiet);
         let t2 = Instant::now();
-        let profile = prism_render::Profile::default();
+        let profile = prism_render::profile::Profile::default();
         let sums = pool.install(|| {
-            render_share_profiled(
-                &prepared,
-                &options,
-                &share,
-                &|done| bar.set_position(done),
-                &profile,
-            )
+            let job = Job {
+                share: &share,
+                skip: None,
+                profile: Some(&profile),
+            };
+            render_share(&prepared, &options, &job, &|done| bar.set_position(done))
         });
         let render_time = t2.elapsed();
         bar.finish_and_clear();
@@ -578,7 +589,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
 /// Prints the path integrator's share of time per stage (`stages: camera rays 5.9%, ...`)
 /// and its time per stage summed over the threads (`stage times: camera rays 61.2 ms,
 /// ...`), if it ran.
-fn print_stages(profile: &prism_render::Profile) {
+fn print_stages(profile: &prism_render::profile::Profile) {
     if let Some(shares) = profile.shares() {
         let stages: Vec<String> = shares
             .iter()

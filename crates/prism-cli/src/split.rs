@@ -8,7 +8,8 @@ use anyhow::Result;
 use clap::Args;
 use prism_image::{Bloom, Image};
 use prism_math::Rgb;
-use prism_render::{merge, Part, PartFile, PixelSum};
+use prism_render::film::PixelSum;
+use prism_render::parts::{merge, Part, PartFile};
 
 use crate::output::ImageFormat;
 use crate::UserError;
@@ -35,7 +36,7 @@ pub fn parse_tile(s: &str) -> std::result::Result<(u32, u32), String> {
 
 /// Checks that a `width x height` image has at least `parts` tiles to share out.
 pub fn check_tile_count(parts: u32, width: u32, height: u32) -> Result<()> {
-    let tiles = prism_render::tile_count(width, height);
+    let tiles = prism_render::film::tile_count(width, height);
     if parts as usize > tiles {
         return Err(UserError(format!(
             "--tile I/{parts}: a {width}x{height} image has only {tiles} tiles of 32x32 to share \

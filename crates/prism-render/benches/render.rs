@@ -9,7 +9,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use prism_render::{render, Integrator, RenderOptions, RenderScene};
+use prism_render::film::FilmSettings;
+use prism_render::integrators::{Integrator, PathSettings};
+use prism_render::render::{render, RenderOptions};
+use prism_render::render_scene::RenderScene;
 use prism_scene::SceneOptions;
 
 fn main() {
@@ -30,9 +33,14 @@ fn main() {
         let integrators = [Integrator::Path, Integrator::PathScalar];
         let run = |integrator: Integrator| {
             let opts = RenderOptions {
-                spp,
-                integrator,
-                ..RenderOptions::default()
+                film: FilmSettings {
+                    spp,
+                    ..FilmSettings::default()
+                },
+                path: PathSettings {
+                    integrator,
+                    ..PathSettings::default()
+                },
             };
             let t = Instant::now();
             let out = render(&prepared, &opts, &|_| {});

@@ -10,9 +10,9 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use prism_math::Ray;
-use prism_render::{
-    raytrace, trace_pixel, RayKind, RaytraceOptions, WhittedScene, WhittedSettings,
-};
+use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::tracer::{RayKind, WhittedSettings};
 use prism_scene::{Features, OrbitCamera, Preset};
 use rayon::prelude::*;
 
@@ -80,8 +80,11 @@ fn main() {
                                 let dist = d.length();
                                 let l = d / dist;
                                 q.push(Query::Occluded(
-                                    Ray::new(r.origin + prism_render::RAY_EPSILON * l, l),
-                                    dist - prism_render::RAY_EPSILON,
+                                    Ray::new(
+                                        r.origin + prism_render::whitted::tracer::RAY_EPSILON * l,
+                                        l,
+                                    ),
+                                    dist - prism_render::whitted::tracer::RAY_EPSILON,
                                 ));
                             }
                             _ => {}

@@ -1,78 +1,43 @@
-//! The film: [`RenderOptions`], the pixel loop over 32x32 tiles on rayon, each pixel's samples
-//! with adaptive sampling into its [`PixelSum`], the [`Share`] of tiles and sample indices a
-//! split render computes, and the [`Rendered`] image with its sample counts.
+//! The film: its [`FilmSettings`], its 32x32 tiles, each pixel's samples with adaptive
+//! sampling into its [`PixelSum`], the [`Share`] of tiles and sample indices a split render
+//! computes, and each sample's sampler and camera ray.
 
 use std::ops::Range;
 
-use prism_image::Image;
 use prism_math::{ExactSum, Ray, Rgb};
-use rayon::prelude::*;
 
-use crate::camera::Perspective;
-use crate::integrators::{radiance, wavefront, Integrator};
-use crate::profile::Profile;
-use crate::render_scene::RenderScene;
+use crate::camera::{camera_ray, Perspective};
 use crate::sampler::Sampler;
 
-/// Render settings.
+/// The film's settings (the integrators' are [`crate::integrators::PathSettings`]).
 #[derive(Clone, Copy, Debug)]
-pub struct RenderOptions {
+pub struct FilmSettings {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
     /// Samples per pixel (the most, with adaptive sampling).
     pub spp: u32,
-    /// Samples per area or hemisphere light per shading point.
-    pub light_samples: u32,
-    /// Most bounces a path may take (the course's `-m`): 0 shows emitters only, 1 adds
-    /// direct light.
-    pub max_bounces: u32,
-    /// The estimator.
-    pub integrator: Integrator,
-    /// Keep only light that took exactly this many bounces (the course's "only the m-th
-    /// bounce" mode).
-    pub only_bounce: Option<u32>,
     /// Adaptive sampling: stop a pixel once its 95% confidence interval is within this
     /// fraction of its mean illuminance, checked every `batch` samples.
     pub adaptive: Option<f32>,
     /// Samples between convergence checks.
     pub batch: u32,
-    /// Russian roulette may end a path once it has this many bounces: after the BSDF sample
-    /// at that surface, before its ray is traced (Mitsuba's `rr_depth`, default 5).
-    pub rr_bounces: u32,
     /// Seed of every random number.
     pub seed: u64,
 }
 
-impl Default for RenderOptions {
-    fn default() -> RenderOptions {
-        RenderOptions {
+impl Default for FilmSettings {
+    fn default() -> FilmSettings {
+        FilmSettings {
             width: 512,
             height: 384,
             spp: 64,
-            light_samples: 1,
-            max_bounces: 7,
-            integrator: Integrator::Path,
-            only_bounce: None,
             adaptive: None,
             batch: 32,
-            rr_bounces: 5,
             seed: 0,
         }
     }
-}
-
-/// A rendered picture.
-pub struct Rendered {
-    /// Linear radiance per pixel.
-    pub image: Image<Rgb>,
-    /// Samples taken per pixel.
-    pub samples: Image<u32>,
-    /// All samples taken.
-    pub total_samples: u64,
-    /// Where the path integrator's time went (empty for the other integrators).
-    pub profile: Profile,
 }
 
 /// The side of a film tile in pixels: the unit of work of a thread and of a split render.
@@ -144,121 +109,6 @@ pub fn film_bytes(width: u32, height: u32) -> u64 {
     u64::from(width) * u64::from(height) * per_pixel as u64
 }
 
-/// Renders the scene. `progress` is called with the number of samples taken so far after
-/// each tile (from worker threads). The image is the same whatever the thread count.
-pub fn render(
-    scene: &RenderScene,
-    opts: &RenderOptions,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Rendered {
-    let profile = Profile::default();
-    let sums = render_tiles(
-        scene,
-        opts,
-        &Share::whole(opts.spp),
-        None,
-        progress,
-        Some(&profile),
-    );
-    Rendered {
-        image: sums.map(|p| p.mean()),
-        samples: sums.map(|p| p.n),
-        total_samples: sums.pixels().iter().map(|p| u64::from(p.n)).sum(),
-        profile,
-    }
-}
-
-/// Renders one share of the scene: the sums of the share's pixels; the other pixels hold no
-/// samples. Each pixel's sums equal those of the whole render when the share starts at sample
-/// 0, whatever the thread count. `progress` is called as in [`render`].
-pub fn render_share(
-    scene: &RenderScene,
-    opts: &RenderOptions,
-    share: &Share,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Image<PixelSum> {
-    render_share_except(scene, opts, share, None, progress)
-}
-
-/// [`render_share`], adding the path integrator's time per stage to `profile`.
-pub fn render_share_profiled(
-    scene: &RenderScene,
-    opts: &RenderOptions,
-    share: &Share,
-    progress: &(dyn Fn(u64) + Sync),
-    profile: &Profile,
-) -> Image<PixelSum> {
-    render_tiles(scene, opts, share, None, progress, Some(profile))
-}
-
-/// [`render_share`] leaving out the pixels `skip` marks (row by row, `width x height`
-/// entries): they hold no samples. A progressive renderer uses it to stop converged pixels.
-///
-/// # Panics
-/// If `skip` does not have one entry per pixel.
-pub fn render_share_except(
-    scene: &RenderScene,
-    opts: &RenderOptions,
-    share: &Share,
-    skip: Option<&[bool]>,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Image<PixelSum> {
-    render_tiles(scene, opts, share, skip, progress, None)
-}
-
-/// [`render_share_except`], adding the path integrator's time per stage to `profile`.
-fn render_tiles(
-    scene: &RenderScene,
-    opts: &RenderOptions,
-    share: &Share,
-    skip: Option<&[bool]>,
-    progress: &(dyn Fn(u64) + Sync),
-    profile: Option<&Profile>,
-) -> Image<PixelSum> {
-    let (w, h) = (opts.width, opts.height);
-    if let Some(s) = skip {
-        assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
-    }
-    let skipped = |x: u32, y: u32| skip.is_some_and(|s| s[(y * w + x) as usize]);
-    let camera = Perspective::new(&scene.camera, w, h);
-    let tiles: Vec<(u32, u32)> = tiles(w, h)
-        .into_iter()
-        .enumerate()
-        .filter(|&(k, _)| share.has_tile(k))
-        .map(|(_, t)| t)
-        .collect();
-    let done = std::sync::atomic::AtomicU64::new(0);
-    // Each tile's pixels rendered and their sums.
-    type Rendered = (Vec<(u32, u32)>, Vec<PixelSum>);
-    let results: Vec<Rendered> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
-            let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
-                .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
-                .filter(|&(x, y)| !skipped(x, y))
-                .collect();
-            let out = if opts.integrator == Integrator::Path {
-                wavefront::tile(scene, &camera, opts, &pixels, &share.samples, profile)
-            } else {
-                pixels
-                    .iter()
-                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y, &share.samples))
-                    .collect()
-            };
-            let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
-            progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
-            (pixels, out)
-        })
-        .collect();
-    let mut sums = Image::new(w, h, PixelSum::default());
-    for (pixels, out) in &results {
-        for (&(x, y), s) in pixels.iter().zip(out) {
-            sums.set(x, y, *s);
-        }
-    }
-    sums
-}
-
 /// A pixel's running sums: its radiance, exactly (so that samples split into ranges and
 /// summed in any order give the same bits), and its illuminance's first two moments for
 /// adaptive sampling.
@@ -295,7 +145,7 @@ impl PixelSum {
 
     /// Adds a sample (as [`PixelSum::accumulate`]), then checks convergence every `batch`
     /// samples when sampling is adaptive.
-    pub(crate) fn add(&mut self, l: Rgb, opts: &RenderOptions) {
+    pub(crate) fn add(&mut self, l: Rgb, opts: &FilmSettings) {
         self.accumulate(l);
         let n = self.n;
         if let Some(tol) = opts.adaptive {
@@ -359,7 +209,7 @@ impl PixelSum {
 /// camera ray.
 pub(crate) fn camera_sample(
     camera: &Perspective,
-    opts: &RenderOptions,
+    opts: &FilmSettings,
     (x, y): (u32, u32),
     n: u32,
 ) -> (Sampler, Ray) {
@@ -367,34 +217,4 @@ pub(crate) fn camera_sample(
     let mut sampler = Sampler::new(opts.seed, index, u64::from(n));
     let ray = camera_ray(camera, (x, y), &mut sampler);
     (sampler, ray)
-}
-
-/// The camera ray through pixel `(x, y)` that a sample's first dimensions choose (the
-/// position in the pixel, then the lens point if there is a lens).
-pub(crate) fn camera_ray(camera: &Perspective, (x, y): (u32, u32), sampler: &mut Sampler) -> Ray {
-    let u = sampler.next_2d();
-    // The lens takes dimensions only when there is one: pinhole images keep their bytes.
-    let lens = if camera.has_lens() {
-        sampler.next_2d()
-    } else {
-        prism_math::Vec2::ZERO
-    };
-    camera.ray(x as f32 + u.x, y as f32 + u.y, lens)
-}
-
-fn pixel(
-    scene: &RenderScene,
-    camera: &Perspective,
-    opts: &RenderOptions,
-    x: u32,
-    y: u32,
-    samples: &Range<u32>,
-) -> PixelSum {
-    let mut px = PixelSum::default();
-    let most = samples.len() as u32;
-    while px.wants_more(most) {
-        let (mut sampler, ray) = camera_sample(camera, opts, (x, y), samples.start + px.n);
-        px.add(radiance(scene, &ray, &mut sampler, opts), opts);
-    }
-    px
 }

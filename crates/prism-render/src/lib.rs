@@ -1,51 +1,23 @@
-//! Floor-3 rendering for prism, split by noun: a perspective camera (pinhole or thin lens,
-//! `camera`), a deterministic sampler (`sampler`), BSDFs (`bsdf`), lights (`lights`, the
-//! environment map's data in `envmap`), the render scene with its BVH (`render_scene`) and the
-//! hit records it returns (`interaction`), the integrators (`integrators`: `normals`,
-//! `direct`, `path`, and `wavefront`, which runs a tile's paths together and sixteen at a time
-//! where it can) and the film that loops over pixels with adaptive sampling (`film`),
-//! over a scene from prism-scene; a split render's part files and their merge (`parts`). The Whitted ray tracer of the Delft project has its scene
-//! (`whitted_scene`), integrator (`integrators::whitted`), orbit camera (`camera`) and film
-//! with per-pixel ray recording (`raytrace`).
+//! Floor-3 rendering for prism, one module a room. The path tracer: a perspective camera
+//! (pinhole or thin lens, [`camera`]), a deterministic sampler ([`sampler`]), BSDFs
+//! ([`bsdf`]), lights with the environment map ([`lights`]), the render scene with its BVH
+//! ([`render_scene`]) and the hit records it returns ([`interaction`]), the integrators and
+//! their settings ([`integrators`]: normals, direct, path, and the wavefront, which runs a
+//! tile's paths together, stage by stage), the film with its pixel sums and adaptive sampling
+//! ([`film`]), the tile loop ([`render`]), a split render's part files and their merge
+//! ([`parts`]) and where a render's time goes ([`profile`]), over a scene from prism-scene.
+//! The Whitted ray tracer of the Delft project is one module, [`whitted`].
 #![warn(missing_docs)]
 
 pub mod bsdf;
-mod camera;
-mod debug_output;
-mod envmap;
-mod film;
-mod integrators;
-mod interaction;
-mod lights;
-mod overlay;
-mod parts;
-mod profile;
-mod raytrace;
-mod render_scene;
-mod sampler;
-mod whitted_scene;
-
-pub use bsdf::{Bsdf, BsdfSample};
-pub use camera::{OrbitView, Perspective};
-pub use envmap::{direction_to_uv, uv_to_direction, EnvMap};
-pub use film::{
-    film_bytes, render, render_share, render_share_except, render_share_profiled, tile_count,
-    tile_of, tiles, PixelSum, RenderOptions, Rendered, Share, TILE,
-};
-pub use integrators::whitted::{
-    parallelogram_color, parallelogram_grid, phong, DebugRay, PixelSampler, RayCounts, RayKind,
-    WhittedSettings, WhittedTracer, MISS_LENGTH, RAY_EPSILON,
-};
-pub use integrators::{radiance, Integrator};
-pub use interaction::Interaction;
-pub use lights::{LightSample, MeshLight, RenderLight};
-pub use overlay::{palette, Overlay};
-pub use parts::{merge, merge_order, Merged, Part, PartError, PartFile, PartHeader};
-pub use profile::{Profile, Stage};
-pub use raytrace::{
-    raytrace, raytrace_bytes, raytrace_share, trace_pixel, with_bloom, PixelTrace, RaytraceOptions,
-    Raytraced,
-};
-pub use render_scene::RenderScene;
-pub use sampler::Sampler;
-pub use whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
+pub mod camera;
+pub mod film;
+pub mod integrators;
+pub mod interaction;
+pub mod lights;
+pub mod parts;
+pub mod profile;
+pub mod render;
+pub mod render_scene;
+pub mod sampler;
+pub mod whitted;

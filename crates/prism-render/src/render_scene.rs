@@ -7,8 +7,8 @@ use prism_math::{Ray, Rgb, Vec3};
 use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
-use crate::envmap::EnvMap;
 use crate::interaction::Interaction;
+use crate::lights::envmap::EnvMap;
 use crate::lights::{MeshLight, RenderLight};
 
 /// What a BVH primitive is.

@@ -5,17 +5,20 @@
 use std::path::PathBuf;
 
 use prism_image::ExrSamples;
-use prism_render::{
-    merge, render_share, tile_of, tiles, Part, PartError, PartFile, RenderOptions, RenderScene,
-    Share,
-};
+use prism_render::film::{tile_of, tiles, FilmSettings, Share};
+use prism_render::parts::{merge, Part, PartError, PartFile};
+use prism_render::render::{render_share, Job, RenderOptions};
+use prism_render::render_scene::RenderScene;
 
 fn options() -> RenderOptions {
     RenderOptions {
-        width: 75,
-        height: 40,
-        spp: 5,
-        seed: 11,
+        film: FilmSettings {
+            width: 75,
+            height: 40,
+            spp: 5,
+            seed: 11,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     }
 }
@@ -23,9 +26,9 @@ fn options() -> RenderOptions {
 fn identity(opts: &RenderOptions) -> Vec<(String, String)> {
     [
         ("kind", "render".to_string()),
-        ("width", opts.width.to_string()),
-        ("height", opts.height.to_string()),
-        ("spp", opts.spp.to_string()),
+        ("width", opts.film.width.to_string()),
+        ("height", opts.film.height.to_string()),
+        ("spp", opts.film.spp.to_string()),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
@@ -67,7 +70,12 @@ fn shares_partition_the_tiles_evenly() {
 fn parts_round_trip_and_merge_to_the_whole_render() {
     let scene = RenderScene::new(&prism_scene::cornell_box());
     let opts = options();
-    let whole = render_share(&scene, &opts, &Share::whole(opts.spp), &|_| {});
+    let whole = render_share(
+        &scene,
+        &opts,
+        &Job::share(&Share::whole(opts.film.spp)),
+        &|_| {},
+    );
     let dir = std::env::temp_dir().join(format!("prism-parts-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut parts = Vec::new();
@@ -78,7 +86,7 @@ fn parts_round_trip_and_merge_to_the_whole_render() {
                 parts: 3,
                 samples,
             };
-            let sums = render_share(&scene, &opts, &share, &|_| {});
+            let sums = render_share(&scene, &opts, &Job::share(&share), &|_| {});
             let p = Part::new(identity(&opts), share, sums);
             let file = dir.join(format!("p{part}-{}.exr", p.header.share.samples.start));
             p.write(&file).unwrap();
@@ -121,7 +129,7 @@ fn part_data_must_fit_the_share() {
         parts: 2,
         samples: 1..3,
     };
-    let sums = render_share(&scene, &opts, &share, &|_| {});
+    let sums = render_share(&scene, &opts, &Job::share(&share), &|_| {});
     let good = Part::new(identity(&opts), share, sums).to_exr();
     let file = PathBuf::from("p.exr");
     assert!(Part::from_exr(&good, &file).is_ok());
@@ -195,9 +203,12 @@ fn part_data_must_fit_the_share() {
 #[test]
 fn sums_that_overflow_are_refused() {
     let opts = RenderOptions {
-        width: 2,
-        height: 1,
-        spp: 2,
+        film: FilmSettings {
+            width: 2,
+            height: 1,
+            spp: 2,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
     let dir = std::env::temp_dir().join(format!("prism-overflow-{}", std::process::id()));
@@ -210,7 +221,7 @@ fn sums_that_overflow_are_refused() {
             parts: 1,
             samples,
         };
-        let mut sums = prism_image::Image::new(2, 1, prism_render::PixelSum::default());
+        let mut sums = prism_image::Image::new(2, 1, prism_render::film::PixelSum::default());
         for p in sums.pixels_mut() {
             p.n = 1;
             p.sum = [prism_math::ExactSum(i128::MAX / 2 + 1); 3];

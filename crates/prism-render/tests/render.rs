@@ -1,7 +1,10 @@
 //! End-to-end rendering tests, each against an independent truth.
 
 use prism_math::{Rgb, Vec3};
-use prism_render::{render, Integrator, RenderOptions, RenderScene};
+use prism_render::film::FilmSettings;
+use prism_render::integrators::{Integrator, PathSettings};
+use prism_render::render::{render, RenderOptions};
+use prism_render::render_scene::RenderScene;
 use prism_scene::{Camera, Light, Material, Scene, SceneSphere};
 
 fn furnace(material: Material) -> Scene {
@@ -32,7 +35,7 @@ fn furnace(material: Material) -> Scene {
 }
 
 /// The image's bits, channel by channel, for exact comparisons.
-fn bits(r: &prism_render::Rendered) -> Vec<u32> {
+fn bits(r: &prism_render::render::Rendered) -> Vec<u32> {
     r.image
         .pixels()
         .iter()
@@ -52,12 +55,17 @@ fn mean(img: &prism_image::Image<Rgb>) -> Rgb {
 #[test]
 fn white_furnace() {
     let opts = RenderOptions {
-        width: 48,
-        height: 48,
-        spp: 64,
-        max_bounces: 64,
-        rr_bounces: 64,
-        ..RenderOptions::default()
+        film: FilmSettings {
+            width: 48,
+            height: 48,
+            spp: 64,
+            ..FilmSettings::default()
+        },
+        path: PathSettings {
+            max_bounces: 64,
+            rr_bounces: 64,
+            ..PathSettings::default()
+        },
     };
     for (material, expect) in [
         (
@@ -110,13 +118,18 @@ fn deterministic_across_thread_counts() {
     let scene = RenderScene::new(&prism_scene::cornell_box());
     for integrator in [Integrator::Path, Integrator::Direct { hemisphere: true }] {
         let opts = RenderOptions {
-            width: 40,
-            height: 30,
-            spp: 8,
-            integrator,
-            adaptive: Some(0.2),
-            batch: 4,
-            ..RenderOptions::default()
+            film: FilmSettings {
+                width: 40,
+                height: 30,
+                spp: 8,
+                adaptive: Some(0.2),
+                batch: 4,
+                ..FilmSettings::default()
+            },
+            path: PathSettings {
+                integrator,
+                ..PathSettings::default()
+            },
         };
         let run =
             |threads: usize| prism_testkit::on_threads(threads, || render(&scene, &opts, &|_| {}));
@@ -139,9 +152,12 @@ fn deterministic_across_thread_counts() {
 fn cornell_box_agrees_with_mitsuba() {
     let scene = RenderScene::new(&prism_scene::cornell_box());
     let opts = RenderOptions {
-        width: 256,
-        height: 192,
-        spp: 16,
+        film: FilmSettings {
+            width: 256,
+            height: 192,
+            spp: 16,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
     let full = mean(&render(&scene, &opts, &|_| {}).image);
@@ -156,9 +172,14 @@ fn cornell_box_agrees_with_mitsuba() {
     let mut sum = Rgb::BLACK;
     for m in 0..=7 {
         let o = RenderOptions {
-            only_bounce: Some(m),
-            spp: 8,
-            ..opts
+            film: FilmSettings {
+                spp: 8,
+                ..opts.film
+            },
+            path: PathSettings {
+                only_bounce: Some(m),
+                ..opts.path
+            },
         };
         sum += mean(&render(&scene, &o, &|_| {}).image);
     }
@@ -168,9 +189,14 @@ fn cornell_box_agrees_with_mitsuba() {
         &render(
             &scene,
             &RenderOptions {
-                max_bounces: 0,
-                spp: 4,
-                ..opts
+                film: FilmSettings {
+                    spp: 4,
+                    ..opts.film
+                },
+                path: PathSettings {
+                    max_bounces: 0,
+                    ..opts.path
+                },
             },
             &|_| {},
         )
@@ -186,12 +212,17 @@ fn cornell_box_agrees_with_mitsuba() {
 #[test]
 fn constant_map_renders_as_the_constant_environment() {
     let opts = RenderOptions {
-        width: 32,
-        height: 32,
-        spp: 32,
-        max_bounces: 64,
-        rr_bounces: 64,
-        ..RenderOptions::default()
+        film: FilmSettings {
+            width: 32,
+            height: 32,
+            spp: 32,
+            ..FilmSettings::default()
+        },
+        path: PathSettings {
+            max_bounces: 64,
+            rr_bounces: 64,
+            ..PathSettings::default()
+        },
     };
     let white = Material::Diffuse {
         reflectance: Rgb::WHITE,
@@ -224,17 +255,25 @@ fn sky_map_lights_like_the_hemisphere_light() {
         Scene::from_collada(&doc, &prism_scene::SceneOptions::default(), "bunny.dae").unwrap();
     assert!(matches!(scene.lights[..], [Light::Hemisphere { .. }]));
     let opts = RenderOptions {
-        width: 48,
-        height: 36,
-        spp: 64,
+        film: FilmSettings {
+            width: 48,
+            height: 36,
+            spp: 64,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
     let geometry: Vec<bool> = render(
         &RenderScene::new(&scene),
         &RenderOptions {
-            integrator: Integrator::Normals,
-            spp: 1,
-            ..opts
+            film: FilmSettings {
+                spp: 1,
+                ..opts.film
+            },
+            path: PathSettings {
+                integrator: Integrator::Normals,
+                ..opts.path
+            },
         },
         &|_| {},
     )
@@ -340,12 +379,17 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
         (Integrator::Path, 256),
     ] {
         let opts = RenderOptions {
-            width: 8,
-            height: 8,
-            spp,
-            max_bounces: 1,
-            integrator,
-            ..RenderOptions::default()
+            film: FilmSettings {
+                width: 8,
+                height: 8,
+                spp,
+                ..FilmSettings::default()
+            },
+            path: PathSettings {
+                max_bounces: 1,
+                integrator,
+                ..PathSettings::default()
+            },
         };
         let got = mean(&render(&scene, &opts, &|_| {}).image).g;
         assert!(
@@ -419,12 +463,26 @@ fn textured_diffuse_shows_its_texture_the_right_way_up() {
         prism_image::Image::from_fn(4, 4, |_, y| if y < 2 { [255, 0, 0] } else { [0, 0, 255] });
     let scene = RenderScene::new(&textured_square(&halves, "halves"));
     let opts = RenderOptions {
-        width: 16,
-        height: 16,
-        spp: 16,
+        film: FilmSettings {
+            width: 16,
+            height: 16,
+            spp: 16,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
-    let img = render(&scene, &RenderOptions { spp: 64, ..opts }, &|_| {}).image;
+    let img = render(
+        &scene,
+        &RenderOptions {
+            film: FilmSettings {
+                spp: 64,
+                ..opts.film
+            },
+            ..opts
+        },
+        &|_| {},
+    )
+    .image;
     // The mean of rows 1..4 (a quarter up from the top) and 12..15 (from the bottom).
     let band = |rows: std::ops::Range<u32>| {
         let n = (rows.len() * 16) as f32;
@@ -478,7 +536,10 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         let b = render(
             scene,
             &RenderOptions {
-                integrator: Integrator::PathScalar,
+                path: PathSettings {
+                    integrator: Integrator::PathScalar,
+                    ..opts.path
+                },
                 ..opts
             },
             &|_| {},
@@ -487,10 +548,13 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         assert_eq!(a.samples.pixels(), b.samples.pixels(), "{what}");
     };
     let small = RenderOptions {
-        width: 32,
-        height: 24,
-        spp: 4,
-        seed: 11,
+        film: FilmSettings {
+            width: 32,
+            height: 24,
+            spp: 4,
+            seed: 11,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -529,37 +593,52 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         (
             "one bounce kept",
             RenderOptions {
-                only_bounce: Some(2),
+                path: PathSettings {
+                    only_bounce: Some(2),
+                    ..small.path
+                },
                 ..small
             },
         ),
         (
             "three light samples",
             RenderOptions {
-                light_samples: 3,
+                path: PathSettings {
+                    light_samples: 3,
+                    ..small.path
+                },
                 ..small
             },
         ),
         (
             "adaptive",
             RenderOptions {
-                spp: 16,
-                adaptive: Some(0.3),
-                batch: 4,
+                film: FilmSettings {
+                    spp: 16,
+                    adaptive: Some(0.3),
+                    batch: 4,
+                    ..small.film
+                },
                 ..small
             },
         ),
         (
             "two bounces",
             RenderOptions {
-                max_bounces: 2,
+                path: PathSettings {
+                    max_bounces: 2,
+                    ..small.path
+                },
                 ..small
             },
         ),
         (
             "early roulette",
             RenderOptions {
-                rr_bounces: 1,
+                path: PathSettings {
+                    rr_bounces: 1,
+                    ..small.path
+                },
                 ..small
             },
         ),
@@ -589,7 +668,10 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
             lit.lights = lights;
         }
         let opts = RenderOptions {
-            light_samples: samples,
+            path: PathSettings {
+                light_samples: samples,
+                ..small.path
+            },
             ..small
         };
         same(&RenderScene::new(&lit), opts, what);
@@ -615,7 +697,10 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         uvs: None,
     });
     let opts = RenderOptions {
-        light_samples: 2,
+        path: PathSettings {
+            light_samples: 2,
+            ..small.path
+        },
         ..small
     };
     same(&RenderScene::new(&glowing), opts, "emissive mesh");

@@ -6,10 +6,10 @@ use std::path::PathBuf;
 
 use prism_image::Bloom;
 use prism_math::{Ray, Rgb, Vec3};
-use prism_render::{
-    parallelogram_color, phong, raytrace, trace_pixel, RayKind, RaytraceOptions, WhittedScene,
-    WhittedSettings,
-};
+use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::shading::{parallelogram_color, phong};
+use prism_render::whitted::tracer::{RayKind, WhittedSettings};
 use prism_scene::{Features, Light, Material, OrbitCamera, Preset, Scene, Shading, TriangleMesh};
 
 fn all_on() -> Features {
@@ -447,10 +447,10 @@ fn orbit_camera_closed_form() {
     let (s, c) = 20f32.to_radians().sin_cos();
     let want = Vec3::new(-3.0 * c * s, 3.0 * s, -3.0 * c * c);
     assert!((cam.eye() - want).length() < 1e-5, "{}", cam.eye());
-    let view = prism_render::OrbitView::new(&cam, 200, 100);
+    let view = prism_render::whitted::camera::OrbitView::new(&cam, 200, 100);
     let centre = view.ray(100.0, 50.0);
     assert!((centre.dir - (-cam.eye()).normalize()).length() < 1e-5);
-    let head = prism_render::OrbitView::new(&head_on(), 200, 100);
+    let head = prism_render::whitted::camera::OrbitView::new(&head_on(), 200, 100);
     let hh = 25f32.to_radians().tan();
     let corner = head.ray(0.0, 0.0).dir;
     let want = Vec3::new(2.0 * hh, -hh, 1.0).normalize();
@@ -510,7 +510,7 @@ fn row_directions_equal_single_rays_bit_for_bit() {
             fov_y: 61.0,
             ..OrbitCamera::default()
         };
-        let view = prism_render::OrbitView::new(&cam, w, h);
+        let view = prism_render::whitted::camera::OrbitView::new(&cam, w, h);
         let mut dirs = Vec::new();
         for y in 0..h {
             view.corner_directions(y, &mut dirs);

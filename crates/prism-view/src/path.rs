@@ -10,7 +10,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use prism_image::{heatmap, Image, Rgb8Image};
-use prism_render::{render_share_except, PixelSum, RenderOptions, RenderScene, Share};
+use prism_render::film::{FilmSettings, PixelSum, Share};
+use prism_render::integrators::PathSettings;
+use prism_render::render::{render_share, Job, RenderOptions};
+use prism_render::render_scene::RenderScene;
 
 use crate::input::{Input, Key};
 use crate::orbit::Orbit;
@@ -85,12 +88,17 @@ impl PathMode {
     /// The render settings of a `w x h` pass.
     fn options(&self, w: u32, h: u32) -> RenderOptions {
         RenderOptions {
-            width: w,
-            height: h,
-            spp: MAX_PASSES,
-            only_bounce: self.only_bounce,
-            seed: self.seed,
-            ..RenderOptions::default()
+            film: FilmSettings {
+                width: w,
+                height: h,
+                spp: MAX_PASSES,
+                seed: self.seed,
+                ..FilmSettings::default()
+            },
+            path: PathSettings {
+                only_bounce: self.only_bounce,
+                ..PathSettings::default()
+            },
         }
     }
 
@@ -185,7 +193,12 @@ impl Mode for PathMode {
             };
             let t = Instant::now();
             let skip = self.adaptive.then_some(self.done.as_slice());
-            let pass = render_share_except(&self.scene, &opts, &share, skip, &|_| {});
+            let job = Job {
+                share: &share,
+                skip,
+                profile: None,
+            };
+            let pass = render_share(&self.scene, &opts, &job, &|_| {});
             let secs = t.elapsed().as_secs_f64();
             let taken: u64 = pass.pixels().iter().map(|p| u64::from(p.n)).sum();
             self.rate = taken as f64 / secs.max(1e-9);

@@ -4,10 +4,11 @@
 //! shown level by level and leaf by leaf.
 
 use prism_image::{Bloom, Rgb8Image, RgbImage};
-use prism_render::{
-    raytrace, trace_pixel, OrbitView, Overlay, PixelTrace, RaytraceOptions, WhittedScene,
-    WhittedSettings,
-};
+use prism_render::whitted::camera::OrbitView;
+use prism_render::whitted::film::{raytrace, trace_pixel, PixelTrace, RaytraceOptions};
+use prism_render::whitted::overlay::Overlay;
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera, Scene};
 
 use crate::input::{Input, Key};

@@ -4,8 +4,8 @@
 
 use prism_math::{Frame, Ray, Rgb, Vec3};
 
-use super::power;
-use crate::film::RenderOptions;
+use super::mis::power;
+use super::settings::PathSettings;
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::render_scene::RenderScene;
@@ -18,7 +18,7 @@ pub(super) fn direct(
     hit: &Interaction,
     ray: &Ray,
     sampler: &mut Sampler,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     hemisphere: bool,
 ) -> Rgb {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
@@ -41,7 +41,7 @@ pub(super) fn direct_lights(
     hit: &Interaction,
     (frame, wo, wo_l): (&Frame, Vec3, Vec3),
     sampler: &mut Sampler,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     mis: bool,
 ) -> Rgb {
     if !hit.bsdf.is_smooth() {
@@ -106,7 +106,7 @@ fn direct_hemisphere(
     hit: &Interaction,
     wo: Vec3,
     sampler: &mut Sampler,
-    opts: &RenderOptions,
+    opts: &PathSettings,
 ) -> Rgb {
     if !hit.bsdf.is_smooth() {
         return Rgb::BLACK;

@@ -4,8 +4,8 @@
 use prism_math::{Ray, Rgb, Vec3};
 
 use super::direct::direct_lights;
-use super::power;
-use crate::film::RenderOptions;
+use super::mis::power;
+use super::settings::PathSettings;
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
 use crate::sampler::Sampler;
@@ -16,7 +16,7 @@ pub(super) fn path(
     first: Interaction,
     ray: &Ray,
     sampler: &mut Sampler,
-    opts: &RenderOptions,
+    opts: &PathSettings,
 ) -> Rgb {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
     let mut l = if keep(0) { first.emitted } else { Rgb::BLACK };

@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use prism_render::{render, RenderOptions, RenderScene};
+use prism_render::film::FilmSettings;
+use prism_render::render::{render, RenderOptions};
+use prism_render::render_scene::RenderScene;
 use prism_view::{Input, Key, Mode, PathMode, Viewer};
 
 fn key(c: char) -> Input {
@@ -25,10 +27,13 @@ fn progressive_passes_are_the_batch_render() {
     let picture = mode.draw(64, 48);
     assert_eq!(mode.passes(), 4);
     let opts = RenderOptions {
-        width: 64,
-        height: 48,
-        spp: 4,
-        seed: 7,
+        film: FilmSettings {
+            width: 64,
+            height: 48,
+            spp: 4,
+            seed: 7,
+            ..FilmSettings::default()
+        },
         ..RenderOptions::default()
     };
     let batch = render(&RenderScene::new(&scene), &opts, &|_| {});
@@ -48,12 +53,14 @@ fn adaptive_passes_are_the_adaptive_render() {
         picture = mode.draw(40, 30);
     }
     let opts = RenderOptions {
-        width: 40,
-        height: 30,
-        spp: 64,
-        seed: 3,
-        adaptive: Some(0.05),
-        batch: 32,
+        film: FilmSettings {
+            width: 40,
+            height: 30,
+            spp: 64,
+            seed: 3,
+            adaptive: Some(0.05),
+            batch: 32,
+        },
         ..RenderOptions::default()
     };
     let batch = render(&RenderScene::new(&scene), &opts, &|_| {});

@@ -1,7 +1,9 @@
 //! The Whitted mode driven headlessly: its picture against the batch ray tracer, a click's
 //! ray tree against `trace_pixel`, and what drags, feature keys and BVH keys do.
 
-use prism_render::{raytrace, trace_pixel, RaytraceOptions, WhittedScene, WhittedSettings};
+use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
+use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera, Preset};
 use prism_view::{Input, Key, Viewer, WhittedMode};
 

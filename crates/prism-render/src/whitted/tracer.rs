@@ -1,4 +1,4 @@
-//! The Whitted integrator of the Delft ray tracer: Phong per light sample, hard shadows
+//! The Whitted tracer of the Delft ray tracer: Phong per light sample, hard shadows
 //! from point lights, stratified samples of segment and parallelogram lights, recursive
 //! mirror reflection, textures, transparency; every ray it casts can be recorded.
 
@@ -6,8 +6,9 @@ use prism_image::PixelSampling;
 use prism_math::{Ray, Rgb, Vec2, Vec3};
 use prism_scene::{Features, Light};
 
+use super::scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
+use super::shading::{parallelogram_color, parallelogram_grid, phong};
 use crate::sampler::Sampler;
-use crate::whitted_scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
 
 /// Offset of secondary-ray origins along their direction.
 pub const RAY_EPSILON: f32 = 1e-4;
@@ -168,23 +169,6 @@ struct ShadePoint<'h> {
     ks: Rgb,
     shininess: f32,
     depth: u32,
-}
-
-/// The Phong response `c (kd (n.l) + ks max(r.v, 0)^Ns)` to light of colour `c` from unit
-/// direction `l`, seen along unit `v`; zero when `n.l <= 0`.
-#[must_use]
-pub fn phong(n: Vec3, l: Vec3, v: Vec3, kd: Rgb, ks: Rgb, shininess: f32, c: Rgb) -> Rgb {
-    let nl = n.dot(l);
-    if nl <= 0.0 {
-        return Rgb::BLACK;
-    }
-    if ks == Rgb::BLACK {
-        // The same value without the costly power: ks x (a finite number) is 0.
-        return c * (kd * nl + ks);
-    }
-    let r = 2.0 * nl * n - l;
-    let spec = r.dot(v).max(0.0).powf(shininess);
-    c * (kd * nl + ks * spec)
 }
 
 impl WhittedTracer<'_> {
@@ -410,21 +394,4 @@ impl WhittedTracer<'_> {
         }
         phong(hit.n_s, l, at.v, at.kd, at.ks, at.shininess, c)
     }
-}
-
-/// The side `k` of the `k x k` grid of samples a parallelogram light takes for a target
-/// of `n` samples: `ceil(sqrt(n))`, at least 1.
-#[must_use]
-pub fn parallelogram_grid(n: u32) -> u32 {
-    let mut k = 1;
-    while k * k < n.max(1) {
-        k += 1;
-    }
-    k
-}
-
-/// The colour of a parallelogram light at `(a, b)`: bilinear in its corners' colours.
-#[must_use]
-pub fn parallelogram_color(c: &[Rgb; 4], a: f32, b: f32) -> Rgb {
-    (c[0] * (1.0 - b) + c[2] * b) * (1.0 - a) + (c[1] * (1.0 - b) + c[3] * b) * a
 }

@@ -8,12 +8,10 @@ use prism_image::{Bloom, Image, RgbImage};
 use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
-use crate::camera::OrbitView;
+use super::camera::OrbitView;
+use super::scene::WhittedScene;
+use super::tracer::{DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer};
 use crate::film::{tile_of, PixelSum, Share};
-use crate::integrators::whitted::{
-    DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
-};
-use crate::whitted_scene::WhittedScene;
 
 /// Whitted render settings.
 #[derive(Clone, Copy, Debug)]

@@ -5,9 +5,9 @@
 use prism_image::RgbImage;
 use prism_math::{Aabb, Ray, Rgb, Vec3};
 
-use crate::camera::OrbitView;
-use crate::integrators::whitted::{DebugRay, RayKind};
-use crate::whitted_scene::WhittedScene;
+use super::camera::OrbitView;
+use super::scene::WhittedScene;
+use super::tracer::{DebugRay, RayKind};
 
 /// An image being drawn over, with the depth of the scene at each pixel.
 pub struct Overlay {

@@ -5,9 +5,9 @@ use std::fmt::Write;
 
 use prism_math::{Rgb, Vec3};
 
-use crate::integrators::whitted::DebugRay;
-use crate::raytrace::PixelTrace;
-use crate::whitted_scene::Surface;
+use super::film::PixelTrace;
+use super::scene::Surface;
+use super::tracer::DebugRay;
 
 /// A number as JSON: the shortest round-trip decimal, `null` if not finite.
 fn num(out: &mut String, x: f32) {

@@ -1,13 +1,16 @@
 //! Lights as the integrators see them: [`RenderLight`] (point, directional, area rectangle,
 //! emissive mesh, hemisphere, constant and mapped environment) and the [`LightSample`] each
-//! one draws, with the density of every sample (pbrt's `lights`).
+//! one draws, with the density of every sample (pbrt's `lights`); the environment map's data
+//! in [`envmap`].
+
+pub mod envmap;
 
 use prism_math::warp::{
     cosine_hemisphere, cosine_hemisphere_pdf, uniform_sphere, uniform_sphere_pdf,
 };
 use prism_math::{Frame, Rgb, Vec2, Vec3};
 
-use crate::envmap::EnvMap;
+use envmap::EnvMap;
 
 /// A light source ready to sample: the renderer's form of a [`prism_scene::Light`].
 #[derive(Clone, Debug)]

@@ -1,4 +1,4 @@
-//! The wavefront's step for sixteen paths at once at smooth surfaces (diffuse or rough
+//! The wavefront's lane scatter stage: the step for sixteen paths at once at smooth surfaces (diffuse or rough
 //! conductor, one kind per group): shading frames, light samples with their MIS weights and
 //! shadow rays, the BSDF sample and Russian roulette on sixteen lanes, the random numbers
 //! and the BSDFs' evaluation and sampling too. Area, point, directional and hemisphere
@@ -14,9 +14,9 @@ use prism_math::lanes::{F16, LANES, M16, V16};
 use prism_math::warp::cosine_hemisphere_lanes;
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 
-use super::wavefront::{PathState, Shadows};
+use super::queues::{PathState, Shadows};
 use crate::bsdf::lanes::{SmoothKind, SmoothLanes};
-use crate::film::RenderOptions;
+use crate::integrators::PathSettings;
 use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::sampler::lane_values;
@@ -76,7 +76,7 @@ impl GroupTerms {
     #[inline(always)]
     pub(super) fn gather(
         &self,
-        opts: &RenderOptions,
+        opts: &PathSettings,
         lights: &[RenderLight],
         waiting: &[Waiting],
         blocked: &[bool],
@@ -224,7 +224,7 @@ fn power(nf: f32, f: F16, g: F16) -> F16 {
 #[inline(always)]
 pub(super) fn step(
     kind: SmoothKind,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     lights: &[RenderLight],
     (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
@@ -490,7 +490,7 @@ pub(super) fn step(
 #[target_feature(enable = "avx512f,avx512dq")]
 pub(super) unsafe fn step_avx512(
     kind: SmoothKind,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     lights: &[RenderLight],
     (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
@@ -508,7 +508,7 @@ pub(super) unsafe fn step_avx512(
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn step_avx2(
     kind: SmoothKind,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     lights: &[RenderLight],
     (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],
@@ -521,7 +521,7 @@ pub(super) unsafe fn step_avx2(
 /// [`step`] on the best instructions the processor has.
 pub(super) fn step_dispatch(
     kind: SmoothKind,
-    opts: &RenderOptions,
+    opts: &PathSettings,
     lights: &[RenderLight],
     (paths, rays): (&mut [PathState], &mut [Ray]),
     surfs: &[Option<Interaction>],

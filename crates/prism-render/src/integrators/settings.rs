@@ -1,0 +1,55 @@
+//! [`PathSettings`], what the path-space integrators are told: which estimator
+//! ([`Integrator`]), how many light samples, how many bounces, which bounce to keep, and
+//! when Russian roulette starts.
+
+/// Which estimator computes radiance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// The shading normal as a colour, `(n + 1) / 2`.
+    Normals,
+    /// Emission plus one bounce of direct light, by the course's two estimators: uniform
+    /// hemisphere sampling, or light sampling (`-l` samples per area light).
+    Direct {
+        /// Uniform hemisphere sampling instead of light sampling.
+        hemisphere: bool,
+    },
+    /// Path tracing: next-event estimation and BSDF sampling combined by multiple importance
+    /// sampling (power heuristic), Russian roulette; a tile's paths advance together, stage
+    /// by stage (the wavefront integrator).
+    Path,
+    /// The same estimator one path at a time, camera to end: the reference that [`Path`]
+    /// equals bit for bit.
+    ///
+    /// [`Path`]: Integrator::Path
+    PathScalar,
+}
+
+/// The integrators' settings (the film's are [`crate::film::FilmSettings`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PathSettings {
+    /// Samples per area or hemisphere light per shading point.
+    pub light_samples: u32,
+    /// Most bounces a path may take (the course's `-m`): 0 shows emitters only, 1 adds
+    /// direct light.
+    pub max_bounces: u32,
+    /// The estimator.
+    pub integrator: Integrator,
+    /// Keep only light that took exactly this many bounces (the course's "only the m-th
+    /// bounce" mode).
+    pub only_bounce: Option<u32>,
+    /// Russian roulette may end a path once it has this many bounces: after the BSDF sample
+    /// at that surface, before its ray is traced (Mitsuba's `rr_depth`, default 5).
+    pub rr_bounces: u32,
+}
+
+impl Default for PathSettings {
+    fn default() -> PathSettings {
+        PathSettings {
+            light_samples: 1,
+            max_bounces: 7,
+            integrator: Integrator::Path,
+            only_bounce: None,
+            rr_bounces: 5,
+        }
+    }
+}

@@ -1,0 +1,168 @@
+//! The tile loop: [`RenderOptions`] (the film's settings and the integrators'), the [`Job`]
+//! one call computes (a share of the tiles, pixels left out, an optional profile), and
+//! [`render_share`], which runs the film's tiles on rayon through the chosen integrator;
+//! [`render`] is the whole picture as a [`Rendered`] image with its sample counts.
+
+use std::ops::Range;
+
+use prism_image::Image;
+use prism_math::Rgb;
+use rayon::prelude::*;
+
+use crate::camera::Perspective;
+use crate::film::{camera_sample, tiles, FilmSettings, PixelSum, Share, TILE};
+use crate::integrators::{radiance, wavefront, Integrator, PathSettings};
+use crate::profile::Profile;
+use crate::render_scene::RenderScene;
+
+/// Render settings: the film's and the integrators'.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RenderOptions {
+    /// Image size, samples per pixel, adaptive sampling and seed.
+    pub film: FilmSettings,
+    /// The estimator and its light samples, bounces and Russian roulette.
+    pub path: PathSettings,
+}
+
+/// A rendered picture.
+pub struct Rendered {
+    /// Linear radiance per pixel.
+    pub image: Image<Rgb>,
+    /// Samples taken per pixel.
+    pub samples: Image<u32>,
+    /// All samples taken.
+    pub total_samples: u64,
+    /// Where the path integrator's time went (empty for the other integrators).
+    pub profile: Profile,
+}
+
+/// What one call of [`render_share`] computes: a share of the tiles and sample indices,
+/// without the pixels `skip` marks (row by row, one entry per pixel; a progressive renderer
+/// uses it to stop converged pixels), adding the path integrator's time per stage to
+/// `profile` if there is one.
+#[derive(Clone, Copy, Debug)]
+pub struct Job<'a> {
+    /// The tiles and sample indices computed.
+    pub share: &'a Share,
+    /// Pixels left out: they hold no samples.
+    pub skip: Option<&'a [bool]>,
+    /// Where the path integrator's time per stage is added.
+    pub profile: Option<&'a Profile>,
+}
+
+impl<'a> Job<'a> {
+    /// The share `share`, every pixel of it, without a profile.
+    #[must_use]
+    pub fn share(share: &'a Share) -> Job<'a> {
+        Job {
+            share,
+            skip: None,
+            profile: None,
+        }
+    }
+}
+
+/// Renders the scene. `progress` is called with the number of samples taken so far after
+/// each tile (from worker threads). The image is the same whatever the thread count.
+pub fn render(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Rendered {
+    let profile = Profile::default();
+    let share = Share::whole(opts.film.spp);
+    let job = Job {
+        share: &share,
+        skip: None,
+        profile: Some(&profile),
+    };
+    let sums = render_share(scene, opts, &job, progress);
+    Rendered {
+        image: sums.map(|p| p.mean()),
+        samples: sums.map(|p| p.n),
+        total_samples: sums.pixels().iter().map(|p| u64::from(p.n)).sum(),
+        profile,
+    }
+}
+
+/// Renders one job: the sums of its share's pixels; the other pixels, and those it skips,
+/// hold no samples. Each pixel's sums equal those of the whole render when the share starts
+/// at sample 0, whatever the thread count. `progress` is called as in [`render`].
+///
+/// # Panics
+/// If the job's `skip` does not have one entry per pixel.
+pub fn render_share(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    job: &Job<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Image<PixelSum> {
+    let (share, skip, profile) = (job.share, job.skip, job.profile);
+    let (w, h) = (opts.film.width, opts.film.height);
+    if let Some(s) = skip {
+        assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
+    }
+    let skipped = |x: u32, y: u32| skip.is_some_and(|s| s[(y * w + x) as usize]);
+    let camera = Perspective::new(&scene.camera, w, h);
+    let tiles: Vec<(u32, u32)> = tiles(w, h)
+        .into_iter()
+        .enumerate()
+        .filter(|&(k, _)| share.has_tile(k))
+        .map(|(_, t)| t)
+        .collect();
+    let done = std::sync::atomic::AtomicU64::new(0);
+    // Each tile's pixels rendered and their sums.
+    type Rendered = (Vec<(u32, u32)>, Vec<PixelSum>);
+    let results: Vec<Rendered> = tiles
+        .par_iter()
+        .map(|&(x0, y0)| {
+            let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
+                .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+                .filter(|&(x, y)| !skipped(x, y))
+                .collect();
+            let out = if opts.path.integrator == Integrator::Path {
+                wavefront::tile(
+                    scene,
+                    &camera,
+                    &opts.film,
+                    &opts.path,
+                    &pixels,
+                    &share.samples,
+                    profile,
+                )
+            } else {
+                pixels
+                    .iter()
+                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y, &share.samples))
+                    .collect()
+            };
+            let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
+            progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
+            (pixels, out)
+        })
+        .collect();
+    let mut sums = Image::new(w, h, PixelSum::default());
+    for (pixels, out) in &results {
+        for (&(x, y), s) in pixels.iter().zip(out) {
+            sums.set(x, y, *s);
+        }
+    }
+    sums
+}
+
+fn pixel(
+    scene: &RenderScene,
+    camera: &Perspective,
+    opts: &RenderOptions,
+    x: u32,
+    y: u32,
+    samples: &Range<u32>,
+) -> PixelSum {
+    let mut px = PixelSum::default();
+    let most = samples.len() as u32;
+    while px.wants_more(most) {
+        let (mut sampler, ray) = camera_sample(camera, &opts.film, (x, y), samples.start + px.n);
+        px.add(radiance(scene, &ray, &mut sampler, &opts.path), &opts.film);
+    }
+    px
+}
