@@ -9,6 +9,8 @@ use std::time::{Duration, Instant};
 
 use crate::random::{GlibcRand, RAND_MAX};
 use crate::scene::{ClothScene, Orientation, PlaneParams, SphereParams};
+#[cfg(target_arch = "x86_64")]
+use crate::simd;
 
 /// Frames per simulated second.
 pub const FRAMES_PER_SECOND: f64 = 90.0;
@@ -248,28 +250,11 @@ impl SpringLaw {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     unsafe fn forces_avx(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
-        use std::arch::x86_64::{
-            _mm256_add_pd, _mm256_and_pd, _mm256_cmp_pd, _mm256_div_pd, _mm256_loadu_pd,
-            _mm256_mul_pd, _mm256_setzero_pd, _mm256_sqrt_pd, _mm256_storeu_pd, _mm256_sub_pd,
-            _CMP_NEQ_UQ,
-        };
         let mut spring_chunks = springs.chunks_exact(LANES);
         for (o, s) in out.iter_mut().zip(&mut spring_chunks) {
             let lanes = self.load(positions, s);
-            // SAFETY: every pointer is to an array of four f64.
-            unsafe {
-                let [dx, dy, dz, rest, k] = lanes.map(|a| _mm256_loadu_pd(a.as_ptr()));
-                let len = _mm256_sqrt_pd(_mm256_add_pd(
-                    _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
-                    _mm256_mul_pd(dz, dz),
-                ));
-                let scale = _mm256_mul_pd(k, _mm256_sub_pd(len, rest));
-                let live = _mm256_cmp_pd::<_CMP_NEQ_UQ>(len, _mm256_setzero_pd());
-                let axis = |d| _mm256_and_pd(live, _mm256_mul_pd(scale, _mm256_div_pd(d, len)));
-                _mm256_storeu_pd(o.x.as_mut_ptr(), axis(dx));
-                _mm256_storeu_pd(o.y.as_mut_ptr(), axis(dy));
-                _mm256_storeu_pd(o.z.as_mut_ptr(), axis(dz));
-            }
+            // SAFETY: the caller guarantees AVX.
+            unsafe { simd::spring_law_avx(&lanes, &mut o.x, &mut o.y, &mut o.z) };
         }
         self.forces_tail(positions, spring_chunks.remainder(), out);
     }

@@ -7,7 +7,7 @@
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
 
-use crate::Vec3;
+use glam::Vec3;
 
 /// Lanes per group.
 pub const LANES: usize = 16;

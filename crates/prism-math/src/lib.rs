@@ -5,27 +5,25 @@
 //! instruction sets the kernels may use, and the resource limits every reader shares.
 #![warn(missing_docs)]
 
-mod cache;
 mod color;
 mod elementary;
 mod exact;
 mod geometry;
-mod isa;
 pub mod lanes;
 pub mod limits;
 mod random;
+mod simd;
 mod text;
 mod transform;
 pub mod warp;
 
-pub use cache::prefetch;
 pub use color::Rgb;
 pub use elementary::{acos, exp, ln};
 pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
 pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};
-pub use isa::Isa;
 pub use random::{hash_extend, hash_words, mix64, unit_f32, word_mix, Pcg32};
+pub use simd::{prefetch, Isa};
 pub use text::LineIndex;
 pub use transform::Transform;

@@ -10,6 +10,7 @@
 mod bezier;
 mod error;
 mod halfedge;
+mod limits;
 mod loop_subdivision;
 mod normals;
 mod obj;
@@ -26,6 +27,7 @@ pub use error::MeshError;
 pub use halfedge::{
     EdgeId, FaceId, HalfedgeId, HalfedgeMesh, TopologyError, ValidationError, VertexId,
 };
+pub use limits::MAX_MESH_FILE_BYTES;
 pub use loop_subdivision::{
     check_subdivision, loop_subdivide, subdivided_size, LoopWeights, BYTES_PER_FACE,
 };
@@ -35,6 +37,3 @@ pub use ply::{parse_ply, read_ply, write_ply, PlyFormat};
 pub use polymesh::PolyMesh;
 pub use repair::SplitVertex;
 pub use shapes::icosahedron;
-
-/// The largest mesh file (OBJ or PLY) the readers open: 1 GiB.
-pub const MAX_MESH_FILE_BYTES: u64 = 1 << 30;

@@ -7,7 +7,8 @@ use std::path::Path;
 
 use prism_math::glam::DVec3;
 
-use crate::{MeshError, PolyMesh, MAX_MESH_FILE_BYTES};
+use crate::limits::MAX_MESH_FILE_BYTES;
+use crate::{MeshError, PolyMesh};
 
 /// Parses OBJ text; `file` names the source in errors.
 ///

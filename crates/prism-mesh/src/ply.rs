@@ -383,13 +383,12 @@ pub fn parse_ply(bytes: &[u8], file: &str) -> Result<PolyMesh, MeshError> {
 /// [`MeshError::Io`] if unreadable, else as [`parse_ply`].
 pub fn read_ply(path: &Path) -> Result<PolyMesh, MeshError> {
     let name = path.display().to_string();
-    let bytes =
-        prism_math::limits::read_input(path, crate::MAX_MESH_FILE_BYTES).map_err(|source| {
-            MeshError::Io {
-                path: name.clone(),
-                source,
-            }
-        })?;
+    let bytes = prism_math::limits::read_input(path, crate::limits::MAX_MESH_FILE_BYTES).map_err(
+        |source| MeshError::Io {
+            path: name.clone(),
+            source,
+        },
+    )?;
     parse_ply(&bytes, &name)
 }
 

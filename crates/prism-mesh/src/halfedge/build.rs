@@ -1,7 +1,7 @@
 //! Building a [`HalfedgeMesh`] from a polygon soup ([`PolyMesh`]), with located errors for
 //! soups that cannot be a manifold, and converting back.
 
-use super::{FaceId, HalfedgeMesh, VertexId, NONE};
+use super::mesh::{FaceId, HalfedgeMesh, VertexId, NONE};
 use crate::{MeshError, PolyMesh};
 
 impl HalfedgeMesh {

@@ -1,7 +1,7 @@
 //! Edge flips, splits and collapses, each with the predicate that checks it first
 //! (`can_flip` then `flip`), and [`TopologyError`], the reason an operation is refused.
 
-use super::{EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId, NONE};
+use super::mesh::{EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId, NONE};
 
 /// Why an edge flip, split or collapse was refused; the mesh is unchanged when one is
 /// returned. Ids are those of the mesh before the operation.

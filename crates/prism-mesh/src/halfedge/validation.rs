@@ -1,7 +1,7 @@
 //! [`HalfedgeMesh::validate`], the check of every invariant of the halfedge mesh, and
 //! [`ValidationError`], one variant per invariant.
 
-use super::{EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId, NONE};
+use super::mesh::{EdgeId, FaceId, HalfedgeId, HalfedgeMesh, VertexId, NONE};
 
 /// The first broken invariant [`HalfedgeMesh::validate`] finds, naming the element that
 /// breaks it.

@@ -1,7 +1,9 @@
-//! Pieces shared by both SVG dialects: errors with locations, limits, numbers, transforms.
+//! Pieces shared by both SVG dialects: errors with locations, limits, number lists and
+//! numbers with units, transforms.
 
 use std::sync::Arc;
 
+use super::number::{number_prefix_len, to_num, Precision};
 use super::pathdata::PathDataError;
 use crate::document::Mat3;
 
@@ -246,64 +248,6 @@ impl Loc<'_> {
     }
 }
 
-/// How numbers are rounded on reading: the course renderer reads `f32`.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Precision {
-    F32,
-    F64,
-}
-
-/// Length of the longest prefix of `s` that is an SVG number (sign, digits, fraction,
-/// exponent), or 0.
-pub(crate) fn number_prefix_len(s: &str) -> usize {
-    let b = s.as_bytes();
-    let mut i = 0;
-    if i < b.len() && (b[i] == b'+' || b[i] == b'-') {
-        i += 1;
-    }
-    let digits_start = i;
-    while i < b.len() && b[i].is_ascii_digit() {
-        i += 1;
-    }
-    let mut any = i > digits_start;
-    if i < b.len() && b[i] == b'.' {
-        let j = i + 1;
-        let mut k = j;
-        while k < b.len() && b[k].is_ascii_digit() {
-            k += 1;
-        }
-        if k > j || any {
-            any = any || k > j;
-            i = k;
-        }
-    }
-    if !any {
-        return 0;
-    }
-    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-        let mut k = i + 1;
-        if k < b.len() && (b[k] == b'+' || b[k] == b'-') {
-            k += 1;
-        }
-        let ds = k;
-        while k < b.len() && b[k].is_ascii_digit() {
-            k += 1;
-        }
-        if k > ds {
-            i = k;
-        }
-    }
-    i
-}
-
-pub(crate) fn to_num(s: &str, p: Precision) -> Option<f64> {
-    let v = match p {
-        Precision::F32 => s.parse::<f32>().ok().map(f64::from),
-        Precision::F64 => s.parse::<f64>().ok(),
-    }?;
-    v.is_finite().then_some(v)
-}
-
 /// Reads a whole list of numbers separated by whitespace and/or single commas.
 pub(crate) fn number_list(
     s: &str,
@@ -446,16 +390,6 @@ mod tests {
             line: 3,
             element: "rect",
         }
-    }
-
-    #[test]
-    fn number_prefixes() {
-        assert_eq!(number_prefix_len("487.211px"), 7);
-        assert_eq!(number_prefix_len(".5.5"), 2);
-        assert_eq!(number_prefix_len("-1e-3x"), 5);
-        assert_eq!(number_prefix_len("1em"), 1);
-        assert_eq!(number_prefix_len("abc"), 0);
-        assert_eq!(number_prefix_len("-."), 0);
     }
 
     #[test]

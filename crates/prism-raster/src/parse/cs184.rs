@@ -9,10 +9,13 @@ use prism_math::{DVec2, Rgb};
 use roxmltree::Node;
 
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, Precision, SvgError,
-    MAX_DEPTH, MAX_ITEMS,
+    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, SvgError, MAX_DEPTH,
+    MAX_ITEMS,
 };
-use super::{element_loc, Ctx};
+use super::context::{element_loc, Ctx};
+use super::course::course_element;
+use super::images::image_item;
+use super::number::Precision;
 use crate::document::{Document, Item, Mat3};
 use crate::triangulate::ear_clip;
 
@@ -176,10 +179,10 @@ fn walk<'a>(
                 }
             }
             "colortri" | "texture" | "textri" => {
-                super::course_element(&node, name, t, ctx, doc, textures, &loc, P)?;
+                course_element(&node, name, t, ctx, doc, textures, &loc, P)?;
             }
             "image" => {
-                if let Some(item) = super::image_item(&node, t, ctx, doc, &loc, P)? {
+                if let Some(item) = image_item(&node, t, ctx, doc, &loc, P)? {
                     doc.items.push(item);
                 }
             }

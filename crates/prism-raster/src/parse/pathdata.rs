@@ -2,7 +2,7 @@
 
 use prism_math::DVec2;
 
-use super::common::{number_prefix_len, to_num, Precision};
+use super::number::{number_prefix_len, to_num, Precision};
 use crate::path::Path;
 
 /// What is wrong with path data, at a byte offset into the `d` attribute.

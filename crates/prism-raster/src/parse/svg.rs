@@ -14,324 +14,28 @@ use roxmltree::Node;
 
 use super::color::parse_color;
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, Precision, SvgError,
-    MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
+    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, SvgError, MAX_DEPTH,
+    MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
+use super::context::{element_loc, Ctx};
+use super::course::course_element;
+use super::images::image_item;
+use super::number::Precision;
 use super::pathdata::parse_path_data_prefix;
-use super::{element_loc, image_item, Ctx};
-use crate::document::{
-    Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop,
-};
-use crate::path::{LineCap, LineJoin, Path, StrokeStyle};
+use super::style::{apply_declarations, declarations, opacity_value, PaintSpec, Style};
+use super::viewport::{length, view_box_transform, Axis, Viewport};
+use crate::document::{Document, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+use crate::path::Path;
 
 const P: Precision = Precision::F64;
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
 const XLINK_NS: &str = "http://www.w3.org/1999/xlink";
-
-#[derive(Clone, Debug)]
-enum PaintSpec {
-    None,
-    Color(Rgb, f32),
-    CurrentColor,
-    Url(String, Option<Box<PaintSpec>>),
-}
-
-#[derive(Clone, Debug)]
-struct Style {
-    fill: PaintSpec,
-    fill_opacity: f32,
-    fill_rule: FillRule,
-    stroke_paint: PaintSpec,
-    stroke_opacity: f32,
-    stroke: StrokeStyle,
-    color: Rgb,
-    visible: bool,
-}
-
-impl Default for Style {
-    fn default() -> Self {
-        Style {
-            fill: PaintSpec::Color(Rgb::BLACK, 1.0),
-            fill_opacity: 1.0,
-            fill_rule: FillRule::NonZero,
-            stroke_paint: PaintSpec::None,
-            stroke_opacity: 1.0,
-            stroke: StrokeStyle::default(),
-            color: Rgb::BLACK,
-            visible: true,
-        }
-    }
-}
-
-/// Viewport size used to resolve percentages.
-#[derive(Clone, Copy)]
-struct Viewport {
-    w: f64,
-    h: f64,
-}
-
-impl Viewport {
-    fn diag(&self) -> f64 {
-        ((self.w * self.w + self.h * self.h) / 2.0).sqrt()
-    }
-}
-
-#[derive(Clone, Copy)]
-enum Axis {
-    X,
-    Y,
-    Diag,
-}
-
-fn length(s: &str, loc: &Loc, attr: &str, vp: Viewport, axis: Axis) -> Result<f64, SvgError> {
-    let (v, unit) = number_with_unit(s, P, loc, attr)?;
-    let k = match unit {
-        "" | "px" => 1.0,
-        "pt" => 4.0 / 3.0,
-        "pc" => 16.0,
-        "mm" => 96.0 / 25.4,
-        "cm" => 96.0 / 2.54,
-        "in" => 96.0,
-        "em" => 16.0,
-        "ex" => 8.0,
-        "%" => {
-            let base = match axis {
-                Axis::X => vp.w,
-                Axis::Y => vp.h,
-                Axis::Diag => vp.diag(),
-            };
-            base / 100.0
-        }
-        other => return Err(loc.err(format!("{attr}: unknown unit {other:?} in {s:?}"))),
-    };
-    Ok(v * k)
-}
-
-fn parse_paint(s: &str, loc: &Loc, attr: &str) -> Result<PaintSpec, SvgError> {
-    let t = s.trim();
-    if t == "none" {
-        return Ok(PaintSpec::None);
-    }
-    if t == "currentColor" {
-        return Ok(PaintSpec::CurrentColor);
-    }
-    if let Some(rest) = t.strip_prefix("url(") {
-        let close = rest
-            .find(')')
-            .ok_or_else(|| loc.err(format!("{attr}: expected ')' in {t:?}")))?;
-        let id = rest[..close].trim().trim_matches(|c| c == '\'' || c == '"');
-        let id = id.strip_prefix('#').unwrap_or(id).to_string();
-        let fallback = rest[close + 1..].trim();
-        let fb = if fallback.is_empty() {
-            None
-        } else {
-            Some(Box::new(parse_paint(fallback, loc, attr)?))
-        };
-        return Ok(PaintSpec::Url(id, fb));
-    }
-    parse_color(t)
-        .map(|(c, a)| PaintSpec::Color(c, a))
-        .ok_or_else(|| {
-            loc.err(format!(
-                "{attr}: expected a colour, 'none' or url(#id), found {t:?}"
-            ))
-        })
-}
-
-fn opacity_value(s: &str, loc: &Loc, attr: &str) -> Result<f32, SvgError> {
-    let (v, unit) = number_with_unit(s, P, loc, attr)?;
-    let v = match unit {
-        "" => v,
-        "%" => v / 100.0,
-        _ => return Err(loc.err(format!("{attr}: expected a number in [0, 1], found {s:?}"))),
-    };
-    Ok(v.clamp(0.0, 1.0) as f32)
-}
-
-/// The element's own declarations: presentation attributes, overridden by `style`.
-fn declarations<'a>(node: &Node<'a, 'a>) -> Vec<(String, String)> {
-    let mut out: Vec<(String, String)> = node
-        .attributes()
-        .filter(|a| a.namespace().is_none())
-        .map(|a| (a.name().to_string(), a.value().to_string()))
-        .collect();
-    if let Some(style) = node.attr("style") {
-        for decl in style.split(';') {
-            if let Some((k, v)) = decl.split_once(':') {
-                let v = v.trim().trim_end_matches("!important").trim();
-                out.push((k.trim().to_string(), v.to_string()));
-            }
-        }
-    }
-    out
-}
 
 struct Parser<'c, 'a> {
     ctx: &'c mut Ctx<'a>,
     doc: Document,
     ids: HashMap<&'a str, Node<'a, 'a>>,
     textures: HashMap<String, usize>,
-}
-
-/// Properties this reader resolves; anything else in `style` is ignored. An invalid value
-/// is treated as absent, as the SVG specification and browsers do: the property keeps the
-/// value it had, and the error is returned with the property's name, for one warning.
-fn apply_declarations(
-    style: &mut Style,
-    decls: &[(String, String)],
-    loc: &Loc,
-    vp: Viewport,
-) -> (f32, bool, Vec<(String, SvgError)>) {
-    let mut opacity = 1.0;
-    let mut display = true;
-    let mut invalid = Vec::new();
-    for (k, v) in decls {
-        let v = v.as_str();
-        if v.trim() == "inherit" {
-            continue;
-        }
-        let mut apply = || -> Result<(), SvgError> {
-            match k.as_str() {
-                "fill" => style.fill = parse_paint(v, loc, k)?,
-                "stroke" => style.stroke_paint = parse_paint(v, loc, k)?,
-                "color" => {
-                    if let Some((c, _)) = parse_color(v) {
-                        style.color = c;
-                    }
-                }
-                "fill-opacity" => style.fill_opacity = opacity_value(v, loc, k)?,
-                "stroke-opacity" => style.stroke_opacity = opacity_value(v, loc, k)?,
-                "opacity" => opacity = opacity_value(v, loc, k)?,
-                "fill-rule" => {
-                    style.fill_rule = match v.trim() {
-                        "evenodd" => FillRule::EvenOdd,
-                        "nonzero" => FillRule::NonZero,
-                        other => {
-                            return Err(loc.err(format!(
-                                "fill-rule: expected nonzero or evenodd, found {other:?}"
-                            )))
-                        }
-                    }
-                }
-                "stroke-width" => {
-                    let w = length(v, loc, k, vp, Axis::Diag)?;
-                    if w < 0.0 {
-                        return Err(loc.err(format!(
-                            "stroke-width: expected a non-negative length, found {v:?}"
-                        )));
-                    }
-                    style.stroke.width = w;
-                }
-                "stroke-linejoin" => {
-                    style.stroke.join = match v.trim() {
-                        "miter" | "miter-clip" | "arcs" => LineJoin::Miter,
-                        "round" => LineJoin::Round,
-                        "bevel" => LineJoin::Bevel,
-                        other => {
-                            return Err(loc.err(format!(
-                                "stroke-linejoin: expected miter, round or bevel, found {other:?}"
-                            )))
-                        }
-                    }
-                }
-                "stroke-linecap" => {
-                    style.stroke.cap = match v.trim() {
-                        "butt" => LineCap::Butt,
-                        "round" => LineCap::Round,
-                        "square" => LineCap::Square,
-                        other => {
-                            return Err(loc.err(format!(
-                                "stroke-linecap: expected butt, round or square, found {other:?}"
-                            )))
-                        }
-                    }
-                }
-                "stroke-miterlimit" => {
-                    let m = number_with_unit(v, P, loc, k)?.0;
-                    if m < 1.0 {
-                        return Err(loc.err(format!(
-                            "stroke-miterlimit: expected a number >= 1, found {v:?}"
-                        )));
-                    }
-                    style.stroke.miter_limit = m;
-                }
-                "stroke-dasharray" => {
-                    if v.trim() == "none" {
-                        style.stroke.dashes.clear();
-                    } else {
-                        let mut d = Vec::new();
-                        for part in v
-                            .split(|c: char| c == ',' || c.is_whitespace())
-                            .filter(|p| !p.is_empty())
-                        {
-                            d.push(length(part, loc, k, vp, Axis::Diag)?);
-                        }
-                        if d.iter().any(|x| *x < 0.0) {
-                            return Err(loc.err("stroke-dasharray: expected non-negative lengths"));
-                        }
-                        if d.len() % 2 == 1 {
-                            let copy = d.clone();
-                            d.extend(copy);
-                        }
-                        style.stroke.dashes = d;
-                    }
-                }
-                "stroke-dashoffset" => {
-                    style.stroke.dash_offset = length(v, loc, k, vp, Axis::Diag)?
-                }
-                "visibility" => style.visible = v.trim() == "visible",
-                "display" => display = v.trim() != "none",
-                _ => {}
-            }
-            Ok(())
-        };
-        if let Err(e) = apply() {
-            invalid.push((k.clone(), e));
-        }
-    }
-    (opacity, display, invalid)
-}
-
-fn view_box_transform(node: &Node, loc: &Loc, w: f64, h: f64) -> Result<Option<Mat3>, SvgError> {
-    let Some(vb) = node.attr("viewBox") else {
-        return Ok(None);
-    };
-    let v = number_list(vb, P, loc, "viewBox")?;
-    if v.len() != 4 || v[2] <= 0.0 || v[3] <= 0.0 {
-        return Err(loc.err(format!(
-            "viewBox: expected min-x min-y width height with positive size, found {vb:?}"
-        )));
-    }
-    let par = node.attr("preserveAspectRatio").unwrap_or("xMidYMid meet");
-    let mut words = par.split_whitespace();
-    let align = words.next().unwrap_or("xMidYMid");
-    let slice = words.next() == Some("slice");
-    let (sx, sy) = (w / v[2], h / v[3]);
-    if align == "none" {
-        return Ok(Some(
-            Mat3::scale(sx, sy).mul(&Mat3::translate(-v[0], -v[1])),
-        ));
-    }
-    if align.len() != 8 {
-        return Err(loc.err(format!(
-            "preserveAspectRatio: expected an alignment such as xMidYMid, found {align:?}"
-        )));
-    }
-    let s = if slice { sx.max(sy) } else { sx.min(sy) };
-    let frac = |a: &str| match a {
-        "Min" => Ok(0.0),
-        "Mid" => Ok(0.5),
-        "Max" => Ok(1.0),
-        _ => Err(loc.err(format!("preserveAspectRatio: bad alignment {align:?}"))),
-    };
-    let (fx, fy) = (frac(&align[1..4])?, frac(&align[5..8])?);
-    let tx = (w - v[2] * s) * fx;
-    let ty = (h - v[3] * s) * fy;
-    Ok(Some(
-        Mat3::translate(tx, ty)
-            .mul(&Mat3::scale(s, s))
-            .mul(&Mat3::translate(-v[0], -v[1])),
-    ))
 }
 
 pub(crate) fn parse<'a>(root: Node<'a, 'a>, ctx: &mut Ctx<'a>) -> Result<Document, SvgError> {
@@ -777,7 +481,7 @@ impl<'a> Parser<'_, 'a> {
                 return Ok(());
             }
             "colortri" | "texture" | "textri" => {
-                super::course_element(
+                course_element(
                     &node,
                     name,
                     t,

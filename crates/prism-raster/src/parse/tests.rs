@@ -1,7 +1,10 @@
 //! Hostile documents: deep nesting, `use` fan-out and reference cycles, long `href` chains.
 //! Each must end in a located error or a correct document, on a test thread's small stack.
 
+use std::path::PathBuf;
+
 use super::*;
+use crate::document::Item;
 
 fn parse(text: &str, dialect: Dialect) -> Result<Document, SvgError> {
     let source = Source {

@@ -7,7 +7,7 @@ use prism_image::{LevelSampling, PixelSampling, Texture};
 use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
-use super::{RasterOptions, TOLERANCE};
+use super::options::{RasterOptions, TOLERANCE};
 use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread};
 use crate::path::{stroke, Path, StrokeStyle};
 

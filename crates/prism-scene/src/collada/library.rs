@@ -4,7 +4,7 @@ use prism_math::Rgb;
 use roxmltree::Node as XmlNode;
 use std::collections::HashMap;
 
-use super::{child, children, floats, Cx};
+use super::xml::{child, children, floats, Cx};
 use crate::error::SceneError;
 use crate::scene::Material;
 

@@ -1,6 +1,9 @@
 //! Tests of the COLLADA reader and writer: primitives, transforms, up axes, CGL extras,
 //! located errors and limits, warnings, and the writer's round trip.
 
+use prism_math::glam::{DVec2, DVec3};
+use prism_mesh::PolyMesh;
+
 use super::*;
 
 fn doc(up: &str, geometry: &str, nodes: &str) -> String {

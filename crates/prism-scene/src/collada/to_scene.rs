@@ -14,7 +14,8 @@ use prism_math::glam::{DMat4, DVec3, DVec4};
 use prism_math::{Rgb, Vec3};
 use prism_mesh::vertex_normals_area_weighted;
 
-use super::{Collada, Instance, LightKind, Shape};
+use super::document::{Collada, Instance, MeshData, Shape};
+use super::library::{CameraDef, EffectDef, LightKind};
 use crate::error::SceneError;
 use crate::scene::{
     Camera, CameraMode, Light, Material, NormalsMode, Scene, SceneOptions, SceneSphere, Shading,
@@ -258,10 +259,7 @@ impl Scene {
 
 /// An effect's material, its diffuse texture read from the file it names (relative to the
 /// document `file`) and its sRGB encoding undone.
-fn effect_material_of(
-    effect: &crate::collada::EffectDef,
-    file: &str,
-) -> Result<Material, SceneError> {
+fn effect_material_of(effect: &EffectDef, file: &str) -> Result<Material, SceneError> {
     let Some((name, line)) = &effect.diffuse_texture else {
         return Ok(effect.material.clone());
     };
@@ -292,7 +290,7 @@ fn effect_material_of(
 /// vertex when every corner of a vertex agrees, else every triangle corner becomes its own
 /// vertex (shading normals computed first, then kept per corner).
 fn mesh(
-    m: &crate::collada::MeshData,
+    m: &MeshData,
     world: DMat4,
     material: usize,
     name: &str,
@@ -394,11 +392,7 @@ fn mesh(
     }
 }
 
-fn place_camera(
-    scene: &Scene,
-    file: Option<&(crate::collada::CameraDef, DMat4)>,
-    mode: CameraMode,
-) -> Camera {
+fn place_camera(scene: &Scene, file: Option<&(CameraDef, DMat4)>, mode: CameraMode) -> Camera {
     let (mut hfov, mut vfov, mut near, mut far) = (50.0f64, 35.0f64, 0.001f64, 1000.0f64);
     if let Some((c, _)) = file {
         hfov = c.xfov.unwrap_or(50.0);

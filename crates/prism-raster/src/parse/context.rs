@@ -1,0 +1,51 @@
+//! What a reader carries while it walks one document: where the document came from
+//! ([`Source`]), the XML tree, line numbers for locating elements, the warnings already
+//! given and the textures already decoded.
+
+use std::path::PathBuf;
+
+use prism_image::UvConvention;
+use roxmltree::Node;
+
+use super::common::Loc;
+use crate::document::Document;
+
+/// Where a document came from, for resolving relative files and naming errors.
+#[derive(Clone, Debug, Default)]
+pub struct Source {
+    /// The name used in error messages (usually the file path).
+    pub name: String,
+    /// The directory relative file references are resolved against.
+    pub base_dir: PathBuf,
+}
+
+/// The state of one reading of a document, shared by both dialects.
+pub(crate) struct Ctx<'a> {
+    pub source: &'a Source,
+    pub xml: &'a roxmltree::Document<'a>,
+    /// Line numbers of the text's byte offsets, for locating elements.
+    pub lines: prism_math::LineIndex<'a>,
+    pub warned: std::collections::BTreeSet<String>,
+    /// Textures already decoded, by reference and uv convention: each file or data URI is
+    /// decoded once however often it is used.
+    pub textures: std::cell::RefCell<std::collections::HashMap<(String, UvConvention), usize>>,
+}
+
+impl Ctx<'_> {
+    /// Records `message` as a warning of `doc`, once per `key`.
+    pub fn warn_once(&mut self, doc: &mut Document, key: &str, message: String) {
+        if self.warned.insert(key.to_string()) {
+            doc.warnings.push(message);
+        }
+    }
+}
+
+/// Where `node` sits in the document, for error messages.
+pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> Loc<'a> {
+    let source: &'a Source = ctx.source;
+    Loc {
+        file: &source.name,
+        line: ctx.lines.line(node.range().start),
+        element: node.tag_name().name(),
+    }
+}
