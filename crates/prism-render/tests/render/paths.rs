@@ -143,6 +143,69 @@ fn deterministic_across_thread_counts() {
     }
 }
 
+/// Oracle: Mitsuba 3's converged render of the same scene, pixel by pixel. The reference
+/// (`tests/golden/mitsuba/CBspheres_lambertian.exr`) holds the half floats of
+/// `../shared/bench/pathtrace/refs/CBspheres_lambertian_4096spp.exr` (512x384, the course's
+/// `-m 7` as Mitsuba's `max_depth 8`, 4,096 samples), stored ZIP- instead of PIZ-compressed;
+/// `CBspheres_lambertian_variance.exr` holds the variance of one sample's luminance in each
+/// pixel, from the spread of 256 Mitsuba renders of 16 samples. A per-pixel Z-test of the
+/// luminance, as Mitsuba's own `test_renders.py` tests its renders: prism's 64-sample mean
+/// (the variance of that mean from the larger of its own second moment, which the film keeps,
+/// and the reference's variance) against the reference's mean (its variance over 4,096
+/// samples, plus its half-float rounding). No pixel may reject one mean at significance 0.01
+/// over all pixels tested (Bonferroni); pixels that vary on neither side must agree to 1e-3.
+#[test]
+fn cornell_box_agrees_with_mitsuba_pixel_by_pixel() {
+    let golden = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/mitsuba");
+    let reference = prism_image::read_exr(&golden.join("CBspheres_lambertian.exr"))
+        .expect("the Mitsuba reference reads");
+    let variance = prism_image::read_exr(&golden.join("CBspheres_lambertian_variance.exr"))
+        .expect("the Mitsuba variance reads");
+    let scene = RenderScene::new(&prism_scene::cornell_box());
+    let opts = RenderOptions {
+        film: FilmSettings {
+            width: reference.width(),
+            height: reference.height(),
+            spp: 64,
+            ..FilmSettings::default()
+        },
+        ..RenderOptions::default()
+    };
+    let share = prism_render::film::Share::whole(opts.film.spp);
+    let job = prism_render::render::Job::share(&share);
+    let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+    let mut ours = Vec::new();
+    let mut theirs = Vec::new();
+    let pixels = sums.pixels().iter().zip(reference.pixels());
+    for ((p, r), v) in pixels.zip(variance.pixels()) {
+        let n = f64::from(p.n);
+        let mean = p.moment1 / n;
+        let own = ((p.moment2 - p.moment1 * mean) / (n - 1.0)).max(0.0);
+        let reference_var = f64::from(v.r);
+        let reference_mean = f64::from(r.luminance());
+        // Half floats keep 11 significant bits: a rounding error uniform over one unit.
+        let unit = reference_mean.abs() * 2f64.powi(-10);
+        ours.push(prism_testkit::Estimate {
+            mean,
+            variance: own.max(reference_var) / n,
+        });
+        theirs.push(prism_testkit::Estimate {
+            mean: reference_mean,
+            variance: reference_var / 4096.0 + unit * unit / 12.0,
+        });
+    }
+    let z = prism_testkit::z_test(&ours, &theirs, 0.01, 1e-3);
+    let width = reference.width() as usize;
+    let (x, y) = (z.worst_pixel % width, z.worst_pixel / width);
+    assert!(
+        z.passed(),
+        "{z:?}: pixel ({x}, {y}) prism {:?} vs Mitsuba {:?}",
+        ours[z.worst_pixel],
+        theirs[z.worst_pixel]
+    );
+    assert!(z.tested > 60_000, "{} pixels vary", z.tested);
+}
+
 /// Oracle: Mitsuba 3's converged render of the same scene (`../shared/bench/pathtrace/refs/
 /// CBspheres_lambertian_4096spp.exr`, per-channel means 0.12176, 0.10751, 0.12159 as listed
 /// in that folder's README). prism's built-in Cornell box is that scene; at 16 spp its mean
