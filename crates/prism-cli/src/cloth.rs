@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use prism_cloth::{
     cloth_mesh, course_view, obstacles, read_scene, Cloth, FRAMES_PER_SECOND, STEPS_PER_FRAME,
 };
+use prism_mesh::obj::{Corner, NumberStyle, ObjWriter};
 use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms};
 
 use crate::output::write_text;
@@ -56,25 +57,34 @@ pub struct ClothArgs {
 /// Most frames one run may ask for.
 const MAX_FRAMES: u32 = 1_000_000;
 
-/// The OBJ of the cloth's state: masses, uvs, normals, faces.
+/// The OBJ of the cloth's state: masses, uvs, normals, faces (numbers as Rust shows them).
 fn cloth_obj(c: &Cloth) -> String {
-    use std::fmt::Write;
+    let mut out = Vec::new();
+    write_cloth_obj(c, &mut ObjWriter::new(&mut out, NumberStyle::Plain))
+        .expect("writing to memory");
+    String::from_utf8(out).expect("OBJ text is ASCII")
+}
+
+/// Writes [`cloth_obj`]'s statements.
+fn write_cloth_obj(c: &Cloth, w: &mut ObjWriter<impl std::io::Write>) -> std::io::Result<()> {
     let m = cloth_mesh(c);
-    let mut out = String::new();
     for p in &c.positions {
-        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+        w.vector("v", &p.to_array())?;
     }
     for uv in &m.uvs {
-        let _ = writeln!(out, "vt {} {}", uv.x, uv.y);
+        w.vector("vt", &uv.to_array())?;
     }
     for n in &m.normals {
-        let _ = writeln!(out, "vn {} {} {}", n.x, n.y, n.z);
+        w.vector("vn", &n.to_array())?;
     }
     for t in &m.triangles {
-        let [a, b, c] = t.map(|i| i + 1);
-        let _ = writeln!(out, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
+        w.face(t.map(|v| Corner {
+            v,
+            vt: Some(v),
+            vn: Some(v),
+        }))?;
     }
-    out
+    Ok(())
 }
 
 /// Runs `prism cloth`.

@@ -1,5 +1,53 @@
-//! [`LineIndex`]: the line number of a byte offset in a text, in constant time per query,
-//! for readers that name lines in their errors.
+//! Places in text files for the readers' errors: [`Loc`] (a file, line and column, one type
+//! every reader's errors share) and [`LineIndex`] (the line number of a byte offset, in
+//! constant time per query).
+
+use std::fmt;
+
+/// Where in a text file something is: the file's name as given, a 1-based line, and a
+/// 1-based column (0 when only the line is known). Shown as `file:line` or
+/// `file:line:column`.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Loc {
+    /// The file (or `<memory>`).
+    pub file: String,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column; 0 if unknown.
+    pub column: u32,
+}
+
+impl Loc {
+    /// Line `line` of `file`.
+    #[must_use]
+    pub fn line(file: &str, line: u32) -> Loc {
+        Loc {
+            file: file.to_string(),
+            line,
+            column: 0,
+        }
+    }
+
+    /// Line `line`, column `column` of `file`.
+    #[must_use]
+    pub fn at(file: &str, line: u32, column: u32) -> Loc {
+        Loc {
+            file: file.to_string(),
+            line,
+            column,
+        }
+    }
+}
+
+impl fmt::Display for Loc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.column == 0 {
+            write!(f, "{}:{}", self.file, self.line)
+        } else {
+            write!(f, "{}:{}:{}", self.file, self.line, self.column)
+        }
+    }
+}
 
 /// Bytes between checkpoints: a query scans at most this many bytes.
 const STRIDE: usize = 4096;
@@ -47,6 +95,13 @@ impl<'t> LineIndex<'t> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A location shows as the compilers show theirs: `file:line`, `file:line:column`.
+    #[test]
+    fn locations_show_file_line_and_column() {
+        assert_eq!(Loc::line("a.obj", 3).to_string(), "a.obj:3");
+        assert_eq!(Loc::at("b.svg", 2, 14).to_string(), "b.svg:2:14");
+    }
 
     /// Brute force: every offset of a text with lines of varied lengths (some longer than
     /// the stride) gets the line a scan from the start gives.

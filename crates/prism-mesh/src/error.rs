@@ -23,6 +23,9 @@ pub enum MeshError {
         /// What was expected and what was found.
         message: String,
     },
+    /// A malformed or too large OBJ file, with its location.
+    #[error(transparent)]
+    Obj(#[from] crate::obj::ObjError),
     /// The polygon soup cannot be a manifold halfedge mesh.
     #[error("face {face}: {message}")]
     Topology {

@@ -13,7 +13,7 @@ mod halfedge;
 mod limits;
 mod loop_subdivision;
 mod normals;
-mod obj;
+pub mod obj;
 mod ply;
 mod polymesh;
 mod repair;

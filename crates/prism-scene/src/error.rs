@@ -79,6 +79,16 @@ pub enum SceneError {
     },
 }
 
+impl From<prism_mesh::obj::ObjError> for SceneError {
+    fn from(e: prism_mesh::obj::ObjError) -> SceneError {
+        SceneError::Line {
+            file: e.at.file,
+            line: e.at.line,
+            message: e.message,
+        }
+    }
+}
+
 /// Errors are equal when they say the same thing about the same place; OS errors compare
 /// by kind.
 impl PartialEq for SceneError {

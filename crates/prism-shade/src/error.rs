@@ -3,16 +3,9 @@
 /// Everything that can go wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ShadeError {
-    /// A line of a mesh file is malformed.
-    #[error("{file}:{line}: {message}")]
-    Parse {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// What was expected and what was found.
-        message: String,
-    },
+    /// A malformed or too large OBJ file, with its location.
+    #[error(transparent)]
+    Obj(#[from] prism_mesh::obj::ObjError),
     /// The camera cannot form a picture.
     #[error("camera: {0}")]
     Camera(String),

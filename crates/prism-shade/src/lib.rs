@@ -14,8 +14,9 @@ mod pipeline;
 mod shaders;
 
 pub use error::ShadeError;
-pub use mesh::{ShadeMesh, MAX_FACE_CORNERS};
+pub use mesh::ShadeMesh;
 pub use pipeline::{frame_bytes, shade, shade_rgb8, to_bytes, ShadeOptions, View, FAR, NEAR};
+pub use prism_mesh::obj::MAX_FACE_CORNERS;
 pub use shaders::{
     blinn_phong, bumped_normal, course_texture, fragment, height, Needs, Shader, Uniforms, Varyings,
 };

@@ -7,10 +7,9 @@ use std::collections::HashMap;
 use prism_math::glam::DVec3;
 use prism_math::{Vec2, Vec3};
 
-use crate::error::ShadeError;
+use prism_mesh::obj::{Corner, ObjDocument, ObjOptions};
 
-/// Most corners one OBJ face may have.
-pub const MAX_FACE_CORNERS: usize = 1 << 16;
+use crate::error::ShadeError;
 
 /// Vertex attributes and triangles, ready for the vertex stage.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -45,110 +44,40 @@ impl ShadeMesh {
     /// [`ShadeMesh::compute_tangents`]. `file` names the text in errors.
     ///
     /// # Errors
-    /// [`ShadeError::Parse`] with the line of a malformed number or index.
+    /// [`ShadeError::Obj`] at the first malformed statement (the rules of
+    /// [`ObjDocument::parse`]).
     pub fn from_obj(text: &str, file: &str) -> Result<ShadeMesh, ShadeError> {
-        let mut v: Vec<DVec3> = Vec::new();
-        let mut vt: Vec<[f64; 2]> = Vec::new();
-        let mut vn: Vec<DVec3> = Vec::new();
-        let mut corner_of: HashMap<(usize, Option<usize>, Option<usize>), u32> = HashMap::new();
+        let options = ObjOptions {
+            attributes: true,
+            markers: false,
+        };
+        let doc = ObjDocument::<f64>::parse(text, file, options)?;
+        let v: Vec<DVec3> = doc
+            .positions
+            .iter()
+            .map(|p| DVec3::from_array(*p))
+            .collect();
+        let vn: Vec<DVec3> = doc.normals.iter().map(|n| DVec3::from_array(*n)).collect();
+        let vt = &doc.uvs;
+        let mut corner_of: HashMap<Corner, u32> = HashMap::new();
         let mut corners: Vec<(usize, Option<usize>, Option<usize>)> = Vec::new();
         let mut triangles = Vec::new();
         let mut face = Vec::new();
-        for (ln, raw) in text.lines().enumerate() {
-            let err = |message: String| ShadeError::Parse {
-                file: file.to_string(),
-                line: ln + 1,
-                message,
-            };
-            let line = raw.split('#').next().unwrap_or("");
-            let mut words = line.split_whitespace();
-            let Some(key) = words.next() else { continue };
-            let mut numbers = |n: usize| -> Result<[f64; 3], ShadeError> {
-                let mut out = [0.0; 3];
-                for (k, slot) in out.iter_mut().take(n).enumerate() {
-                    let w = words
-                        .next()
-                        .ok_or_else(|| err(format!("{key}: expected {n} numbers, found {k}")))?;
-                    *slot = w
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|x| x.is_finite())
-                        .ok_or_else(|| {
-                            err(format!("{key}: expected a finite number, found {w:?}"))
-                        })?;
-                }
-                Ok(out)
-            };
-            match key {
-                "v" => v.push(DVec3::from_array(numbers(3)?)),
-                "vn" => vn.push(DVec3::from_array(numbers(3)?)),
-                "vt" => {
-                    let [a, _, _] = numbers(1)?;
-                    // A missing second coordinate is 0.
-                    let b =
-                        match words.next() {
-                            None => 0.0,
-                            Some(w) => w.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(
-                                || err(format!("vt: expected a finite number, found {w:?}")),
-                            )?,
-                        };
-                    vt.push([a, b]);
-                }
-                "f" => {
-                    face.clear();
-                    for w in words {
-                        let mut parts = w.split('/');
-                        // A file without any `vt` (`vn`) reads none wherever a corner names one,
-                        // as the course app does.
-                        let index = |s: Option<&str>,
-                                     n: usize,
-                                     what: &str|
-                         -> Result<Option<usize>, ShadeError> {
-                            let Some(s) = s.filter(|s| !s.is_empty()) else {
-                                return Ok(None);
-                            };
-                            if n == 0 && what != "vertex" {
-                                return Ok(None);
-                            }
-                            let i: i64 = s.parse().map_err(|_| {
-                                err(format!("f: expected a {what} index, found {w:?}"))
-                            })?;
-                            let idx = if i > 0 { i - 1 } else { n as i64 + i };
-                            if i == 0 || idx < 0 || idx >= n as i64 {
-                                return Err(err(format!(
-                                    "f: {what} index {i} is out of range ({n} defined so far)"
-                                )));
-                            }
-                            Ok(Some(idx as usize))
-                        };
-                        let vi = index(parts.next(), v.len(), "vertex")?.ok_or_else(|| {
-                            err(format!("f: expected a vertex index, found {w:?}"))
-                        })?;
-                        let ti = index(parts.next(), vt.len(), "texture coordinate")?;
-                        let ni = index(parts.next(), vn.len(), "normal")?;
-                        let key = (vi, ti, ni);
-                        let c = *corner_of.entry(key).or_insert_with(|| {
-                            corners.push(key);
-                            (corners.len() - 1) as u32
-                        });
-                        face.push(c);
-                        if face.len() > MAX_FACE_CORNERS {
-                            return Err(err(format!(
-                                "f: more than {MAX_FACE_CORNERS} corners in one face"
-                            )));
-                        }
-                    }
-                    if face.len() < 3 {
-                        return Err(err(format!(
-                            "f: expected at least 3 corners, found {}",
-                            face.len()
-                        )));
-                    }
-                    for i in 1..face.len() - 1 {
-                        triangles.push([face[0], face[i], face[i + 1]]);
-                    }
-                }
-                _ => {}
+        for f in &doc.faces {
+            face.clear();
+            for &c in doc.face_corners(f) {
+                let index = *corner_of.entry(c).or_insert_with(|| {
+                    corners.push((
+                        c.v as usize,
+                        c.vt.map(|t| t as usize),
+                        c.vn.map(|n| n as usize),
+                    ));
+                    (corners.len() - 1) as u32
+                });
+                face.push(index);
+            }
+            for i in 1..face.len() - 1 {
+                triangles.push([face[0], face[i], face[i + 1]]);
             }
         }
         let position_of: Vec<usize> = corners.iter().map(|c| c.0).collect();

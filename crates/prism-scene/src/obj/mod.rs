@@ -10,6 +10,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use prism_math::{Rgb, Vec2, Vec3};
+use prism_mesh::obj::{Corner, Marker, MarkerKind, ObjDocument};
+pub use prism_mesh::obj::{ObjOptions, MAX_FACE_CORNERS};
 
 use crate::error::SceneError;
 use crate::scene::{Material, MaterialTexture, OrbitCamera, Scene, Shading, TriangleMesh};
@@ -18,8 +20,6 @@ pub(crate) use mtl::parse_mtl;
 
 /// Largest OBJ or MTL file read (1 GiB).
 pub const MAX_OBJ_BYTES: u64 = 1 << 30;
-/// Most corners one face may have.
-pub const MAX_FACE_CORNERS: usize = 1 << 16;
 
 /// A source of an OBJ's companion files (MTL libraries, textures) by their name as
 /// written in the file: the bytes, or a located error.
@@ -59,46 +59,77 @@ pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
     })
 }
 
-/// One non-empty line of an OBJ or MTL file, comments removed.
-pub(crate) struct Statement<'t> {
-    /// 1-based line.
-    pub line: u32,
-    /// The first word.
-    pub key: &'t str,
-    /// The whole line, trimmed, the key included.
-    pub content: &'t str,
+/// The materials an OBJ's libraries define, and the one its faces are using.
+#[derive(Default)]
+struct Materials {
+    libs: Vec<mtl::MtlMaterial>,
+    /// Each material's index by name, the last definition winning (as a search from the end).
+    by_name: HashMap<String, usize>,
+    /// The libraries read, as named.
+    files: Vec<String>,
+    /// The libraries read, as [`same_file_key`]s.
+    keys: HashSet<String>,
+    current: Option<usize>,
 }
 
-impl Statement<'_> {
-    /// An error at this line of `file`.
-    pub fn error(&self, file: &str, message: String) -> SceneError {
-        SceneError::Line {
+impl Materials {
+    /// Applies marker `m` of `file`: reads the libraries it names (each once, however often
+    /// or however it is named), or takes the material it names. True if it starts a new run
+    /// of faces (a shape, or another material).
+    fn apply(
+        &mut self,
+        m: &Marker,
+        file: &str,
+        companions: &Companions<'_>,
+    ) -> Result<bool, SceneError> {
+        let err = |message: String| SceneError::Line {
             file: file.to_string(),
-            line: self.line,
+            line: m.line,
             message,
+        };
+        match &m.kind {
+            MarkerKind::MaterialLibraries(names) => {
+                for name in names {
+                    if !self.keys.insert(same_file_key(name)) {
+                        continue;
+                    }
+                    let bytes = companions(name).map_err(|e| {
+                        err(format!("mtllib: cannot read the material library: {e}"))
+                    })?;
+                    let what = Path::new(file)
+                        .parent()
+                        .unwrap_or(Path::new(""))
+                        .join(name)
+                        .display()
+                        .to_string();
+                    let text = String::from_utf8(bytes)
+                        .map_err(|_| err(format!("mtllib {name}: expected UTF-8 text")))?;
+                    for m in parse_mtl(&text, &what)? {
+                        self.by_name.insert(m.name.clone(), self.libs.len());
+                        self.libs.push(m);
+                    }
+                    self.files.push(name.to_string());
+                }
+                Ok(false)
+            }
+            MarkerKind::UseMaterial(name) => {
+                let Some(&found) = self.by_name.get(name) else {
+                    return Err(err(if self.files.is_empty() {
+                        format!("usemtl {name}: no material library was named before it")
+                    } else {
+                        format!(
+                            "usemtl {name}: no such material in {}",
+                            self.files.join(", ")
+                        )
+                    }));
+                };
+                let changed = self.current != Some(found);
+                self.current = Some(found);
+                Ok(changed)
+            }
+            MarkerKind::Shape => Ok(true),
         }
     }
-}
-
-/// The statements of OBJ or MTL text, in order.
-pub(crate) fn statements(text: &str) -> impl Iterator<Item = Statement<'_>> {
-    text.lines().enumerate().filter_map(|(ln, raw)| {
-        let content = raw.split('#').next().unwrap_or("").trim();
-        let key = content.split_whitespace().next()?;
-        Some(Statement {
-            line: (ln + 1) as u32,
-            key,
-            content,
-        })
-    })
-}
-
-/// One corner of a face: indices into the position, uv and normal lists.
-#[derive(Clone, Copy)]
-struct Corner {
-    v: usize,
-    vt: Option<usize>,
-    vn: Option<usize>,
 }
 
 /// A run of triangles with one material, as corners.
@@ -119,127 +150,55 @@ pub fn parse_obj_scene(
     companions: &Companions<'_>,
     normalize: bool,
 ) -> Result<Scene, SceneError> {
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut uvs: Vec<Vec2> = Vec::new();
-    let mut normals: Vec<Vec3> = Vec::new();
-    let mut libs: Vec<mtl::MtlMaterial> = Vec::new();
-    // Each material's index by name, the last definition winning (as a search from the end).
-    let mut by_name: HashMap<String, usize> = HashMap::new();
-    let mut lib_files: Vec<String> = Vec::new();
-    let mut lib_names: HashSet<String> = HashSet::new();
-    // Faces are stored as corners: their count is checked against the memory budget.
+    let options = ObjOptions {
+        attributes: true,
+        markers: true,
+    };
+    let doc = ObjDocument::<f32>::parse(text, file, options).map_err(SceneError::from)?;
+    let positions: Vec<Vec3> = doc.positions.iter().map(|&p| Vec3::from_array(p)).collect();
+    let uvs: Vec<Vec2> = doc.uvs.iter().map(|&t| Vec2::from_array(t)).collect();
+    let normals: Vec<Vec3> = doc.normals.iter().map(|&n| Vec3::from_array(n)).collect();
+    let mut materials = Materials::default();
+    // Faces become fans of triangles: their count is checked against the memory budget.
     let most_triangles = prism_math::limits::memory_budget() / size_of::<[Corner; 3]>() as u64;
     let mut triangle_count = 0u64;
     let mut runs: Vec<Run> = Vec::new();
-    let mut current: Option<usize> = None;
     // A shape boundary (`o`, `g`) or a material change starts a new run.
     let mut new_run = true;
-    let mut corners: Vec<Corner> = Vec::new();
-    for st in statements(text) {
-        let (key, content) = (st.key, st.content);
-        let err = |message: String| st.error(file, message);
-        let mut words = content.split_whitespace().skip(1);
-        let mut numbers = |n: usize, what: &str| -> Result<[f32; 3], SceneError> {
-            let mut out = [0.0; 3];
-            for (k, slot) in out.iter_mut().take(n).enumerate() {
-                let w = words
-                    .next()
-                    .ok_or_else(|| err(format!("{key}: expected {n} {what}, found {k}")))?;
-                *slot = w
-                    .parse::<f32>()
-                    .ok()
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| err(format!("{key}: expected a finite number, found {w:?}")))?;
-            }
-            Ok(out)
-        };
-        match key {
-            "v" => positions.push(Vec3::from_array(numbers(3, "coordinates")?)),
-            "vn" => normals.push(Vec3::from_array(numbers(3, "coordinates")?)),
-            "vt" => {
-                let [u, v, _] = numbers(2, "coordinates")?;
-                uvs.push(Vec2::new(u, v));
-            }
-            "mtllib" => {
-                for name in content[key.len()..].split_whitespace() {
-                    // Each library is read once, however often or however it is named.
-                    if !lib_names.insert(same_file_key(name)) {
-                        continue;
-                    }
-                    let bytes = companions(name).map_err(|e| {
-                        err(format!("mtllib: cannot read the material library: {e}"))
-                    })?;
-                    let what = Path::new(file)
-                        .parent()
-                        .unwrap_or(Path::new(""))
-                        .join(name)
-                        .display()
-                        .to_string();
-                    let text = String::from_utf8(bytes)
-                        .map_err(|_| err(format!("mtllib {name}: expected UTF-8 text")))?;
-                    for m in parse_mtl(&text, &what)? {
-                        by_name.insert(m.name.clone(), libs.len());
-                        libs.push(m);
-                    }
-                    lib_files.push(name.to_string());
-                }
-            }
-            "usemtl" => {
-                let name = content[key.len()..].trim();
-                let Some(&found) = by_name.get(name) else {
-                    return Err(err(if lib_files.is_empty() {
-                        format!("usemtl {name}: no material library was named before it")
-                    } else {
-                        format!(
-                            "usemtl {name}: no such material in {}",
-                            lib_files.join(", ")
-                        )
-                    }));
-                };
-                if current != Some(found) {
-                    new_run = true;
-                }
-                current = Some(found);
-            }
-            "o" | "g" => new_run = true,
-            "f" => {
-                corners.clear();
-                for w in words {
-                    corners.push(corner(w, &positions, &uvs, &normals).map_err(&err)?);
-                    if corners.len() > MAX_FACE_CORNERS {
-                        return Err(err(format!(
-                            "f: more than {MAX_FACE_CORNERS} corners in one face"
-                        )));
-                    }
-                }
-                if corners.len() < 3 {
-                    return Err(err(format!(
-                        "f: expected at least 3 corners, found {}",
-                        corners.len()
-                    )));
-                }
-                if new_run || runs.is_empty() {
-                    runs.push(Run {
-                        material: current,
-                        triangles: Vec::new(),
-                    });
-                    new_run = false;
-                }
-                triangle_count += corners.len() as u64 - 2;
-                if triangle_count > most_triangles {
-                    let need = triangle_count * size_of::<[Corner; 3]>() as u64;
-                    let over = prism_math::limits::check_memory(need).expect_err("over the budget");
-                    return Err(err(format!("f: storing the faces {over}")));
-                }
-                let run = runs.last_mut().expect("a run was just ensured");
-                // A fan from the first corner: a quad becomes (0 1 2) and (0 2 3).
-                for i in 1..corners.len() - 1 {
-                    run.triangles.push([corners[0], corners[i], corners[i + 1]]);
-                }
-            }
-            _ => {}
+    let mut markers = doc.markers.iter().peekable();
+    for (index, face) in doc.faces.iter().enumerate() {
+        while let Some(m) = markers.next_if(|m| m.before_face as usize <= index) {
+            new_run |= materials.apply(m, file, companions)?;
+        }
+        let corners = doc.face_corners(face);
+        if new_run || runs.is_empty() {
+            runs.push(Run {
+                material: materials.current,
+                triangles: Vec::new(),
+            });
+            new_run = false;
+        }
+        triangle_count += corners.len() as u64 - 2;
+        if triangle_count > most_triangles {
+            let need = triangle_count * size_of::<[Corner; 3]>() as u64;
+            let over = prism_math::limits::check_memory(need).expect_err("over the budget");
+            return Err(SceneError::Line {
+                file: file.to_string(),
+                line: face.line,
+                message: format!("f: storing the faces {over}"),
+            });
+        }
+        let run = runs.last_mut().expect("a run was just ensured");
+        // A fan from the first corner: a quad becomes (0 1 2) and (0 2 3).
+        for i in 1..corners.len() - 1 {
+            run.triangles.push([corners[0], corners[i], corners[i + 1]]);
         }
     }
+    // Libraries and materials named after the last face are still read and checked.
+    for m in markers {
+        materials.apply(m, file, companions)?;
+    }
+    let libs = materials.libs;
 
     let mut scene = Scene::new(OrbitCamera::default().to_camera(1.0));
     // Materials in the order they are first used; faces without one share the default.
@@ -282,47 +241,6 @@ pub fn parse_obj_scene(
         normalize_meshes(&mut scene.meshes);
     }
     Ok(scene)
-}
-
-/// Parses one face corner: `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or negative.
-fn corner(w: &str, positions: &[Vec3], uvs: &[Vec2], normals: &[Vec3]) -> Result<Corner, String> {
-    let mut parts = w.split('/');
-    let index = |s: &str, n: usize, what: &str| -> Result<usize, String> {
-        let i: i64 = s
-            .parse()
-            .map_err(|_| format!("f: expected a {what} index, found {w:?}"))?;
-        let idx = if i > 0 { i - 1 } else { n as i64 + i };
-        if i == 0 || idx < 0 || idx >= n as i64 {
-            return Err(format!(
-                "f: {what} index {i} is out of range ({n} defined so far)"
-            ));
-        }
-        Ok(idx as usize)
-    };
-    let v = index(parts.next().unwrap_or(""), positions.len(), "vertex")?;
-    // A file with no `vt` (no `vn`) at all gets (0, 0) (the geometric normal) wherever a
-    // corner names one, as the template does.
-    // A file with no `vt` (no `vn`) still names a number there.
-    let number = |s: &str, what: &str| match s.parse::<i64>() {
-        Ok(i) if i != 0 => Ok(None),
-        _ => Err(format!("f: expected a {what} index, found {w:?}")),
-    };
-    let vt = match parts.next() {
-        None | Some("") => None,
-        Some(s) if uvs.is_empty() => number(s, "texture coordinate")?,
-        Some(s) => Some(index(s, uvs.len(), "texture coordinate")?),
-    };
-    let vn = match parts.next() {
-        None | Some("") => None,
-        Some(s) if normals.is_empty() => number(s, "normal")?,
-        Some(s) => Some(index(s, normals.len(), "normal")?),
-    };
-    if parts.next().is_some() {
-        return Err(format!(
-            "f: expected v, v/vt, v//vn or v/vt/vn, found {w:?}"
-        ));
-    }
-    Ok(Corner { v, vt, vn })
 }
 
 /// A companion file's name with the spellings of one path made one (`./a//b.mtl`, `a/b.mtl`
@@ -419,13 +337,13 @@ fn build_mesh(
     let mut mesh_uvs = Vec::new();
     let mut triangles = Vec::with_capacity(run.triangles.len());
     for tri in &run.triangles {
-        let [p0, p1, p2] = tri.map(|c| positions[c.v]);
+        let [p0, p1, p2] = tri.map(|c| positions[c.v as usize]);
         let geometric = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         let mut t = [0u32; 3];
         for (j, c) in tri.iter().enumerate() {
-            let p = positions[c.v];
-            let n = c.vn.map_or(geometric, |i| normals[i]);
-            let uv = c.vt.map_or(Vec2::ZERO, |i| uvs[i]);
+            let p = positions[c.v as usize];
+            let n = c.vn.map_or(geometric, |i| normals[i as usize]);
+            let uv = c.vt.map_or(Vec2::ZERO, |i| uvs[i as usize]);
             t[j] = *cache.entry(vertex_key(p, n, uv)).or_insert_with(|| {
                 mesh_positions.push(p);
                 mesh_normals.push(n);

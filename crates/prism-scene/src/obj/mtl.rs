@@ -3,6 +3,8 @@
 
 use prism_math::Rgb;
 
+use prism_mesh::obj::statements;
+
 use crate::error::SceneError;
 
 /// Largest colour value or exponent a material may give.
@@ -30,9 +32,13 @@ pub(crate) struct MtlMaterial {
 /// Parses MTL text; `file` names it in errors.
 pub(crate) fn parse_mtl(text: &str, file: &str) -> Result<Vec<MtlMaterial>, SceneError> {
     let mut out: Vec<MtlMaterial> = Vec::new();
-    for st in super::statements(text) {
+    for st in statements(text) {
         let (line, key, content) = (st.line, st.key, st.content);
-        let err = |message: String| st.error(file, message);
+        let err = |message: String| SceneError::Line {
+            file: file.to_string(),
+            line: st.line,
+            message,
+        };
         let mut words = content.split_whitespace().skip(1);
         if key == "newmtl" {
             let name = content[key.len()..].trim();

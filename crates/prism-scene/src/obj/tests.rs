@@ -127,7 +127,7 @@ fn normalisation_is_mean_and_max_distance() {
 #[test]
 fn malformed_input_is_located() {
     let cases: [(&str, &str); 8] = [
-        ("v 0 0\n", "t.obj:1: v: expected 3 coordinates, found 2"),
+        ("v 0 0\n", "t.obj:1: v: expected 3 numbers, found 2"),
         (
             "v 0 nan 0\n",
             "t.obj:1: v: expected a finite number, found \"nan\"",
