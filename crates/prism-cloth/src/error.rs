@@ -1,5 +1,7 @@
 //! [`ClothError`], what can go wrong reading a cloth scene, each with its file and line.
 
+use prism_math::Loc;
+
 /// Everything that can go wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ClothError {
@@ -12,12 +14,10 @@ pub enum ClothError {
         message: String,
     },
     /// The text is not JSON, or a value is missing, of the wrong type or out of range.
-    #[error("{file}:{line}: {message}")]
+    #[error("{at}: {message}")]
     Parse {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line.
+        at: Loc,
         /// What was expected and what was found.
         message: String,
     },

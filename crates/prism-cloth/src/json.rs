@@ -2,6 +2,7 @@
 //! arrays, numbers, strings, booleans and null, nested at most [`MAX_JSON_DEPTH`] deep.
 
 use crate::error::ClothError;
+use prism_math::Loc;
 
 /// Deepest nesting of arrays and objects read.
 pub const MAX_JSON_DEPTH: usize = 64;
@@ -57,8 +58,7 @@ struct Parser<'a> {
 impl Parser<'_> {
     fn err(&self, message: String) -> ClothError {
         ClothError::Parse {
-            file: self.file.to_string(),
-            line: self.line,
+            at: Loc::line(self.file, self.line),
             message,
         }
     }

@@ -2,6 +2,7 @@
 //! every key required (`pinned` aside), unknown keys refused, values checked; and `--set`
 //! overrides applied to the text's values before they are checked.
 
+use prism_math::Loc;
 use std::path::Path;
 
 use prism_math::glam::DVec3;
@@ -122,9 +123,9 @@ pub fn parse_scene(text: &str, file: &str, overrides: &[String]) -> Result<Cloth
     // A value an override set is checked as the file's are; its errors name the override,
     // not a line of the file.
     let overridden = |e: ClothError| match e {
-        ClothError::Parse { line, message, .. } if line >= override_line(overrides.len()) => {
+        ClothError::Parse { at, message } if at.line >= override_line(overrides.len()) => {
             ClothError::Override {
-                setting: overrides[(u32::MAX - line) as usize].clone(),
+                setting: overrides[(u32::MAX - at.line) as usize].clone(),
                 message,
             }
         }
@@ -223,8 +224,7 @@ type Fields = [(String, u32, Json)];
 impl Cx<'_> {
     fn err(&self, line: u32, message: String) -> ClothError {
         ClothError::Parse {
-            file: self.file.to_string(),
-            line,
+            at: Loc::line(self.file, line),
             message,
         }
     }

@@ -1,6 +1,7 @@
 //! Bezier curves of any degree and bicubic Bezier patches, evaluated by de Casteljau's
 //! algorithm (repeated linear interpolation), and the course's `.bzc` and `.bez` files.
 
+use prism_math::Loc;
 use std::collections::HashMap;
 use std::ops::{Add, Mul};
 
@@ -75,8 +76,7 @@ fn numbers(text: &str, file: &str) -> Result<Vec<(f64, usize)>, MeshError> {
                 .ok()
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| MeshError::Parse {
-                    file: file.to_string(),
-                    line: ln + 1,
+                    at: Loc::line(file, (ln + 1) as u32),
                     message: format!("expected a finite number, found {w:?}"),
                 })?;
             out.push((v, ln + 1));
@@ -87,14 +87,12 @@ fn numbers(text: &str, file: &str) -> Result<Vec<(f64, usize)>, MeshError> {
 
 fn count(nums: &[(f64, usize)], file: &str, what: &str) -> Result<usize, MeshError> {
     let &(n, line) = nums.first().ok_or_else(|| MeshError::Parse {
-        file: file.to_string(),
-        line: 1,
+        at: Loc::line(file, 1),
         message: format!("expected the number of {what}, found an empty file"),
     })?;
     if n < 0.0 || n.fract() != 0.0 || n > 1e6 {
         return Err(MeshError::Parse {
-            file: file.to_string(),
-            line,
+            at: Loc::line(file, line as u32),
             message: format!("expected a count of {what}, found {n}"),
         });
     }
@@ -110,8 +108,7 @@ pub fn parse_bzc(text: &str, file: &str) -> Result<Vec<DVec2>, MeshError> {
     let n = count(&nums, file, "points")?;
     if nums.len() != 1 + 2 * n || n == 0 {
         return Err(MeshError::Parse {
-            file: file.to_string(),
-            line: nums.last().map_or(1, |x| x.1),
+            at: Loc::line(file, nums.last().map_or(1, |x| x.1) as u32),
             message: format!(
                 "expected {n} points (2 numbers each) after the count, found {} numbers",
                 nums.len() - 1
@@ -133,8 +130,7 @@ pub fn parse_bez(text: &str, file: &str) -> Result<Vec<BezierPatch>, MeshError> 
     let n = count(&nums, file, "patches")?;
     if nums.len() != 1 + 48 * n {
         return Err(MeshError::Parse {
-            file: file.to_string(),
-            line: nums.last().map_or(1, |x| x.1),
+            at: Loc::line(file, nums.last().map_or(1, |x| x.1) as u32),
             message: format!(
                 "expected {n} patches of 16 points (48 numbers each), found {} numbers",
                 nums.len() - 1

@@ -1,5 +1,7 @@
 //! [`MeshError`], what can go wrong reading a mesh file or building its connectivity.
 
+use prism_math::Loc;
+
 /// Everything that can go wrong reading a mesh or building its connectivity. Face and
 /// vertex numbers in topology errors count from 0, in file order.
 #[derive(Debug, thiserror::Error)]
@@ -14,12 +16,10 @@ pub enum MeshError {
         source: std::io::Error,
     },
     /// A syntax or value error in a mesh file, with its location.
-    #[error("{file}:{line}: {message}")]
+    #[error("{at}: {message}")]
     Parse {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line.
-        line: usize,
+        /// Where: the file (or `<memory>`) and the line.
+        at: Loc,
         /// What was expected and what was found.
         message: String,
     },

@@ -3,6 +3,7 @@
 //! `s t`); faces take `vertex_indices` (or `vertex_index`). Other elements and properties
 //! are read past and dropped.
 
+use prism_math::Loc;
 use std::io::Write;
 use std::path::Path;
 
@@ -96,8 +97,7 @@ impl Body<'_> {
             format!("at byte {}: {message}", self.pos)
         };
         MeshError::Parse {
-            file: self.file.to_string(),
-            line,
+            at: Loc::line(self.file, line as u32),
             message,
         }
     }
@@ -163,8 +163,7 @@ impl Body<'_> {
 /// coordinate, or a face index out of range.
 pub fn parse_ply(bytes: &[u8], file: &str) -> Result<PolyMesh, MeshError> {
     let perr = |line: usize, message: String| MeshError::Parse {
-        file: file.to_string(),
-        line,
+        at: Loc::line(file, line as u32),
         message,
     };
     // Header

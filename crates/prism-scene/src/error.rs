@@ -1,5 +1,7 @@
 //! [`SceneError`], what can go wrong reading a scene, each with its file and location.
 
+use prism_math::Loc;
+
 use std::sync::Arc;
 
 /// Everything that can go wrong reading a scene.
@@ -46,12 +48,10 @@ pub enum SceneError {
         source: roxmltree::Error,
     },
     /// A line of a text format (OBJ, MTL, TOML) is missing something or malformed.
-    #[error("{file}:{line}: {message}")]
+    #[error("{at}: {message}")]
     Line {
-        /// The file.
-        file: String,
-        /// 1-based line.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line.
+        at: Loc,
         /// What was expected and what was found.
         message: String,
     },
@@ -66,12 +66,10 @@ pub enum SceneError {
         searched: Vec<String>,
     },
     /// An element is missing, malformed or refers to something that does not exist.
-    #[error("{file}:{line}: <{element}>: {message}")]
+    #[error("{at}: <{element}>: {message}")]
     Element {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the element's start tag.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the element's start tag.
+        at: Loc,
         /// The element's tag name.
         element: String,
         /// What was expected and what was found.
@@ -82,8 +80,7 @@ pub enum SceneError {
 impl From<prism_mesh::obj::ObjError> for SceneError {
     fn from(e: prism_mesh::obj::ObjError) -> SceneError {
         SceneError::Line {
-            file: e.at.file,
-            line: e.at.line,
+            at: Loc::line(&e.at.file, e.at.line),
             message: e.message,
         }
     }

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
+use prism_math::Loc;
 use prism_math::{LineIndex, Rgb, Vec3};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
@@ -162,8 +163,7 @@ pub fn parse_render_config(
         lines: &lines,
     };
     let root = DeTable::parse(text).map_err(|e| SceneError::Line {
-        file: file.to_string(),
-        line: lines.line(e.span().map_or(0, |s| s.start)),
+        at: Loc::line(file, lines.line(e.span().map_or(0, |s| s.start))),
         message: format!("expected TOML: {}", e.message()),
     })?;
     let root = root.get_ref();
@@ -328,8 +328,7 @@ type Val<'i> = Spanned<DeValue<'i>>;
 impl Cx<'_> {
     fn err<T>(&self, at: &Spanned<T>, message: String) -> SceneError {
         SceneError::Line {
-            file: self.file.to_string(),
-            line: self.lines.line(at.span().start),
+            at: Loc::line(self.file, self.lines.line(at.span().start)),
             message,
         }
     }

@@ -3,6 +3,8 @@
 
 use std::sync::Arc;
 
+use prism_math::Loc;
+
 use super::number::{number_prefix_len, to_num, Precision};
 use super::pathdata::PathDataError;
 use crate::document::Mat3;
@@ -50,35 +52,29 @@ pub enum SvgError {
         limit: u64,
     },
     /// The text is not well-formed XML.
-    #[error("{file}:{line}: xml: malformed XML: {source}")]
+    #[error("{at}: xml: malformed XML: {source}")]
     Xml {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the syntax error.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the syntax error.
+        at: Loc,
         /// The XML parser's error.
         #[source]
         source: roxmltree::Error,
     },
     /// An element or attribute is missing, malformed or refers to nothing.
-    #[error("{file}:{line}: {element}: {message}")]
+    #[error("{at}: {element}: {message}")]
     Element {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the element's start tag.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the element's start tag.
+        at: Loc,
         /// The element's name.
         element: String,
         /// What was expected and what was found.
         message: String,
     },
     /// An element's `d` attribute is not valid path data.
-    #[error("{file}:{line}: {element}: d: {source}")]
+    #[error("{at}: {element}: d: {source}")]
     PathData {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the element's start tag.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the element's start tag.
+        at: Loc,
         /// The element's name.
         element: String,
         /// What is wrong, and where in the attribute.
@@ -86,48 +82,40 @@ pub enum SvgError {
         source: PathDataError,
     },
     /// Elements nest deeper than [`MAX_DEPTH`] (counting `use` references).
-    #[error("{file}:{line}: {element}: elements nest deeper than the limit of {limit}")]
+    #[error("{at}: {element}: elements nest deeper than the limit of {limit}")]
     NestingLimit {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the first element past the limit.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the first element past the limit.
+        at: Loc,
         /// Its name.
         element: String,
         /// The limit.
         limit: usize,
     },
     /// The document produces more than [`MAX_ITEMS`] drawables.
-    #[error("{file}:{line}: {element}: more than {limit} drawables")]
+    #[error("{at}: {element}: more than {limit} drawables")]
     ItemsLimit {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the element that passed the limit.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the element that passed the limit.
+        at: Loc,
         /// Its name.
         element: String,
         /// The limit.
         limit: usize,
     },
     /// Expanding `use` references would create more than [`MAX_USE_ELEMENTS`] elements.
-    #[error("{file}:{line}: {element}: use references would expand to more than {limit} elements")]
+    #[error("{at}: {element}: use references would expand to more than {limit} elements")]
     UseLimit {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the element whose expansion passes the limit.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the element whose expansion passes the limit.
+        at: Loc,
         /// Its name.
         element: String,
         /// The limit.
         limit: usize,
     },
     /// A gradient's `href` chain holds more than [`MAX_HREF_CHAIN`] gradients.
-    #[error("{file}:{line}: {element}: href chain is longer than the limit of {limit} gradients")]
+    #[error("{at}: {element}: href chain is longer than the limit of {limit} gradients")]
     HrefChainLimit {
-        /// The file (or `<memory>`).
-        file: String,
-        /// 1-based line of the gradient that starts the chain.
-        line: u32,
+        /// Where: the file (or `<memory>`) and the line of the gradient that starts the chain.
+        at: Loc,
         /// Its name.
         element: String,
         /// The limit.
@@ -136,35 +124,20 @@ pub enum SvgError {
 }
 
 impl SvgError {
-    /// The file the error is in.
+    /// Where the error is: the file, and its line (0 for errors about the whole file).
     #[must_use]
-    pub fn file(&self) -> &str {
+    pub fn at(&self) -> Loc {
         match self {
             SvgError::Io { file, .. }
             | SvgError::Encoding { file, .. }
-            | SvgError::FileTooLarge { file, .. }
-            | SvgError::Xml { file, .. }
-            | SvgError::Element { file, .. }
-            | SvgError::PathData { file, .. }
-            | SvgError::NestingLimit { file, .. }
-            | SvgError::ItemsLimit { file, .. }
-            | SvgError::UseLimit { file, .. }
-            | SvgError::HrefChainLimit { file, .. } => file,
-        }
-    }
-
-    /// The 1-based line the error is on, or 0 for errors about the whole file.
-    #[must_use]
-    pub fn line(&self) -> u32 {
-        match self {
-            SvgError::Io { .. } | SvgError::Encoding { .. } | SvgError::FileTooLarge { .. } => 0,
-            SvgError::Xml { line, .. }
-            | SvgError::Element { line, .. }
-            | SvgError::PathData { line, .. }
-            | SvgError::NestingLimit { line, .. }
-            | SvgError::ItemsLimit { line, .. }
-            | SvgError::UseLimit { line, .. }
-            | SvgError::HrefChainLimit { line, .. } => *line,
+            | SvgError::FileTooLarge { file, .. } => Loc::line(file, 0),
+            SvgError::Xml { at, .. }
+            | SvgError::Element { at, .. }
+            | SvgError::PathData { at, .. }
+            | SvgError::NestingLimit { at, .. }
+            | SvgError::ItemsLimit { at, .. }
+            | SvgError::UseLimit { at, .. }
+            | SvgError::HrefChainLimit { at, .. } => at.clone(),
         }
     }
 }
@@ -186,17 +159,21 @@ impl<'a, 'i> PlainAttribute<'a> for roxmltree::Node<'a, 'i> {
 
 /// Where the element being read sits, for error messages.
 #[derive(Clone, Copy)]
-pub(crate) struct Loc<'a> {
+pub(crate) struct ElementAt<'a> {
     pub file: &'a str,
     pub line: u32,
     pub element: &'a str,
 }
 
-impl Loc<'_> {
+impl ElementAt<'_> {
+    /// The file and line.
+    fn at(&self) -> Loc {
+        Loc::line(self.file, self.line)
+    }
+
     pub fn err(&self, message: impl Into<String>) -> SvgError {
         SvgError::Element {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             message: message.into(),
         }
@@ -204,8 +181,7 @@ impl Loc<'_> {
 
     pub fn path_data(&self, source: PathDataError) -> SvgError {
         SvgError::PathData {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             source,
         }
@@ -213,8 +189,7 @@ impl Loc<'_> {
 
     pub fn nesting_limit(&self) -> SvgError {
         SvgError::NestingLimit {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             limit: MAX_DEPTH,
         }
@@ -222,8 +197,7 @@ impl Loc<'_> {
 
     pub fn items_limit(&self) -> SvgError {
         SvgError::ItemsLimit {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             limit: MAX_ITEMS,
         }
@@ -231,8 +205,7 @@ impl Loc<'_> {
 
     pub fn href_chain_limit(&self) -> SvgError {
         SvgError::HrefChainLimit {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             limit: MAX_HREF_CHAIN,
         }
@@ -240,8 +213,7 @@ impl Loc<'_> {
 
     pub fn use_limit(&self) -> SvgError {
         SvgError::UseLimit {
-            file: self.file.to_string(),
-            line: self.line,
+            at: self.at(),
             element: self.element.to_string(),
             limit: MAX_USE_ELEMENTS,
         }
@@ -252,7 +224,7 @@ impl Loc<'_> {
 pub(crate) fn number_list(
     s: &str,
     p: Precision,
-    loc: &Loc,
+    loc: &ElementAt,
     attr: &str,
 ) -> Result<Vec<f64>, SvgError> {
     let mut out = Vec::new();
@@ -280,7 +252,7 @@ pub(crate) fn number_list(
 pub(crate) fn number_with_unit<'s>(
     s: &'s str,
     p: Precision,
-    loc: &Loc,
+    loc: &ElementAt,
     attr: &str,
 ) -> Result<(f64, &'s str), SvgError> {
     let t = s.trim();
@@ -303,7 +275,7 @@ pub(crate) fn number_with_unit<'s>(
 pub(crate) fn parse_transform(
     s: &str,
     p: Precision,
-    loc: &Loc,
+    loc: &ElementAt,
     scale_y_defaults_to_one: bool,
 ) -> Result<Mat3, SvgError> {
     let mut m = Mat3::IDENTITY;
@@ -384,8 +356,8 @@ mod tests {
     use super::*;
     use prism_math::DVec2;
 
-    fn loc() -> Loc<'static> {
-        Loc {
+    fn loc() -> ElementAt<'static> {
+        ElementAt {
             file: "t.svg",
             line: 3,
             element: "rect",

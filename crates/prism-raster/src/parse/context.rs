@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use prism_image::UvConvention;
 use roxmltree::Node;
 
-use super::common::Loc;
+use super::common::ElementAt;
 use crate::document::Document;
 
 /// Where a document came from, for resolving relative files and naming errors.
@@ -41,9 +41,9 @@ impl Ctx<'_> {
 }
 
 /// Where `node` sits in the document, for error messages.
-pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> Loc<'a> {
+pub(crate) fn element_loc<'a>(ctx: &Ctx<'a>, node: &Node<'a, 'a>) -> ElementAt<'a> {
     let source: &'a Source = ctx.source;
-    Loc {
+    ElementAt {
         file: &source.name,
         line: ctx.lines.line(node.range().start),
         element: node.tag_name().name(),

@@ -6,7 +6,7 @@ use prism_image::UvConvention;
 use prism_math::{DVec2, Rgb, Vec2};
 use roxmltree::Node;
 
-use super::common::{number_list, Loc, PlainAttribute, SvgError};
+use super::common::{number_list, ElementAt, PlainAttribute, SvgError};
 use super::context::Ctx;
 use super::images::load_texture;
 use super::number::Precision;
@@ -17,7 +17,7 @@ fn exact_numbers(
     node: &Node,
     attr: &str,
     n: usize,
-    loc: &Loc,
+    loc: &ElementAt,
     p: Precision,
 ) -> Result<Vec<f64>, SvgError> {
     let v = number_list(node.attr(attr).unwrap_or(""), p, loc, attr)?;
@@ -39,7 +39,7 @@ pub(crate) fn course_element(
     ctx: &Ctx,
     doc: &mut Document,
     textures: &mut HashMap<String, usize>,
-    loc: &Loc,
+    loc: &ElementAt,
     p: Precision,
 ) -> Result<bool, SvgError> {
     let tri = |v: &[f64]| {

@@ -9,7 +9,7 @@ use prism_math::{DVec2, Rgb};
 use roxmltree::Node;
 
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, SvgError, MAX_DEPTH,
+    number_list, number_with_unit, parse_transform, ElementAt, PlainAttribute, SvgError, MAX_DEPTH,
     MAX_ITEMS,
 };
 use super::context::{element_loc, Ctx};
@@ -32,14 +32,14 @@ pub(crate) fn hex_color(s: &str) -> Rgb {
     Rgb::new(ch(16), ch(8), ch(0))
 }
 
-fn num_attr(node: &Node, name: &str, loc: &Loc) -> Result<f64, SvgError> {
+fn num_attr(node: &Node, name: &str, loc: &ElementAt) -> Result<f64, SvgError> {
     match node.attr(name) {
         None => Ok(0.0),
         Some(s) => Ok(number_with_unit(s, P, loc, name)?.0),
     }
 }
 
-fn points_attr(node: &Node, name: &str, loc: &Loc) -> Result<Vec<DVec2>, SvgError> {
+fn points_attr(node: &Node, name: &str, loc: &ElementAt) -> Result<Vec<DVec2>, SvgError> {
     let l = number_list(node.attr(name).unwrap_or(""), P, loc, name)?;
     if l.len() % 2 != 0 {
         return Err(loc.err(format!(

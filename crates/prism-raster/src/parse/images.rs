@@ -8,7 +8,7 @@ use base64::Engine;
 use prism_image::{Texture, UvConvention};
 use roxmltree::Node;
 
-use super::common::{number_with_unit, Loc, PlainAttribute, SvgError};
+use super::common::{number_with_unit, ElementAt, PlainAttribute, SvgError};
 use super::context::Ctx;
 use super::number::Precision;
 use crate::document::{Document, Item, Mat3};
@@ -18,7 +18,7 @@ pub(crate) fn load_texture(
     ctx: &Ctx,
     doc: &mut Document,
     href: &str,
-    loc: &Loc,
+    loc: &ElementAt,
     uv: UvConvention,
 ) -> Result<usize, SvgError> {
     let key = (href.to_string(), uv);
@@ -79,7 +79,7 @@ pub(crate) fn image_item(
     transform: Mat3,
     ctx: &Ctx,
     doc: &mut Document,
-    loc: &Loc,
+    loc: &ElementAt,
     p: Precision,
 ) -> Result<Option<Item>, SvgError> {
     let href = node

@@ -16,6 +16,7 @@ mod style;
 mod svg;
 mod viewport;
 
+use prism_math::Loc;
 use std::path::Path as FsPath;
 use std::sync::Arc;
 
@@ -56,8 +57,7 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
         ..Default::default()
     };
     let xml = roxmltree::Document::parse_with_options(text, opts).map_err(|e| SvgError::Xml {
-        file: source.name.clone(),
-        line: e.pos().row,
+        at: Loc::line(&source.name, e.pos().row),
         source: e,
     })?;
     let root = xml.root_element();

@@ -7,7 +7,7 @@ use prism_math::Rgb;
 use roxmltree::Node;
 
 use super::color::parse_color;
-use super::common::{number_with_unit, Loc, PlainAttribute, SvgError};
+use super::common::{number_with_unit, ElementAt, PlainAttribute, SvgError};
 use super::number::Precision;
 use super::viewport::{length, Axis, Viewport};
 use crate::document::FillRule;
@@ -58,7 +58,7 @@ impl Default for Style {
 }
 
 /// Reads a paint: `none`, `currentColor`, `url(#id)` with an optional fallback, or a colour.
-fn parse_paint(s: &str, loc: &Loc, attr: &str) -> Result<PaintSpec, SvgError> {
+fn parse_paint(s: &str, loc: &ElementAt, attr: &str) -> Result<PaintSpec, SvgError> {
     let t = s.trim();
     if t == "none" {
         return Ok(PaintSpec::None);
@@ -90,7 +90,7 @@ fn parse_paint(s: &str, loc: &Loc, attr: &str) -> Result<PaintSpec, SvgError> {
 }
 
 /// Reads an opacity (a number or a percentage), clamped to [0, 1].
-pub(super) fn opacity_value(s: &str, loc: &Loc, attr: &str) -> Result<f32, SvgError> {
+pub(super) fn opacity_value(s: &str, loc: &ElementAt, attr: &str) -> Result<f32, SvgError> {
     let (v, unit) = number_with_unit(s, P, loc, attr)?;
     let v = match unit {
         "" => v,
@@ -124,7 +124,7 @@ pub(super) fn declarations<'a>(node: &Node<'a, 'a>) -> Vec<(String, String)> {
 pub(super) fn apply_declarations(
     style: &mut Style,
     decls: &[(String, String)],
-    loc: &Loc,
+    loc: &ElementAt,
     vp: Viewport,
 ) -> (f32, bool, Vec<(String, SvgError)>) {
     let mut opacity = 1.0;

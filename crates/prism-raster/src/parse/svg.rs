@@ -14,7 +14,7 @@ use roxmltree::Node;
 
 use super::color::parse_color;
 use super::common::{
-    number_list, number_with_unit, parse_transform, Loc, PlainAttribute, SvgError, MAX_DEPTH,
+    number_list, number_with_unit, parse_transform, ElementAt, PlainAttribute, SvgError, MAX_DEPTH,
     MAX_HREF_CHAIN, MAX_ITEMS, MAX_USE_ELEMENTS,
 };
 use super::context::{element_loc, Ctx};
@@ -251,14 +251,14 @@ impl<'a> Parser<'_, 'a> {
     ) -> Result<(), SvgError> {
         let ctx = &*self.ctx;
         let loc = element_loc(ctx, &node);
-        let loc = Loc {
+        let loc = ElementAt {
             file: loc.file,
             line: loc.line,
             element: loc.element,
         };
         // Copy the location out of the borrow of ctx.
         let (file, line, elem) = (loc.file.to_string(), loc.line, loc.element.to_string());
-        let loc = Loc {
+        let loc = ElementAt {
             file: &file,
             line,
             element: &elem,
@@ -544,7 +544,7 @@ impl<'a> Parser<'_, 'a> {
         style: &Style,
         opacity: f32,
         name: &str,
-        loc: &Loc,
+        loc: &ElementAt,
     ) -> Result<(), SvgError> {
         let fillable = name != "line";
         let fill = if fillable {
@@ -592,7 +592,7 @@ impl<'a> Parser<'_, 'a> {
         spec: &PaintSpec,
         style: &Style,
         path: &Path,
-        loc: &Loc,
+        loc: &ElementAt,
     ) -> Result<Option<(Paint, f32)>, SvgError> {
         Ok(match spec {
             PaintSpec::None => None,
@@ -629,7 +629,7 @@ impl<'a> Parser<'_, 'a> {
         &mut self,
         id: &str,
         path: &Path,
-        loc: &Loc,
+        loc: &ElementAt,
     ) -> Result<Option<Arc<Gradient>>, SvgError> {
         let Some(&node) = self.ids.get(id) else {
             return Ok(None);
@@ -667,7 +667,7 @@ impl<'a> Parser<'_, 'a> {
         let attr = |name: &str| chain.iter().find_map(|n| n.attr(name));
         let gloc = element_loc(self.ctx, &node);
         let (gfile, gline, gelem) = (gloc.file.to_string(), gloc.line, gloc.element.to_string());
-        let gloc = Loc {
+        let gloc = ElementAt {
             file: &gfile,
             line: gline,
             element: &gelem,
@@ -693,7 +693,7 @@ impl<'a> Parser<'_, 'a> {
             for s in sn.children().filter(|c| c.tag_name().name() == "stop") {
                 let sl = element_loc(self.ctx, &s);
                 let (sfile, sline) = (sl.file.to_string(), sl.line);
-                let sloc = Loc {
+                let sloc = ElementAt {
                     file: &sfile,
                     line: sline,
                     element: "stop",

@@ -36,13 +36,8 @@ fn hundred_thousand_nested_groups_are_a_located_error() {
     let text = nested("<g>", "</g>", 100_000);
     for dialect in [Dialect::Svg, Dialect::Cs184] {
         match parse(&text, dialect) {
-            Err(SvgError::NestingLimit {
-                line,
-                element,
-                limit,
-                ..
-            }) => {
-                assert_eq!((line, element.as_str(), limit), (2, "g", MAX_DEPTH));
+            Err(SvgError::NestingLimit { at, element, limit }) => {
+                assert_eq!((at.line, element.as_str(), limit), (2, "g", MAX_DEPTH));
             }
             other => panic!("{dialect:?}: expected the nesting limit, got {other:?}"),
         }
@@ -97,13 +92,8 @@ fn use_fan_out_under_the_limit_draws_every_copy() {
 fn use_fan_out_past_the_limit_is_refused() {
     let err = parse(&fan_out(30), Dialect::Svg).unwrap_err();
     match &err {
-        SvgError::UseLimit {
-            line,
-            element,
-            limit,
-            ..
-        } => assert_eq!(
-            (*line, element.as_str(), *limit),
+        SvgError::UseLimit { at, element, limit } => assert_eq!(
+            (at.line, element.as_str(), *limit),
             (20, "g", MAX_USE_ELEMENTS)
         ),
         other => panic!("expected the use limit, got {other:?}"),
@@ -124,7 +114,7 @@ fn use_cycles_are_located_errors() {
     let mutual = svg("<g id='a'><use href='#b'/></g><g id='b'><use href='#a'/></g>");
     let err = parse(&mutual, Dialect::Svg).unwrap_err();
     assert!(err.to_string().contains("leads back"), "{err}");
-    assert_eq!(err.line(), 2);
+    assert_eq!(err.at().line, 2);
     let unused = svg("<defs><g id='a'><use href='#b'/></g><g id='b'><use href='#a'/></g></defs>");
     assert!(parse(&unused, Dialect::Svg).unwrap().items.is_empty());
 }

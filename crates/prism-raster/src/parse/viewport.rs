@@ -3,7 +3,7 @@
 
 use roxmltree::Node;
 
-use super::common::{number_list, number_with_unit, Loc, PlainAttribute, SvgError};
+use super::common::{number_list, number_with_unit, ElementAt, PlainAttribute, SvgError};
 use super::number::Precision;
 use crate::document::Mat3;
 
@@ -41,7 +41,7 @@ pub(super) enum Axis {
 /// `%` of the viewport along `axis`) into user units.
 pub(super) fn length(
     s: &str,
-    loc: &Loc,
+    loc: &ElementAt,
     attr: &str,
     vp: Viewport,
     axis: Axis,
@@ -73,7 +73,7 @@ pub(super) fn length(
 /// `None` without a `viewBox`.
 pub(super) fn view_box_transform(
     node: &Node,
-    loc: &Loc,
+    loc: &ElementAt,
     w: f64,
     h: f64,
 ) -> Result<Option<Mat3>, SvgError> {

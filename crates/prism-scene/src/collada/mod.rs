@@ -33,6 +33,7 @@ mod to_scene;
 mod writer;
 mod xml;
 
+use prism_math::Loc;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -273,8 +274,7 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
         }
         if placed > MAX_PLACED_FACES {
             return Err(SceneError::Element {
-                file: file.to_string(),
-                line: n.line,
+                at: Loc::line(file, n.line),
                 element: "node".into(),
                 message: format!(
                     "the instances place more than {MAX_PLACED_FACES} polygons in the world"

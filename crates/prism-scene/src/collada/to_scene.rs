@@ -11,6 +11,7 @@
 //! - The camera is placed by the course's rule unless the file's own camera is asked for.
 
 use prism_math::glam::{DMat4, DVec3, DVec4};
+use prism_math::Loc;
 use prism_math::{Rgb, Vec3};
 use prism_mesh::vertex_normals_area_weighted;
 
@@ -50,8 +51,7 @@ impl Scene {
         });
         scene.warnings.clone_from(&doc.warnings);
         let err = |line: u32, element: &str, message: String| SceneError::Element {
-            file: file.to_string(),
-            line,
+            at: Loc::line(file, line),
             element: element.to_string(),
             message,
         };
@@ -264,8 +264,7 @@ fn effect_material_of(effect: &EffectDef, file: &str) -> Result<Material, SceneE
         return Ok(effect.material.clone());
     };
     let located = |message: String| SceneError::Element {
-        file: file.to_string(),
-        line: *line,
+        at: Loc::line(file, *line),
         element: "texture".to_string(),
         message,
     };

@@ -1,6 +1,7 @@
 //! Reading values out of the XML tree: located errors ([`Cx`]), child lookup, `#id`
 //! references, and the numbers and indices in an element's text.
 
+use prism_math::Loc;
 use roxmltree::Node as XmlNode;
 
 use crate::error::SceneError;
@@ -22,8 +23,7 @@ impl Cx<'_, '_> {
     /// A [`SceneError::Element`] at `n`.
     pub(super) fn err(&self, n: XmlNode, message: impl Into<String>) -> SceneError {
         SceneError::Element {
-            file: self.file.to_string(),
-            line: self.line(n),
+            at: Loc::line(self.file, self.line(n)),
             element: n.tag_name().name().to_string(),
             message: message.into(),
         }

@@ -9,6 +9,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
+use prism_math::Loc;
 use prism_math::{Rgb, Vec2, Vec3};
 use prism_mesh::obj::{Corner, Marker, MarkerKind, ObjDocument};
 pub use prism_mesh::obj::{ObjOptions, MAX_FACE_CORNERS};
@@ -50,11 +51,13 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
 pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
     let bytes = read_bytes(path)?;
     String::from_utf8(bytes).map_err(|e| SceneError::Line {
-        file: path.display().to_string(),
-        line: 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count() as u32,
+        at: Loc::line(
+            &path.display().to_string(),
+            1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count() as u32,
+        ),
         message: "expected UTF-8 text".into(),
     })
 }
@@ -83,8 +86,7 @@ impl Materials {
         companions: &Companions<'_>,
     ) -> Result<bool, SceneError> {
         let err = |message: String| SceneError::Line {
-            file: file.to_string(),
-            line: m.line,
+            at: Loc::line(file, m.line),
             message,
         };
         match &m.kind {
@@ -183,8 +185,7 @@ pub fn parse_obj_scene(
             let need = triangle_count * size_of::<[Corner; 3]>() as u64;
             let over = prism_math::limits::check_memory(need).expect_err("over the budget");
             return Err(SceneError::Line {
-                file: file.to_string(),
-                line: face.line,
+                at: Loc::line(file, face.line),
                 message: format!("f: storing the faces {over}"),
             });
         }
@@ -276,8 +277,7 @@ fn to_material(
                 std::collections::hash_map::Entry::Occupied(e) => Arc::clone(e.get()),
                 std::collections::hash_map::Entry::Vacant(slot) => {
                     let located = |message: String| SceneError::Line {
-                        file: m.file.clone(),
-                        line: *line,
+                        at: Loc::line(&m.file.clone(), *line),
                         message,
                     };
                     let bytes = companions(name).map_err(|e| {

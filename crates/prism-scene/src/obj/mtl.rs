@@ -1,6 +1,7 @@
 //! Wavefront MTL material libraries as the Delft ray tracer reads them: `newmtl`, `Kd`,
 //! `Ks`, `Ns`, `d` and `map_Kd`; every other statement is read past.
 
+use prism_math::Loc;
 use prism_math::Rgb;
 
 use prism_mesh::obj::statements;
@@ -35,8 +36,7 @@ pub(crate) fn parse_mtl(text: &str, file: &str) -> Result<Vec<MtlMaterial>, Scen
     for st in statements(text) {
         let (line, key, content) = (st.line, st.key, st.content);
         let err = |message: String| SceneError::Line {
-            file: file.to_string(),
-            line: st.line,
+            at: Loc::line(file, st.line),
             message,
         };
         let mut words = content.split_whitespace().skip(1);
