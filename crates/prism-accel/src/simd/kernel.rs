@@ -110,6 +110,7 @@ impl Kernel for Avx {
     }
 }
 
+/// AVX-512VL has AVX2 and FMA: `Wide` walks use [`Avx`]'s set-up and node tests.
 #[cfg(target_arch = "x86_64")]
 impl Kernel for Wide {
     const AVX: bool = true;
@@ -117,14 +118,11 @@ impl Kernel for Wide {
 
     #[inline(always)]
     fn set_up(ray: &Ray) -> (RayPre, SlabRay) {
-        // SAFETY: `Wide` is named only in walks compiled for AVX-512VL (which has AVX2 and
-        // FMA), which their callers enter after detecting it.
-        unsafe { set_up_avx(ray) }
+        Avx::set_up(ray)
     }
 
     #[inline(always)]
     fn node_hit(n: &Node8, r: &SlabRay, tmin: f32, tmax: f32, fused: bool) -> ([f32; 8], u32) {
-        // SAFETY: as in `set_up`; the walks set `fused` only for a fused ray.
-        unsafe { node_hit_avx(n, r, tmin, tmax, fused) }
+        Avx::node_hit(n, r, tmin, tmax, fused)
     }
 }
