@@ -98,8 +98,8 @@ impl Kernel for Avx {
 
     #[inline(always)]
     fn set_up(ray: &Ray) -> (RayPre, SlabRay) {
-        // SAFETY: `Avx` is named only in walks compiled for AVX2 and FMA, which their
-        // callers enter after detecting them.
+        // SAFETY: `Avx` and `Wide` are named only in walks compiled for AVX2 and FMA (or
+        // AVX-512VL, which implies them), which their callers enter after detecting them.
         unsafe { set_up_avx(ray) }
     }
 
