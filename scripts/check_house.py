@@ -4,6 +4,7 @@ that imports it back (through any chain), no `std::arch` outside a crate's `simd
 no source file over 1,000 lines outside tests. Prints every breach and exits 1 if there is one.
 
 Usage: python3 scripts/check_house.py [workspace root]
+       python3 scripts/check_house.py --self-test   (the checks against small trees made to break them)
 """
 import os
 import re
@@ -162,8 +163,8 @@ def cycles(graph):
     return out
 
 
-def main():
-    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
+def problems_in(root):
+    """Every breach of the rules in the workspace at `root`."""
     crates = os.path.join(root, "crates")
     problems = []
     for crate in sorted(os.listdir(crates)):
@@ -183,6 +184,51 @@ def main():
             lines = text.count("\n")
             if lines > MAX_LINES and module[-1:] != ("tests",):
                 problems.append(f"{crate}/src/{rel}: {lines} lines (at most {MAX_LINES})")
+    return problems
+
+
+def self_test():
+    """Each rule against a tree that breaks it and one that keeps it."""
+    import tempfile
+
+    def tree(files):
+        root = tempfile.mkdtemp()
+        for rel, text in files.items():
+            path = os.path.join(root, "crates", "c", "src", rel)
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(text)
+        return root
+
+    clean = {
+        "lib.rs": "mod a;\nmod b;\nmod simd;\n",
+        "a.rs": "use crate::b::B;\n// std::arch in a comment\n",
+        "b.rs": "pub struct B;\n#[cfg(test)]\nmod tests {\n    use crate::a;\n    fn f() { std::arch::x86_64::_mm_pause() }\n}\n",
+        "simd/mod.rs": "use std::arch::x86_64::*;\n",
+    }
+    assert problems_in(tree(clean)) == [], problems_in(tree(clean))
+    circle = dict(clean, **{"b.rs": "use crate::a::{self, X};\npub struct B;\n"})
+    assert any("circle: a.rs, b.rs" in p for p in problems_in(tree(circle)))
+    through_reexport = dict(clean, **{
+        "lib.rs": "mod a;\nmod b;\npub use b::B;\n",
+        "a.rs": "use crate::B;\npub struct A;\n",
+        "b.rs": "use super::a::A;\npub struct B;\n",
+    })
+    assert any("circle" in p for p in problems_in(tree(through_reexport)))
+    arch = dict(clean, **{"a.rs": "fn f() { unsafe { std::arch::x86_64::_mm_pause() } }\n"})
+    assert problems_in(tree(arch)) == ["c/src/a.rs: uses std::arch outside simd/"]
+    long = dict(clean, **{"a.rs": "fn f() {}\n" * (MAX_LINES + 1)})
+    assert problems_in(tree(long)) == [f"c/src/a.rs: {MAX_LINES + 1} lines (at most {MAX_LINES})"]
+    print("self-test passed")
+
+
+def main():
+    if sys.argv[1:] == ["--self-test"]:
+        self_test()
+        return
+    root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
+    crates = os.path.join(root, "crates")
+    problems = problems_in(root)
     for problem in problems:
         print(problem)
     if problems:
