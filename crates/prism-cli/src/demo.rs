@@ -224,7 +224,7 @@ fn write_shaded(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -
         wire_width: if m.triangles.len() > 1000 { 0.3 } else { 0.75 },
     };
     let img = prism_shade::shade(&m, &view, &prism_shade::Shader::Phong, &u, &opts)
-        .map_err(|e| crate::UserError(e.to_string()))?;
+        .map_err(|e| crate::error::UserError(e.to_string()))?;
     prism_image::write_png(out, &prism_shade::to_bytes(&img))
         .with_context(|| format!("writing {}", out.display()))
 }
@@ -415,13 +415,14 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     }
     let bunny = a.assets.join("pathtracer/dae/sky/CBbunny.dae");
     if bunny.is_file() {
-        let doc = prism_scene::read_collada(&bunny).map_err(|e| crate::UserError(e.to_string()))?;
+        let doc = prism_scene::read_collada(&bunny)
+            .map_err(|e| crate::error::UserError(e.to_string()))?;
         let scene = prism_scene::Scene::from_collada(
             &doc,
             &prism_scene::SceneOptions::default(),
             &bunny.display().to_string(),
         )
-        .map_err(|e| crate::UserError(e.to_string()))?;
+        .map_err(|e| crate::error::UserError(e.to_string()))?;
         trace(&scene, &base, &a.output.join("render_bunny.png"), None)?;
         entries.push(Entry {
             file: "render_bunny.png".into(),
@@ -433,13 +434,14 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     prism_image::write_exr(&a.output.join("sky.exr"), &sky)?;
     let unlit = a.assets.join("pathtracer/dae/sky/bunny_unlit.dae");
     if unlit.is_file() {
-        let doc = prism_scene::read_collada(&unlit).map_err(|e| crate::UserError(e.to_string()))?;
+        let doc = prism_scene::read_collada(&unlit)
+            .map_err(|e| crate::error::UserError(e.to_string()))?;
         let mut scene = prism_scene::Scene::from_collada(
             &doc,
             &prism_scene::SceneOptions::default(),
             &unlit.display().to_string(),
         )
-        .map_err(|e| crate::UserError(e.to_string()))?;
+        .map_err(|e| crate::error::UserError(e.to_string()))?;
         scene.lights = vec![prism_scene::Light::EnvironmentMap {
             radiance: std::sync::Arc::new(sky),
         }];
@@ -536,7 +538,7 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         seed: 0,
     };
     let cam = OrbitCamera::default();
-    let user = |e: prism_scene::SceneError| crate::UserError(e.to_string());
+    let user = |e: prism_scene::SceneError| crate::error::UserError(e.to_string());
     let write = |name: &str, img: &prism_image::RgbImage| {
         prism_image::write_png(&a.output.join(name), &img.to_rgb8_truncated())
             .with_context(|| format!("writing {name}"))
@@ -684,7 +686,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         return Ok(());
     }
     let (w, h) = (240u32, 188u32);
-    let user = |e: prism_cloth::ClothError| crate::UserError(e.to_string());
+    let user = |e: prism_cloth::ClothError| crate::error::UserError(e.to_string());
     let run = |name: &str, set: &[String], frames: u32| -> Result<prism_cloth::Cloth> {
         let scene =
             prism_cloth::read_scene(&scenes.join(format!("{name}.json")), set).map_err(user)?;
@@ -707,7 +709,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
             &prism_shade::Uniforms::default(),
             &prism_shade::ShadeOptions::default(),
         )
-        .map_err(|e| crate::UserError(e.to_string()).into())
+        .map_err(|e| crate::error::UserError(e.to_string()).into())
     };
     let frames = 90;
     let save = |name: &str, panels: &[prism_image::RgbImage], cols: usize| -> Result<()> {

@@ -17,9 +17,9 @@ use prism_render::whitted::scene::WhittedScene;
 use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
 
+use crate::error::UserError;
 use crate::output::write_text;
 use crate::output::{image_output, ImageFormat};
-use crate::UserError;
 
 /// Arguments of `prism raytrace`.
 #[derive(Args, Debug)]

@@ -12,7 +12,7 @@ use prism_render::render::{render, render_share, Job, RenderOptions};
 use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// The estimator.
 #[derive(Clone, Copy, Debug, ValueEnum)]

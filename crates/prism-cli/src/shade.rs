@@ -9,8 +9,8 @@ use clap::{Args, ValueEnum};
 use prism_math::{Rgb, Vec3};
 use prism_shade::{course_texture, shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
+use crate::error::UserError;
 use crate::output::{image_output, ImageFormat};
-use crate::UserError;
 
 /// The shader.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

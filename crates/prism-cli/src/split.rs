@@ -11,8 +11,8 @@ use prism_math::Rgb;
 use prism_render::film::PixelSum;
 use prism_render::parts::{merge, Part, PartFile};
 
+use crate::error::UserError;
 use crate::output::ImageFormat;
-use crate::UserError;
 
 /// The colour merged pictures give pixels that no part held (with `--allow-missing`).
 const HOLE: Rgb = Rgb {

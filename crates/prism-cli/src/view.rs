@@ -16,7 +16,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key as WinitKey, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// What the file is viewed as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
