@@ -9,9 +9,11 @@ use clap::Args;
 use prism_image::Bloom;
 use prism_math::Rgb;
 use prism_render::film::Share;
-use prism_render::parts::Part;
+use prism_render::parts::{Part, PartIdentity};
 use prism_render::whitted::camera::OrbitView;
-use prism_render::whitted::film::{raytrace, raytrace_share, trace_pixel, RaytraceOptions};
+use prism_render::whitted::film::{
+    rays_per_pixel, raytrace, raytrace_share, trace_pixel, RaytraceOptions,
+};
 use prism_render::whitted::overlay::Overlay;
 use prism_render::whitted::scene::WhittedScene;
 use prism_render::whitted::tracer::WhittedSettings;
@@ -471,17 +473,12 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let mut render_time = std::time::Duration::ZERO;
     let mut write_time = std::time::Duration::ZERO;
     if let Some((part, parts)) = a.tile {
-        let fingerprint = format!("{:016x}", loaded.scene.fingerprint());
+        let fingerprint = loaded.scene.fingerprint();
         for (ci, camera) in loaded.cameras.iter().enumerate() {
-            let rays = if opts.settings.features.multiple_rays_per_pixel {
-                opts.spp.max(1)
-            } else {
-                1
-            };
             let share = Share {
                 part,
                 parts,
-                samples: 0..rays,
+                samples: 0..rays_per_pixel(&opts),
             };
             let bar = crate::progress::bar(u64::from(h), "raytrace", a.quiet);
             let (sums, _) = pool.install(|| {
@@ -490,24 +487,8 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
                 })
             });
             bar.finish_and_clear();
-            let bloom = opts.settings.features.bloom.then_some(&opts.bloom);
-            let identity = [
-                ("kind", "raytrace".to_string()),
-                ("version", env!("CARGO_PKG_VERSION").to_string()),
-                ("scene", fingerprint.clone()),
-                ("camera", format!("{camera:?}")),
-                ("width", w.to_string()),
-                ("height", h.to_string()),
-                ("spp", rays.to_string()),
-                ("settings", format!("{:?}", opts.settings)),
-                ("bloom", crate::split::bloom_setting(bloom)),
-                ("seed", opts.seed.to_string()),
-                ("encoding", "truncated".to_string()),
-            ]
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect();
-            let part = Part::new(identity, share, sums);
+            let identity = PartIdentity::whitted(fingerprint, camera, &opts);
+            let part = Part::new(identity.to_attributes(), share, sums);
             crate::split::write_part(&part, &numbered(&a.output, ci, n), a.quiet, t0)?;
         }
         return Ok(());

@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_render::film::{FilmSettings, Share};
 use prism_render::integrators::{Integrator, PathSettings};
-use prism_render::parts::Part;
+use prism_render::parts::{Part, PartIdentity};
 use prism_render::render::{render, render_share, Job, RenderOptions};
 use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
@@ -181,46 +181,6 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
         parts,
         samples: from..to,
     }))
-}
-
-/// Every setting of `opts` and `a` that changes pixels, by name, for a part file; the scene,
-/// with its camera, lens, normals and lights, is in its fingerprint.
-fn identity(scene: &prism_scene::Scene, opts: &RenderOptions) -> Vec<(String, String)> {
-    let integrator = match opts.path.integrator {
-        // Both give the same bytes.
-        Integrator::Path | Integrator::PathScalar => "path".to_string(),
-        Integrator::Direct { hemisphere } => format!("direct hemisphere={hemisphere}"),
-        Integrator::Normals => "normals".to_string(),
-    };
-    let opt = |v: Option<String>| v.unwrap_or_else(|| "off".into());
-    [
-        ("kind", "render".to_string()),
-        ("version", env!("CARGO_PKG_VERSION").to_string()),
-        ("scene", format!("{:016x}", scene.fingerprint())),
-        ("width", opts.film.width.to_string()),
-        ("height", opts.film.height.to_string()),
-        ("spp", opts.film.spp.to_string()),
-        ("light_samples", opts.path.light_samples.to_string()),
-        ("max_bounces", opts.path.max_bounces.to_string()),
-        ("integrator", integrator),
-        (
-            "only_bounce",
-            opt(opts.path.only_bounce.map(|m| m.to_string())),
-        ),
-        (
-            "adaptive",
-            opt(opts
-                .film
-                .adaptive
-                .map(|t| format!("{t} batch={}", opts.film.batch))),
-        ),
-        ("rr_bounces", opts.path.rr_bounces.to_string()),
-        ("seed", opts.film.seed.to_string()),
-        ("encoding", "srgb".to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect()
 }
 
 /// Samples between adaptive-sampling checks when --batch is not given.
@@ -511,9 +471,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bar.finish_and_clear();
         let t3 = Instant::now();
         let fingerprint = Instant::now();
-        let identity = identity(&scene, &options);
+        let identity = PartIdentity::path(scene.fingerprint(), &options);
         let fingerprint = fingerprint.elapsed();
-        let part = Part::new(identity, share, sums);
+        let part = Part::new(identity.to_attributes(), share, sums);
         crate::split::write_part(&part, &a.output, a.quiet, t0)?;
         if a.stats {
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
