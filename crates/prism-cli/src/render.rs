@@ -361,47 +361,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     scene.camera.lens = thin_lens(a, &scene.camera)?;
     if let Some(path) = &a.envmap {
         let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
-        // Radiance is finite, non-negative and within what a sample may carry: a NaN, a
-        // negative texel or one of 2^55 or more would make a wrong picture (the renderer
-        // counts such samples as black), so it is refused by position.
-        let limit = prism_math::ExactSum::LIMIT;
-        let within = |v: f32| (0.0..limit).contains(&v);
-        if let Some(i) = map
-            .pixels()
-            .iter()
-            .position(|p| !(within(p.r) && within(p.g) && within(p.b)))
-        {
-            let (x, y) = (i as u32 % map.width(), i as u32 / map.width());
-            return Err(UserError(format!(
-                "--envmap {}: texel ({x}, {y}) is {:?}; expected finite, non-negative radiance \
-                 below 2^55",
-                path.display(),
-                map.get(x, y)
-            ))
-            .into());
-        }
-        let infinite = |l: &prism_scene::Light| {
-            matches!(
-                l,
-                prism_scene::Light::Hemisphere { .. }
-                    | prism_scene::Light::Environment { .. }
-                    | prism_scene::Light::EnvironmentMap { .. }
-            )
-        };
-        if scene
-            .lights
-            .iter()
-            .any(|l| infinite(l) && l.gives_off_light())
-        {
+        let replaced = scene
+            .light_by_environment_map(std::sync::Arc::new(map))
+            .map_err(|e| UserError(format!("--envmap {}: {e}", path.display())))?;
+        if replaced {
             scene.warnings.push(format!(
                 "--envmap replaces the scene's hemisphere or environment light with {}",
                 path.display()
             ));
         }
-        scene.lights.retain(|l| !infinite(l));
-        scene.lights.push(prism_scene::Light::EnvironmentMap {
-            radiance: std::sync::Arc::new(map),
-        });
     }
     if !scene.is_lit() {
         let name = a
