@@ -203,14 +203,16 @@ fn write_shaded(mesh: &prism_mesh::PolyMesh, size: u32, out: &std::path::Path) -
     }
     let r = (hi - lo).length() * 0.5;
     let dir = prism_math::Vec3::new(0.35, 0.45, 1.0).normalize();
-    let view = prism_shade::View {
-        eye: centre + dir * (r / (22.5f32.to_radians().sin()) * 1.05),
-        target: centre,
-        up: prism_math::Vec3::Y,
-        fov_y: 45.0,
-        width: size,
-        height: size,
-    };
+    let view = prism_shade::View::fit(
+        centre,
+        r,
+        dir,
+        prism_math::Vec3::Y,
+        45.0,
+        size,
+        size,
+        prism_shade::Framing::Vertical { margin: 1.05 },
+    );
     let u = prism_shade::Uniforms {
         light_pos: centre + prism_math::Vec3::new(2.0, 3.0, 4.0) * r,
         light_intensity: prism_math::Rgb::splat((29.0f32 * r * r).max(1e-6)),
