@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use base64::Engine;
 use clap::Args;
-use prism_image::{encode_png, Image, LevelSampling, PixelSampling};
+use prism_image::{encode_png, montage, Image, LevelSampling, PixelSampling};
 use prism_raster::{parse_svg, render, Dialect, RasterOptions, Source};
 use prism_render::film::FilmSettings;
 use prism_render::integrators::PathSettings;
@@ -505,18 +505,6 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     Ok(())
 }
 
-/// Panels side by side (all the same size) in one picture, `cols` to a row.
-fn montage(panels: &[prism_image::RgbImage], cols: usize) -> prism_image::RgbImage {
-    let (w, h) = (panels[0].width(), panels[0].height());
-    let rows = panels.len().div_ceil(cols);
-    Image::from_fn(w * cols as u32, h * rows as u32, |x, y| {
-        let i = (y / h) as usize * cols + (x / w) as usize;
-        panels
-            .get(i)
-            .map_or(prism_math::Rgb::BLACK, |p| p.get(x % w, y % h))
-    })
-}
-
 /// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
 /// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
 fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
@@ -554,7 +542,10 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         panels.push(raytrace(&ws, &cam, &opts(200, on), &|_| {}).image);
         names.push(p.name());
     }
-    write("raytrace_presets.png", &montage(&panels, 3))?;
+    write(
+        "raytrace_presets.png",
+        &montage(&panels, 3, prism_math::Rgb::BLACK),
+    )?;
     entries.push(Entry {
         file: "raytrace_presets.png".into(),
         caption: format!("prism raytrace presets: {}", names.join(", ")),
@@ -592,7 +583,10 @@ fn raytrace_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
         .iter()
         .map(|(_, f)| raytrace(&ws, &cam, &opts(200, *f), &|_| {}).image)
         .collect();
-    write("raytrace_toggles.png", &montage(&panels, 4))?;
+    write(
+        "raytrace_toggles.png",
+        &montage(&panels, 4, prism_math::Rgb::BLACK),
+    )?;
     entries.push(Entry {
         file: "raytrace_toggles.png".into(),
         caption: format!(
@@ -715,7 +709,7 @@ fn cloth_gallery(a: &DemoArgs, entries: &mut Vec<Entry>) -> Result<()> {
     };
     let frames = 90;
     let save = |name: &str, panels: &[prism_image::RgbImage], cols: usize| -> Result<()> {
-        let img = montage(panels, cols);
+        let img = montage(panels, cols, prism_math::Rgb::BLACK);
         prism_image::write_png(&a.output.join(name), &prism_shade::to_bytes(&img))
             .with_context(|| format!("writing {name}"))
     };
