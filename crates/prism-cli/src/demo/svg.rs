@@ -135,6 +135,7 @@ fn group_svg() -> String {
     s
 }
 
+/// Rasterizes `svg` and writes it over white to the PNG `out`.
 fn draw(svg: &str, dialect: Dialect, opts: &RasterOptions, out: &Path) -> Result<()> {
     let doc = parse_svg(
         svg,
