@@ -9,8 +9,8 @@ use prism_math::DVec2;
 use prism_mesh::{parse_bez, parse_bzc, tessellate};
 use prism_raster::de_casteljau_construction;
 
+use crate::error::UserError;
 use crate::output::ImageFormat;
-use crate::UserError;
 
 /// Arguments of `prism bezier`.
 #[derive(Args, Debug)]

@@ -12,9 +12,9 @@ use prism_cloth::{
 use prism_mesh::obj::{Corner, NumberStyle, ObjWriter};
 use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms};
 
+use crate::error::UserError;
 use crate::output::write_text;
 use crate::shade::ShaderArg;
-use crate::UserError;
 
 /// Arguments of `prism cloth`.
 #[derive(Args, Debug)]

@@ -3,6 +3,7 @@
 mod bezier;
 mod cloth;
 mod demo;
+mod error;
 mod interrupt;
 mod mesh;
 mod output;
@@ -18,6 +19,8 @@ mod view;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use crate::error::{error_chain, UserError};
 
 /// A computer-graphics toolkit on the CPU: SVG rasterization, mesh editing, path tracing.
 #[derive(Parser)]
@@ -55,33 +58,6 @@ enum Command {
     View(view::ViewArgs),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
     Demo(demo::DemoArgs),
-}
-
-/// An error the user caused (bad input or arguments): exit code 2.
-#[derive(Debug)]
-pub struct UserError(pub String);
-
-impl std::fmt::Display for UserError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for UserError {}
-
-/// An error and its causes on one line, `a: b: c`, leaving out a cause whose text the line
-/// already holds (library errors often show their source in their own message).
-fn error_chain(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut line = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let text = c.to_string();
-        if !line.contains(&text) {
-            line = format!("{line}: {text}");
-        }
-        cause = c.source();
-    }
-    line
 }
 
 fn main() -> ExitCode {

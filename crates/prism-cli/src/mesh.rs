@@ -8,7 +8,7 @@ use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
 use prism_mesh::{loop_subdivide, HalfedgeMesh, LoopWeights, PolyMesh, TopologyError};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// Arguments of `prism mesh`.
 #[derive(Args, Debug)]

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use prism_scene::MeshFormat;
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// An image file format prism writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -7,19 +7,20 @@ use std::time::Instant;
 use anyhow::Result;
 use clap::Args;
 use prism_image::Bloom;
-use prism_math::Rgb;
 use prism_render::film::Share;
-use prism_render::parts::Part;
+use prism_render::parts::{Part, PartIdentity};
 use prism_render::whitted::camera::OrbitView;
-use prism_render::whitted::film::{raytrace, raytrace_share, trace_pixel, RaytraceOptions};
+use prism_render::whitted::film::{
+    rays_per_pixel, raytrace, raytrace_share, trace_pixel, RaytraceOptions,
+};
 use prism_render::whitted::overlay::Overlay;
 use prism_render::whitted::scene::WhittedScene;
 use prism_render::whitted::tracer::WhittedSettings;
-use prism_scene::{Features, OrbitCamera, Preset, RenderConfig, SceneSource};
+use prism_scene::{Features, OrbitCamera};
 
+use crate::error::UserError;
 use crate::output::write_text;
 use crate::output::{image_output, ImageFormat};
-use crate::UserError;
 
 /// Arguments of `prism raytrace`.
 #[derive(Args, Debug)]
@@ -136,14 +137,6 @@ fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()>
     Ok(())
 }
 
-/// The staged data folder, when prism runs from its source tree.
-fn staged_data() -> PathBuf {
-    let dir =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data");
-    // Messages name the folder plainly, not through the crate's own folder and back.
-    std::fs::canonicalize(&dir).unwrap_or(dir)
-}
-
 /// The output path for camera `i` of `n`: the path itself for one camera, else
 /// `STEM-i.EXT`.
 fn numbered(path: &Path, i: usize, n: usize) -> PathBuf {
@@ -196,86 +189,6 @@ fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
         Vec::new()
     };
     crate::output::check_distinct(&inputs, &outputs)
-}
-
-/// What the command loads: the scene, its cameras, the config if any.
-pub struct Loaded {
-    /// The scene.
-    pub scene: prism_scene::Scene,
-    /// The config's cameras (one default camera without a config).
-    pub cameras: Vec<OrbitCamera>,
-    /// The features that start on.
-    pub features: Features,
-    /// The config's window size.
-    pub window: Option<[u32; 2]>,
-}
-
-fn load(a: &RaytraceArgs) -> Result<Loaded> {
-    load_scene(&a.scene, a.data.as_ref())
-}
-
-/// Loads a Delft scene: a preset name, an OBJ scene (lit by a point light at (-1, 1, -1)) or
-/// a TOML render config; preset OBJ files come from `data`, else the staged folder, else
-/// the copies built in.
-pub fn load_scene(name: &str, data: Option<&PathBuf>) -> Result<Loaded> {
-    let user = |e: prism_scene::SceneError| anyhow::Error::from(UserError(e.to_string()));
-    let mut dirs = Vec::new();
-    if let Some(d) = data {
-        if !d.is_dir() {
-            return Err(UserError(format!("--data {}: expected a folder", d.display())).into());
-        }
-        dirs.push(d.clone());
-    }
-    dirs.push(staged_data());
-    let lower = name.to_ascii_lowercase();
-    if lower.ends_with(".toml") {
-        let cfg: RenderConfig = prism_scene::read_render_config(Path::new(&name)).map_err(user)?;
-        for w in &cfg.warnings {
-            eprintln!("prism: warning: {w}");
-        }
-        if data.is_some() && cfg.data_path.is_some() {
-            eprintln!("prism: warning: --data has no effect: the config's data_path is used");
-        }
-        let scene = cfg.load_scene(&dirs).map_err(user)?;
-        if matches!(cfg.scene, SceneSource::File(_)) && cfg.lights.is_empty() {
-            eprintln!("prism: warning: {}: the scene is an OBJ and the config has no [[lights]]; it renders black under shading", cfg.file);
-        }
-        let cameras = if cfg.cameras.is_empty() {
-            vec![OrbitCamera::default()]
-        } else {
-            cfg.cameras.clone()
-        };
-        return Ok(Loaded {
-            scene,
-            cameras,
-            features: cfg.features,
-            window: cfg.window_size,
-        });
-    }
-    let scene = if lower.ends_with(".obj") {
-        let mut s = prism_scene::read_obj_scene(Path::new(&name), false).map_err(user)?;
-        s.lights = vec![prism_scene::Light::Point {
-            position: prism_math::Vec3::new(-1.0, 1.0, -1.0),
-            intensity: Rgb::WHITE,
-        }];
-        s
-    } else {
-        let preset = Preset::from_name(name).ok_or_else(|| {
-            let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
-            UserError(format!(
-                "{}: expected a preset ({}), an .obj scene or a .toml config",
-                name,
-                names.join(", ")
-            ))
-        })?;
-        preset.load(&dirs).map_err(user)?
-    };
-    Ok(Loaded {
-        scene,
-        cameras: vec![OrbitCamera::default()],
-        features: Features::prism_defaults(),
-        window: None,
-    })
 }
 
 /// Runs `prism raytrace`.
@@ -354,7 +267,10 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         crate::split::check_part_output(&a.output, &pictures)?;
     }
     let t0 = Instant::now();
-    let loaded = load(a)?;
+    let loaded = prism_scene::load_delft(&a.scene, a.data.as_deref(), &mut |w| {
+        eprintln!("prism: warning: {w}");
+    })
+    .map_err(|e| UserError(e.to_string()))?;
     let mut features = loaded.features;
     for n in &a.enable {
         set_feature(&mut features, n, true, "--enable")?;
@@ -471,17 +387,12 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let mut render_time = std::time::Duration::ZERO;
     let mut write_time = std::time::Duration::ZERO;
     if let Some((part, parts)) = a.tile {
-        let fingerprint = format!("{:016x}", loaded.scene.fingerprint());
+        let fingerprint = loaded.scene.fingerprint();
         for (ci, camera) in loaded.cameras.iter().enumerate() {
-            let rays = if opts.settings.features.multiple_rays_per_pixel {
-                opts.spp.max(1)
-            } else {
-                1
-            };
             let share = Share {
                 part,
                 parts,
-                samples: 0..rays,
+                samples: 0..rays_per_pixel(&opts),
             };
             let bar = crate::progress::bar(u64::from(h), "raytrace", a.quiet);
             let (sums, _) = pool.install(|| {
@@ -490,24 +401,8 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
                 })
             });
             bar.finish_and_clear();
-            let bloom = opts.settings.features.bloom.then_some(&opts.bloom);
-            let identity = [
-                ("kind", "raytrace".to_string()),
-                ("version", env!("CARGO_PKG_VERSION").to_string()),
-                ("scene", fingerprint.clone()),
-                ("camera", format!("{camera:?}")),
-                ("width", w.to_string()),
-                ("height", h.to_string()),
-                ("spp", rays.to_string()),
-                ("settings", format!("{:?}", opts.settings)),
-                ("bloom", crate::split::bloom_setting(bloom)),
-                ("seed", opts.seed.to_string()),
-                ("encoding", "truncated".to_string()),
-            ]
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect();
-            let part = Part::new(identity, share, sums);
+            let identity = PartIdentity::whitted(fingerprint, camera, &opts);
+            let part = Part::new(identity.to_attributes(), share, sums);
             crate::split::write_part(&part, &numbered(&a.output, ci, n), a.quiet, t0)?;
         }
         return Ok(());

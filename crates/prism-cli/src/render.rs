@@ -7,12 +7,12 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_render::film::{FilmSettings, Share};
 use prism_render::integrators::{Integrator, PathSettings};
-use prism_render::parts::Part;
+use prism_render::parts::{Part, PartIdentity};
 use prism_render::render::{render, render_share, Job, RenderOptions};
 use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// The estimator.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -181,46 +181,6 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
         parts,
         samples: from..to,
     }))
-}
-
-/// Every setting of `opts` and `a` that changes pixels, by name, for a part file; the scene,
-/// with its camera, lens, normals and lights, is in its fingerprint.
-fn identity(scene: &prism_scene::Scene, opts: &RenderOptions) -> Vec<(String, String)> {
-    let integrator = match opts.path.integrator {
-        // Both give the same bytes.
-        Integrator::Path | Integrator::PathScalar => "path".to_string(),
-        Integrator::Direct { hemisphere } => format!("direct hemisphere={hemisphere}"),
-        Integrator::Normals => "normals".to_string(),
-    };
-    let opt = |v: Option<String>| v.unwrap_or_else(|| "off".into());
-    [
-        ("kind", "render".to_string()),
-        ("version", env!("CARGO_PKG_VERSION").to_string()),
-        ("scene", format!("{:016x}", scene.fingerprint())),
-        ("width", opts.film.width.to_string()),
-        ("height", opts.film.height.to_string()),
-        ("spp", opts.film.spp.to_string()),
-        ("light_samples", opts.path.light_samples.to_string()),
-        ("max_bounces", opts.path.max_bounces.to_string()),
-        ("integrator", integrator),
-        (
-            "only_bounce",
-            opt(opts.path.only_bounce.map(|m| m.to_string())),
-        ),
-        (
-            "adaptive",
-            opt(opts
-                .film
-                .adaptive
-                .map(|t| format!("{t} batch={}", opts.film.batch))),
-        ),
-        ("rr_bounces", opts.path.rr_bounces.to_string()),
-        ("seed", opts.film.seed.to_string()),
-        ("encoding", "srgb".to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect()
 }
 
 /// Samples between adaptive-sampling checks when --batch is not given.
@@ -401,47 +361,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     scene.camera.lens = thin_lens(a, &scene.camera)?;
     if let Some(path) = &a.envmap {
         let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
-        // Radiance is finite, non-negative and within what a sample may carry: a NaN, a
-        // negative texel or one of 2^55 or more would make a wrong picture (the renderer
-        // counts such samples as black), so it is refused by position.
-        let limit = prism_math::ExactSum::LIMIT;
-        let within = |v: f32| (0.0..limit).contains(&v);
-        if let Some(i) = map
-            .pixels()
-            .iter()
-            .position(|p| !(within(p.r) && within(p.g) && within(p.b)))
-        {
-            let (x, y) = (i as u32 % map.width(), i as u32 / map.width());
-            return Err(UserError(format!(
-                "--envmap {}: texel ({x}, {y}) is {:?}; expected finite, non-negative radiance \
-                 below 2^55",
-                path.display(),
-                map.get(x, y)
-            ))
-            .into());
-        }
-        let infinite = |l: &prism_scene::Light| {
-            matches!(
-                l,
-                prism_scene::Light::Hemisphere { .. }
-                    | prism_scene::Light::Environment { .. }
-                    | prism_scene::Light::EnvironmentMap { .. }
-            )
-        };
-        if scene
-            .lights
-            .iter()
-            .any(|l| infinite(l) && l.gives_off_light())
-        {
+        let replaced = scene
+            .light_by_environment_map(std::sync::Arc::new(map))
+            .map_err(|e| UserError(format!("--envmap {}: {e}", path.display())))?;
+        if replaced {
             scene.warnings.push(format!(
                 "--envmap replaces the scene's hemisphere or environment light with {}",
                 path.display()
             ));
         }
-        scene.lights.retain(|l| !infinite(l));
-        scene.lights.push(prism_scene::Light::EnvironmentMap {
-            radiance: std::sync::Arc::new(map),
-        });
     }
     if !scene.is_lit() {
         let name = a
@@ -511,9 +439,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bar.finish_and_clear();
         let t3 = Instant::now();
         let fingerprint = Instant::now();
-        let identity = identity(&scene, &options);
+        let identity = PartIdentity::path(scene.fingerprint(), &options);
         let fingerprint = fingerprint.elapsed();
-        let part = Part::new(identity, share, sums);
+        let part = Part::new(identity.to_attributes(), share, sums);
         crate::split::write_part(&part, &a.output, a.quiet, t0)?;
         if a.stats {
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// Parses a byte count: a whole number with an optional unit, `K`, `M`, `G` or `T` (binary
 /// multiples, with or without `iB`/`B`), as `--max-memory 4G` or `--max-memory 512MiB`.

@@ -7,10 +7,12 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use prism_math::{Rgb, Vec3};
-use prism_shade::{course_texture, shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
+use prism_shade::{
+    course_texture, shade_rgb8, Framing, ShadeMesh, ShadeOptions, Shader, Uniforms, View,
+};
 
+use crate::error::UserError;
 use crate::output::{image_output, ImageFormat};
-use crate::UserError;
 
 /// The shader.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -284,24 +286,27 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         Some(t) => three(t, "--target")?,
         None => centre,
     };
-    let eye = match &a.eye {
-        Some(e) => three(e, "--eye")?,
-        None => {
-            // Far enough that the bounding sphere fits the narrower field of view.
-            let r = ((hi - lo).length() * 0.5).max(1e-3);
-            let half = a.fov_y.to_radians() * 0.5;
-            let aspect = (w as f32 / h as f32).min(1.0);
-            let fit = (half.tan() * aspect).atan();
-            target + Vec3::new(0.0, 0.0, 1.1 * r / fit.sin())
-        }
-    };
-    let view = View {
-        eye,
-        target,
-        up,
-        fov_y: a.fov_y,
-        width: w,
-        height: h,
+    let view = match &a.eye {
+        Some(e) => View {
+            eye: three(e, "--eye")?,
+            target,
+            up,
+            fov_y: a.fov_y,
+            width: w,
+            height: h,
+        },
+        // In front of the mesh along +z, far enough that its bounding sphere fits the
+        // narrower field of view.
+        None => View::fit(
+            target,
+            (hi - lo).length() * 0.5,
+            Vec3::Z,
+            up,
+            a.fov_y,
+            w,
+            h,
+            Framing::NarrowerSide { margin: 1.1 },
+        ),
     };
     let uniforms = Uniforms {
         light_pos: light,

@@ -6,13 +6,13 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
-use prism_image::{Bloom, Image};
+use prism_image::Image;
 use prism_math::Rgb;
 use prism_render::film::PixelSum;
-use prism_render::parts::{merge, Part, PartFile};
+use prism_render::parts::{merge, Encoding, Part, PartFile, PartIdentity};
 
+use crate::error::UserError;
 use crate::output::ImageFormat;
-use crate::UserError;
 
 /// The colour merged pictures give pixels that no part held (with `--allow-missing`).
 const HOLE: Rgb = Rgb {
@@ -130,15 +130,11 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     for hole in &merged.holes {
         eprintln!("prism: warning: missing {hole}");
     }
-    let setting = |k: &str| {
-        merged
-            .identity
-            .iter()
-            .find(|(n, _)| n == k)
-            .map(|(_, v)| v.as_str())
-    };
+    // Parts prism wrote always have an identity it reads; others merge without bloom, and
+    // as sRGB.
+    let identity = PartIdentity::from_attributes(&merged.identity).ok();
     let mut image: Image<Rgb> = merged.sums.map(PixelSum::mean);
-    if let Some(bloom) = setting("bloom").and_then(parse_bloom) {
+    if let Some(bloom) = identity.as_ref().and_then(PartIdentity::bloom) {
         let layer = bloom.layer(&image);
         for (p, l) in image.pixels_mut().iter_mut().zip(layer.pixels()) {
             *p += *l;
@@ -150,7 +146,9 @@ pub fn run(a: &MergeArgs) -> Result<()> {
             *p = HOLE;
         }
     }
-    let truncated = setting("encoding") == Some("truncated");
+    let truncated = identity
+        .as_ref()
+        .is_some_and(|i| i.encoding() == Encoding::Truncated);
     match format {
         ImageFormat::Exr => prism_image::write_exr(&a.output, &image)?,
         _ if truncated => {
@@ -185,23 +183,6 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     Ok(())
 }
 
-/// The bloom a Whitted part records: `THRESHOLD PASSES`, or `off`.
-fn parse_bloom(v: &str) -> Option<Bloom> {
-    let (t, p) = v.split_once(' ')?;
-    Some(Bloom {
-        threshold: t.parse().ok()?,
-        passes: p.parse().ok()?,
-    })
-}
-
-/// The bloom setting a Whitted part records (see `parse_bloom`).
-pub fn bloom_setting(bloom: Option<&Bloom>) -> String {
-    match bloom {
-        Some(b) => format!("{} {}", b.threshold, b.passes),
-        None => "off".into(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,17 +195,5 @@ mod tests {
         for bad in ["7/7", "1/0", "-1/3", "a/b", "3", "1/2/3", ""] {
             assert!(parse_tile(bad).is_err(), "{bad}");
         }
-    }
-
-    /// Oracle: the bloom setting written is the one read back.
-    #[test]
-    fn bloom_setting_round_trips() {
-        let b = Bloom {
-            threshold: 0.75,
-            passes: 3,
-        };
-        let back = parse_bloom(&bloom_setting(Some(&b))).unwrap();
-        assert_eq!((back.threshold, back.passes), (0.75, 3));
-        assert!(parse_bloom(&bloom_setting(None)).is_none());
     }
 }

@@ -8,8 +8,8 @@ use clap::{Args, ValueEnum};
 use prism_image::{LevelSampling, PixelSampling};
 use prism_raster::{read_svg, render, Dialect, Document, RasterOptions, View};
 
+use crate::error::UserError;
 use crate::output::{image_output, write_rgb8, ImageFormat};
-use crate::UserError;
 
 /// Texel lookup within a mip level.
 #[derive(Clone, Copy, Debug, ValueEnum)]

@@ -16,7 +16,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::keyboard::{Key as WinitKey, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
-use crate::UserError;
+use crate::error::UserError;
 
 /// What the file is viewed as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -162,7 +162,10 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             Ok(Viewer::new(Box::new(mode), w, h))
         }
         ModeArg::Whitted => {
-            let loaded = crate::raytrace::load_scene(&a.file.to_string_lossy(), None)?;
+            let loaded = prism_scene::load_delft(&a.file.to_string_lossy(), None, &mut |w| {
+                eprintln!("prism: warning: {w}");
+            })
+            .map_err(|e| UserError(e.to_string()))?;
             let (w, h) = match (&a.resolution, loaded.window) {
                 (None, Some([cw, ch])) => (cw, ch),
                 _ => (w, h),

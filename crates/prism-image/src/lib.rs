@@ -1,6 +1,7 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
 //! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
-//! cube maps looked up as OpenGL does, heat maps, bloom, BMP output and animated PNGs.
+//! cube maps looked up as OpenGL does, heat maps, bloom, BMP output, animated PNGs and
+//! montages (pictures side by side in a grid).
 #![warn(missing_docs)]
 
 mod animation;
@@ -12,6 +13,7 @@ mod exr;
 mod heatmap;
 mod image;
 mod io;
+mod montage;
 mod srgb;
 mod texture;
 
@@ -31,5 +33,6 @@ pub use io::{
     remove_temporaries_before_exit, write_atomic, write_atomic_with, write_bmp, write_jpeg,
     write_png, write_png_rgba, JPEG_QUALITY, MAX_IMAGE_FILE_BYTES,
 };
+pub use montage::montage;
 pub use srgb::{linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear};
 pub use texture::{LevelSampling, PixelSampling, Texture, UvConvention, Wrap};

@@ -1,6 +1,6 @@
 //! Split renders: the [`Part`] file one share of a render writes (an OpenEXR file with the
-//! mean radiance, each pixel's sums and sample count, and the render's identity as string
-//! attributes), and [`merge`], which checks that a set of parts makes one whole render and
+//! mean radiance, each pixel's sums and sample count, and the render's identity, a [`PartIdentity`],
+//! as string attributes), and [`merge`], which checks that a set of parts makes one whole render and
 //! adds them up.
 
 use std::path::{Path, PathBuf};
@@ -9,6 +9,10 @@ use prism_image::{ExrLayers, ExrSamples, Image, ImageError};
 use prism_math::ExactSum;
 
 use crate::film::{tile_count, tile_of, PixelSum, Share};
+
+mod identity;
+
+pub use self::identity::{Encoding, IdentityError, PartIdentity, Renderer};
 
 /// Attribute-name prefix of a part's identity and share.
 const PREFIX: &str = "prism.";

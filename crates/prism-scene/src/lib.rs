@@ -10,7 +10,9 @@
 //!
 //! The Delft ray tracer's inputs: OBJ scenes with MTL materials and textures
 //! ([`read_obj_scene`]), its built-in scenes ([`Preset`]) and its TOML render
-//! configuration ([`read_render_config`]).
+//! configuration ([`read_render_config`]); [`load_delft`] finds a scene named on the command
+//! line among the three and lights a lone OBJ.
+//! [`Scene::light_by_environment_map`] lights a scene by an environment map.
 //!
 //! [`Scene`] is what renderers consume: world-space meshes and spheres with materials,
 //! lights and a camera, built from a document by [`Scene::from_collada`]; the module that
@@ -19,6 +21,8 @@
 
 mod builtin;
 mod collada;
+mod delft;
+mod environment;
 mod error;
 mod load;
 mod mesh_io;
@@ -34,6 +38,10 @@ pub use collada::{
     LightDef, LightKind, MeshData, Node, Part, Shape, UpAxis, MAX_COLLADA_BYTES, MAX_NODES,
     MAX_NODE_DEPTH, MAX_PLACED_FACES,
 };
+pub use delft::{
+    default_obj_lights, load_delft, staged_data, DelftError, DelftScene, DelftWarning,
+};
+pub use environment::EnvironmentMapError;
 pub use error::SceneError;
 pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};

@@ -6,14 +6,17 @@
 //! - `shaders`: [`Shader`], the course's shaders with their [`Uniforms`] and formulas.
 //! - `pipeline`: [`shade`], vertex stage, clipping, depth-tested rasterization with
 //!   perspective-correct varyings, supersampling and an optional wireframe on top.
+//! - `framing`: [`View::fit`], a view that frames a bounding sphere ([`Framing`]).
 #![warn(missing_docs)]
 
 mod error;
+mod framing;
 mod mesh;
 mod pipeline;
 mod shaders;
 
 pub use error::ShadeError;
+pub use framing::{Framing, MIN_FIT_RADIUS};
 pub use mesh::ShadeMesh;
 pub use pipeline::{frame_bytes, shade, shade_rgb8, to_bytes, ShadeOptions, View, FAR, NEAR};
 pub use prism_mesh::obj::MAX_FACE_CORNERS;

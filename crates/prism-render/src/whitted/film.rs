@@ -49,8 +49,10 @@ fn pixel_sampler(opts: &RaytraceOptions, x: u32, row: u32, s: u32) -> PixelSampl
     )
 }
 
-/// Rays per pixel actually cast.
-fn rays_per_pixel(opts: &RaytraceOptions) -> u32 {
+/// Rays per pixel actually cast: `opts.spp` (at least 1) with multiple rays per pixel on,
+/// else 1.
+#[must_use]
+pub fn rays_per_pixel(opts: &RaytraceOptions) -> u32 {
     if opts.settings.features.multiple_rays_per_pixel {
         opts.spp.max(1)
     } else {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use prism_image::ExrSamples;
 use prism_render::film::{tile_of, tiles, FilmSettings, Share};
-use prism_render::parts::{merge, Part, PartError, PartFile};
+use prism_render::parts::{merge, Part, PartError, PartFile, PartIdentity};
 use prism_render::render::{render_share, Job, RenderOptions};
 use prism_render::render_scene::RenderScene;
 
@@ -239,4 +239,25 @@ fn sums_that_overflow_are_refused() {
     );
     assert!(e.to_string().contains("overflow"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Oracle: the identity given. A render's [`PartIdentity`], written into a part file and
+/// merged, reads back as the same value.
+#[test]
+fn identity_survives_the_part_file() {
+    let cornell = prism_scene::cornell_box();
+    let scene = RenderScene::new(&cornell);
+    let opts = options();
+    let id = PartIdentity::path(cornell.fingerprint(), &opts);
+    let share = Share::whole(opts.film.spp);
+    let sums = render_share(&scene, &opts, &Job::share(&share), &|_| {});
+    let dir = std::env::temp_dir().join(format!("prism-identity-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("whole.exr");
+    Part::new(id.to_attributes(), share, sums)
+        .write(&file)
+        .unwrap();
+    let merged = merge(&[PartFile::open(&file).unwrap()], false).unwrap();
+    assert_eq!(PartIdentity::from_attributes(&merged.identity), Ok(id));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

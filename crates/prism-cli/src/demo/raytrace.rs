@@ -1,0 +1,176 @@
+//! The gallery's Whitted ray-tracer pictures: the presets, feature switches side by side,
+//! bloom and its layer, a BVH level, and a pixel's ray tree.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use prism_image::montage;
+
+use super::index::Entry;
+
+/// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
+/// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
+pub fn pictures(output: &Path, assets: &Path, entries: &mut Vec<Entry>) -> Result<()> {
+    use prism_render::whitted::camera::OrbitView;
+    use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
+    use prism_render::whitted::overlay::Overlay;
+    use prism_render::whitted::scene::WhittedScene;
+    use prism_scene::{OrbitCamera, Preset};
+    let dirs = vec![assets.join("delft-raytracer/data")];
+    let on = prism_scene::Features::prism_defaults();
+    let opts = |size: u32, features: prism_scene::Features| RaytraceOptions {
+        width: size,
+        height: size,
+        settings: prism_render::whitted::tracer::WhittedSettings {
+            features,
+            light_samples: 16,
+            max_depth: 3,
+        },
+        spp: 4,
+        bloom: prism_image::Bloom::default(),
+        seed: 0,
+    };
+    let cam = OrbitCamera::default();
+    let user = |e: prism_scene::SceneError| crate::error::UserError(e.to_string());
+    let write = |name: &str, img: &prism_image::RgbImage| {
+        prism_image::write_png(&output.join(name), &img.to_rgb8_truncated())
+            .with_context(|| format!("writing {name}"))
+    };
+    // Every preset whose file is here (the dragon is never shipped).
+    let mut panels = Vec::new();
+    let mut names = Vec::new();
+    for p in Preset::ALL {
+        let Ok(scene) = p.load(&dirs) else { continue };
+        let ws = WhittedScene::new(&scene, true);
+        panels.push(raytrace(&ws, &cam, &opts(200, on), &|_| {}).image);
+        names.push(p.name());
+    }
+    write(
+        "raytrace_presets.png",
+        &montage(&panels, 3, prism_math::Rgb::BLACK),
+    )?;
+    entries.push(Entry {
+        file: "raytrace_presets.png".into(),
+        caption: format!("prism raytrace presets: {}", names.join(", ")),
+    });
+    // Feature switches on the Cornell box with the four-colour parallelogram light.
+    let scene = Preset::CornellBoxParallelogramLight
+        .load(&dirs)
+        .map_err(user)?;
+    let ws = WhittedScene::new(&scene, true);
+    let switches: [(&str, prism_scene::Features); 4] = [
+        ("everything on", on),
+        (
+            "--disable shading",
+            prism_scene::Features {
+                shading: false,
+                ..on
+            },
+        ),
+        (
+            "--disable soft-shadow",
+            prism_scene::Features {
+                soft_shadow: false,
+                ..on
+            },
+        ),
+        (
+            "--disable recursive",
+            prism_scene::Features {
+                recursive: false,
+                ..on
+            },
+        ),
+    ];
+    let panels: Vec<_> = switches
+        .iter()
+        .map(|(_, f)| raytrace(&ws, &cam, &opts(200, *f), &|_| {}).image)
+        .collect();
+    write(
+        "raytrace_toggles.png",
+        &montage(&panels, 4, prism_math::Rgb::BLACK),
+    )?;
+    entries.push(Entry {
+        file: "raytrace_toggles.png".into(),
+        caption: format!(
+            "cornell-box-parallelogram-light, left to right: {}",
+            switches.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
+        ),
+    });
+    // Bloom on the spheres, and the layer it adds.
+    let spheres = WhittedScene::new(&Preset::Spheres.load(&dirs).map_err(user)?, true);
+    let mut b = opts(300, prism_scene::Features { bloom: true, ..on });
+    b.bloom.passes = 2;
+    let out = raytrace(&spheres, &cam, &b, &|_| {});
+    write("raytrace_bloom.png", &out.image)?;
+    write(
+        "raytrace_bloom_layer.png",
+        out.bloom_layer.as_ref().expect("bloom is on"),
+    )?;
+    entries.push(Entry {
+        file: "raytrace_bloom.png".into(),
+        caption: "spheres with bloom (--enable bloom --bloom-passes 2)".into(),
+    });
+    entries.push(Entry {
+        file: "raytrace_bloom_layer.png".into(),
+        caption: "its bloom layer alone (--bloom-debug)".into(),
+    });
+    // The mirror Cornell box: a BVH level, and the ray tree of a pixel on the mirror.
+    let scene = Preset::CornellBox.load(&dirs).map_err(user)?;
+    let ws = WhittedScene::new(&scene, true);
+    let o = opts(300, on);
+    let img = raytrace(&ws, &cam, &o, &|_| {}).image;
+    let mut ov = Overlay::new(img.clone(), OrbitView::new(&cam, 300, 300), &ws);
+    let bvh = ws.bvh().expect("built");
+    for (i, bx) in bvh.level_boxes(1).iter().enumerate() {
+        ov.aabb(bx, prism_render::whitted::overlay::palette(i));
+    }
+    write("raytrace_bvh_level.png", &ov.image)?;
+    entries.push(Entry {
+        file: "raytrace_bvh_level.png".into(),
+        caption: "the BVH's level 1 over the mirror Cornell box (--bvh-level 1)".into(),
+    });
+    // The middle one of the pixels of row 120 whose camera rays meet the mirror box.
+    let on_mirror: Vec<_> = (0..300)
+        .map(|x| trace_pixel(&ws, &cam, &o, x, 120))
+        .filter(|t| {
+            t.rays
+                .first()
+                .and_then(|r| r.hit.as_ref())
+                .is_some_and(|h| h.0 == "tallBox")
+        })
+        .collect();
+    if let Some(t) = on_mirror.get(on_mirror.len() / 2) {
+        let debug_cam = OrbitCamera {
+            rotation: prism_math::Vec3::new(10.0, -15.0, 0.0),
+            distance: 3.2,
+            ..cam
+        };
+        let base = raytrace(&ws, &debug_cam, &o, &|_| {})
+            .image
+            .map(|p| *p * 0.5);
+        let mut ov = Overlay::new(base, OrbitView::new(&debug_cam, 300, 300), &ws);
+        for r in &t.rays {
+            let on_top = matches!(
+                r.kind,
+                prism_render::whitted::tracer::RayKind::Normal
+                    | prism_render::whitted::tracer::RayKind::InterpolatedNormal
+            );
+            ov.segment(r.origin, r.end, r.color, !on_top);
+        }
+        for r in &t.rays {
+            if let Some(p) = r.blocked_at {
+                ov.marker(p, prism_math::Rgb::new(1.0, 0.0, 0.0));
+            }
+        }
+        write("raytrace_debug_pixel.png", &ov.image)?;
+        entries.push(Entry {
+            file: "raytrace_debug_pixel.png".into(),
+            caption: format!(
+                "the ray tree of pixel {},{} on the mirror box, seen from another orbit                  (--debug-pixel {},{} --debug-camera 10,-15,0,3.2)",
+                t.pixel.0, t.pixel.1, t.pixel.0, t.pixel.1
+            ),
+        });
+    }
+    Ok(())
+}
