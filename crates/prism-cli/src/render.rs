@@ -1,5 +1,6 @@
 //! `prism render`: path-trace a CS184 COLLADA scene (or the built-in Cornell box).
 
+use prism_math::Warning;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -365,10 +366,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .light_by_environment_map(std::sync::Arc::new(map))
             .map_err(|e| UserError(format!("--envmap {}: {e}", path.display())))?;
         if replaced {
-            scene.warnings.push(format!(
+            scene.warnings.push(Warning::new(format!(
                 "--envmap replaces the scene's hemisphere or environment light with {}",
                 path.display()
-            ));
+            )));
         }
     }
     if !scene.is_lit() {
@@ -376,10 +377,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             .scene
             .as_ref()
             .map_or("the scene".to_string(), |p| p.display().to_string());
-        scene.warnings.push(format!(
+        scene.warnings.push(Warning::new(format!(
             "{name}: the scene has no light and no emitting surface that gives off light; it \
              renders black (`--envmap FILE.exr` lights it, `--integrator normals` shows its shapes)"
-        ));
+        )));
     }
     for w in &scene.warnings {
         eprintln!("warning: {w}");

@@ -134,7 +134,7 @@ fn render_one(
     format: ImageFormat,
     a: &SvgArgs,
     view: Option<View>,
-) -> Result<Vec<String>> {
+) -> Result<Vec<prism_math::Warning>> {
     let dialect = if a.compat.is_some() {
         Dialect::Cs184
     } else {
@@ -207,7 +207,7 @@ pub fn run(a: &SvgArgs) -> Result<()> {
         ))
         .into());
     }
-    let warn = |ws: Vec<String>| {
+    let warn = |ws: Vec<prism_math::Warning>| {
         if !a.quiet {
             for w in ws {
                 eprintln!("prism: warning: {w}");

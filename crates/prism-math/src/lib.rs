@@ -25,5 +25,5 @@ pub use glam;
 pub use glam::{DAffine2, DMat2, DVec2, Vec2, Vec3};
 pub use random::{hash_extend, hash_words, mix64, unit_f32, word_mix, Pcg32};
 pub use simd::{prefetch, Isa};
-pub use text::{LineIndex, Loc};
+pub use text::{LineIndex, Loc, Warning};
 pub use transform::Transform;

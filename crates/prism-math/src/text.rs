@@ -1,5 +1,6 @@
-//! Places in text files for the readers' errors: [`Loc`] (a file, line and column, one type
-//! every reader's errors share) and [`LineIndex`] (the line number of a byte offset, in
+//! Places in text files for the readers' errors and warnings: [`Loc`] (a file, line and
+//! column, one type every reader's errors share), [`Warning`] (what a reader read past, and
+//! where) and [`LineIndex`] (the line number of a byte offset, in
 //! constant time per query).
 
 use std::fmt;
@@ -35,6 +36,46 @@ impl Loc {
             file: file.to_string(),
             line,
             column,
+        }
+    }
+}
+
+/// Something a reader read past or could not honour, and where: shown as `file:line: message`
+/// (or the message alone when it has no one place).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Warning {
+    /// Where, if at one place.
+    pub at: Option<Loc>,
+    /// What was read past, and what was done instead.
+    pub message: String,
+}
+
+impl Warning {
+    /// A warning at `at`.
+    #[must_use]
+    pub fn at(at: Loc, message: impl Into<String>) -> Warning {
+        Warning {
+            at: Some(at),
+            message: message.into(),
+        }
+    }
+
+    /// A warning about the whole input (or one whose message names its place itself, as an
+    /// error read past does).
+    #[must_use]
+    pub fn new(message: impl Into<String>) -> Warning {
+        Warning {
+            at: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.at {
+            Some(at) => write!(f, "{at}: {}", self.message),
+            None => f.write_str(&self.message),
         }
     }
 }
@@ -101,6 +142,9 @@ mod tests {
     fn locations_show_file_line_and_column() {
         assert_eq!(Loc::line("a.obj", 3).to_string(), "a.obj:3");
         assert_eq!(Loc::at("b.svg", 2, 14).to_string(), "b.svg:2:14");
+        let w = Warning::at(Loc::line("a.dae", 7), "<skew> is not read");
+        assert_eq!(w.to_string(), "a.dae:7: <skew> is not read");
+        assert_eq!(Warning::new("no light").to_string(), "no light");
     }
 
     /// Brute force: every offset of a text with lines of varied lengths (some longer than

@@ -331,5 +331,5 @@ pub struct Document {
     /// alpha is dropped (the course's `<texture>`).
     pub texture_alpha: Vec<Option<Arc<Texture>>>,
     /// One line per kind of thing that was skipped or approximated.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<prism_math::Warning>,
 }

@@ -51,7 +51,7 @@ pub enum DelftError {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum DelftWarning {
     /// A config key without effect in prism.
-    Config(String),
+    Config(prism_math::Warning),
     /// A data folder was given, but the config's `data_path` wins.
     DataFolderIgnored,
     /// The config renders an OBJ and has no lights.
@@ -64,7 +64,7 @@ pub enum DelftWarning {
 impl std::fmt::Display for DelftWarning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            DelftWarning::Config(w) => f.write_str(w),
+            DelftWarning::Config(w) => w.fmt(f),
             DelftWarning::DataFolderIgnored => {
                 f.write_str("--data has no effect: the config's data_path is used")
             }

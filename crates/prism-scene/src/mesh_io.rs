@@ -64,7 +64,7 @@ pub enum MeshIoError {
 ///
 /// # Errors
 /// [`MeshIoError::UnknownFormat`], or the reader's located error.
-pub fn read_mesh(path: &Path) -> Result<(PolyMesh, Vec<String>), MeshIoError> {
+pub fn read_mesh(path: &Path) -> Result<(PolyMesh, Vec<prism_math::Warning>), MeshIoError> {
     match MeshFormat::from_path(path) {
         Some(MeshFormat::Obj) => Ok((prism_mesh::read_obj(path)?, Vec::new())),
         Some(MeshFormat::Ply) => Ok((prism_mesh::read_ply(path)?, Vec::new())),

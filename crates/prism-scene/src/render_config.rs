@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use prism_math::Loc;
-use prism_math::{LineIndex, Rgb, Vec3};
+use prism_math::{LineIndex, Rgb, Vec3, Warning};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
@@ -133,7 +133,7 @@ pub struct RenderConfig {
     /// `[[lights]]`, used by OBJ scenes (presets bring their own).
     pub lights: Vec<Light>,
     /// Keys read but without effect in prism, one message each.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<prism_math::Warning>,
 }
 
 /// Reads a render configuration.
@@ -482,7 +482,11 @@ impl Cx<'_> {
             .ok_or_else(|| self.err(at, format!("{place}: missing required key {key:?}")))
     }
 
-    fn features(&self, v: &Val<'_>, warnings: &mut Vec<String>) -> Result<Features, SceneError> {
+    fn features(
+        &self,
+        v: &Val<'_>,
+        warnings: &mut Vec<prism_math::Warning>,
+    ) -> Result<Features, SceneError> {
         let t = v.get_ref().as_table().ok_or_else(|| {
             self.err(
                 v,
@@ -552,11 +556,7 @@ impl Cx<'_> {
             ] {
                 if flag(key, e)? {
                     let at = e.get(key).expect("the flag was read");
-                    warnings.push(format!(
-                        "{}:{}: features.extra.{key} is not a feature of prism's ray tracer and has no effect",
-                        self.file,
-                        self.lines.line(at.span().start)
-                    ));
+                    warnings.push(Warning::at(Loc::line(self.file, self.lines.line(at.span().start)), format!("features.extra.{key} is not a feature of prism's ray tracer and has no effect")));
                 }
             }
         }

@@ -370,7 +370,7 @@ pub struct Scene {
     /// The camera.
     pub camera: Camera,
     /// Things read past without being used, one message each.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<prism_math::Warning>,
 }
 
 impl Scene {
@@ -468,7 +468,8 @@ mod tests {
     fn fingerprint_tells_scenes_apart() {
         let a = crate::cornell_box();
         let mut b = a.clone();
-        b.warnings.push("read past something".into());
+        b.warnings
+            .push(prism_math::Warning::new("read past something"));
         assert_eq!(a.fingerprint(), b.fingerprint());
         let mut c = a.clone();
         let p = &mut c.meshes[0].positions[0];

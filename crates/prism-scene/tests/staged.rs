@@ -388,7 +388,9 @@ fn course_files_with_a_short_camera_matrix_load_as_the_intact_ones() {
         let doc = prism_scene::parse_collada(&short, name).unwrap();
         let line = 1 + text[..open].matches('\n').count();
         assert!(
-            doc.warnings[0].starts_with(&format!("{name}:{line}: <matrix>: expected 16 numbers")),
+            doc.warnings[0]
+                .to_string()
+                .starts_with(&format!("{name}:{line}: <matrix>: expected 16 numbers")),
             "{:?}",
             doc.warnings
         );

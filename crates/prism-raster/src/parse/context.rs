@@ -2,6 +2,7 @@
 //! ([`Source`]), the XML tree, line numbers for locating elements, the warnings already
 //! given and the textures already decoded.
 
+use prism_math::Warning;
 use std::path::PathBuf;
 
 use prism_image::UvConvention;
@@ -32,10 +33,10 @@ pub(crate) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    /// Records `message` as a warning of `doc`, once per `key`.
-    pub fn warn_once(&mut self, doc: &mut Document, key: &str, message: String) {
+    /// Records `warning` in `doc`, once per `key`.
+    pub fn warn_once(&mut self, doc: &mut Document, key: &str, warning: Warning) {
         if self.warned.insert(key.to_string()) {
-            doc.warnings.push(message);
+            doc.warnings.push(warning);
         }
     }
 }

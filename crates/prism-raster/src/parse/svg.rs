@@ -9,7 +9,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use prism_math::{DVec2, Rgb};
+use prism_math::{DVec2, Loc, Rgb, Warning};
 use roxmltree::Node;
 
 use super::color::parse_color;
@@ -229,15 +229,15 @@ impl<'a> Parser<'_, 'a> {
         Ok(())
     }
 
-    fn warn(&mut self, key: &str, message: String) {
-        self.ctx.warn_once(&mut self.doc, key, message);
+    fn warn(&mut self, key: &str, warning: Warning) {
+        self.ctx.warn_once(&mut self.doc, key, warning);
     }
 
     /// One warning per property of the file whose value is invalid (and treated as absent).
     fn warn_invalid(&mut self, property: &str, e: &SvgError) {
         self.warn(
             &format!("invalid:{property}"),
-            format!("{e}; treated as absent (warned once per property)"),
+            Warning::new(format!("{e}; treated as absent (warned once per property)")),
         );
     }
 
@@ -293,8 +293,9 @@ impl<'a> Parser<'_, 'a> {
             if node.attr(unsupported).is_some_and(|v| v.trim() != "none") {
                 self.warn(
                     unsupported,
-                    format!(
-                        "{file}:{line}: {elem}: {unsupported} is not supported; drawn without it"
+                    Warning::at(
+                        Loc::line(&file, line),
+                        format!("{elem}: {unsupported} is not supported; drawn without it"),
                     ),
                 );
             }
@@ -345,7 +346,10 @@ impl<'a> Parser<'_, 'a> {
                 let Some(&target) = self.ids.get(id) else {
                     self.warn(
                         &format!("use#{id}"),
-                        format!("{file}:{line}: use: no element with id {id:?}; skipped"),
+                        Warning::at(
+                            Loc::line(&file, line),
+                            format!("use: no element with id {id:?}; skipped"),
+                        ),
                     );
                     return Ok(());
                 };
@@ -455,7 +459,7 @@ impl<'a> Parser<'_, 'a> {
                 if let Some(e) = error {
                     self.warn(
                         "invalid:d",
-                        format!("{}; drawn up to the error", loc.path_data(e)),
+                        Warning::new(format!("{}; drawn up to the error", loc.path_data(e))),
                     );
                 }
                 path
@@ -496,14 +500,20 @@ impl<'a> Parser<'_, 'a> {
             "text" | "tspan" | "textPath" => {
                 self.warn(
                     "text",
-                    format!("{file}:{line}: {name}: text is not supported; skipped"),
+                    Warning::at(
+                        Loc::line(&file, line),
+                        format!("{name}: text is not supported; skipped"),
+                    ),
                 );
                 return Ok(());
             }
             other => {
                 self.warn(
                     &format!("elem:{other}"),
-                    format!("{file}:{line}: {other}: unknown element; skipped"),
+                    Warning::at(
+                        Loc::line(&file, line),
+                        format!("{other}: unknown element; skipped"),
+                    ),
                 );
                 return Ok(());
             }
@@ -610,9 +620,9 @@ impl<'a> Parser<'_, 'a> {
                     Some(fb) => self.resolve_paint(fb, style, path, loc)?,
                     None => {
                         if !self.ids.contains_key(id.as_str()) {
-                            let msg = format!(
-                                "{}:{}: {}: paint url(#{id}) not found; not painted",
-                                loc.file, loc.line, loc.element
+                            let msg = Warning::at(
+                                Loc::line(loc.file, loc.line),
+                                format!("{}: paint url(#{id}) not found; not painted", loc.element),
                             );
                             self.warn(&format!("paint#{id}"), msg);
                         }
@@ -639,9 +649,9 @@ impl<'a> Parser<'_, 'a> {
             if kind == "pattern" {
                 self.warn(
                     "pattern",
-                    format!(
-                        "{}:{}: pattern paint is not supported; not painted",
-                        loc.file, loc.line
+                    Warning::at(
+                        Loc::line(loc.file, loc.line),
+                        "pattern paint is not supported; not painted",
                     ),
                 );
             }

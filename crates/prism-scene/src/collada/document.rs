@@ -67,7 +67,7 @@ pub struct Collada {
     /// why it has none (a user of the material refuses it with that error).
     pub materials: Vec<(String, Result<usize, SceneError>)>,
     /// Features read past without being understood, one message each.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<prism_math::Warning>,
 }
 
 /// One `<geometry>`.

@@ -2,6 +2,7 @@
 //! (`<polylist>`, `<triangles>`, `<polygons>`) read into polygons over shared positions
 //! with per-corner normals and texture coordinates; the CGL sphere extra.
 
+use prism_math::{Loc, Warning};
 use std::collections::HashMap;
 
 use prism_math::glam::{DVec2, DVec3};
@@ -87,7 +88,7 @@ fn read_source(cx: &Cx, s: XmlNode, min_stride: usize) -> Result<Source, SceneEr
 pub(super) fn read_geometry(
     cx: &Cx,
     g: XmlNode,
-    warn: &mut dyn FnMut(&str, String),
+    warn: &mut dyn FnMut(&str, Warning),
 ) -> Result<Shape, SceneError> {
     if let Some(mesh) = child(g, "mesh") {
         return read_mesh(cx, mesh, warn).map(Shape::Mesh);
@@ -110,10 +111,9 @@ pub(super) fn read_geometry(
         .map_or("nothing", |c| c.tag_name().name());
     warn(
         &format!("geometry:{kind}"),
-        format!(
-            "{}:{}: <geometry> holding <{kind}> is not read; it is skipped",
-            cx.file,
-            cx.line(g)
+        Warning::at(
+            Loc::line(cx.file, cx.line(g)),
+            format!("<geometry> holding <{kind}> is not read; it is skipped"),
         ),
     );
     Ok(Shape::Empty)
@@ -131,7 +131,7 @@ struct Inputs<'s> {
 fn read_mesh(
     cx: &Cx,
     mesh: XmlNode,
-    warn: &mut dyn FnMut(&str, String),
+    warn: &mut dyn FnMut(&str, Warning),
 ) -> Result<MeshData, SceneError> {
     let mut sources = HashMap::new();
     for s in children(mesh, "source") {
@@ -219,10 +219,9 @@ fn read_mesh(
             ) {
                 warn(
                     &format!("primitive:{kind}"),
-                    format!(
-                        "{}:{}: <{kind}> is not read; its primitives are skipped",
-                        cx.file,
-                        cx.line(prim)
+                    Warning::at(
+                        Loc::line(cx.file, cx.line(prim)),
+                        format!("<{kind}> is not read; its primitives are skipped"),
                     ),
                 );
             }
@@ -320,10 +319,9 @@ fn read_mesh(
                 if let Some(ph) = child(prim, "ph") {
                     warn(
                         "polygons:ph",
-                        format!(
-                            "{}:{}: polygons with holes (<ph>) are not read; they are skipped",
-                            cx.file,
-                            cx.line(ph)
+                        Warning::at(
+                            Loc::line(cx.file, cx.line(ph)),
+                            "polygons with holes (<ph>) are not read; they are skipped",
                         ),
                     );
                 }

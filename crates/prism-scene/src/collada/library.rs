@@ -1,6 +1,7 @@
 //! The libraries a renderer needs: effects (materials), lights and cameras.
 
 use prism_math::Rgb;
+use prism_math::{Loc, Warning};
 use roxmltree::Node as XmlNode;
 use std::collections::HashMap;
 
@@ -269,7 +270,7 @@ pub(super) fn effect(
     cx: &Cx,
     e: XmlNode,
     images: &HashMap<String, String>,
-    warn: &mut dyn FnMut(&str, String),
+    warn: &mut dyn FnMut(&str, Warning),
 ) -> Result<EffectDef, SceneError> {
     let mut material = None;
     let mut diffuse_texture = None;
@@ -284,12 +285,7 @@ pub(super) fn effect(
                 Some(m) => material = Some(m),
                 None => warn(
                     &format!("bsdf:{}", b.tag_name().name()),
-                    format!(
-                        "{}:{}: CGL BSDF <{}> is not known; the effect falls back to its common profile",
-                        cx.file,
-                        cx.line(b),
-                        b.tag_name().name()
-                    ),
+                    Warning::at(Loc::line(cx.file, cx.line(b)), format!("CGL BSDF <{}> is not known; the effect falls back to its common profile", b.tag_name().name())),
                 ),
             }
         }
@@ -331,7 +327,7 @@ pub(super) fn effect(
 pub(super) fn light(
     cx: &Cx,
     l: XmlNode,
-    warn: &mut dyn FnMut(&str, String),
+    warn: &mut dyn FnMut(&str, Warning),
 ) -> Result<Option<LightDef>, SceneError> {
     let cgl = l
         .children()
@@ -354,10 +350,9 @@ pub(super) fn light(
         other => {
             warn(
                 &format!("light:{other}"),
-                format!(
-                    "{}:{}: light type <{other}> is not known; the light is skipped",
-                    cx.file,
-                    cx.line(shape)
+                Warning::at(
+                    Loc::line(cx.file, cx.line(shape)),
+                    format!("light type <{other}> is not known; the light is skipped"),
                 ),
             );
             return Ok(None);

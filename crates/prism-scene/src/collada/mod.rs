@@ -34,6 +34,7 @@ mod writer;
 mod xml;
 
 use prism_math::Loc;
+use prism_math::Warning;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -94,15 +95,16 @@ pub fn parse_collada(text: &str, file: &str) -> Result<Collada, SceneError> {
     }
     let mut out = Collada::default();
     let mut warned = std::collections::BTreeSet::new();
-    let mut warn = |out: &mut Collada, key: &str, message: String| {
+    let mut warn = |out: &mut Collada, key: &str, warning: Warning| {
         if warned.insert(key.to_string()) {
-            out.warnings.push(message);
+            out.warnings.push(warning);
         }
     };
     // A malformed entry is kept with its error, which is an error only for its users.
     let defect = |out: &mut Collada, e: SceneError| {
-        out.warnings
-            .push(format!("{e}; read past: an error only where it is used"));
+        out.warnings.push(Warning::new(format!(
+            "{e}; read past: an error only where it is used"
+        )));
         Some(e)
     };
 

@@ -2,6 +2,7 @@
 //! (and refusing cycles) before expanding, the depth-first walk that composes world
 //! matrices and reads instances, and the transform elements.
 
+use prism_math::{Loc, Warning};
 use std::collections::{HashMap, HashSet};
 
 use prism_math::glam::{DMat4, DVec3, DVec4};
@@ -111,7 +112,7 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
         parent_defect: Option<&SceneError>,
         depth: usize,
         out: &mut Vec<Node>,
-        warnings: &mut Vec<(String, String)>,
+        warnings: &mut Vec<(String, Warning)>,
     ) -> Result<(), SceneError> {
         let cx = self.cx;
         if depth >= MAX_NODE_DEPTH {
@@ -121,9 +122,9 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
         let mut defect = parent_defect.cloned();
         let mut instances = Vec::new();
         let mut kids = Vec::new();
-        let note = |e: SceneError, warnings: &mut Vec<(String, String)>| {
+        let note = |e: SceneError, warnings: &mut Vec<(String, Warning)>| {
             let message = format!("{e}; read past: an error only where it is used");
-            warnings.push((message.clone(), message));
+            warnings.push((message.clone(), Warning::new(message)));
             e
         };
         for c in n.children().filter(|c| c.is_element()) {
@@ -144,10 +145,9 @@ impl<'b, 'i> Walker<'_, 'b, 'i> {
             match name {
                 "skew" => warnings.push((
                     "transform:skew".into(),
-                    format!(
-                        "{}:{}: <skew> is not read; the node is placed without it",
-                        cx.file,
-                        cx.line(c)
+                    Warning::at(
+                        Loc::line(cx.file, cx.line(c)),
+                        "<skew> is not read; the node is placed without it",
                     ),
                 )),
                 "instance_geometry" => {

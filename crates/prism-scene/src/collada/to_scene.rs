@@ -12,7 +12,7 @@
 
 use prism_math::glam::{DMat4, DVec3, DVec4};
 use prism_math::Loc;
-use prism_math::{Rgb, Vec3};
+use prism_math::{Rgb, Vec3, Warning};
 use prism_mesh::vertex_normals_area_weighted;
 
 use super::document::{Collada, Instance, MeshData, Shape};
@@ -218,10 +218,7 @@ impl Scene {
                             }
                             LightKind::Spot if !warned_spot => {
                                 warned_spot = true;
-                                scene.warnings.push(format!(
-                                    "{file}:{}: spot lights are not rendered (the course's are black); skipped",
-                                    l.line
-                                ));
+                                scene.warnings.push(Warning::at(Loc::line(file, l.line), "spot lights are not rendered (the course's are black); skipped"));
                             }
                             LightKind::Spot => {}
                         }
@@ -236,11 +233,14 @@ impl Scene {
                                     if opts.camera == CameraMode::File {
                                         return Err(e.clone());
                                     }
-                                    scene.warnings.push(format!(
-                                        "{file}:{}: camera node {:?}: its transform is malformed; \
+                                    scene.warnings.push(Warning::at(
+                                        Loc::line(file, node.line),
+                                        format!(
+                                            "camera node {:?}: its transform is malformed; \
                                          the course's placement reads its direction from the \
                                          numbers given, in order",
-                                        node.line, node.name
+                                            node.name
+                                        ),
                                     ));
                                 }
                                 file_camera = Some((c.clone(), world));

@@ -160,7 +160,7 @@ fn unsupported_extras_warn() {
         .unwrap();
     assert_eq!(c.warnings.len(), 1);
     assert!(
-        c.warnings[0].contains("enable_motion_blur"),
+        c.warnings[0].to_string().contains("enable_motion_blur"),
         "{:?}",
         c.warnings
     );
