@@ -130,11 +130,16 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     for hole in &merged.holes {
         eprintln!("prism: warning: missing {hole}");
     }
-    // Parts prism wrote always have an identity it reads; others merge without bloom, and
-    // as sRGB.
-    let identity = PartIdentity::from_attributes(&merged.identity).ok();
+    // Parts prism wrote always have an identity it reads (merge has checked that every part
+    // holds the same one); a part that does not is refused, not merged on guesses.
+    let identity = PartIdentity::from_attributes(&merged.identity).map_err(|e| {
+        UserError(format!(
+            "{}: the part's identity: {e}",
+            a.parts[0].display()
+        ))
+    })?;
     let mut image: Image<Rgb> = merged.sums.map(PixelSum::mean);
-    if let Some(bloom) = identity.as_ref().and_then(PartIdentity::bloom) {
+    if let Some(bloom) = identity.bloom() {
         let layer = bloom.layer(&image);
         for (p, l) in image.pixels_mut().iter_mut().zip(layer.pixels()) {
             *p += *l;
@@ -146,9 +151,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
             *p = HOLE;
         }
     }
-    let truncated = identity
-        .as_ref()
-        .is_some_and(|i| i.encoding() == Encoding::Truncated);
+    let truncated = identity.encoding() == Encoding::Truncated;
     match format {
         ImageFormat::Exr => prism_image::write_exr(&a.output, &image)?,
         _ if truncated => {
