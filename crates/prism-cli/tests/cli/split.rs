@@ -357,3 +357,46 @@ fn impossible_splits_are_refused() {
     );
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// A set of parts whose (common) identity prism cannot read, here an integrator no render
+/// has, is refused with exit 2 naming the file, and writes nothing: it is not merged on
+/// guesses about its bloom or encoding.
+#[test]
+fn parts_with_an_unreadable_identity_are_refused() {
+    let dir = scratch("identity");
+    let parts: Vec<PathBuf> = (0..2).map(|i| dir.join(format!("p{i}.exr"))).collect();
+    for (i, part) in parts.iter().enumerate() {
+        let tile = format!("{i}/2");
+        ok(run(
+            "render",
+            &[&lambertian(), "-s", "2"],
+            &[&SMALL[..], &["--tile", &tile]].concat(),
+            part,
+        ));
+        let mut bytes = std::fs::read(part).unwrap();
+        let key = b"prism.integrator\0string\0";
+        let at = bytes
+            .windows(key.len())
+            .position(|w| w == key)
+            .expect("the part records its integrator")
+            + key.len()
+            + 4;
+        assert_eq!(&bytes[at..at + 4], b"path");
+        bytes[at..at + 4].copy_from_slice(b"pith");
+        std::fs::write(part, bytes).unwrap();
+    }
+    let out = dir.join("merged.png");
+    let o = merge(&parts, &out, &[]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("p0.exr: the part's identity: setting integrator is `pith`"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
