@@ -147,13 +147,12 @@ fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
     Ok(Rgb::new(c.x, c.y, c.z))
 }
 
-/// The staged course assets, when prism runs from its source tree.
-fn staged(rel: &str) -> PathBuf {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/assets/clothsim/textures")
-        .join(rel);
-    // Messages name the file plainly, not through the crate's own folder and back.
-    std::fs::canonicalize(&path).unwrap_or(path)
+/// A file of the course's cloth textures (`clothsim/textures/REL` in the course's files,
+/// found as [`prism_scene::course_assets`] finds them), for a shader given no file of its own.
+fn staged(rel: &str, flag: &str) -> Result<PathBuf> {
+    let assets = prism_scene::course_assets(None)
+        .map_err(|e| UserError(format!("{flag} not given, and {e}")))?;
+    Ok(assets.join("clothsim/textures").join(rel))
 }
 
 fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
@@ -237,7 +236,10 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         ShaderArg::Diffuse => Shader::Diffuse,
         ShaderArg::Phong => Shader::Phong,
         ShaderArg::Texture => {
-            let path = a.texture.clone().unwrap_or_else(|| staged("texture_1.png"));
+            let path = match &a.texture {
+                Some(p) => p.clone(),
+                None => staged("texture_1.png", "--texture")?,
+            };
             Shader::Texture(course_texture(load_rgb(&path, "--texture")?))
         }
         ShaderArg::Bump | ShaderArg::Displacement => {
@@ -259,7 +261,10 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
             }
         }
         ShaderArg::Mirror => {
-            let dir = a.cubemap.clone().unwrap_or_else(|| staged("cube"));
+            let dir = match &a.cubemap {
+                Some(d) => d.clone(),
+                None => staged("cube", "--cubemap")?,
+            };
             Shader::Mirror(
                 prism_image::CubeMap::read(&dir)
                     .map_err(|e| UserError(format!("--cubemap: {e}")))?,

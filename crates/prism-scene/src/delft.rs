@@ -83,14 +83,15 @@ fn preset_names() -> String {
     names.join(", ")
 }
 
-/// The staged `delft-raytracer/data` folder beside prism's source tree (the course assets),
-/// made plain (no `..`) when it exists.
+/// The course's `delft-raytracer/data` folder, if the course's files are found
+/// ([`crate::course_assets`]: `PRISM_DATA`, or a `shared/assets` folder above the executable
+/// or the working folder).
 #[must_use]
-pub fn staged_data() -> PathBuf {
-    let dir =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/delft-raytracer/data");
-    // Messages name the folder plainly, not through the crate's own folder and back.
-    std::fs::canonicalize(&dir).unwrap_or(dir)
+pub fn staged_data() -> Option<PathBuf> {
+    let dir = crate::course_assets(None)
+        .ok()?
+        .join("delft-raytracer/data");
+    dir.is_dir().then_some(dir)
 }
 
 /// The light an OBJ scene named on its own gets: a white point light at (-1, 1, -1).
@@ -122,7 +123,7 @@ pub fn load_delft(
         }
         dirs.push(d.to_path_buf());
     }
-    dirs.push(staged_data());
+    dirs.extend(staged_data());
     let lower = name.to_ascii_lowercase();
     if lower.ends_with(".toml") {
         let cfg = read_render_config(Path::new(name))?;

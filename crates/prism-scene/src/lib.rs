@@ -19,6 +19,7 @@
 //! defines it reads no file. [`load`] reads a scene file by its extension.
 #![warn(missing_docs)]
 
+mod assets;
 mod builtin;
 mod collada;
 mod delft;
@@ -32,6 +33,7 @@ mod render_config;
 mod scene;
 mod texture_file;
 
+pub use assets::{course_assets, AssetsError, DATA_ENV};
 pub use builtin::cornell_box;
 pub use collada::{
     parse_collada, read_collada, write_collada, CameraDef, Collada, EffectDef, Geometry, Instance,

@@ -10,6 +10,7 @@ mod raytrace;
 mod render;
 mod svg;
 
+use crate::error::UserError;
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
@@ -24,25 +25,39 @@ pub struct DemoArgs {
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
-    /// The course's staged assets, for the pictures that need their files (the bunny); those
-    /// pictures are left out when the folder is missing.
-    #[arg(long, default_value = "../shared/assets")]
-    pub assets: PathBuf,
+    /// The course's files (`shared/assets`), for the pictures made from them (the bunnies, the
+    /// Delft presets, the cloth). Without it: `PRISM_DATA`, else a `shared/assets` folder above
+    /// the executable or the working folder; if none is found, those pictures are left out
+    /// and the run says so.
+    #[arg(long, alias = "assets", value_name = "DIR")]
+    pub data: Option<PathBuf>,
 }
 
 /// Runs `prism demo`.
 pub fn run(a: &DemoArgs) -> Result<()> {
     std::fs::create_dir_all(&a.output)
         .with_context(|| format!("creating {}", a.output.display()))?;
+    let assets = match prism_scene::course_assets(a.data.as_deref()) {
+        Ok(found) => Some(found),
+        Err(e @ prism_scene::AssetsError::NotFound { .. }) => {
+            eprintln!(
+                "prism: warning: {e}; the demo leaves out the pictures made from them (the \
+                 bunnies, the Delft presets prism has no copy of, the cloth)"
+            );
+            None
+        }
+        Err(e) => return Err(UserError(e.to_string()).into()),
+    };
+    let assets = assets.as_deref();
     let mut entries = Vec::new();
     let jobs = svg::jobs()?;
     let pb = crate::progress::bar(jobs.len() as u64 + 11, "demo", a.quiet);
     svg::draw_jobs(jobs, &a.output, &mut entries, &pb)?;
     mesh::subdivision(&a.output, &mut entries, &pb)?;
-    render::pictures(&a.output, &a.assets, &mut entries, &pb)?;
+    render::pictures(&a.output, assets, &mut entries, &pb)?;
     mesh::teapot(&a.output, &mut entries, &pb)?;
-    raytrace::pictures(&a.output, &a.assets, &mut entries)?;
-    cloth::pictures(&a.output, &a.assets, &mut entries)?;
+    raytrace::pictures(&a.output, assets, &mut entries)?;
+    cloth::pictures(&a.output, assets, &mut entries)?;
     pb.finish_and_clear();
     index::write_index(&a.output, &entries)?;
     if !a.quiet {

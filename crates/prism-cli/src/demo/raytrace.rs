@@ -10,13 +10,16 @@ use super::index::Entry;
 
 /// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
 /// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
-pub fn pictures(output: &Path, assets: &Path, entries: &mut Vec<Entry>) -> Result<()> {
+pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) -> Result<()> {
     use prism_render::whitted::camera::OrbitView;
     use prism_render::whitted::film::{raytrace, trace_pixel, RaytraceOptions};
     use prism_render::whitted::overlay::Overlay;
     use prism_render::whitted::scene::WhittedScene;
     use prism_scene::{OrbitCamera, Preset};
-    let dirs = vec![assets.join("delft-raytracer/data")];
+    let dirs: Vec<_> = assets
+        .map(|a| a.join("delft-raytracer/data"))
+        .into_iter()
+        .collect();
     let on = prism_scene::Features::prism_defaults();
     let opts = |size: u32, features: prism_scene::Features| RaytraceOptions {
         width: size,

@@ -55,7 +55,7 @@ fn sky_map() -> prism_image::RgbImage {
 /// Writes the sky map, sky.exr, beside the pictures.
 pub fn pictures(
     output: &Path,
-    assets: &Path,
+    assets: Option<&Path>,
     entries: &mut Vec<Entry>,
     pb: &ProgressBar,
 ) -> Result<()> {
@@ -129,8 +129,8 @@ pub fn pictures(
         });
         pb.inc(1);
     }
-    let bunny = assets.join("pathtracer/dae/sky/CBbunny.dae");
-    if bunny.is_file() {
+    let course = |rel: &str| assets.map(|a| a.join(rel)).filter(|p| p.is_file());
+    if let Some(bunny) = course("pathtracer/dae/sky/CBbunny.dae") {
         let doc = prism_scene::read_collada(&bunny)
             .map_err(|e| crate::error::UserError(e.to_string()))?;
         let scene = prism_scene::Scene::from_collada(
@@ -148,8 +148,7 @@ pub fn pictures(
     // The course's unlit bunny under a procedural sky map (written beside the pictures).
     let sky = sky_map();
     prism_image::write_exr(&output.join("sky.exr"), &sky)?;
-    let unlit = assets.join("pathtracer/dae/sky/bunny_unlit.dae");
-    if unlit.is_file() {
+    if let Some(unlit) = course("pathtracer/dae/sky/bunny_unlit.dae") {
         let doc = prism_scene::read_collada(&unlit)
             .map_err(|e| crate::error::UserError(e.to_string()))?;
         let mut scene = prism_scene::Scene::from_collada(

@@ -1876,3 +1876,50 @@ fn outputs_are_the_same_bytes_on_every_instruction_set() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The course's files are found at run time: a copy of the binary outside the checkout (as
+/// `cargo install` puts it), run from another folder with `PRISM_DATA`, writes the demo's
+/// pictures made from them (the bunny, the Delft presets, the cloth) and traces a Delft
+/// preset from their data; `PRISM_DATA` naming no folder is refused, naming it.
+#[test]
+fn an_installed_binary_finds_the_course_files_by_prism_data() {
+    let dir = scratch("installed");
+    let bin = dir.join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let exe = bin.join("prism");
+    std::fs::copy(env!("CARGO_BIN_EXE_prism"), &exe).unwrap();
+    let work = dir.join("work");
+    std::fs::create_dir_all(&work).unwrap();
+    let run = |args: &[&str], data: &std::path::Path| {
+        Command::new(&exe)
+            .args(args)
+            .current_dir(&work)
+            .env("PRISM_DATA", data)
+            .output()
+            .unwrap()
+    };
+    let assets = prism_testkit::shared_assets();
+    let o = run(&["demo", "-q", "-o", "gallery"], &assets);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for f in [
+        "render_bunny.png",
+        "raytrace_presets.png",
+        "cloth_scenes.png",
+        "cloth_shaders.png",
+    ] {
+        assert!(work.join("gallery").join(f).is_file(), "{f} missing");
+    }
+    let o = run(
+        &["raytrace", "teapot", "-r", "32", "32", "-o", "t.png", "-q"],
+        &assets,
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let gone = dir.join("gone");
+    let o = run(&["demo", "-q", "-o", "g2"], &gone);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!("PRISM_DATA {}: no such folder", gone.display())),
+        "{}",
+        stderr(&o)
+    );
+}
