@@ -59,19 +59,17 @@ pub fn course_assets(given: Option<&Path>) -> Result<PathBuf, AssetsError> {
     let env = std::env::var_os(DATA_ENV).filter(|v| !v.is_empty());
     let exe = std::env::current_exe().ok();
     let cwd = std::env::current_dir().ok();
-    find(
-        given,
-        env.as_deref().map(Path::new),
-        [exe.as_deref().and_then(Path::parent), cwd.as_deref()],
-    )
+    let starts = [exe.as_deref().and_then(Path::parent), cwd.as_deref()];
+    let upwards = starts.into_iter().flatten().flat_map(Path::ancestors);
+    find(given, env.as_deref().map(Path::new), upwards)
 }
 
 /// [`course_assets`] with its inputs given: the folder `--data` names, the one `PRISM_DATA`
-/// names, and the folders to look upwards from.
-fn find(
+/// names, and the folders to look in, in order.
+fn find<'a>(
     given: Option<&Path>,
     env: Option<&Path>,
-    starts: [Option<&Path>; 2],
+    dirs: impl IntoIterator<Item = &'a Path>,
 ) -> Result<PathBuf, AssetsError> {
     let plain = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
     for (from, path) in [("--data", given), (DATA_ENV, env)] {
@@ -86,15 +84,13 @@ fn find(
         }
     }
     let mut searched = Vec::new();
-    for start in starts.into_iter().flatten() {
-        for dir in start.ancestors() {
-            for candidate in [dir.join("shared/assets"), dir.join("assets")] {
-                if holds_course_files(&candidate) {
-                    return Ok(plain(&candidate));
-                }
-                if !searched.contains(&candidate) {
-                    searched.push(candidate);
-                }
+    for dir in dirs {
+        for candidate in [dir.join("shared/assets"), dir.join("assets")] {
+            if holds_course_files(&candidate) {
+                return Ok(plain(&candidate));
+            }
+            if !searched.contains(&candidate) {
+                searched.push(candidate);
             }
         }
     }
@@ -120,25 +116,37 @@ mod tests {
         root
     }
 
-    /// The order of the rules: `--data`, then `PRISM_DATA`, then upwards from the
-    /// executable's folder, then from the working folder.
+    /// The folders from `from` up to `root`, as the search walks them (kept inside the
+    /// scratch tree, whatever lies above it on this machine).
+    fn up(from: &Path, root: &Path) -> Vec<PathBuf> {
+        from.ancestors()
+            .take_while(|d| d.starts_with(root))
+            .map(Path::to_path_buf)
+            .collect()
+    }
+
+    /// The order of the rules: `--data`, then `PRISM_DATA`, then the folders upwards (from
+    /// the executable's folder first).
     #[test]
     fn data_then_environment_then_upwards() {
         let root = tree("order");
         let assets = std::fs::canonicalize(root.join("shared/assets")).unwrap();
         let exe = root.join("checkout/target/release");
         let elsewhere = root.join("elsewhere");
-        assert_eq!(find(None, None, [Some(&exe), None]), Ok(assets.clone()));
+        let from_exe = up(&exe, &root);
+        let walk = |dirs: &[PathBuf]| find(None, None, dirs.iter().map(PathBuf::as_path));
+        assert_eq!(walk(&from_exe), Ok(assets.clone()));
         assert_eq!(
-            find(None, None, [Some(&elsewhere), Some(&exe)]),
-            Ok(assets.clone())
+            walk(&[up(&elsewhere, &root), from_exe.clone()].concat()),
+            Ok(assets)
         );
         let given = std::fs::canonicalize(&elsewhere).unwrap();
+        let dirs = from_exe.iter().map(PathBuf::as_path);
         assert_eq!(
-            find(Some(&elsewhere), None, [Some(&exe), None]),
+            find(Some(&elsewhere), None, dirs.clone()),
             Ok(given.clone())
         );
-        assert_eq!(find(None, Some(&elsewhere), [Some(&exe), None]), Ok(given));
+        assert_eq!(find(None, Some(&elsewhere), dirs), Ok(given));
         std::fs::remove_dir_all(&root).unwrap();
     }
 
@@ -148,15 +156,19 @@ mod tests {
     fn what_is_missing_is_named() {
         let root = tree("missing");
         let gone = root.join("gone");
+        let none: [&Path; 0] = [];
         assert_eq!(
-            find(None, Some(&gone), [None, None])
-                .unwrap_err()
-                .to_string(),
+            find(None, Some(&gone), none).unwrap_err().to_string(),
             format!("PRISM_DATA {}: no such folder", gone.display())
+        );
+        assert_eq!(
+            find(Some(&gone), None, none).unwrap_err().to_string(),
+            format!("--data {}: no such folder", gone.display())
         );
         std::fs::remove_dir_all(root.join("shared")).unwrap();
         let elsewhere = root.join("elsewhere");
-        let e = find(None, None, [Some(&elsewhere), None]).unwrap_err();
+        let dirs = up(&elsewhere, &root);
+        let e = find(None, None, dirs.iter().map(PathBuf::as_path)).unwrap_err();
         let AssetsError::NotFound { searched } = &e else {
             panic!("{e}")
         };
