@@ -18,7 +18,21 @@
 #   usage: scripts/view-check.sh [PRISM_BINARY]   (default: target/release/prism)
 # Run from the repository, with ../shared beside it (the scene comes from there).
 set -euo pipefail
+# Every tool the checks use, named when missing (each one's Debian package in brackets).
+missing=()
+for tool in Xvfb:xvfb xdotool:xdotool xdpyinfo:x11-utils import:imagemagick \
+    convert:imagemagick compare:imagemagick bc:bc realpath:coreutils; do
+    command -v "${tool%%:*}" >/dev/null 2>&1 || missing+=("${tool%%:*} (${tool##*:})")
+done
+if ((${#missing[@]})); then
+    echo "view-check: missing tools: ${missing[*]}; apt-get install -y xvfb xdotool x11-utils imagemagick bc libxkbcommon-x11-0" >&2
+    exit 2
+fi
 prism=$(realpath "${1:-target/release/prism}")
+if [ ! -x "$prism" ]; then
+    echo "view-check: $prism is not an executable prism (build it: cargo build --release)" >&2
+    exit 2
+fi
 scene=$(realpath ../shared/assets/pathtracer/dae/sky/CBspheres_lambertian.dae)
 cloth=$(realpath ../shared/assets/clothsim/scene/pinned2.json)
 teapot=$(realpath ../shared/assets/meshedit/dae/teapot.dae)
@@ -40,8 +54,10 @@ colours() { convert "$1" -crop 400x280+0+0 +repage -format %k info:; }
 # Pixels that differ between two screenshots, in the region WxH+X+Y if one is given.
 differ() {
     if (($# > 2)); then
-        compare -metric AE <(convert "$1" -crop "$3" +repage png:-) \
-            <(convert "$2" -crop "$3" +repage png:-) null: 2>&1 || true
+        # Crops go through files: ImageMagick cannot read /dev/fd on every system.
+        convert "$1" -crop "$3" +repage "$work/crop-a.png"
+        convert "$2" -crop "$3" +repage "$work/crop-b.png"
+        compare -metric AE "$work/crop-a.png" "$work/crop-b.png" null: 2>&1 || true
     else
         compare -metric AE "$1" "$2" null: 2>&1 || true
     fi

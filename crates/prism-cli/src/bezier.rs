@@ -35,6 +35,9 @@ pub struct BezierArgs {
     /// Picture size in pixels for curves.
     #[arg(long, default_value_t = 800)]
     pub size: u32,
+    /// Quiet, as on every subcommand (`prism bezier` prints nothing but errors anyway).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Runs `prism bezier`.

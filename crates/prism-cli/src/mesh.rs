@@ -20,6 +20,10 @@ pub struct MeshArgs {
     /// face on an edge already used in its direction gets vertices of its own).
     #[arg(long, global = true)]
     strict: bool,
+    /// No progress bar, warnings or summary lines (errors and the listings asked for still
+    /// print).
+    #[arg(short, long, global = true)]
+    quiet: bool,
 }
 
 /// Neighbour weights for Loop subdivision.
@@ -106,17 +110,14 @@ enum MeshCommand {
         /// Print per-stage times on stderr (`subdivide: 12.3 ms`, one line per stage).
         #[arg(long)]
         stats: bool,
-        /// No progress bar (it is drawn only on a terminal anyway).
-        #[arg(short, long)]
-        quiet: bool,
     },
 }
 
 /// Reads a mesh by its extension (prism-scene's table of formats), printing the reader's
 /// warnings.
-fn read(path: &Path) -> Result<PolyMesh> {
+fn read(path: &Path, quiet: bool) -> Result<PolyMesh> {
     let (mesh, warnings) = prism_scene::read_mesh(path).map_err(|e| UserError(e.to_string()))?;
-    for w in &warnings {
+    for w in warnings.iter().filter(|_| !quiet) {
         eprintln!("warning: {w}");
     }
     Ok(mesh)
@@ -134,44 +135,49 @@ const SPLIT_WARNINGS: usize = 10;
 /// naming each repair: a face on an edge already used in its direction gets its own
 /// vertices, and a vertex where fans of faces touch becomes one vertex per fan (vertices
 /// numbered from 1, as in OBJ files; faces from 0).
-fn load(path: &Path, strict: bool) -> Result<PolyMesh> {
-    let mut p = read(path)?;
+fn load(path: &Path, (strict, quiet): (bool, bool)) -> Result<PolyMesh> {
+    let mut p = read(path, quiet)?;
     if strict {
         return Ok(p);
     }
+    let warn = |message: String| {
+        if !quiet {
+            eprintln!("warning: {message}");
+        }
+    };
     let detached = p.detach_faces_on_used_edges();
     for f in detached.iter().take(SPLIT_WARNINGS) {
-        eprintln!(
-            "warning: {}: face {f} uses an edge an earlier face already uses in that direction \
+        warn(format!(
+            "{}: face {f} uses an edge an earlier face already uses in that direction \
              (a non-manifold edge or a face turned over); it gets vertices of its own \
              (--strict refuses such a mesh)",
             path.display()
-        );
+        ));
     }
     if detached.len() > SPLIT_WARNINGS {
-        eprintln!(
-            "warning: {}: {} more faces detached the same way",
+        warn(format!(
+            "{}: {} more faces detached the same way",
             path.display(),
             detached.len() - SPLIT_WARNINGS
-        );
+        ));
     }
     let split = p.split_nonmanifold_vertices();
     for s in split.iter().take(SPLIT_WARNINGS) {
-        eprintln!(
-            "warning: {}: vertex {} joins {} fans of faces that touch only there; split into \
+        warn(format!(
+            "{}: vertex {} joins {} fans of faces that touch only there; split into \
              {} vertices (--strict refuses such a mesh)",
             path.display(),
             s.vertex + 1,
             s.copies.len() + 1,
             s.copies.len() + 1
-        );
+        ));
     }
     if split.len() > SPLIT_WARNINGS {
-        eprintln!(
-            "warning: {}: {} more vertices split the same way",
+        warn(format!(
+            "{}: {} more vertices split the same way",
             path.display(),
             split.len() - SPLIT_WARNINGS
-        );
+        ));
     }
     Ok(p)
 }
@@ -232,13 +238,13 @@ fn list(kind: &str, count: usize, limit: usize, line: impl Fn(usize) -> String) 
 /// `op` says what it did, in words.
 fn edge_op(
     args: &EdgeArgs,
-    strict: bool,
+    (strict, quiet): (bool, bool),
     what: &str,
     op: impl FnOnce(&mut HalfedgeMesh, prism_mesh::EdgeId) -> Result<String, TopologyError>,
 ) -> Result<()> {
     let (input, output) = (&args.input, &args.output);
     let (edge, vertices) = (args.edge, args.vertices.as_deref());
-    let p = load(input, strict)?;
+    let p = load(input, (strict, quiet))?;
     let mut m = build(input, &p)?;
     let e = match (edge, vertices) {
         (Some(e), _) => prism_mesh::EdgeId(e),
@@ -271,13 +277,15 @@ fn edge_op(
     let done = op(&mut m, e)
         .map_err(|err| UserError(format!("{}: cannot {what}: {err}", input.display())))?;
     write(output, &m.to_polymesh())?;
-    println!("{before}: {done}");
-    println!(
-        "now {} vertices, {} edges, {} faces",
-        m.vertex_count(),
-        m.edge_count(),
-        m.face_count()
-    );
+    if !quiet {
+        println!("{before}: {done}");
+        println!(
+            "now {} vertices, {} edges, {} faces",
+            m.vertex_count(),
+            m.edge_count(),
+            m.face_count()
+        );
+    }
     Ok(())
 }
 
@@ -302,7 +310,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
         };
         crate::output::check_distinct(&[("the mesh", input)], &[("--output", output)])?;
     }
-    let strict = a.strict;
+    let reading = (a.strict, a.quiet);
     match &a.command {
         MeshCommand::Info {
             input,
@@ -311,7 +319,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             faces,
             limit,
         } => {
-            let p = load(input, strict)?;
+            let p = load(input, reading)?;
             let m = build(input, &p)?;
             let boundary_edges = (0..m.edge_count())
                 .filter(|&e| m.is_boundary_edge(prism_mesh::EdgeId(e as u32)))
@@ -357,20 +365,20 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             Ok(())
         }
         MeshCommand::Normals { input, output } => {
-            let mut p = load(input, strict)?;
+            let mut p = load(input, reading)?;
             p.normals = Some(prism_mesh::vertex_normals_area_weighted(&p));
             write(output, &p)
         }
         MeshCommand::Convert { input, output } => {
-            let p = load(input, strict)?;
+            let p = load(input, reading)?;
             build(input, &p)?;
             write(output, &p)
         }
-        MeshCommand::Flip(e) => edge_op(e, a.strict, "flip", |m, id| {
+        MeshCommand::Flip(e) => edge_op(e, reading, "flip", |m, id| {
             m.flip(id)?;
             Ok(format!("flipped; it now joins {}", edge_words(m, id)))
         }),
-        MeshCommand::Split(e) => edge_op(e, a.strict, "split", |m, id| {
+        MeshCommand::Split(e) => edge_op(e, reading, "split", |m, id| {
             let v = m.split(id)?;
             Ok(format!(
                 "split at new vertex {} ({})",
@@ -378,7 +386,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
                 xyz(m.position(v))
             ))
         }),
-        MeshCommand::Collapse(e) => edge_op(e, a.strict, "collapse", |m, id| {
+        MeshCommand::Collapse(e) => edge_op(e, reading, "collapse", |m, id| {
             let v = m.collapse(id)?;
             Ok(format!(
                 "collapsed to vertex {} ({}); vertices above may be renumbered",
@@ -392,14 +400,13 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             levels,
             weights,
             stats,
-            quiet,
         } => {
             let w = match weights {
                 Weights::Warren => LoopWeights::Warren,
                 Weights::Loop => LoopWeights::Loop,
             };
             let t = Instant::now();
-            let mut p = load(input, strict)?;
+            let mut p = load(input, reading)?;
             let read_time = t.elapsed();
             // Refuse before allocating what cannot fit: every level makes 4 faces of one.
             prism_mesh::check_subdivision(p.face_count(), *levels).map_err(|e| {
@@ -415,7 +422,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
                     .map(|l| (p.face_count() as u64) << (2 * l))
                     .sum(),
                 "subdivide",
-                *quiet,
+                a.quiet,
             );
             let (mut build_time, mut sub_time) =
                 (std::time::Duration::ZERO, std::time::Duration::ZERO);

@@ -1959,3 +1959,57 @@ fn docs_examples_run() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(std::fs::metadata(dir.join("drape.gif")).unwrap().len() > 1000);
 }
+
+/// The subcommands a `--help` page lists under `Commands:` (without `help`).
+fn subcommands(help: &str) -> Vec<String> {
+    help.lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter(|l| !l.starts_with("   "))
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .filter(|c| c != "help")
+        .collect()
+}
+
+/// One set of habits, walked through every subcommand's `--help` (found from `prism --help`
+/// and `prism mesh --help`, so a new one is walked too): each page opens, every command takes
+/// `-q, --quiet`, and every command that writes files names them with `-o, --output`. The
+/// window (`view`) writes nothing and has no quiet mode; `mesh info` prints a report.
+#[test]
+fn every_subcommand_has_the_common_flags() {
+    let help = |args: &[&str]| {
+        let o = prism().args(args).arg("--help").output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{args:?}: {}", stderr(&o));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let top = subcommands(&help(&[]));
+    assert!(top.len() >= 10, "{top:?}");
+    let mut walked = 0;
+    for cmd in &top {
+        let page = help(&[cmd]);
+        let nested = subcommands(&page);
+        let pages: Vec<(String, String)> = if nested.is_empty() {
+            vec![(cmd.clone(), page)]
+        } else {
+            nested
+                .iter()
+                .map(|sub| (format!("{cmd} {sub}"), help(&[cmd, sub])))
+                .collect()
+        };
+        for (name, page) in pages {
+            walked += 1;
+            if name == "view" {
+                continue;
+            }
+            assert!(page.contains("-q, --quiet"), "prism {name}: no -q, --quiet");
+            if name != "mesh info" {
+                assert!(
+                    page.contains("-o, --output"),
+                    "prism {name}: no -o, --output"
+                );
+            }
+        }
+    }
+    assert!(walked >= 16, "{walked} pages walked");
+}
