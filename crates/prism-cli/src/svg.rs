@@ -226,6 +226,16 @@ pub fn run(a: &SvgArgs) -> Result<()> {
         crate::output::check_distinct(&[("the SVG", &a.input)], &[("--output", &a.output)])?;
         return render_one(&a.input, &a.output, format, a, view).map(warn);
     }
+    // A folder of drawings is written into a folder that exists (its subfolders mirror the
+    // input's); prism does not create the output folder itself.
+    if !a.output.is_dir() {
+        return Err(UserError(format!(
+            "--output {}: a folder of SVGs is written into an existing folder, and this is \
+             not one (prism does not create it)",
+            a.output.display()
+        ))
+        .into());
+    }
     let mut files = Vec::new();
     find_svgs(&a.input, &mut files)?;
     let pb = crate::progress::bar(files.len() as u64, "svg", a.quiet);

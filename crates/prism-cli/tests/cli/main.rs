@@ -132,8 +132,9 @@ fn unknown_elements_warn_once_and_render() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A directory in gives a directory out with the same tree; output is identical whatever
-/// the thread count.
+/// A directory in gives a directory out with the same tree, written into a folder that
+/// exists (a missing one, or a file name, is refused and not created); output is identical
+/// whatever the thread count.
 #[test]
 fn batch_directory_and_determinism() {
     let dir = scratch("batch");
@@ -143,6 +144,23 @@ fn batch_directory_and_determinism() {
     std::fs::write(input.join("a.svg"), svg).unwrap();
     std::fs::write(input.join("sub/b.svg"), svg).unwrap();
     let out = dir.join("out");
+    for missing in [dir.join("single.png"), out.clone(), dir.join("nodir/")] {
+        let o = prism()
+            .arg("svg")
+            .arg(&input)
+            .arg("-o")
+            .arg(&missing)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("a folder of SVGs is written into an existing folder"),
+            "{}",
+            stderr(&o)
+        );
+        assert!(!missing.exists(), "{} was created", missing.display());
+    }
+    std::fs::create_dir(&out).unwrap();
     let o = prism()
         .args(["svg"])
         .arg(&input)
