@@ -78,11 +78,7 @@ fn write_cloth_obj(c: &Cloth, w: &mut ObjWriter<impl std::io::Write>) -> std::io
         w.vector("vn", &n.to_array())?;
     }
     for t in &m.triangles {
-        w.face(t.map(|v| Corner {
-            v,
-            vt: Some(v),
-            vn: Some(v),
-        }))?;
+        w.face(t.map(|v| Corner::new(v, Some(v), Some(v))))?;
     }
     Ok(())
 }

@@ -69,8 +69,8 @@ impl ShadeMesh {
                 let index = *corner_of.entry(c).or_insert_with(|| {
                     corners.push((
                         c.v as usize,
-                        c.vt.map(|t| t as usize),
-                        c.vn.map(|n| n as usize),
+                        c.vt().map(|t| t as usize),
+                        c.vn().map(|n| n as usize),
                     ));
                     (corners.len() - 1) as u32
                 });

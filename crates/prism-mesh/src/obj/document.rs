@@ -2,7 +2,7 @@
 //! and shape statements between them), read once by one set of rules and checked against
 //! the memory budget; the mesh, the shading mesh and the Delft scene are built from it.
 
-use prism_math::limits::{memory_budget, OverBudget};
+use prism_math::limits::{format_bytes, memory_budget};
 use prism_math::Loc;
 
 use super::lexer::{statements, ObjFloat, Statement};
@@ -22,15 +22,51 @@ pub struct ObjOptions {
     pub markers: bool,
 }
 
-/// A face corner: 0-based indices into the positions, uvs and normals.
+/// A face corner: 0-based indices into the positions, uvs and normals, in 12 bytes (a
+/// document holds one per corner of the file).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Corner {
     /// The position.
     pub v: u32,
+    /// The texture coordinate, or [`Corner::ABSENT`].
+    vt: u32,
+    /// The normal, or [`Corner::ABSENT`].
+    vn: u32,
+}
+
+impl Corner {
+    /// An index a corner does not name (no list holds 2^32 - 1 entries: the reader refuses
+    /// files with as many).
+    const ABSENT: u32 = u32::MAX;
+
+    /// The corner of position `v`, texture coordinate `vt` and normal `vn`.
+    ///
+    /// # Panics
+    /// If `vt` or `vn` is `u32::MAX`, which names no entry.
+    #[must_use]
+    pub fn new(v: u32, vt: Option<u32>, vn: Option<u32>) -> Corner {
+        let index = |i: Option<u32>| {
+            assert_ne!(i, Some(Corner::ABSENT), "an index below 2^32 - 1");
+            i.unwrap_or(Corner::ABSENT)
+        };
+        Corner {
+            v,
+            vt: index(vt),
+            vn: index(vn),
+        }
+    }
+
     /// The texture coordinate, if the corner names one (and the file has some).
-    pub vt: Option<u32>,
+    #[must_use]
+    pub fn vt(&self) -> Option<u32> {
+        (self.vt != Corner::ABSENT).then_some(self.vt)
+    }
+
     /// The normal, if the corner names one (and the file has some).
-    pub vn: Option<u32>,
+    #[must_use]
+    pub fn vn(&self) -> Option<u32> {
+        (self.vn != Corner::ABSENT).then_some(self.vn)
+    }
 }
 
 /// A face: its corners are `corners[first..first + count]`.
@@ -157,7 +193,7 @@ impl<F: ObjFloat> ObjDocument<F> {
                         let counts = (doc.positions.len(), uv_count, normal_count);
                         let mut c = corner(w, counts).map_err(err)?;
                         if !options.attributes {
-                            (c.vt, c.vn) = (None, None);
+                            c = Corner::new(c.v, None, None);
                         }
                         corners.push(c);
                         if corners.len() > MAX_FACE_CORNERS {
@@ -190,11 +226,13 @@ impl<F: ObjFloat> ObjDocument<F> {
             };
             held += grew as u64;
             if held > budget {
-                let over = OverBudget {
-                    bytes: held,
-                    budget,
-                };
-                return Err(err(format!("{}: storing the file's data {over}", st.key)));
+                // The file's whole need is not known here, only that it passes the budget.
+                return Err(err(format!(
+                    "{}: the file's data passes the memory budget of {} here (--max-memory \
+                     raises it)",
+                    st.key,
+                    format_bytes(budget)
+                )));
             }
         }
         Ok(doc)
@@ -228,7 +266,11 @@ fn corner(w: &str, (positions, uvs, normals): (usize, usize, usize)) -> Result<C
                 "f: {what} index {i} is out of range ({n} defined so far)"
             ));
         }
-        Ok(idx as u32)
+        // Lists of 2^32 - 1 entries or more never fit the memory budget.
+        u32::try_from(idx)
+            .ok()
+            .filter(|&i| i != Corner::ABSENT)
+            .ok_or_else(|| format!("f: {what} index {i} is past 2^32 - 2"))
     };
     let v = index(parts.next().unwrap_or(""), positions, "vertex")?;
     // A file with no `vt` (`vn`) so far still names a number there, which reads as none (the
@@ -252,7 +294,7 @@ fn corner(w: &str, (positions, uvs, normals): (usize, usize, usize)) -> Result<C
             "f: expected v, v/vt, v//vn or v/vt/vn, found {w:?}"
         ));
     }
-    Ok(Corner { v, vt, vn })
+    Ok(Corner::new(v, vt, vn))
 }
 
 #[cfg(test)]
@@ -272,9 +314,10 @@ mod tests {
     /// without `vt` or `vn`: the index must be a number and reads as none.
     #[test]
     fn corners_in_every_form() {
+        assert_eq!(size_of::<Corner>(), 12);
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1 2/1 3//1\nf -3/-1/-1 2 3\n";
         let doc = parse(text, ALL).unwrap();
-        let c = |v, vt, vn| Corner { v, vt, vn };
+        let c = Corner::new;
         assert_eq!(
             doc.corners,
             [
@@ -290,7 +333,7 @@ mod tests {
         assert!(bare
             .corners
             .iter()
-            .all(|c| c.vt.is_none() && c.vn.is_none()));
+            .all(|c| c.vt().is_none() && c.vn().is_none()));
         assert_eq!(
             parse("v 0 0 0\nf 1/x 1 1\n", ALL).unwrap_err(),
             "t.obj:2: f: expected a texture coordinate index, found \"1/x\""
@@ -307,18 +350,11 @@ mod tests {
         let text = "v 0 0 0\nvt 0.5\nvn 0 0 1\ng a\nusemtl m\nf 1/1/1 1 1\n";
         let kept = parse(text, ALL).unwrap();
         assert_eq!(kept.uvs, [[0.5, 0.0]]);
-        assert_eq!(kept.corners[0].vt, Some(0));
+        assert_eq!(kept.corners[0].vt(), Some(0));
         assert_eq!(kept.markers.len(), 2);
         let plain = parse(text, ObjOptions::default()).unwrap();
         assert!(plain.uvs.is_empty() && plain.normals.is_empty() && plain.markers.is_empty());
-        assert_eq!(
-            plain.corners[0],
-            Corner {
-                v: 0,
-                vt: None,
-                vn: None
-            }
-        );
+        assert_eq!(plain.corners[0], Corner::new(0, None, None));
         let bad = "v 0 0 0\nvt 0 x\nf 1 1 1\n";
         for options in [ALL, ObjOptions::default()] {
             assert_eq!(
@@ -363,9 +399,10 @@ mod tests {
         };
         assert!(read(3).is_ok());
         let e = read(5).unwrap_err();
-        assert!(
-            e.starts_with("t.obj:4: v: storing the file's data needs"),
-            "{e}"
+        assert_eq!(
+            e,
+            "t.obj:4: v: the file's data passes the memory budget of 80 B here (--max-memory \
+             raises it)"
         );
     }
 }

@@ -90,7 +90,7 @@ impl<W: Write> ObjWriter<W> {
                 line.extend_from_slice(int.format(u64::from(i) + 1).as_bytes());
             };
             index(&mut self.int, &mut self.line, c.v);
-            match (c.vt, c.vn) {
+            match (c.vt(), c.vn()) {
                 (None, None) => {}
                 (Some(t), None) => {
                     self.line.push(b'/');
@@ -129,11 +129,10 @@ pub fn write_obj(mesh: &PolyMesh, out: &mut impl Write) -> io::Result<()> {
         w.vector("vn", &n.to_array())?;
     }
     for f in mesh.faces() {
-        w.face(f.iter().map(|&v| Corner {
-            v,
-            vt: None,
-            vn: normals.is_some().then_some(v),
-        }))?;
+        w.face(
+            f.iter()
+                .map(|&v| Corner::new(v, None, normals.is_some().then_some(v))),
+        )?;
     }
     Ok(())
 }

@@ -342,8 +342,8 @@ fn build_mesh(
         let mut t = [0u32; 3];
         for (j, c) in tri.iter().enumerate() {
             let p = positions[c.v as usize];
-            let n = c.vn.map_or(geometric, |i| normals[i as usize]);
-            let uv = c.vt.map_or(Vec2::ZERO, |i| uvs[i as usize]);
+            let n = c.vn().map_or(geometric, |i| normals[i as usize]);
+            let uv = c.vt().map_or(Vec2::ZERO, |i| uvs[i as usize]);
             t[j] = *cache.entry(vertex_key(p, n, uv)).or_insert_with(|| {
                 mesh_positions.push(p);
                 mesh_normals.push(n);
