@@ -25,7 +25,7 @@ const COURSE_FOLDERS: [&str; 5] = [
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum AssetsError {
     /// A folder was named (by `--data` or `PRISM_DATA`) that is not a folder.
-    #[error("{from} {}: no such folder", path.display())]
+    #[error("{from} {}: {}", path.display(), if path.exists() { "not a folder" } else { "no such folder" })]
     NotAFolder {
         /// What named it: `--data` or `PRISM_DATA`.
         from: &'static str,

@@ -45,6 +45,9 @@ pub enum DelftError {
     /// The config, OBJ or preset file could not be read.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// `PRISM_DATA` names no folder.
+    #[error(transparent)]
+    Assets(#[from] crate::AssetsError),
 }
 
 /// Something a run should be told while a scene loads.
@@ -86,12 +89,19 @@ fn preset_names() -> String {
 /// The course's `delft-raytracer/data` folder, if the course's files are found
 /// ([`crate::course_assets`]: `PRISM_DATA`, or a `shared/assets` folder above the executable
 /// or the working folder).
-#[must_use]
-pub fn staged_data() -> Option<PathBuf> {
-    let dir = crate::course_assets(None)
-        .ok()?
-        .join("delft-raytracer/data");
-    dir.is_dir().then_some(dir)
+///
+/// # Errors
+/// [`crate::AssetsError::NotAFolder`] if `PRISM_DATA` names no folder (not finding the files
+/// at all is no error: the presets have copies built in).
+pub fn staged_data() -> Result<Option<PathBuf>, crate::AssetsError> {
+    match crate::course_assets(None) {
+        Ok(assets) => {
+            let dir = assets.join("delft-raytracer/data");
+            Ok(dir.is_dir().then_some(dir))
+        }
+        Err(crate::AssetsError::NotFound { .. }) => Ok(None),
+        Err(e) => Err(e),
+    }
 }
 
 /// The light an OBJ scene named on its own gets: a white point light at (-1, 1, -1).
@@ -123,7 +133,7 @@ pub fn load_delft(
         }
         dirs.push(d.to_path_buf());
     }
-    dirs.extend(staged_data());
+    dirs.extend(staged_data()?);
     let lower = name.to_ascii_lowercase();
     if lower.ends_with(".toml") {
         let cfg = read_render_config(Path::new(name))?;

@@ -35,8 +35,6 @@ pub struct DemoArgs {
 
 /// Runs `prism demo`.
 pub fn run(a: &DemoArgs) -> Result<()> {
-    std::fs::create_dir_all(&a.output)
-        .with_context(|| format!("creating {}", a.output.display()))?;
     let assets = match prism_scene::course_assets(a.data.as_deref()) {
         Ok(found) => Some(found),
         Err(e @ prism_scene::AssetsError::NotFound { .. }) => {
@@ -48,6 +46,9 @@ pub fn run(a: &DemoArgs) -> Result<()> {
         }
         Err(e) => return Err(UserError(e.to_string()).into()),
     };
+    // Only once the inputs are known good is anything created.
+    std::fs::create_dir_all(&a.output)
+        .with_context(|| format!("creating {}", a.output.display()))?;
     let assets = assets.as_deref();
     let mut entries = Vec::new();
     let jobs = svg::jobs()?;

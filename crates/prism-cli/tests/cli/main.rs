@@ -1940,6 +1940,21 @@ fn an_installed_binary_finds_the_course_files_by_prism_data() {
         "{}",
         stderr(&o)
     );
+    assert!(
+        !work.join("g2").exists(),
+        "the demo made its folder before refusing"
+    );
+    // A file is no folder either, for the demo and for the Delft presets' data.
+    for args in [
+        &["demo", "-q", "-o", "g3"][..],
+        &["raytrace", "teapot", "-o", "t3.png"],
+    ] {
+        let o = run(args, &exe);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let want = format!("PRISM_DATA {}: not a folder", exe.display());
+        assert!(stderr(&o).contains(&want), "{args:?}: {}", stderr(&o));
+    }
+    assert!(!work.join("g3").exists() && !work.join("t3.png").exists());
 }
 
 /// The README's examples in `docs/examples` run as it shows them: the render config writes
