@@ -56,7 +56,7 @@ pub enum SceneError {
         message: String,
     },
     /// No data folder holds a preset's file and prism has no copy built in.
-    #[error("preset {preset}: {file} is in none of the data folders ({searched}); give one with --data DIR or data_path", searched = if searched.is_empty() { "none given".to_string() } else { searched.join(", ") })]
+    #[error("preset {preset}: {file} is in none of the data folders ({searched}); give one with --data DIR, data_path or PRISM_DATA (the course's shared/assets)", searched = if searched.is_empty() { "none found".to_string() } else { searched.join(", ") })]
     PresetFileMissing {
         /// The preset.
         preset: &'static str,
