@@ -39,7 +39,7 @@ run() {
     done
 }
 
-run demo demo -o OUT/gallery -q
+run demo demo -o OUT/gallery -q --assets "$assets"
 for dialect in svg cs184; do
     compat=""
     [ "$dialect" = cs184 ] && compat="--compat cs184"
