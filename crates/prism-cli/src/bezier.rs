@@ -21,7 +21,8 @@ pub struct BezierArgs {
     /// patches. The folder must exist.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Curve parameter, in [0, 1], at which the de Casteljau levels are drawn.
+    /// Curve parameter, in [0, 1], at which the de Casteljau levels are drawn (`-t` is the
+    /// course's flag here, not threads: the work is one thread's).
     #[arg(
         short = 't',
         long = "parameter",
@@ -38,6 +39,9 @@ pub struct BezierArgs {
     /// Quiet, as on every subcommand (`prism bezier` prints nothing but errors anyway).
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print per-stage times on stderr: read, then draw or tessellate, then write.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 /// Runs `prism bezier`.
@@ -58,8 +62,16 @@ pub fn run(a: &BezierArgs) -> Result<()> {
         _ => return Err(UserError(format!("{name}: expected a .bzc or .bez file")).into()),
     };
     crate::output::check_distinct(&[("the input", &a.input)], &[("--output", &a.output)])?;
+    let t0 = std::time::Instant::now();
     let text = prism_math::limits::read_input_text(&a.input, prism_mesh::MAX_MESH_FILE_BYTES)
         .map_err(|e| UserError(format!("{name}: {e}")))?;
+    let stage = |what: &str, t: std::time::Instant| {
+        if a.stats {
+            eprintln!("{what}: {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+        }
+    };
+    stage("read", t0);
+    let t1 = std::time::Instant::now();
     match curve_format {
         Some(format) => {
             if !(0.0..=1.0).contains(&a.t) {
@@ -70,7 +82,9 @@ pub fn run(a: &BezierArgs) -> Result<()> {
                 .into());
             }
             let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
-            write_curve(&pts, a.t, a.size, &a.output, format)
+            write_curve(&pts, a.t, a.size, &a.output, format)?;
+            stage("draw and write", t1);
+            Ok(())
         }
         None => {
             if a.resolution == 0 || a.resolution > 1024 {
@@ -82,7 +96,11 @@ pub fn run(a: &BezierArgs) -> Result<()> {
             }
             let patches = parse_bez(&text, &name).map_err(|e| UserError(e.to_string()))?;
             let mesh = tessellate(&patches, a.resolution);
-            crate::mesh::write(&a.output, &mesh)
+            stage("tessellate", t1);
+            let t2 = std::time::Instant::now();
+            crate::mesh::write(&a.output, &mesh)?;
+            stage("write", t2);
+            Ok(())
         }
     }
 }

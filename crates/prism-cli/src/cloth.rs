@@ -5,16 +5,16 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use prism_cloth::{
     cloth_mesh, course_view, obstacles, read_scene, Cloth, FRAMES_PER_SECOND, STEPS_PER_FRAME,
 };
 use prism_mesh::obj::{Corner, NumberStyle, ObjWriter};
-use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms};
+use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Uniforms};
 
 use crate::error::UserError;
 use crate::output::write_text;
-use crate::shade::ShaderArg;
+use crate::shade::{ShaderArg, ShaderFiles};
 
 /// Arguments of `prism cloth`.
 #[derive(Args, Debug)]
@@ -29,9 +29,20 @@ pub struct ClothArgs {
     /// Frames to simulate (30 steps each, 90 frames a simulated second).
     #[arg(long, default_value_t = 90)]
     frames: u32,
-    /// The cloth's shader when drawing (the sphere and plane take the same).
+    /// The cloth's shader when drawing (the sphere and plane take the same); `wireframe`
+    /// draws every triangle's edges in white over black, hidden lines removed.
     #[arg(long, value_enum, default_value_t = ShaderArg::Phong)]
     shader: ShaderArg,
+    #[command(flatten)]
+    files: ShaderFiles,
+    /// Samples per pixel when drawing: a square number (1, 4, 9, 16, ...).
+    #[arg(
+        short = 's',
+        long = "spp",
+        visible_alias = "samples",
+        default_value_t = 1
+    )]
+    samples: u32,
     /// Picture size: WIDTH HEIGHT (the course app's window by default).
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [1024, 800])]
     resolution: Vec<u32>,
@@ -49,9 +60,12 @@ pub struct ClothArgs {
     /// Print per-stage times and `particle-updates/s` on stderr.
     #[arg(long)]
     stats: bool,
-    /// No progress bar and no summary line.
+    /// No progress bar, warnings or summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    threads: Option<usize>,
 }
 
 /// Most frames one run may ask for.
@@ -85,6 +99,11 @@ fn write_cloth_obj(c: &Cloth, w: &mut ObjWriter<impl std::io::Write>) -> std::io
 
 /// Runs `prism cloth`.
 pub fn run(a: &ClothArgs) -> Result<()> {
+    crate::resources::pool(a.threads)?.install(|| run_in_pool(a))
+}
+
+/// Runs `prism cloth` on the current worker pool.
+fn run_in_pool(a: &ClothArgs) -> Result<()> {
     if a.frames == 0 || a.frames > MAX_FRAMES {
         return Err(UserError(format!(
             "--frames: expected 1 to {MAX_FRAMES}, found {}",
@@ -100,7 +119,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
         .into());
     }
     // A frame is drawn while the one before it is written: two in flight.
-    let bytes = 2 * prism_shade::frame_bytes(w, h, 1);
+    let bytes = 2 * prism_shade::frame_bytes(w, h, a.samples.clamp(1, 256));
     crate::resources::check_frame("--resolution", w, h, bytes)?;
     // Where the pictures go: a folder (one per frame) or one animation (.png or .gif).
     let mut gif = false;
@@ -147,23 +166,46 @@ pub fn run(a: &ClothArgs) -> Result<()> {
             .map(|p| ("--output", p)),
     );
     outputs.extend(a.obj.as_deref().map(|p| ("--obj", p)));
-    crate::output::check_distinct(&[("the scene", &a.scene)], &outputs)?;
-    let shader = match a.shader {
-        ShaderArg::Normal => Shader::Normal,
-        ShaderArg::Wireframe => Shader::Wireframe,
-        ShaderArg::Diffuse => Shader::Diffuse,
-        ShaderArg::Phong => Shader::Phong,
-        other => {
-            return Err(UserError(format!(
-                "--shader {}: prism cloth draws with normal, wireframe, diffuse or phong; for \
-                 textures, write --obj and use prism shade",
-                other
-                    .to_possible_value()
-                    .map_or("?".into(), |v| v.get_name().to_string())
-            ))
-            .into())
-        }
+    let mut inputs = vec![("the scene", a.scene.as_path())];
+    inputs.extend(a.files.inputs());
+    crate::output::check_distinct(&inputs, &outputs)?;
+    let shader = a.files.shader(a.shader, a.quiet)?;
+    if !(1..=16u32).any(|k| k * k == a.samples) {
+        return Err(UserError(format!(
+            "--spp: expected a square number from 1 to 256, found {}",
+            a.samples
+        ))
+        .into());
+    }
+    // Wireframe: every edge in white, depth-tested against faces filled with the
+    // background, so that hidden lines are removed.
+    let (uniforms, shade_options) = if a.shader == ShaderArg::Wireframe {
+        (
+            Uniforms {
+                color: prism_math::Rgb::BLACK,
+                ..Uniforms::default()
+            },
+            ShadeOptions {
+                samples: a.samples,
+                wireframe: Some(prism_math::Rgb::WHITE),
+                ..ShadeOptions::default()
+            },
+        )
+    } else {
+        (
+            Uniforms::default(),
+            ShadeOptions {
+                samples: a.samples,
+                ..ShadeOptions::default()
+            },
+        )
     };
+    if a.output.is_none() && a.obj.is_none() && a.obj_sequence.is_none() && !a.stats && !a.quiet {
+        eprintln!(
+            "prism: warning: nothing will be written: give -o (pictures), --obj or \
+             --obj-sequence (the state), or --stats to time the run"
+        );
+    }
     let t0 = Instant::now();
     let scene = read_scene(&a.scene, &a.set).map_err(|e| UserError(e.to_string()))?;
     let read = t0.elapsed();
@@ -195,13 +237,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
                 || {
                     drawing.map(|(g, mesh)| {
                         let t = Instant::now();
-                        let img = shade_rgb8(
-                            &mesh,
-                            &view,
-                            &shader,
-                            &Uniforms::default(),
-                            &ShadeOptions::default(),
-                        );
+                        let img = shade_rgb8(&mesh, &view, &shader, &uniforms, &shade_options);
                         (g, img, t.elapsed())
                     })
                 },

@@ -24,6 +24,10 @@ pub struct MeshArgs {
     /// print).
     #[arg(short, long, global = true)]
     quiet: bool,
+    /// Print times on stderr: per stage for subdivide (`subdivide: 12.3 ms`), the whole
+    /// command's for the others (`total: 1.2 ms`).
+    #[arg(long, global = true)]
+    stats: bool,
 }
 
 /// Neighbour weights for Loop subdivision.
@@ -107,9 +111,6 @@ enum MeshCommand {
         /// Neighbour weights.
         #[arg(long, value_enum, default_value_t = Weights::Warren)]
         weights: Weights,
-        /// Print per-stage times on stderr (`subdivide: 12.3 ms`, one line per stage).
-        #[arg(long)]
-        stats: bool,
     },
 }
 
@@ -291,6 +292,16 @@ fn edge_op(
 
 /// Runs `prism mesh`.
 pub fn run(a: &MeshArgs) -> Result<()> {
+    let t = Instant::now();
+    run_command(a)?;
+    if a.stats && !matches!(a.command, MeshCommand::Subdivide { .. }) {
+        eprintln!("total: {}", ms(t.elapsed()));
+    }
+    Ok(())
+}
+
+/// Runs the `prism mesh` subcommand `a` names.
+fn run_command(a: &MeshArgs) -> Result<()> {
     // The output's format and folder are checked before any work.
     let output = match &a.command {
         MeshCommand::Info { .. } => None,
@@ -399,7 +410,6 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             output,
             levels,
             weights,
-            stats,
         } => {
             let w = match weights {
                 Weights::Warren => LoopWeights::Warren,
@@ -439,7 +449,7 @@ pub fn run(a: &MeshArgs) -> Result<()> {
             bar.finish_and_clear();
             let t = Instant::now();
             write(output, &p)?;
-            if *stats {
+            if a.stats {
                 eprintln!("read: {}", ms(read_time));
                 eprintln!("build: {}", ms(build_time));
                 eprintln!("subdivide: {}", ms(sub_time));

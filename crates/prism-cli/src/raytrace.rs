@@ -40,8 +40,10 @@ pub struct RaytraceArgs {
     /// Image size: WIDTH HEIGHT (default: the config's window_size, else 800 800).
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
     resolution: Option<Vec<u32>>,
-    /// Folder of the preset OBJ files (default: the config's data_path, else the staged
-    /// delft-raytracer/data folder, else the copies built into prism).
+    /// The course's files (`shared/assets`, whose `delft-raytracer/data` holds the presets'
+    /// OBJ files), or that data folder itself (default: the config's data_path, else
+    /// PRISM_DATA or a `shared/assets` folder above the executable or the working folder,
+    /// else the copies built into prism).
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
     /// Turn features on, comma-separated: shading, recursive, hard-shadow, soft-shadow,
@@ -58,7 +60,7 @@ pub struct RaytraceArgs {
     no_bvh: bool,
     /// Rays per pixel, jittered over the pixel (more than 1 turns multi-rays on; with
     /// multi-rays on and no --spp, 16).
-    #[arg(long = "spp")]
+    #[arg(short = 's', long = "spp")]
     spp: Option<u32>,
     /// Samples per segment light; a parallelogram takes a k x k grid, k = ceil(sqrt(N)).
     #[arg(long = "light-samples", default_value_t = 16)]

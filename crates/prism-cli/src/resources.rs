@@ -55,6 +55,20 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     b.build().context("starting worker threads")
 }
 
+/// Sets the global worker pool to `threads` threads as [`pool`] counts them, for a command
+/// whose work must start on the main thread (the window's event loop).
+pub fn global_pool(threads: Option<usize>) -> Result<()> {
+    let Some(t) = threads else { return Ok(()) };
+    let most = max_threads();
+    if t > most {
+        eprintln!("prism: warning: --threads {t}: more than four a core; using {most} threads");
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(t.clamp(1, most))
+        .build_global()
+        .context("starting worker threads")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -78,35 +78,30 @@ pub struct ShadeArgs {
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [800, 600])]
     resolution: Vec<u32>,
     /// Samples per pixel: a square number (1, 4, 9, 16, ...).
-    #[arg(long, default_value_t = 1)]
+    #[arg(
+        short = 's',
+        long = "spp",
+        visible_alias = "samples",
+        default_value_t = 1
+    )]
     samples: u32,
-    /// Texture for --shader texture (default: the course's texture_1.png when staged).
-    #[arg(long, value_name = "PNG")]
-    texture: Option<PathBuf>,
-    /// Height map for --shader bump and displacement (its red channel).
-    #[arg(long, value_name = "PNG")]
-    height_map: Option<PathBuf>,
-    /// Folder with the cube map's faces posx, negx, posy, negy, posz, negz (.png or .jpg)
-    /// for --shader mirror (default: the course's textures/cube when staged).
-    #[arg(long, value_name = "DIR")]
-    cubemap: Option<PathBuf>,
-    /// Light position.
+    #[command(flatten)]
+    files: ShaderFiles,
+    /// Light position (default: the course's (0.5, 2, 2) when the mesh lies within a unit
+    /// of the origin, as the course's meshes do; else that point scaled by the mesh's
+    /// size and moved with its centre, so that the light stands where it stands for the
+    /// course's meshes).
     #[arg(
         long,
         value_name = "X,Y,Z",
         value_delimiter = ',',
-        allow_hyphen_values = true,
-        default_value = "0.5,2,2"
+        allow_hyphen_values = true
     )]
-    light: Vec<f32>,
-    /// Light intensity.
-    #[arg(
-        long,
-        value_name = "R,G,B",
-        value_delimiter = ',',
-        default_value = "3,3,3"
-    )]
-    light_intensity: Vec<f32>,
+    light: Option<Vec<f32>>,
+    /// Light intensity (default: the course's 3,3,3, times the square of the scale when
+    /// the light is placed by the mesh's size, so that the mesh is lit as the course's are).
+    #[arg(long, value_name = "R,G,B", value_delimiter = ',')]
+    light_intensity: Option<Vec<f32>>,
     /// Background colour.
     #[arg(
         long,
@@ -124,6 +119,94 @@ pub struct ShadeArgs {
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    threads: Option<usize>,
+}
+
+/// The files the course's image-reading shaders take, shared by `prism shade` and
+/// `prism cloth`.
+#[derive(Args, Debug)]
+pub struct ShaderFiles {
+    /// Texture for --shader texture (default: the course's texture_1.png).
+    #[arg(long, value_name = "PNG")]
+    texture: Option<PathBuf>,
+    /// Height map for --shader bump and displacement (its red channel; default: the
+    /// course's texture_2.png).
+    #[arg(long, value_name = "PNG")]
+    height_map: Option<PathBuf>,
+    /// Folder with the cube map's faces posx, negx, posy, negy, posz, negz (.png or .jpg)
+    /// for --shader mirror (default: the course's textures/cube).
+    #[arg(long, value_name = "DIR")]
+    cubemap: Option<PathBuf>,
+    /// The course's files (`shared/assets`), where the default texture, height map and cube
+    /// map are found (default: PRISM_DATA, else a `shared/assets` folder above the
+    /// executable or the working folder).
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+}
+
+impl ShaderFiles {
+    /// The files given, named by their flags, for the check that no output replaces them.
+    pub fn inputs(&self) -> Vec<(&'static str, &Path)> {
+        let mut v = Vec::new();
+        v.extend(self.texture.as_deref().map(|p| ("--texture", p)));
+        v.extend(self.height_map.as_deref().map(|p| ("--height-map", p)));
+        v.extend(self.cubemap.as_deref().map(|p| ("--cubemap", p)));
+        v
+    }
+
+    /// The shader `arg` names with the images it reads: the files given, else the course's
+    /// (`clothsim/textures`: texture_1.png, texture_2.png, cube). Warns of a file given to a
+    /// shader that does not read it unless `quiet`.
+    pub fn shader(&self, arg: ShaderArg, quiet: bool) -> Result<Shader> {
+        let file = |given: &Option<PathBuf>, rel: &str, flag: &str| match given {
+            Some(p) => Ok(p.clone()),
+            None => staged(self.data.as_deref(), rel, flag),
+        };
+        let shader = match arg {
+            ShaderArg::Normal => Shader::Normal,
+            ShaderArg::Wireframe => Shader::Wireframe,
+            ShaderArg::Diffuse => Shader::Diffuse,
+            ShaderArg::Phong => Shader::Phong,
+            ShaderArg::Texture => {
+                let path = file(&self.texture, "texture_1.png", "--texture")?;
+                Shader::Texture(course_texture(load_rgb(&path, "--texture")?))
+            }
+            ShaderArg::Bump | ShaderArg::Displacement => {
+                let path = file(&self.height_map, "texture_2.png", "--height-map")?;
+                let map = course_texture(load_rgb(&path, "--height-map")?);
+                if arg == ShaderArg::Bump {
+                    Shader::Bump(map)
+                } else {
+                    Shader::Displacement(map)
+                }
+            }
+            ShaderArg::Mirror => {
+                let dir = file(&self.cubemap, "cube", "--cubemap")?;
+                Shader::Mirror(
+                    prism_image::CubeMap::read(&dir)
+                        .map_err(|e| UserError(format!("--cubemap: {e}")))?,
+                )
+            }
+        };
+        if !quiet {
+            if self.texture.is_some() && arg != ShaderArg::Texture {
+                eprintln!(
+                    "prism: warning: --texture has no effect: it applies to --shader texture"
+                );
+            }
+            if self.height_map.is_some()
+                && !matches!(arg, ShaderArg::Bump | ShaderArg::Displacement)
+            {
+                eprintln!("prism: warning: --height-map has no effect: it applies to --shader bump and displacement");
+            }
+            if self.cubemap.is_some() && arg != ShaderArg::Mirror {
+                eprintln!("prism: warning: --cubemap has no effect: it applies to --shader mirror");
+            }
+        }
+        Ok(shader)
+    }
 }
 
 fn three(v: &[f32], flag: &str) -> Result<Vec3> {
@@ -149,8 +232,8 @@ fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
 
 /// A file of the course's cloth textures (`clothsim/textures/REL` in the course's files,
 /// found as [`prism_scene::course_assets`] finds them), for a shader given no file of its own.
-fn staged(rel: &str, flag: &str) -> Result<PathBuf> {
-    let assets = prism_scene::course_assets(None)
+fn staged(data: Option<&Path>, rel: &str, flag: &str) -> Result<PathBuf> {
+    let assets = prism_scene::course_assets(data)
         .map_err(|e| UserError(format!("{flag} not given, and {e}")))?;
     Ok(assets.join("clothsim/textures").join(rel))
 }
@@ -176,17 +259,36 @@ pub fn read_shade_mesh(path: &Path) -> Result<ShadeMesh> {
     }
 }
 
+/// The light of a mesh given none, as its position and its intensity's scale: the course's
+/// light (0.5, 2, 2) for a mesh within a unit of the origin (the course's meshes are), else
+/// that point scaled by the mesh's half diagonal `r` and moved with the centre of its
+/// bounds `lo`..`hi`, with the intensity scaled by `r^2`, so that the mesh is lit as the
+/// course's meshes are (the same directions, the same `I / d^2`).
+#[must_use]
+pub fn default_light(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
+    let course = Uniforms::default().light_pos;
+    let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    if lo.abs().max_element() <= 1.0 && hi.abs().max_element() <= 1.0 {
+        (course, 1.0)
+    } else {
+        (centre + course * radius, radius * radius)
+    }
+}
+
 /// Runs `prism shade`.
 pub fn run(a: &ShadeArgs) -> Result<()> {
+    crate::resources::pool(a.threads)?.install(|| run_in_pool(a))
+}
+
+/// Runs `prism shade` on the current worker pool.
+fn run_in_pool(a: &ShadeArgs) -> Result<()> {
     let format = image_output(
         &a.output,
         "--output",
         &[ImageFormat::Png, ImageFormat::Bmp, ImageFormat::Jpeg],
     )?;
     let mut inputs = vec![("the mesh", a.mesh.as_path())];
-    inputs.extend(a.texture.as_deref().map(|p| ("--texture", p)));
-    inputs.extend(a.height_map.as_deref().map(|p| ("--height-map", p)));
-    inputs.extend(a.cubemap.as_deref().map(|p| ("--cubemap", p)));
+    inputs.extend(a.files.inputs());
     crate::output::check_distinct(&inputs, &[("--output", &a.output)])?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
@@ -203,7 +305,7 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         .into());
     }
     if a.samples == 0 || a.samples > 256 {
-        return Err(UserError(format!("--samples: expected 1 to 256, found {}", a.samples)).into());
+        return Err(UserError(format!("--spp: expected 1 to 256, found {}", a.samples)).into());
     }
     let bytes = prism_shade::frame_bytes(w, h, a.samples);
     crate::resources::check_frame("--resolution", w, h, bytes)?;
@@ -214,14 +316,22 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
     );
     if per_row > 1 << 20 || all > 1 << 28 {
         return Err(UserError(format!(
-            "--resolution {w} {h} with --samples {}: {all} samples is over the limit of 2^28 (and 2^20 a row)",
+            "--resolution {w} {h} with --spp {}: {all} samples is over the limit of 2^28 (and 2^20 a row)",
             a.samples
         ))
         .into());
     }
     let up = three(&a.up, "--up")?;
-    let light = three(&a.light, "--light")?;
-    let intensity = colour(&a.light_intensity, "--light-intensity")?;
+    let light = a
+        .light
+        .as_deref()
+        .map(|l| three(l, "--light"))
+        .transpose()?;
+    let intensity = a
+        .light_intensity
+        .as_deref()
+        .map(|c| colour(c, "--light-intensity"))
+        .transpose()?;
     let background = colour(&a.background, "--background")?;
     let wire = a
         .wireframe
@@ -230,56 +340,7 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
         .transpose()?;
     let t0 = Instant::now();
     let mesh = read_shade_mesh(&a.mesh)?;
-    let shader = match a.shader {
-        ShaderArg::Normal => Shader::Normal,
-        ShaderArg::Wireframe => Shader::Wireframe,
-        ShaderArg::Diffuse => Shader::Diffuse,
-        ShaderArg::Phong => Shader::Phong,
-        ShaderArg::Texture => {
-            let path = match &a.texture {
-                Some(p) => p.clone(),
-                None => staged("texture_1.png", "--texture")?,
-            };
-            Shader::Texture(course_texture(load_rgb(&path, "--texture")?))
-        }
-        ShaderArg::Bump | ShaderArg::Displacement => {
-            let Some(path) = &a.height_map else {
-                let name = if a.shader == ShaderArg::Bump {
-                    "bump"
-                } else {
-                    "displacement"
-                };
-                return Err(
-                    UserError(format!("--shader {name}: it needs --height-map PNG")).into(),
-                );
-            };
-            let map = course_texture(load_rgb(path, "--height-map")?);
-            if a.shader == ShaderArg::Bump {
-                Shader::Bump(map)
-            } else {
-                Shader::Displacement(map)
-            }
-        }
-        ShaderArg::Mirror => {
-            let dir = match &a.cubemap {
-                Some(d) => d.clone(),
-                None => staged("cube", "--cubemap")?,
-            };
-            Shader::Mirror(
-                prism_image::CubeMap::read(&dir)
-                    .map_err(|e| UserError(format!("--cubemap: {e}")))?,
-            )
-        }
-    };
-    if a.texture.is_some() && a.shader != ShaderArg::Texture {
-        eprintln!("prism: warning: --texture has no effect: it applies to --shader texture");
-    }
-    if a.height_map.is_some() && !matches!(a.shader, ShaderArg::Bump | ShaderArg::Displacement) {
-        eprintln!("prism: warning: --height-map has no effect: it applies to --shader bump and displacement");
-    }
-    if a.cubemap.is_some() && a.shader != ShaderArg::Mirror {
-        eprintln!("prism: warning: --cubemap has no effect: it applies to --shader mirror");
-    }
+    let shader = a.files.shader(a.shader, a.quiet)?;
     let (lo, hi) = mesh.bounds().ok_or_else(|| {
         UserError(format!(
             "{}: the mesh has no faces to draw",
@@ -313,9 +374,17 @@ pub fn run(a: &ShadeArgs) -> Result<()> {
             Framing::NarrowerSide { margin: 1.1 },
         ),
     };
+    let (placed, scale) = default_light(lo, hi);
     let uniforms = Uniforms {
-        light_pos: light,
-        light_intensity: intensity,
+        light_pos: light.unwrap_or(placed),
+        light_intensity: intensity.unwrap_or_else(|| {
+            let course = Uniforms::default().light_intensity;
+            if light.is_some() {
+                course
+            } else {
+                course * scale
+            }
+        }),
         ..Uniforms::default()
     };
     let opts = ShadeOptions {

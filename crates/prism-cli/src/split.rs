@@ -113,6 +113,9 @@ pub struct MergeArgs {
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// Print per-stage times on stderr: read (opening and checking the parts), merge, write.
+    #[arg(long)]
+    stats: bool,
 }
 
 /// Runs `prism merge`.
@@ -125,6 +128,8 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     for path in &a.parts {
         parts.push(PartFile::open(path).map_err(|e| UserError(e.to_string()))?);
     }
+    let read_time = t0.elapsed();
+    let t1 = Instant::now();
     let merged = merge(&parts, a.allow_missing).map_err(|e| UserError(e.to_string()))?;
     drop(parts);
     for hole in &merged.holes {
@@ -151,6 +156,8 @@ pub fn run(a: &MergeArgs) -> Result<()> {
             *p = HOLE;
         }
     }
+    let merge_time = t1.elapsed();
+    let t2 = Instant::now();
     let truncated = identity.encoding() == Encoding::Truncated;
     match format {
         ImageFormat::Exr => prism_image::write_exr(&a.output, &image)?,
@@ -168,6 +175,12 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         let samples = merged.sums.map(|p| p.n);
         crate::output::write_rgb8(path, f, &prism_image::heatmap(&samples))?;
         written.push(path.display().to_string());
+    }
+    if a.stats {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read: {:.1} ms", ms(read_time));
+        eprintln!("merge: {:.1} ms", ms(merge_time));
+        eprintln!("write: {:.1} ms", ms(t2.elapsed()));
     }
     if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         let (w, h) = (merged.sums.width(), merged.sums.height());

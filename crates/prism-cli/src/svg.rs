@@ -57,7 +57,12 @@ pub struct SvgArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// Samples per pixel: a perfect square (1, 4, 9, 16, ...; at most 256).
-    #[arg(short = 's', long, default_value_t = 1)]
+    #[arg(
+        short = 's',
+        long = "spp",
+        visible_alias = "samples",
+        default_value_t = 1
+    )]
     pub samples: u32,
     /// Texel lookup for textured triangles.
     #[arg(long, value_enum, default_value_t = PixelMode::Nearest)]
@@ -71,9 +76,13 @@ pub struct SvgArgs {
     /// Reproduce another renderer's behaviour.
     #[arg(long, value_enum)]
     pub compat: Option<Compat>,
-    /// Print per-stage times on stderr (`parse: 1.2 ms`, one line per stage).
+    /// Print per-stage times on stderr (`parse: 1.2 ms`, one line per stage; for a folder,
+    /// each file's block opens with its name).
     #[arg(long)]
     pub stats: bool,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    pub threads: Option<usize>,
     /// No progress bar and no warnings.
     #[arg(short, long)]
     pub quiet: bool,
@@ -171,6 +180,9 @@ fn render_one(
     }
     let encode = t1.elapsed();
     if a.stats {
+        if a.input.is_dir() {
+            eprintln!("{}:", input.display());
+        }
         eprintln!("parse: {}", ms(parse));
         eprintln!("prepare: {}", ms(stats.prepare));
         eprintln!("raster: {}", ms(stats.raster));
@@ -180,28 +192,42 @@ fn render_one(
     Ok(doc.warnings)
 }
 
-fn find_svgs(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading directory {}", dir.display()))?
-        .collect::<Result<_, _>>()?;
-    entries.sort_by_key(std::fs::DirEntry::path);
-    for e in entries {
-        let p = e.path();
-        if p.is_dir() {
-            find_svgs(&p, out)?;
-        } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("svg")) {
-            out.push(p);
+/// The `*.svg` files under `dir`, in path order, walked with a stack of folders (not
+/// recursion, so the depth of the tree costs no call stack).
+fn find_svgs(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    let mut folders = vec![dir.to_path_buf()];
+    while let Some(d) = folders.pop() {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(&d)
+            .with_context(|| format!("reading directory {}", d.display()))?
+            .map(|e| e.map(|e| e.path()))
+            .collect::<Result<_, _>>()?;
+        entries.sort();
+        // Folders are pushed in reverse so that they are walked in path order.
+        for p in entries.iter().rev() {
+            if p.is_dir() {
+                folders.push(p.clone());
+            }
         }
+        out.extend(entries.into_iter().filter(|p| {
+            !p.is_dir() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("svg"))
+        }));
     }
-    Ok(())
+    out.sort();
+    Ok(out)
 }
 
 /// Runs `prism svg`.
 pub fn run(a: &SvgArgs) -> Result<()> {
+    crate::resources::pool(a.threads)?.install(|| run_in_pool(a))
+}
+
+/// Runs `prism svg` on the current worker pool.
+fn run_in_pool(a: &SvgArgs) -> Result<()> {
     let view = a.view.as_deref().map(parse_view).transpose()?;
     if prism_raster::sample_rate(a.samples).is_none() {
         return Err(UserError(format!(
-            "--samples: expected a perfect square from 1 to {} (1, 4, 9, 16, ...), found {}",
+            "--spp: expected a perfect square from 1 to {} (1, 4, 9, 16, ...), found {}",
             prism_raster::MAX_SAMPLES,
             a.samples
         ))
@@ -236,8 +262,7 @@ pub fn run(a: &SvgArgs) -> Result<()> {
         ))
         .into());
     }
-    let mut files = Vec::new();
-    find_svgs(&a.input, &mut files)?;
+    let files = find_svgs(&a.input)?;
     let pb = crate::progress::bar(files.len() as u64, "svg", a.quiet);
     let mut failed = 0usize;
     for f in &files {

@@ -57,16 +57,19 @@ pub enum ModeArg {
              W wireframe, Ctrl+Z undo, Ctrl+S save as NAME-edited.obj; drag orbits, wheel
              zooms, arrows pan, R resets the view")]
 pub struct ViewArgs {
-    /// The file to open; its extension chooses the mode (.svg: svg; .dae with a light: path;
-    /// .json: cloth; .obj, .toml or a Delft preset name such as cornell-box: whitted; .ply or
-    /// .dae without a light: mesh).
+    /// The file to open; its extension chooses the mode (.svg: svg; .json: cloth; .obj,
+    /// .toml or a Delft preset name such as cornell-box: whitted; .ply: mesh; .dae: path if
+    /// it has lights of its own, mesh if it is lit only by a modelling tool's default lamp
+    /// (a white point or directional light and no emitting material, as every MeshEdit
+    /// file is) or not at all).
     file: PathBuf,
     /// The mode, instead of the one the extension chooses.
     #[arg(long, value_enum)]
     mode: Option<ModeArg>,
-    /// Read SVG as the CS184 course dialect (its elements, quirks and view).
-    #[arg(long)]
-    compat: bool,
+    /// Reproduce another renderer: `cs184` reads SVG as the CS184 course dialect (its
+    /// elements, quirks and view), as `prism svg --compat cs184`.
+    #[arg(long, value_enum)]
+    compat: Option<crate::svg::Compat>,
     /// Window size: WIDTH HEIGHT (default 960 640; 512 384 for path tracing; 1024 800, the
     /// course app's, for cloth; the config's window or 800 800 for whitted).
     #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
@@ -77,22 +80,45 @@ pub struct ViewArgs {
     /// Cloth: override a scene value, as `prism cloth --set` (`--set ks=500`).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
+    /// The course's files (`shared/assets`), where the Delft presets' OBJ files are found
+    /// (default: PRISM_DATA, else a `shared/assets` folder above the executable or the
+    /// working folder, else the copies built into prism).
+    #[arg(long, value_name = "DIR")]
+    data: Option<PathBuf>,
+    /// Worker threads (default: one per core).
+    #[arg(short = 't', long)]
+    threads: Option<usize>,
 }
 
 /// The mode for `a.file`.
 fn open(a: &ViewArgs) -> Result<Viewer> {
+    let mut chosen = None;
+    let viewer = open_mode(a, &mut chosen)?;
+    Ok(match chosen {
+        Some(m) => viewer.with_message(m.to_string()),
+        None => viewer,
+    })
+}
+
+/// The viewer of `a.file` in the mode `--mode` names or its extension chooses; `chosen`
+/// is set to a line saying why when the choice was not plain from the extension.
+fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> {
     let mode = match a.mode {
         Some(m) => m,
         None => match crate::output::extension(&a.file).as_str() {
             "svg" => ModeArg::Svg,
             "dae" => {
-                let lit = prism_scene::load(&a.file, &prism_scene::SceneOptions::default())
-                    .map(|s| s.is_lit())
-                    .unwrap_or(true);
-                if lit {
-                    ModeArg::Path
-                } else {
+                let lamp = prism_scene::load(&a.file, &prism_scene::SceneOptions::default())
+                    .map(|s| s.lit_only_by_a_default_lamp())
+                    .unwrap_or(false);
+                if lamp {
+                    *chosen = Some(
+                        "mesh mode: no light of its own (--mode path to path-trace it)",
+                    );
                     ModeArg::Mesh
+                } else {
+                    *chosen = Some("path mode: the scene's own lights (--mode mesh to edit it)");
+                    ModeArg::Path
                 }
             }
             "ply" => ModeArg::Mesh,
@@ -131,7 +157,7 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
     }
     match mode {
         ModeArg::Svg => {
-            let dialect = if a.compat {
+            let dialect = if a.compat.is_some() {
                 Dialect::Cs184
             } else {
                 Dialect::Svg
@@ -162,7 +188,8 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
             Ok(Viewer::new(Box::new(mode), w, h))
         }
         ModeArg::Whitted => {
-            let loaded = prism_scene::load_delft(&a.file.to_string_lossy(), None, &mut |w| {
+            let name = a.file.to_string_lossy();
+            let loaded = prism_scene::load_delft(&name, a.data.as_deref(), &mut |w| {
                 eprintln!("prism: warning: {w}");
             })
             .map_err(|e| UserError(e.to_string()))?;
@@ -195,6 +222,9 @@ fn open(a: &ViewArgs) -> Result<Viewer> {
 
 /// Runs `prism view`.
 pub fn run(a: &ViewArgs) -> Result<()> {
+    // The window's events stay on the main thread; the modes' workers (path tracing,
+    // shading, rasterizing) run on the global pool.
+    crate::resources::global_pool(a.threads)?;
     let viewer = open(a)?;
     if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
         return Err(UserError(

@@ -114,7 +114,8 @@ pub fn default_obj_lights() -> Vec<Light> {
 }
 
 /// Loads a Delft scene by name: a `.toml` render config, an `.obj` scene (lit by
-/// [`default_obj_lights`]) or a preset name. Preset files come from `data`, else the staged
+/// [`default_obj_lights`]) or a preset name. Preset files come from `data` (the course's
+/// files, whose `delft-raytracer/data` is used, or a folder of OBJ files), else the staged
 /// folder, else the copies built in; a config's `data_path` replaces both folders. Each
 /// warning is handed to `warn` as soon as it is known.
 ///
@@ -131,7 +132,13 @@ pub fn load_delft(
         if !d.is_dir() {
             return Err(DelftError::NotAFolder(d.to_path_buf()));
         }
-        dirs.push(d.to_path_buf());
+        // The course's files hold the data folder; a folder of OBJ files is the folder.
+        let inner = d.join("delft-raytracer/data");
+        dirs.push(if inner.is_dir() {
+            inner
+        } else {
+            d.to_path_buf()
+        });
     }
     dirs.extend(staged_data()?);
     let lower = name.to_ascii_lowercase();

@@ -440,6 +440,29 @@ impl Scene {
         emitters || self.lights.iter().any(Light::gives_off_light)
     }
 
+    /// True if the scene is lit only as a modelling tool's export lights a mesh, as every
+    /// file of the course's MeshEdit is: no emitting material, and every light that gives
+    /// off light is a point or directional light of colour exactly (1, 1, 1) (Blender's and
+    /// Maya's default lamp). Such a file is a mesh to edit, not a scene to path-trace.
+    #[must_use]
+    pub fn lit_only_by_a_default_lamp(&self) -> bool {
+        let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
+        let emitters = self.materials.iter().any(|m| match m {
+            Material::Emission { radiance } => shines(radiance),
+            _ => false,
+        });
+        !emitters
+            && self
+                .lights
+                .iter()
+                .filter(|l| l.gives_off_light())
+                .all(|l| match l {
+                    Light::Point { intensity: c, .. }
+                    | Light::Directional { irradiance: c, .. } => *c == Rgb::WHITE,
+                    _ => false,
+                })
+    }
+
     /// The bounding box of every mesh vertex and sphere: `(min, max)`, or `None` if the
     /// scene has no geometry.
     #[must_use]

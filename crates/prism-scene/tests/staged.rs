@@ -404,3 +404,35 @@ fn course_files_with_a_short_camera_matrix_load_as_the_intact_ones() {
         assert!(prism_scene::Scene::from_collada(&doc, &file_camera, name).is_err());
     }
 }
+
+/// Property over the course's files: every MeshEdit file (`meshedit/dae`, and the copies of
+/// its meshes in `pathtracer/dae/meshedit`) is lit only by a default lamp, so `prism view`
+/// opens it to edit; every path-tracer scene with its own light is not.
+#[test]
+fn meshedit_files_and_only_they_are_lit_by_a_default_lamp() {
+    let mut files = Vec::new();
+    for d in ["meshedit/dae", "pathtracer/dae"] {
+        dae_files(&shared_assets().join(d), &mut files);
+    }
+    files.sort();
+    let mut lamp_lit = Vec::new();
+    for f in &files {
+        let scene = prism_scene::load(f, &prism_scene::SceneOptions::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let rel = f
+            .strip_prefix(shared_assets())
+            .unwrap()
+            .display()
+            .to_string();
+        let meshedit = rel.contains("meshedit/");
+        if scene.lit_only_by_a_default_lamp() {
+            lamp_lit.push(rel.clone());
+        }
+        assert_eq!(
+            scene.lit_only_by_a_default_lamp(),
+            meshedit || !scene.is_lit(),
+            "{rel}"
+        );
+    }
+    assert!(lamp_lit.len() >= 10, "{lamp_lit:?}");
+}

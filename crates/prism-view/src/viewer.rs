@@ -76,6 +76,14 @@ impl Viewer {
         }
     }
 
+    /// The viewer with `message` on its status line from the first frame (why the file
+    /// opened in this mode, say).
+    #[must_use]
+    pub fn with_message(mut self, message: String) -> Viewer {
+        self.message = Some(message);
+        self
+    }
+
     /// The mode.
     #[must_use]
     pub fn mode(&self) -> &dyn Mode {
@@ -166,7 +174,8 @@ impl Viewer {
     }
 
     /// The frame: the picture, a status line at the bottom (the mode's state, the last
-    /// message, the picture's time) and the help overlay when shown.
+    /// message, the picture's time; wrapped onto more rows when the window is narrow) and
+    /// the help overlay when shown (its descriptions wrapped to the window's width).
     pub fn frame(&mut self) -> Frame {
         let mut image = self.picture().clone();
         let (w, h) = (image.width(), image.height());
@@ -174,46 +183,53 @@ impl Viewer {
         if let Some(m) = &self.message {
             line = format!("{m} | {line}");
         }
-        if h > STATUS {
-            shade(&mut image, 0, h - STATUS, w, STATUS);
-            draw_text(
-                &mut image,
-                4,
-                i64::from(h - STATUS + 3),
-                &line,
-                1,
-                [255, 255, 255],
-            );
+        let cols = (w.saturating_sub(8) / GLYPH).max(8) as usize;
+        let rows = wrap(&line, cols);
+        let bar = STATUS + (rows.len() as u32 - 1) * (GLYPH + 2);
+        if h > bar {
+            shade(&mut image, 0, h - bar, w, bar);
+            for (i, row) in rows.iter().enumerate() {
+                let y = h - bar + 3 + i as u32 * (GLYPH + 2);
+                draw_text(&mut image, 4, i64::from(y), row, 1, [255, 255, 255]);
+            }
         }
         if self.help {
-            let mut rows: Vec<(String, String)> = vec![
+            let mut entries: Vec<(String, String)> = vec![
                 ("H".into(), "show or hide this help".into()),
                 ("Esc".into(), "quit".into()),
             ];
-            rows.extend(
+            entries.extend(
                 self.mode
                     .help()
                     .into_iter()
                     .map(|(k, d)| (k.to_string(), d.to_string())),
             );
-            let keys = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
-            let longest = rows
-                .iter()
-                .map(|(_, d)| keys + 2 + d.len())
-                .max()
-                .unwrap_or(0) as u32;
-            let (bw, bh) = ((longest + 2) * GLYPH, (rows.len() as u32 + 2) * (GLYPH + 4));
+            let keys = entries.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+            // The box spans the window less 8 pixels each side; text starts 8 pixels in.
+            let inner = (w.saturating_sub(32) / GLYPH) as usize;
+            let desc_cols = inner.saturating_sub(keys + 2).max(12);
+            let mut lines = Vec::new();
+            for (k, d) in &entries {
+                for (i, part) in wrap(d, desc_cols).into_iter().enumerate() {
+                    let key = if i == 0 { k.as_str() } else { "" };
+                    lines.push(format!("{key:keys$}  {part}"));
+                }
+            }
+            let longest = lines.iter().map(String::len).max().unwrap_or(0) as u32;
+            let (bw, bh) = (
+                (longest + 2) * GLYPH,
+                (lines.len() as u32 + 2) * (GLYPH + 4),
+            );
             shade(
                 &mut image,
                 8,
                 8,
-                bw.min(w.saturating_sub(8)),
+                bw.min(w.saturating_sub(16)),
                 bh.min(h.saturating_sub(8)),
             );
-            for (i, (k, d)) in rows.iter().enumerate() {
+            for (i, text) in lines.iter().enumerate() {
                 let y = 8 + (i as u32 + 1) * (GLYPH + 4);
-                let text = format!("{k:keys$}  {d}");
-                draw_text(&mut image, 16, i64::from(y), &text, 1, [255, 255, 160]);
+                draw_text(&mut image, 16, i64::from(y), text, 1, [255, 255, 160]);
             }
         }
         Frame {
@@ -223,6 +239,41 @@ impl Viewer {
     }
 }
 
+/// `text` broken into rows of at most `cols` characters, at spaces where it can (a word
+/// longer than a row is cut); at least one row.
+fn wrap(text: &str, cols: usize) -> Vec<String> {
+    let cols = cols.max(1);
+    let mut rows = vec![String::new()];
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        let mut word: Vec<char> = word.chars().collect();
+        loop {
+            let row = rows.last_mut().expect("one row at least");
+            let used = row.chars().count();
+            let gap = usize::from(used > 0);
+            if used + gap + word.len() <= cols {
+                if gap == 1 {
+                    row.push(' ');
+                }
+                row.extend(word.iter());
+                break;
+            }
+            if used > 0 {
+                rows.push(String::new());
+                continue;
+            }
+            // A word longer than a row: as much as fits, the rest on the next row.
+            let rest = word.split_off(cols);
+            row.extend(word.iter());
+            rows.push(String::new());
+            word = rest;
+        }
+    }
+    if rows.len() > 1 && rows.last().is_some_and(String::is_empty) {
+        rows.pop();
+    }
+    rows
+}
+
 /// Darkens a rectangle to a third, so that text on it reads over any picture.
 fn shade(image: &mut Rgb8Image, x0: u32, y0: u32, w: u32, h: u32) {
     for y in y0..(y0 + h).min(image.height()) {
@@ -230,5 +281,29 @@ fn shade(image: &mut Rgb8Image, x0: u32, y0: u32, w: u32, h: u32) {
             let p = image.get(x, y);
             image.set(x, y, p.map(|c| c / 3));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap;
+
+    /// Property: every row fits, no word is lost, and words are cut only when longer than a
+    /// row.
+    #[test]
+    fn wrapped_rows_fit_and_keep_every_word() {
+        let text = "mesh mode: a MeshEdit file | 12.5 ms | H: help averyveryverylongword x";
+        for cols in [4, 8, 16, 30, 200] {
+            let rows = wrap(text, cols);
+            assert!(
+                rows.iter().all(|r| r.chars().count() <= cols),
+                "{cols}: {rows:?}"
+            );
+            let joined: String = rows.concat().chars().filter(|c| *c != ' ').collect();
+            let want: String = text.chars().filter(|c| *c != ' ').collect();
+            assert_eq!(joined, want, "{cols}");
+        }
+        assert_eq!(wrap("a b c", 200), vec!["a b c"]);
+        assert_eq!(wrap("", 10), vec![""]);
     }
 }

@@ -31,10 +31,22 @@ pub struct DemoArgs {
     /// and the run says so.
     #[arg(long, alias = "assets", value_name = "DIR")]
     pub data: Option<PathBuf>,
+    /// Print each system's time on stderr (`svg: 812.3 ms`, ...).
+    #[arg(long)]
+    pub stats: bool,
+    /// Worker threads (default: one per core; the pictures are the same bytes whatever the
+    /// count).
+    #[arg(short = 't', long)]
+    pub threads: Option<usize>,
 }
 
 /// Runs `prism demo`.
 pub fn run(a: &DemoArgs) -> Result<()> {
+    crate::resources::pool(a.threads)?.install(|| run_in_pool(a))
+}
+
+/// Runs `prism demo` on the current worker pool.
+fn run_in_pool(a: &DemoArgs) -> Result<()> {
     let assets = match prism_scene::course_assets(a.data.as_deref()) {
         Ok(found) => Some(found),
         Err(e @ prism_scene::AssetsError::NotFound { .. }) => {
@@ -53,12 +65,25 @@ pub fn run(a: &DemoArgs) -> Result<()> {
     let mut entries = Vec::new();
     let jobs = svg::jobs()?;
     let pb = crate::progress::bar(jobs.len() as u64 + 11, "demo", a.quiet);
+    let mut t = std::time::Instant::now();
+    let mut stage = |name: &str| {
+        if a.stats {
+            pb.suspend(|| eprintln!("{name}: {:.1} ms", t.elapsed().as_secs_f64() * 1e3));
+        }
+        t = std::time::Instant::now();
+    };
     svg::draw_jobs(jobs, &a.output, &mut entries, &pb)?;
+    stage("svg");
     mesh::subdivision(&a.output, &mut entries, &pb)?;
+    stage("mesh");
     render::pictures(&a.output, assets, &mut entries, &pb)?;
+    stage("render");
     mesh::teapot(&a.output, &mut entries, &pb)?;
+    stage("bezier");
     raytrace::pictures(&a.output, assets, &mut entries)?;
+    stage("raytrace");
     cloth::pictures(&a.output, assets, &mut entries)?;
+    stage("cloth");
     pb.finish_and_clear();
     index::write_index(&a.output, &entries)?;
     if !a.quiet {

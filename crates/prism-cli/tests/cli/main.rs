@@ -1595,8 +1595,10 @@ fn shade_meshes_and_errors() {
                 monkey.display().to_string(),
                 "--shader".into(),
                 "bump".into(),
+                "--data".into(),
+                "/nonexistent-prism-data".into(),
             ],
-            "--shader bump: it needs --height-map PNG",
+            "--height-map not given, and --data /nonexistent-prism-data: no such folder",
         ),
         (
             vec![monkey.display().to_string(), "--eye".into(), "1,2".into()],
@@ -2032,17 +2034,133 @@ fn every_subcommand_has_the_common_flags() {
         };
         for (name, page) in pages {
             walked += 1;
+            let has = |flag: &str| page.contains(flag);
+            // Samples per pixel, threads, the course's files and another renderer's
+            // behaviour, where the subcommand has them, under one spelling.
+            let spp = ["svg", "render", "raytrace", "shade", "cloth"];
+            let threads = [
+                "svg", "render", "raytrace", "shade", "cloth", "view", "demo",
+            ];
+            let data = ["raytrace", "shade", "cloth", "view", "demo"];
+            let compat = ["svg", "view"];
+            let base = name.as_str();
+            if spp.contains(&base) {
+                assert!(has("-s, --spp <"), "prism {name}: no -s, --spp");
+            }
+            if threads.contains(&base) {
+                assert!(has("-t, --threads <"), "prism {name}: no -t, --threads");
+            }
+            if data.contains(&base) {
+                assert!(has("--data <DIR>"), "prism {name}: no --data DIR");
+            }
+            if compat.contains(&base) {
+                assert!(has("--compat <COMPAT>"), "prism {name}: no --compat VALUE");
+            }
+            if name == "bezier" {
+                // The course's -t (the curve parameter) wins, and the help says so.
+                assert!(has("-t, --parameter") && has("not threads"), "{page}");
+            }
             if name == "view" {
                 continue;
             }
-            assert!(page.contains("-q, --quiet"), "prism {name}: no -q, --quiet");
+            assert!(has("-q, --quiet"), "prism {name}: no -q, --quiet");
+            assert!(has("--stats"), "prism {name}: no --stats");
             if name != "mesh info" {
-                assert!(
-                    page.contains("-o, --output"),
-                    "prism {name}: no -o, --output"
-                );
+                assert!(has("-o, --output"), "prism {name}: no -o, --output");
             }
         }
     }
     assert!(walked >= 16, "{walked} pages walked");
+}
+
+/// The share of a picture's pixels that are not black.
+fn lit_share(img: &prism_image::Rgb8Image) -> f64 {
+    let lit = img
+        .pixels()
+        .iter()
+        .filter(|p| p.iter().any(|&c| c > 8))
+        .count();
+    lit as f64 / img.pixels().len() as f64
+}
+
+/// `prism cloth` draws every course shader with the course's files (texture, bump,
+/// displacement, mirror with its cube map), each picture lit; its wireframe is lines (a
+/// property: far fewer lit pixels than the filled shading's silhouette, but some); and a run
+/// that writes nothing says so.
+#[test]
+fn cloth_draws_every_course_shader_and_wireframe_lines() {
+    let dir = scratch("cloth-shaders");
+    let scene = prism_testkit::shared_asset("clothsim/scene/sphere.json");
+    let data = prism_testkit::shared_assets();
+    let mut share = std::collections::BTreeMap::new();
+    for shader in [
+        "normal",
+        "wireframe",
+        "diffuse",
+        "phong",
+        "texture",
+        "bump",
+        "displacement",
+        "mirror",
+    ] {
+        let frames = dir.join(shader);
+        std::fs::create_dir_all(&frames).unwrap();
+        // Lines and silhouettes are compared where lines are thin beside the mesh's cells.
+        let size = if matches!(shader, "normal" | "wireframe") {
+            ["800", "640"]
+        } else {
+            ["200", "160"]
+        };
+        let o = prism()
+            .arg("cloth")
+            .arg(&scene)
+            .args(["--frames", "30", "-r", size[0], size[1], "--shader", shader])
+            .arg("--data")
+            .arg(&data)
+            .arg("-o")
+            .arg(&frames)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{shader}: {}", stderr(&o));
+        let img = prism_image::read_png(&frames.join("frame_0030.png")).unwrap();
+        share.insert(shader, lit_share(&img.to_rgb8()));
+    }
+    for (shader, s) in &share {
+        assert!(*s > 0.005, "{shader}: {s}");
+    }
+    assert!(share["wireframe"] < 0.8 * share["normal"], "{share:?}");
+    let o = prism()
+        .arg("cloth")
+        .arg(&scene)
+        .args(["--frames", "1"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("nothing will be written"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+/// `prism shade` lights a mesh far larger than the course's as the course lights its own: a
+/// property checked on the Delft teapot (tens of units across), whose Blinn-Phong picture
+/// must be more than ambient where the mesh is.
+#[test]
+fn shade_places_the_default_light_by_the_mesh() {
+    let dir = scratch("shade-light");
+    let teapot = prism_testkit::shared_asset("delft-raytracer/data/teapot.obj");
+    let out = dir.join("teapot.png");
+    let o = prism()
+        .arg("shade")
+        .arg(&teapot)
+        .args(["--shader", "phong", "-r", "160", "120", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = prism_image::read_png(&out).unwrap().to_rgb8();
+    // Ambient alone is 0.1 (26 of 255); the lit side must pass twice that.
+    let brightest = img.pixels().iter().map(|p| p[0]).max().unwrap();
+    assert!(brightest > 52, "brightest {brightest}");
 }
