@@ -59,12 +59,20 @@ pub fn run(a: &BezierArgs) -> Result<()> {
             crate::output::mesh_output(&a.output, "--output")?;
             None
         }
-        _ => return Err(UserError(format!("{name}: expected a .bzc or .bez file")).into()),
+        _ => {
+            return Err(UserError::WrongKind {
+                flag: None,
+                path: a.input.clone(),
+                expected: "a .bzc or .bez file".into(),
+            }
+            .into())
+        }
     };
     crate::output::check_distinct(&[("the input", &a.input)], &[("--output", &a.output)])?;
+    crate::error::check_input(&a.input, None)?;
     let t0 = std::time::Instant::now();
     let text = prism_math::limits::read_input_text(&a.input, prism_mesh::MAX_MESH_FILE_BYTES)
-        .map_err(|e| UserError(format!("{name}: {e}")))?;
+        .map_err(|e| UserError::Refused(format!("{name}: {e}")))?;
     let stage = |what: &str, t: std::time::Instant| {
         if a.stats {
             eprintln!("{what}: {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
@@ -75,26 +83,26 @@ pub fn run(a: &BezierArgs) -> Result<()> {
     match curve_format {
         Some(format) => {
             if !(0.0..=1.0).contains(&a.t) {
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "--parameter: expected a value in [0, 1], found {}",
                     a.t
                 ))
                 .into());
             }
-            let pts = parse_bzc(&text, &name).map_err(|e| UserError(e.to_string()))?;
+            let pts = parse_bzc(&text, &name).map_err(UserError::input)?;
             write_curve(&pts, a.t, a.size, &a.output, format)?;
             stage("draw and write", t1);
             Ok(())
         }
         None => {
             if a.resolution == 0 || a.resolution > 1024 {
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "--resolution: expected 1..=1024, found {}",
                     a.resolution
                 ))
                 .into());
             }
-            let patches = parse_bez(&text, &name).map_err(|e| UserError(e.to_string()))?;
+            let patches = parse_bez(&text, &name).map_err(UserError::input)?;
             let mesh = tessellate(&patches, a.resolution);
             stage("tessellate", t1);
             let t2 = std::time::Instant::now();
@@ -113,6 +121,6 @@ pub(crate) fn write_curve(
     output: &std::path::Path,
     format: ImageFormat,
 ) -> Result<()> {
-    let img = de_casteljau_construction(pts, t, size).map_err(|e| UserError(e.to_string()))?;
+    let img = de_casteljau_construction(pts, t, size).map_err(UserError::input)?;
     crate::output::write_rgb8(output, format, &img)
 }

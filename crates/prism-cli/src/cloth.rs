@@ -105,7 +105,7 @@ pub fn run(a: &ClothArgs) -> Result<()> {
 /// Runs `prism cloth` on the current worker pool.
 fn run_in_pool(a: &ClothArgs) -> Result<()> {
     if a.frames == 0 || a.frames > MAX_FRAMES {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--frames: expected 1 to {MAX_FRAMES}, found {}",
             a.frames
         ))
@@ -113,7 +113,7 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
     }
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution: expected 1 to 16384 pixels a side, found {w} x {h}"
         ))
         .into());
@@ -125,13 +125,7 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
     let mut gif = false;
     let frames_dir = match &a.output {
         Some(o) if o.is_dir() || o.to_string_lossy().ends_with('/') => {
-            if !o.is_dir() {
-                return Err(UserError(format!(
-                    "--output {}: the folder does not exist",
-                    o.display()
-                ))
-                .into());
-            }
+            crate::error::check_folder_input(o, "--output")?;
             Some(o.clone())
         }
         Some(o) => {
@@ -145,18 +139,17 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
     };
     if let Some(o) = &a.obj {
         if crate::output::extension(o) != "obj" {
-            return Err(UserError(format!("--obj {}: expected a .obj file", o.display())).into());
+            return Err(UserError::WrongKind {
+                flag: Some("--obj".into()),
+                path: o.clone(),
+                expected: "an .obj file".into(),
+            }
+            .into());
         }
         crate::output::check_folder(o, "--obj")?;
     }
     if let Some(d) = &a.obj_sequence {
-        if !d.is_dir() {
-            return Err(UserError(format!(
-                "--obj-sequence {}: expected an existing folder",
-                d.display()
-            ))
-            .into());
-        }
+        crate::error::check_folder_input(d, "--obj-sequence")?;
     }
     let mut outputs = Vec::new();
     outputs.extend(
@@ -169,9 +162,10 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
     let mut inputs = vec![("the scene", a.scene.as_path())];
     inputs.extend(a.files.inputs());
     crate::output::check_distinct(&inputs, &outputs)?;
+    crate::error::check_input(&a.scene, None)?;
     let shader = a.files.shader(a.shader, a.quiet)?;
     if !(1..=16u32).any(|k| k * k == a.samples) {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--spp: expected a square number from 1 to 256, found {}",
             a.samples
         ))
@@ -207,7 +201,7 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
         );
     }
     let t0 = Instant::now();
-    let scene = read_scene(&a.scene, &a.set).map_err(|e| UserError(e.to_string()))?;
+    let scene = read_scene(&a.scene, &a.set).map_err(UserError::input)?;
     let read = t0.elapsed();
     let mut cloth = Cloth::new(&scene);
     let view = course_view(&cloth, w, h);
@@ -254,14 +248,14 @@ fn run_in_pool(a: &ClothArgs) -> Result<()> {
             }
             if let Some((g, img, t)) = picture {
                 render += t;
-                each(g, img.map_err(|e| UserError(e.to_string()))?, &mut write)?;
+                each(g, img.map_err(UserError::input)?, &mut write)?;
             }
             if !simulating {
                 break;
             }
             if !cloth.is_finite() {
                 bar.finish_and_clear();
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "{}: the simulation diverged in frame {f} (positions left the finite numbers): \
                      ks is too stiff for the masses at this time step",
                     a.scene.display()

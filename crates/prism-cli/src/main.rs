@@ -64,7 +64,12 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
-            let _ = e.print();
+            match error::clap_error_line(&e) {
+                Some(line) => eprintln!("prism: error: {line}"),
+                None => {
+                    let _ = e.print();
+                }
+            }
             return if e.use_stderr() {
                 ExitCode::from(2)
             } else {
@@ -96,5 +101,20 @@ fn main() -> ExitCode {
                 ExitCode::from(1)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// Property: the names the typo suggestion offers are exactly the subcommands.
+    #[test]
+    fn suggested_subcommands_are_the_subcommands() {
+        let names: Vec<String> = super::Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        assert_eq!(names, super::error::SUBCOMMANDS);
     }
 }

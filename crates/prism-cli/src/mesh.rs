@@ -117,7 +117,7 @@ enum MeshCommand {
 /// Reads a mesh by its extension (prism-scene's table of formats), printing the reader's
 /// warnings.
 fn read(path: &Path, quiet: bool) -> Result<PolyMesh> {
-    let (mesh, warnings) = prism_scene::read_mesh(path).map_err(|e| UserError(e.to_string()))?;
+    let (mesh, warnings) = prism_scene::read_mesh(path).map_err(UserError::input)?;
     for w in warnings.iter().filter(|_| !quiet) {
         eprintln!("warning: {w}");
     }
@@ -126,7 +126,7 @@ fn read(path: &Path, quiet: bool) -> Result<PolyMesh> {
 
 fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
     HalfedgeMesh::from_polymesh(mesh)
-        .map_err(|e| UserError(format!("{}: {e}", path.display())).into())
+        .map_err(|e| UserError::input(format!("{}: {e}", path.display())).into())
 }
 
 /// Most split vertices named one by one in warnings.
@@ -206,7 +206,22 @@ fn ms(d: std::time::Duration) -> String {
 
 /// A position as three numbers.
 fn xyz(p: prism_math::glam::DVec3) -> String {
-    format!("{} {} {}", p.x, p.y, p.z)
+    format!("{} {} {}", number(p.x), number(p.y), number(p.z))
+}
+
+/// A coordinate as a person reads it: the shortest text that gives back its single-precision
+/// value (the precision mesh files hold; double-precision noise such as 1.9999984000003002
+/// from a file's transforms is not shown), in exponent form when very small or large.
+fn number(x: f64) -> String {
+    let f = x as f32;
+    let a = f.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if (1e-4..1e7).contains(&a) {
+        format!("{f}")
+    } else {
+        format!("{f:e}")
+    }
 }
 
 /// An edge as `vertices A,B` (numbered from 1), with " (boundary)" when it is one.
@@ -258,7 +273,7 @@ fn edge_op(
                 .ok()
                 .filter(|ids| ids.len() == 2 && ids.iter().all(|&i| i >= 1 && i as usize <= n))
                 .ok_or_else(|| {
-                    UserError(format!(
+                    UserError::Refused(format!(
                         "--vertices: expected A,B with 1 <= A, B <= {n}, found {v:?}"
                     ))
                 })?;
@@ -266,9 +281,13 @@ fn edge_op(
                 prism_mesh::VertexId(ids[0] - 1),
                 prism_mesh::VertexId(ids[1] - 1),
             )
-            .ok_or_else(|| UserError(format!("--vertices {v}: no edge joins these vertices")))?
+            .ok_or_else(|| {
+                UserError::Refused(format!("--vertices {v}: no edge joins these vertices"))
+            })?
         }
-        (None, None) => return Err(UserError("give --edge E or --vertices A,B".into()).into()),
+        (None, None) => {
+            return Err(UserError::Refused("give --edge E or --vertices A,B".into()).into())
+        }
     };
     let before = if (e.0 as usize) < m.edge_count() {
         format!("edge {} ({})", e.0, edge_words(&m, e))
@@ -276,7 +295,7 @@ fn edge_op(
         format!("edge {}", e.0)
     };
     let done = op(&mut m, e)
-        .map_err(|err| UserError(format!("{}: cannot {what}: {err}", input.display())))?;
+        .map_err(|err| UserError::Refused(format!("{}: cannot {what}: {err}", input.display())))?;
     write(output, &m.to_polymesh())?;
     if !quiet {
         println!("{before}: {done}");
@@ -321,6 +340,14 @@ fn run_command(a: &MeshArgs) -> Result<()> {
         };
         crate::output::check_distinct(&[("the mesh", input)], &[("--output", output)])?;
     }
+    let input_path = match &a.command {
+        MeshCommand::Info { input, .. }
+        | MeshCommand::Normals { input, .. }
+        | MeshCommand::Convert { input, .. }
+        | MeshCommand::Subdivide { input, .. } => input,
+        MeshCommand::Split(e) | MeshCommand::Flip(e) | MeshCommand::Collapse(e) => &e.input,
+    };
+    crate::error::check_input(input_path, None)?;
     let reading = (a.strict, a.quiet);
     match &a.command {
         MeshCommand::Info {
@@ -420,7 +447,7 @@ fn run_command(a: &MeshArgs) -> Result<()> {
             let read_time = t.elapsed();
             // Refuse before allocating what cannot fit: every level makes 4 faces of one.
             prism_mesh::check_subdivision(p.face_count(), *levels).map_err(|e| {
-                UserError(format!(
+                UserError::Refused(format!(
                     "{}: {levels} levels of {} faces: {e}",
                     input.display(),
                     p.face_count()
@@ -442,7 +469,7 @@ fn run_command(a: &MeshArgs) -> Result<()> {
                 build_time += t.elapsed();
                 let t = Instant::now();
                 p = loop_subdivide(&m, w)
-                    .map_err(|e| UserError(format!("{}: {e}", input.display())))?;
+                    .map_err(|e| UserError::input(format!("{}: {e}", input.display())))?;
                 sub_time += t.elapsed();
                 bar.inc(p.face_count() as u64);
             }
@@ -457,5 +484,21 @@ fn run_command(a: &MeshArgs) -> Result<()> {
             }
             Ok(())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    /// Closed forms: single-precision shortest text, exponent form for tiny and huge values.
+    #[test]
+    fn coordinates_print_as_people_read_them() {
+        assert_eq!(number(1.999_998_400_000_300_2), "1.9999985");
+        assert_eq!(number(1.644_04e-16), "1.64404e-16");
+        assert_eq!(number(f64::from(2e-7_f32)), "2e-7");
+        assert_eq!(number(-0.0), "0");
+        assert_eq!(number(0.5), "0.5");
+        assert_eq!(number(-2.0), "-2");
     }
 }

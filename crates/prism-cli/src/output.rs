@@ -89,11 +89,11 @@ pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<
         }
         _ => {
             let names: Vec<&str> = allowed.iter().map(|f| f.extensions()).collect();
-            Err(UserError(format!(
-                "{flag} {}: expected a {} file",
-                path.display(),
-                names.join(" or ")
-            ))
+            Err(UserError::WrongKind {
+                flag: Some(flag.to_string()),
+                path: path.to_path_buf(),
+                expected: format!("a {} file", names.join(" or ")),
+            }
             .into())
         }
     }
@@ -103,35 +103,68 @@ pub fn image_output(path: &Path, flag: &str, allowed: &[ImageFormat]) -> Result<
 /// new files.
 pub fn mesh_output(path: &Path, flag: &str) -> Result<MeshFormat> {
     let Some(format) = MeshFormat::from_path(path) else {
-        return Err(UserError(format!(
-            "{flag} {}: expected an .obj, .ply or .dae file",
-            path.display()
-        ))
+        return Err(UserError::WrongKind {
+            flag: Some(flag.to_string()),
+            path: path.to_path_buf(),
+            expected: "an .obj, .ply or .dae file".into(),
+        }
         .into());
     };
     check_folder(path, flag)?;
     Ok(format)
 }
 
+/// What kind of binary file `path` starts as (`a PNG image`, ...), if it is one of the
+/// image and archive kinds a user may hand a text reader by mistake.
+pub fn binary_kind(path: &Path) -> Option<&'static str> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    let n = std::fs::File::open(path).ok()?.read(&mut head).ok()?;
+    let head = &head[..n];
+    [
+        (&b"\x89PNG"[..], "a PNG image"),
+        (&b"\xFF\xD8\xFF"[..], "a JPEG image"),
+        (&b"GIF8"[..], "a GIF image"),
+        (&b"\x76\x2F\x31\x01"[..], "an OpenEXR image"),
+        (
+            &b"\x1F\x8B"[..],
+            "gzip-compressed (an .svgz? unpack it first)",
+        ),
+        (&b"PK\x03\x04"[..], "a zip archive"),
+    ]
+    .into_iter()
+    .find(|(magic, _)| head.starts_with(magic))
+    .map(|(_, kind)| kind)
+}
+
 /// Checks that `path` names a file in an existing folder where a new file can be made.
 pub fn check_folder(path: &Path, flag: &str) -> Result<()> {
-    if path.is_dir() {
-        return Err(UserError(format!(
-            "{flag} {}: expected a file name, found a folder",
-            path.display()
-        ))
+    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
+        return Err(UserError::WrongKind {
+            flag: Some(flag.to_string()),
+            path: path.to_path_buf(),
+            expected: "a file name, not a folder".into(),
+        }
         .into());
     }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    if !dir.is_dir() {
-        return Err(UserError(format!(
-            "{flag} {}: the folder {} does not exist (prism does not create it)",
+    if dir.exists() && !dir.is_dir() {
+        return Err(UserError::Refused(format!(
+            "{flag} {}: {} is a file, not a folder",
             path.display(),
             dir.display()
         ))
+        .into());
+    }
+    if !dir.is_dir() {
+        return Err(UserError::MissingFolder {
+            flag: flag.to_string(),
+            path: path.to_path_buf(),
+            folder: dir.to_path_buf(),
+        }
         .into());
     }
     let probe = dir.join(format!(".prism-probe.{}", std::process::id()));
@@ -140,7 +173,7 @@ pub fn check_folder(path: &Path, flag: &str) -> Result<()> {
             let _ = std::fs::remove_file(&probe);
             Ok(())
         }
-        Err(e) => Err(UserError(format!(
+        Err(e) => Err(UserError::Refused(format!(
             "{flag} {}: cannot write in {}: {e}",
             path.display(),
             dir.display()
@@ -178,7 +211,7 @@ pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
     for (i, (flag, path)) in outputs.iter().enumerate() {
         for (role, input) in inputs {
             if identity(input) == ids[i] {
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "{flag} {}: it names {role} {}, an input (prism never writes over an input)",
                     path.display(),
                     input.display()
@@ -188,7 +221,7 @@ pub fn check_distinct(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
         }
         if let Some(((other, _), _)) = outputs[..i].iter().zip(&ids).find(|(_, id)| **id == ids[i])
         {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "{flag} {}: it names the same file as {other}",
                 path.display()
             ))
@@ -251,7 +284,7 @@ mod tests {
     fn missing_folders_are_named() {
         let path = std::env::temp_dir().join("prism-no-such-folder-xyz/out.png");
         let e = image_output(&path, "-o", &[ImageFormat::Png]).unwrap_err();
-        assert!(e.to_string().contains("does not exist"), "{e}");
+        assert!(e.to_string().contains("no such folder"), "{e}");
         assert!(!path.parent().unwrap().exists());
     }
 }

@@ -128,7 +128,7 @@ const DEFAULT_SIDE: u32 = 800;
 /// Sets feature `name` in `f`.
 fn set_feature(f: &mut Features, name: &str, on: bool, flag: &str) -> Result<()> {
     let Some(slot) = f.switch(name.trim()) else {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "{flag} {}: expected one of {}",
             name.trim(),
             Features::NAMES.join(", ")
@@ -207,25 +207,30 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     }
     if let Some(ply) = &a.debug_ply {
         if crate::output::extension(ply) != "ply" {
-            return Err(UserError(format!(
-                "--debug-ply {}: expected a .ply file",
-                ply.display()
-            ))
+            return Err(UserError::WrongKind {
+                flag: Some("--debug-ply".into()),
+                path: ply.clone(),
+                expected: "a .ply file".into(),
+            }
             .into());
         }
         crate::output::check_folder(ply, "--debug-ply")?;
         if a.debug_pixel.is_none() {
-            return Err(UserError("--debug-ply: it needs --debug-pixel X,Y".into()).into());
+            return Err(
+                UserError::Refused("--debug-ply: it needs --debug-pixel X,Y".into()).into(),
+            );
         }
     }
     if a.debug_camera.is_some() && a.debug_pixel.is_none() {
         eprintln!("prism: warning: --debug-camera has no effect: it applies to --debug-pixel");
     }
     if let Some(spp) = a.spp.filter(|&s| s == 0 || s > 1 << 16) {
-        return Err(UserError(format!("--spp: expected 1 to {}, found {spp}", 1 << 16)).into());
+        return Err(
+            UserError::Refused(format!("--spp: expected 1 to {}, found {spp}", 1 << 16)).into(),
+        );
     }
     if a.light_samples == 0 || a.light_samples > 1 << 16 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--light-samples: expected 1 to {}, found {}",
             1 << 16,
             a.light_samples
@@ -233,21 +238,21 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         .into());
     }
     if a.max_depth > 64 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--max-depth: expected 0 to 64, found {}",
             a.max_depth
         ))
         .into());
     }
     if !(a.bloom_threshold.is_finite() && a.bloom_threshold >= 0.0) {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--bloom-threshold: expected a number of at least 0, found {}",
             a.bloom_threshold
         ))
         .into());
     }
     if a.bloom_passes > 64 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--bloom-passes: expected 0 to 64, found {}",
             a.bloom_passes
         ))
@@ -268,11 +273,12 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         }
         crate::split::check_part_output(&a.output, &pictures)?;
     }
+    crate::error::check_scene_name(&a.scene)?;
     let t0 = Instant::now();
     let loaded = prism_scene::load_delft(&a.scene, a.data.as_deref(), &mut |w| {
         eprintln!("prism: warning: {w}");
     })
-    .map_err(|e| UserError(e.to_string()))?;
+    .map_err(UserError::input)?;
     let mut features = loaded.features;
     for n in &a.enable {
         set_feature(&mut features, n, true, "--enable")?;
@@ -295,7 +301,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         (None, None) => (DEFAULT_SIDE, DEFAULT_SIDE),
     };
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
         ))
         .into());
@@ -310,16 +316,19 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         crate::split::check_tile_count(parts, w, h)?;
     }
     if a.debug_pixel.as_ref().is_some_and(|p| p.len() != 2) {
-        return Err(UserError("--debug-pixel: expected X,Y (two whole numbers)".into()).into());
+        return Err(
+            UserError::Refused("--debug-pixel: expected X,Y (two whole numbers)".into()).into(),
+        );
     }
     if a.debug_camera.as_ref().is_some_and(|c| c.len() != 4) {
-        return Err(
-            UserError("--debug-camera: expected RX,RY,RZ,DIST (four numbers)".into()).into(),
-        );
+        return Err(UserError::Refused(
+            "--debug-camera: expected RX,RY,RZ,DIST (four numbers)".into(),
+        )
+        .into());
     }
     let debug_pixel = match &a.debug_pixel {
         Some(p) if p[0] >= w || p[1] >= h => {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--debug-pixel {},{}: outside the {w} x {h} image",
                 p[0], p[1]
             ))
@@ -330,7 +339,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     };
     if let Some(c) = &a.debug_camera {
         if c.iter().any(|v| !v.is_finite()) || c[3] < 0.0 {
-            return Err(UserError(
+            return Err(UserError::Refused(
                 "--debug-camera: expected finite RX,RY,RZ degrees and a distance of at least 0"
                     .into(),
             )
@@ -342,14 +351,14 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let scene = WhittedScene::new(&loaded.scene, features.accel_structure);
     let build = t1.elapsed();
     if (a.bvh_level.is_some() || a.bvh_leaf.is_some()) && scene.bvh().is_none() {
-        return Err(UserError(
+        return Err(UserError::Refused(
             "--bvh-level and --bvh-leaf draw the BVH; it is off (--no-bvh or --disable bvh)".into(),
         )
         .into());
     }
     if let (Some(bvh), Some(level)) = (scene.bvh(), a.bvh_level) {
         if level >= bvh.levels() {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--bvh-level {level}: the BVH has levels 0 to {}",
                 bvh.levels().saturating_sub(1)
             ))
@@ -359,7 +368,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     if let (Some(bvh), Some(leaf)) = (scene.bvh(), a.bvh_leaf) {
         let n = bvh.leaf_views().len();
         if leaf >= n {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--bvh-leaf {leaf}: the BVH has leaves 0 to {}",
                 n.saturating_sub(1)
             ))

@@ -152,7 +152,7 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
     let (from, to) = (a.samples_from.unwrap_or(0), a.samples_to.unwrap_or(a.spp));
     if a.samples_from.is_some() || a.samples_to.is_some() {
         if adaptive.is_some() {
-            return Err(UserError(
+            return Err(UserError::Refused(
                 "--samples-from/--samples-to with --adaptive: adaptive sampling decides per \
                  pixel when to stop, so its samples cannot be split into ranges; split by \
                  --tile instead"
@@ -161,7 +161,7 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
             .into());
         }
         if !(from < to && to <= a.spp) {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--samples-from {from} --samples-to {to}: expected 0 <= FROM < TO <= --spp ({})",
                 a.spp
             ))
@@ -197,7 +197,7 @@ fn adaptive_settings(a: &RenderArgs) -> Result<(Option<f32>, Option<u32>)> {
     let tol = v[1].parse::<f32>().ok();
     match (batch, tol) {
         (Some(b), Some(t)) => Ok((Some(t), Some(b))),
-        _ => Err(UserError(format!(
+        _ => Err(UserError::Refused(format!(
             "-a: expected BATCH (a positive integer) and TOL (a number), found {} {}",
             v[0], v[1]
         ))
@@ -222,7 +222,7 @@ fn thin_lens(
         }
         Some(r) if r.is_finite() && r >= 0.0 => r,
         Some(r) => {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--lens-radius: expected a radius of 0 or more, found {r}"
             ))
             .into())
@@ -232,7 +232,7 @@ fn thin_lens(
         None => (camera.target - camera.eye).length(),
         Some(d) if d.is_finite() && d > 0.0 => d,
         Some(d) => {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--focal-distance: expected a positive distance, found {d}"
             ))
             .into())
@@ -249,7 +249,7 @@ fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Res
     if let Some(m) = a.bounce {
         let most = match a.integrator {
             IntegratorArg::Normals => {
-                return Err(UserError(
+                return Err(UserError::Refused(
                     "--bounce: the normals integrator does not bounce; use --integrator path"
                         .into(),
                 )
@@ -263,7 +263,7 @@ fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Res
                 IntegratorArg::Direct => "--integrator direct stops after 1".to_string(),
                 _ => format!("--max-bounces is {most}"),
             };
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--bounce {m}: no path gets that far ({why}), so the image would be black"
             ))
             .into());
@@ -303,26 +303,34 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref(), &inputs)?;
     if let Some(map) = &a.envmap {
         if crate::output::extension(map) != "exr" {
-            return Err(UserError(format!(
-                "--envmap {}: expected an OpenEXR (.exr) map",
-                map.display()
-            ))
+            return Err(UserError::WrongKind {
+                flag: Some("--envmap".into()),
+                path: map.clone(),
+                expected: "an OpenEXR (.exr) map".into(),
+            }
             .into());
         }
+    }
+    // The inputs are checked once the outputs are known good.
+    if let Some(scene) = &a.scene {
+        crate::error::check_input(scene, None)?;
+    }
+    if let Some(map) = &a.envmap {
+        crate::error::check_input(map, Some("--envmap"))?;
     }
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
     let share = share(a, adaptive)?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
         ))
         .into());
     }
     crate::resources::check_frame("--resolution", w, h, prism_render::film::film_bytes(w, h))?;
     if a.light_samples == 0 || a.light_samples > MAX_LIGHT_SAMPLES {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--light-samples: expected 1 to {MAX_LIGHT_SAMPLES}, found {}",
             a.light_samples
         ))
@@ -332,11 +340,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         crate::split::check_tile_count(s.parts, w, h)?;
     }
     if a.spp == 0 || a.spp > 1 << 20 {
-        return Err(UserError(format!("--spp: expected 1 to {}, found {}", 1 << 20, a.spp)).into());
+        return Err(UserError::Refused(format!(
+            "--spp: expected 1 to {}, found {}",
+            1 << 20,
+            a.spp
+        ))
+        .into());
     }
     if let Some(t) = adaptive {
         if !(t > 0.0 && t.is_finite()) {
-            return Err(UserError(format!(
+            return Err(UserError::Refused(format!(
                 "--adaptive: expected a positive tolerance, found {t}"
             ))
             .into());
@@ -356,15 +369,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     let scene = match &a.scene {
         None => prism_scene::cornell_box(),
-        Some(path) => prism_scene::load(path, &opts).map_err(|e| UserError(e.to_string()))?,
+        Some(path) => prism_scene::load(path, &opts).map_err(UserError::input)?,
     };
     let mut scene = scene;
     scene.camera.lens = thin_lens(a, &scene.camera)?;
     if let Some(path) = &a.envmap {
-        let map = prism_image::read_exr(path).map_err(|e| UserError(e.to_string()))?;
+        let map = prism_image::read_exr(path).map_err(UserError::input)?;
         let replaced = scene
             .light_by_environment_map(std::sync::Arc::new(map))
-            .map_err(|e| UserError(format!("--envmap {}: {e}", path.display())))?;
+            .map_err(|e| UserError::input(format!("--envmap {}: {e}", path.display())))?;
         if replaced {
             scene.warnings.push(Warning::new(format!(
                 "--envmap replaces the scene's hemisphere or environment light with {}",

@@ -32,7 +32,7 @@ pub fn parse_bytes(s: &str) -> std::result::Result<u64, String> {
 /// budget before it is allocated; `flag` names the option that set the size.
 pub fn check_frame(flag: &str, width: u32, height: u32, bytes: u64) -> Result<()> {
     prism_math::limits::check_memory(bytes)
-        .map_err(|e| UserError(format!("{flag} {width} {height}: the image {e}")).into())
+        .map_err(|e| UserError::Refused(format!("{flag} {width} {height}: the image {e}")).into())
 }
 
 /// The most worker threads a command starts: four a core, at least 16.

@@ -160,6 +160,15 @@ impl ShaderFiles {
     /// (`clothsim/textures`: texture_1.png, texture_2.png, cube). Warns of a file given to a
     /// shader that does not read it unless `quiet`.
     pub fn shader(&self, arg: ShaderArg, quiet: bool) -> Result<Shader> {
+        if let Some(p) = &self.texture {
+            crate::error::check_input(p, Some("--texture"))?;
+        }
+        if let Some(p) = &self.height_map {
+            crate::error::check_input(p, Some("--height-map"))?;
+        }
+        if let Some(p) = &self.cubemap {
+            crate::error::check_folder_input(p, "--cubemap")?;
+        }
         let file = |given: &Option<PathBuf>, rel: &str, flag: &str| match given {
             Some(p) => Ok(p.clone()),
             None => staged(self.data.as_deref(), rel, flag),
@@ -186,7 +195,7 @@ impl ShaderFiles {
                 let dir = file(&self.cubemap, "cube", "--cubemap")?;
                 Shader::Mirror(
                     prism_image::CubeMap::read(&dir)
-                        .map_err(|e| UserError(format!("--cubemap: {e}")))?,
+                        .map_err(|e| UserError::Refused(format!("--cubemap: {e}")))?,
                 )
             }
         };
@@ -211,7 +220,7 @@ impl ShaderFiles {
 
 fn three(v: &[f32], flag: &str) -> Result<Vec3> {
     if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "{flag}: expected three finite numbers separated by commas, found {v:?}"
         ))
         .into());
@@ -222,7 +231,7 @@ fn three(v: &[f32], flag: &str) -> Result<Vec3> {
 fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
     let c = three(v, flag)?;
     if c.min_element() < 0.0 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "{flag}: expected values of at least 0, found {v:?}"
         ))
         .into());
@@ -234,18 +243,19 @@ fn colour(v: &[f32], flag: &str) -> Result<Rgb> {
 /// found as [`prism_scene::course_assets`] finds them), for a shader given no file of its own.
 fn staged(data: Option<&Path>, rel: &str, flag: &str) -> Result<PathBuf> {
     let assets = prism_scene::course_assets(data)
-        .map_err(|e| UserError(format!("{flag} not given, and {e}")))?;
+        .map_err(|e| UserError::Refused(format!("{flag} not given, and {e}")))?;
     Ok(assets.join("clothsim/textures").join(rel))
 }
 
 fn load_rgb(path: &Path, flag: &str) -> Result<prism_image::RgbImage> {
-    let img = prism_image::read_image(path).map_err(|e| UserError(format!("{flag}: {e}")))?;
+    let img =
+        prism_image::read_image(path).map_err(|e| UserError::Refused(format!("{flag}: {e}")))?;
     Ok(img.to_rgb8().to_rgb_f32())
 }
 
 /// Reads the mesh by its extension.
 pub fn read_shade_mesh(path: &Path) -> Result<ShadeMesh> {
-    let user = |m: String| anyhow::Error::from(UserError(m));
+    let user = |m: String| anyhow::Error::from(UserError::Refused(m));
     if crate::output::extension(path) == "obj" {
         let text = prism_math::limits::read_input_text(path, prism_mesh::MAX_MESH_FILE_BYTES)
             .map_err(|e| user(format!("{}: {e}", path.display())))?;
@@ -290,22 +300,25 @@ fn run_in_pool(a: &ShadeArgs) -> Result<()> {
     let mut inputs = vec![("the mesh", a.mesh.as_path())];
     inputs.extend(a.files.inputs());
     crate::output::check_distinct(&inputs, &[("--output", &a.output)])?;
+    crate::error::check_input(&a.mesh, None)?;
     let (w, h) = (a.resolution[0], a.resolution[1]);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution: expected 1 to 16384 pixels a side, found {w} x {h}"
         ))
         .into());
     }
     if !(a.fov_y > 0.0 && a.fov_y < 180.0) {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--fov-y: expected a field of view strictly between 0 and 180 degrees, found {}",
             a.fov_y
         ))
         .into());
     }
     if a.samples == 0 || a.samples > 256 {
-        return Err(UserError(format!("--spp: expected 1 to 256, found {}", a.samples)).into());
+        return Err(
+            UserError::Refused(format!("--spp: expected 1 to 256, found {}", a.samples)).into(),
+        );
     }
     let bytes = prism_shade::frame_bytes(w, h, a.samples);
     crate::resources::check_frame("--resolution", w, h, bytes)?;
@@ -315,7 +328,7 @@ fn run_in_pool(a: &ShadeArgs) -> Result<()> {
         u64::from(w) * u64::from(h) * u64::from(a.samples),
     );
     if per_row > 1 << 20 || all > 1 << 28 {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution {w} {h} with --spp {}: {all} samples is over the limit of 2^28 (and 2^20 a row)",
             a.samples
         ))
@@ -342,7 +355,7 @@ fn run_in_pool(a: &ShadeArgs) -> Result<()> {
     let mesh = read_shade_mesh(&a.mesh)?;
     let shader = a.files.shader(a.shader, a.quiet)?;
     let (lo, hi) = mesh.bounds().ok_or_else(|| {
-        UserError(format!(
+        UserError::Refused(format!(
             "{}: the mesh has no faces to draw",
             a.mesh.display()
         ))
@@ -395,8 +408,7 @@ fn run_in_pool(a: &ShadeArgs) -> Result<()> {
     };
     let read = t0.elapsed();
     let t1 = Instant::now();
-    let bytes = shade_rgb8(&mesh, &view, &shader, &uniforms, &opts)
-        .map_err(|e| UserError(e.to_string()))?;
+    let bytes = shade_rgb8(&mesh, &view, &shader, &uniforms, &opts).map_err(UserError::input)?;
     let render = t1.elapsed();
     let t2 = Instant::now();
     crate::output::write_rgb8(&a.output, format, &bytes).context("writing the picture")?;

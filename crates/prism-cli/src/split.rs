@@ -38,7 +38,7 @@ pub fn parse_tile(s: &str) -> std::result::Result<(u32, u32), String> {
 pub fn check_tile_count(parts: u32, width: u32, height: u32) -> Result<()> {
     let tiles = prism_render::film::tile_count(width, height);
     if parts as usize > tiles {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--tile I/{parts}: a {width}x{height} image has only {tiles} tiles of 32x32 to share \
              out; use at most {tiles} shares"
         ))
@@ -51,7 +51,7 @@ pub fn check_tile_count(parts: u32, width: u32, height: u32) -> Result<()> {
 /// asked for with it; `flags` names the picture outputs given.
 pub fn check_part_output(output: &Path, flags: &[&str]) -> Result<()> {
     if crate::output::extension(output) != "exr" {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--output {}: a split render writes a part file, an OpenEXR file (.exr); merge \
              the parts with `prism merge` for the picture",
             output.display()
@@ -59,7 +59,7 @@ pub fn check_part_output(output: &Path, flags: &[&str]) -> Result<()> {
         .into());
     }
     if let Some(flag) = flags.first() {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "{flag}: a split render writes only its part file; give {flag} to `prism merge`"
         ))
         .into());
@@ -124,13 +124,16 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     let inputs: Vec<(&str, &Path)> = a.parts.iter().map(|p| ("the part", p.as_path())).collect();
     let (format, heatmap_format) =
         crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref(), &inputs)?;
+    for path in &a.parts {
+        crate::error::check_input(path, None)?;
+    }
     let mut parts = Vec::with_capacity(a.parts.len());
     for path in &a.parts {
-        parts.push(PartFile::open(path).map_err(|e| UserError(e.to_string()))?);
+        parts.push(PartFile::open(path).map_err(UserError::input)?);
     }
     let read_time = t0.elapsed();
     let t1 = Instant::now();
-    let merged = merge(&parts, a.allow_missing).map_err(|e| UserError(e.to_string()))?;
+    let merged = merge(&parts, a.allow_missing).map_err(UserError::input)?;
     drop(parts);
     for hole in &merged.holes {
         eprintln!("prism: warning: missing {hole}");
@@ -138,7 +141,7 @@ pub fn run(a: &MergeArgs) -> Result<()> {
     // Parts prism wrote always have an identity it reads (merge has checked that every part
     // holds the same one); a part that does not is refused, not merged on guesses.
     let identity = PartIdentity::from_attributes(&merged.identity).map_err(|e| {
-        UserError(format!(
+        UserError::Refused(format!(
             "{}: the part's identity: {e}",
             a.parts[0].display()
         ))

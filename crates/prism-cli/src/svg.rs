@@ -93,12 +93,14 @@ fn parse_view(s: &str) -> Result<View> {
         .split(',')
         .map(|p| p.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| UserError(format!("--view: expected CX,CY,SPAN numbers, found {s:?}")))?;
+        .map_err(|_| {
+            UserError::Refused(format!("--view: expected CX,CY,SPAN numbers, found {s:?}"))
+        })?;
     match v[..] {
         [cx, cy, span] if cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0 => {
             Ok(View::Region { cx, cy, span })
         }
-        _ => Err(UserError(format!(
+        _ => Err(UserError::Refused(format!(
             "--view: expected CX,CY,SPAN with a positive span, found {s:?}"
         ))
         .into()),
@@ -150,7 +152,7 @@ fn render_one(
         Dialect::Svg
     };
     let t0 = Instant::now();
-    let doc = read_svg(input, dialect).map_err(|e| UserError(e.to_string()))?;
+    let doc = read_svg(input, dialect).map_err(UserError::input)?;
     let parse = t0.elapsed();
     let (width, height) = output_size(&doc, a);
     let opts = RasterOptions {
@@ -170,7 +172,7 @@ fn render_one(
         compat: a.compat.is_some(),
     };
     let (image, stats) =
-        render(&doc, &opts).map_err(|e| UserError(format!("{}: {e}", input.display())))?;
+        render(&doc, &opts).map_err(|e| UserError::input(format!("{}: {e}", input.display())))?;
     let t1 = Instant::now();
     match format {
         // JPEG has no alpha: the picture goes over white, as a browser shows it.
@@ -226,7 +228,7 @@ pub fn run(a: &SvgArgs) -> Result<()> {
 fn run_in_pool(a: &SvgArgs) -> Result<()> {
     let view = a.view.as_deref().map(parse_view).transpose()?;
     if prism_raster::sample_rate(a.samples).is_none() {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--spp: expected a perfect square from 1 to {} (1, 4, 9, 16, ...), found {}",
             prism_raster::MAX_SAMPLES,
             a.samples
@@ -241,27 +243,27 @@ fn run_in_pool(a: &SvgArgs) -> Result<()> {
         }
     };
     if !a.input.is_dir() {
-        if !a.input.exists() {
-            return Err(UserError(format!("{}: no such file", a.input.display())).into());
-        }
         let format = image_output(
             &a.output,
             "--output",
             &[ImageFormat::Png, ImageFormat::Jpeg],
         )?;
+        crate::error::check_input(&a.input, None)?;
+        if let Some(kind) = crate::output::binary_kind(&a.input) {
+            return Err(UserError::WrongKind {
+                flag: None,
+                path: a.input.clone(),
+                expected: format!("an SVG file, and this is {kind}"),
+            }
+            .into());
+        }
         crate::output::check_distinct(&[("the SVG", &a.input)], &[("--output", &a.output)])?;
         return render_one(&a.input, &a.output, format, a, view).map(warn);
     }
     // A folder of drawings is written into a folder that exists (its subfolders mirror the
     // input's); prism does not create the output folder itself.
-    if !a.output.is_dir() {
-        return Err(UserError(format!(
-            "--output {}: a folder of SVGs is written into an existing folder, and this is \
-             not one (prism does not create it)",
-            a.output.display()
-        ))
-        .into());
-    }
+    // A folder of drawings is written into an existing folder.
+    crate::error::check_folder_input(&a.output, "--output")?;
     let files = find_svgs(&a.input)?;
     let pb = crate::progress::bar(files.len() as u64, "svg", a.quiet);
     let mut failed = 0usize;
@@ -283,7 +285,7 @@ fn run_in_pool(a: &SvgArgs) -> Result<()> {
     }
     pb.finish_and_clear();
     if failed > 0 {
-        return Err(UserError(format!("{failed} of {} files failed", files.len())).into());
+        return Err(UserError::Refused(format!("{failed} of {} files failed", files.len())).into());
     }
     Ok(())
 }

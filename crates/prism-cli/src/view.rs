@@ -92,6 +92,7 @@ pub struct ViewArgs {
 
 /// The mode for `a.file`.
 fn open(a: &ViewArgs) -> Result<Viewer> {
+    crate::error::check_scene_name(&a.file.to_string_lossy())?;
     let mut chosen = None;
     let viewer = open_mode(a, &mut chosen)?;
     Ok(match chosen {
@@ -128,7 +129,7 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
                 ModeArg::Whitted
             }
             other => {
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "{}: cannot tell what to view from the extension `.{other}`; prism view \
                      opens .svg drawings, lit .dae scenes, cloth .json scenes and Delft .obj, .toml \
                      or preset scenes, and .ply meshes (--mode svg, path, cloth, whitted or mesh)",
@@ -149,7 +150,7 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
     if !(1..=prism_raster::MAX_DIMENSION).contains(&w)
         || !(1..=prism_raster::MAX_DIMENSION).contains(&h)
     {
-        return Err(UserError(format!(
+        return Err(UserError::Refused(format!(
             "--resolution: expected 1 to {} pixels a side, found {w} x {h}",
             prism_raster::MAX_DIMENSION
         ))
@@ -162,7 +163,7 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
             } else {
                 Dialect::Svg
             };
-            let doc = read_svg(&a.file, dialect).map_err(|e| UserError(e.to_string()))?;
+            let doc = read_svg(&a.file, dialect).map_err(UserError::input)?;
             for w in &doc.warnings {
                 eprintln!("warning: {w}");
             }
@@ -172,12 +173,12 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
         }
         ModeArg::Path => {
             let scene = prism_scene::load(&a.file, &prism_scene::SceneOptions::default())
-                .map_err(|e| UserError(e.to_string()))?;
+                .map_err(UserError::input)?;
             for w in &scene.warnings {
                 eprintln!("warning: {w}");
             }
             if !scene.is_lit() {
-                return Err(UserError(format!(
+                return Err(UserError::Refused(format!(
                     "{}: the scene has no light, so path tracing shows black; prism view \
                      opens lit scenes",
                     a.file.display()
@@ -192,7 +193,7 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
             let loaded = prism_scene::load_delft(&name, a.data.as_deref(), &mut |w| {
                 eprintln!("prism: warning: {w}");
             })
-            .map_err(|e| UserError(e.to_string()))?;
+            .map_err(UserError::input)?;
             let (w, h) = match (&a.resolution, loaded.window) {
                 (None, Some([cw, ch])) => (cw, ch),
                 _ => (w, h),
@@ -203,18 +204,16 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
             Ok(Viewer::new(Box::new(mode), w, h))
         }
         ModeArg::Mesh => {
-            let (poly, warnings) =
-                prism_scene::read_mesh(&a.file).map_err(|e| UserError(e.to_string()))?;
+            let (poly, warnings) = prism_scene::read_mesh(&a.file).map_err(UserError::input)?;
             for w in &warnings {
                 eprintln!("warning: {w}");
             }
             let mesh = prism_mesh::HalfedgeMesh::from_polymesh(&poly)
-                .map_err(|e| UserError(format!("{}: {e}", a.file.display())))?;
+                .map_err(|e| UserError::input(format!("{}: {e}", a.file.display())))?;
             Ok(Viewer::new(Box::new(MeshMode::new(mesh, &a.file)), w, h))
         }
         ModeArg::Cloth => {
-            let scene =
-                prism_cloth::read_scene(&a.file, &a.set).map_err(|e| UserError(e.to_string()))?;
+            let scene = prism_cloth::read_scene(&a.file, &a.set).map_err(UserError::input)?;
             Ok(Viewer::new(Box::new(ClothMode::new(scene, &a.file)), w, h))
         }
     }
@@ -227,7 +226,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     crate::resources::global_pool(a.threads)?;
     let viewer = open(a)?;
     if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        return Err(UserError(
+        return Err(UserError::Refused(
             "prism view needs an X11 display, and DISPLAY is not set (over SSH, connect with \
              ssh -X; headless, start Xvfb :99 and set DISPLAY=:99)"
                 .into(),
@@ -235,7 +234,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         .into());
     }
     let event_loop = EventLoop::new().map_err(|e| {
-        UserError(format!(
+        UserError::Refused(format!(
             "prism view: cannot reach the display: {}",
             without_source_location(&e.to_string())
         ))
@@ -249,7 +248,9 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     };
     event_loop.run_app(&mut app)?;
     match app.error {
-        Some(e) => Err(UserError(format!("prism view: {}", without_source_location(&e))).into()),
+        Some(e) => {
+            Err(UserError::Refused(format!("prism view: {}", without_source_location(&e))).into())
+        }
         None => Ok(()),
     }
 }

@@ -103,6 +103,19 @@ impl Preset {
             .find(|p| p.name().replace('-', "") == key)
     }
 
+    /// The preset whose name is nearest to `s` by edit distance (letters inserted, deleted
+    /// or changed), if it is at most 3 away: the suggestion for a mistyped name.
+    #[must_use]
+    pub fn nearest(s: &str) -> Option<Preset> {
+        let key = s.to_ascii_lowercase();
+        Preset::ALL
+            .into_iter()
+            .map(|p| (prism_math::edit_distance(&key, p.name()), p))
+            .filter(|&(d, _)| d <= 3)
+            .min_by_key(|&(d, _)| d)
+            .map(|(_, p)| p)
+    }
+
     /// The preset with the template's enum value `i` (0 to 9).
     #[must_use]
     pub fn from_index(i: i64) -> Option<Preset> {
@@ -322,5 +335,24 @@ mod tests {
             .load(&[PathBuf::from("/nonexistent")])
             .unwrap_err();
         assert!(e.to_string().contains("monkey.obj"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod suggestion_tests {
+    use super::*;
+
+    /// Closed forms of the edit distance, and the suggestion for typical typos.
+    #[test]
+    fn mistyped_preset_names_find_the_preset() {
+        assert_eq!(
+            Preset::nearest("cornel-box"),
+            Some(Preset::from_name("cornell-box").unwrap())
+        );
+        assert_eq!(
+            Preset::nearest("tepot"),
+            Some(Preset::from_name("teapot").unwrap())
+        );
+        assert_eq!(Preset::nearest("zzzzzzzzzz"), None);
     }
 }

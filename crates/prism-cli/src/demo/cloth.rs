@@ -21,7 +21,7 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         return Ok(());
     }
     let (w, h) = (240u32, 188u32);
-    let user = |e: prism_cloth::ClothError| crate::error::UserError(e.to_string());
+    let user = |e: prism_cloth::ClothError| crate::error::UserError::input(e);
     let run = |name: &str, set: &[String], frames: u32| -> Result<prism_cloth::Cloth> {
         let scene =
             prism_cloth::read_scene(&scenes.join(format!("{name}.json")), set).map_err(user)?;
@@ -44,7 +44,7 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
             &prism_shade::Uniforms::default(),
             &prism_shade::ShadeOptions::default(),
         )
-        .map_err(|e| crate::error::UserError(e.to_string()).into())
+        .map_err(|e| crate::error::UserError::input(e).into())
     };
     let frames = 90;
     let save = |name: &str, panels: &[prism_image::RgbImage], cols: usize| -> Result<()> {

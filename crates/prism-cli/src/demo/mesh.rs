@@ -49,7 +49,7 @@ fn write_shaded(mesh: &prism_mesh::PolyMesh, size: u32, out: &Path) -> Result<()
         wire_width: if m.triangles.len() > 1000 { 0.3 } else { 0.75 },
     };
     let img = prism_shade::shade(&m, &view, &prism_shade::Shader::Phong, &u, &opts)
-        .map_err(|e| crate::error::UserError(e.to_string()))?;
+        .map_err(crate::error::UserError::input)?;
     prism_image::write_png(out, &prism_shade::to_bytes(&img))
         .with_context(|| format!("writing {}", out.display()))
 }

@@ -56,7 +56,7 @@ fn run_in_pool(a: &DemoArgs) -> Result<()> {
             );
             None
         }
-        Err(e) => return Err(UserError(e.to_string()).into()),
+        Err(e) => return Err(UserError::input(e).into()),
     };
     // Only once the inputs are known good is anything created.
     std::fs::create_dir_all(&a.output)

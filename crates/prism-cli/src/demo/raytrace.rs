@@ -34,7 +34,7 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         seed: 0,
     };
     let cam = OrbitCamera::default();
-    let user = |e: prism_scene::SceneError| crate::error::UserError(e.to_string());
+    let user = |e: prism_scene::SceneError| crate::error::UserError::input(e);
     let write = |name: &str, img: &prism_image::RgbImage| {
         prism_image::write_png(&output.join(name), &img.to_rgb8_truncated())
             .with_context(|| format!("writing {name}"))

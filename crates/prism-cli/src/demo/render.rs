@@ -131,14 +131,13 @@ pub fn pictures(
     }
     let course = |rel: &str| assets.map(|a| a.join(rel)).filter(|p| p.is_file());
     if let Some(bunny) = course("pathtracer/dae/sky/CBbunny.dae") {
-        let doc = prism_scene::read_collada(&bunny)
-            .map_err(|e| crate::error::UserError(e.to_string()))?;
+        let doc = prism_scene::read_collada(&bunny).map_err(crate::error::UserError::input)?;
         let scene = prism_scene::Scene::from_collada(
             &doc,
             &prism_scene::SceneOptions::default(),
             &bunny.display().to_string(),
         )
-        .map_err(|e| crate::error::UserError(e.to_string()))?;
+        .map_err(crate::error::UserError::input)?;
         trace(&scene, &base, &output.join("render_bunny.png"), None)?;
         entries.push(Entry {
             file: "render_bunny.png".into(),
@@ -149,14 +148,13 @@ pub fn pictures(
     let sky = sky_map();
     prism_image::write_exr(&output.join("sky.exr"), &sky)?;
     if let Some(unlit) = course("pathtracer/dae/sky/bunny_unlit.dae") {
-        let doc = prism_scene::read_collada(&unlit)
-            .map_err(|e| crate::error::UserError(e.to_string()))?;
+        let doc = prism_scene::read_collada(&unlit).map_err(crate::error::UserError::input)?;
         let mut scene = prism_scene::Scene::from_collada(
             &doc,
             &prism_scene::SceneOptions::default(),
             &unlit.display().to_string(),
         )
-        .map_err(|e| crate::error::UserError(e.to_string()))?;
+        .map_err(crate::error::UserError::input)?;
         scene.lights = vec![prism_scene::Light::EnvironmentMap {
             radiance: std::sync::Arc::new(sky),
         }];

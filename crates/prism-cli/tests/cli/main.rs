@@ -153,11 +153,7 @@ fn batch_directory_and_determinism() {
             .output()
             .unwrap();
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-        assert!(
-            stderr(&o).contains("a folder of SVGs is written into an existing folder"),
-            "{}",
-            stderr(&o)
-        );
+        assert!(stderr(&o).contains(": no such folder"), "{}", stderr(&o));
         assert!(!missing.exists(), "{} was created", missing.display());
     }
     std::fs::create_dir(&out).unwrap();
@@ -963,7 +959,7 @@ fn outputs_are_chosen_by_extension_and_checked_first() {
                 s("-o"),
                 p(&dir.join("nope/m.obj")),
             ],
-            "does not exist (prism does not create it)",
+            "(prism does not create it)",
         ),
         (
             vec![
@@ -972,11 +968,11 @@ fn outputs_are_chosen_by_extension_and_checked_first() {
                 s("-o"),
                 p(&dir.join("nope/r.png")),
             ],
-            "nope does not exist",
+            "no such folder",
         ),
         (
             vec![s("svg"), p(&svg), s("-o"), p(&dir.join("folder.png"))],
-            "expected a file name, found a folder",
+            "expected a file name, not a folder",
         ),
     ];
     for (args, want) in cases {
@@ -985,7 +981,7 @@ fn outputs_are_chosen_by_extension_and_checked_first() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(want), "{args:?}: expected {want:?} in {err}");
         // The output is checked first: a missing input is never what is reported.
-        assert!(!err.contains("No such file"), "{err}");
+        assert!(!err.contains("no such file"), "{err}");
         assert!(!err.contains(".tmp"), "{err}");
     }
     for left in ["r.tif", "h.exr", "s.exr", "c.obj", "t.png", "m.png"] {
@@ -1476,7 +1472,7 @@ fn raytrace_scenes_debugging_and_errors() {
         ),
         (
             vec!["kitchen".into()],
-            "kitchen: expected a preset".to_string(),
+            "kitchen: no such file or preset; presets: single-triangle".to_string(),
         ),
         (
             vec!["cube".into(), "--enable".into(), "glossy".into()],
@@ -2163,4 +2159,237 @@ fn shade_places_the_default_light_by_the_mesh() {
     // Ambient alone is 0.1 (26 of 255); the lit side must pass twice that.
     let brightest = img.pixels().iter().map(|p| p[0]).max().unwrap();
     assert!(brightest > 52, "brightest {brightest}");
+}
+
+/// Every subcommand words each class of user mistake the same way and exits 2 without
+/// writing: a missing file, a folder given as a file, a wrong extension, a missing output
+/// folder, a bad value, a mistyped subcommand or preset (with the name meant).
+#[test]
+fn every_error_class_has_one_wording_on_every_subcommand() {
+    let dir = scratch("error-classes");
+    let folder = dir.join("a-folder.obj");
+    std::fs::create_dir_all(&folder).unwrap();
+    let missing = dir.join("missing.obj");
+    let bez = dir.join("missing.bez");
+    let out = dir.join("no-such-folder/out.png");
+    let svg = prism_testkit::shared_asset("rasterizer/svg/basic/test1.svg");
+    let monkey = prism_testkit::shared_asset("delft-raytracer/data/monkey.obj");
+    let dae = prism_testkit::shared_asset("meshedit/dae/cube.dae");
+    let json = prism_testkit::shared_asset("clothsim/scene/pinned2.json");
+    let bzc = prism_testkit::shared_asset("meshedit/bzc/curve1.bzc");
+    let s = |p: &Path| p.display().to_string();
+    let cases: Vec<(Vec<String>, String)> = vec![
+        // A missing file.
+        (
+            vec!["svg".into(), s(&missing), "-o".into(), "x.png".into()],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["mesh".into(), "info".into(), s(&missing)],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["bezier".into(), s(&bez), "-o".into(), "x.obj".into()],
+            format!("{}: no such file", s(&bez)),
+        ),
+        (
+            vec!["render".into(), s(&missing)],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["raytrace".into(), s(&missing)],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["shade".into(), s(&missing)],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["cloth".into(), s(&missing), "--obj".into(), "x.obj".into()],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["merge".into(), s(&missing), "-o".into(), "x.png".into()],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec!["view".into(), s(&missing)],
+            format!("{}: no such file", s(&missing)),
+        ),
+        (
+            vec![
+                "render".into(),
+                "--envmap".into(),
+                s(&missing).replace(".obj", ".exr"),
+            ],
+            format!(
+                "--envmap {}: no such file",
+                s(&missing).replace(".obj", ".exr")
+            ),
+        ),
+        (
+            vec![
+                "shade".into(),
+                s(&monkey),
+                "--shader".into(),
+                "texture".into(),
+                "--texture".into(),
+                s(&missing),
+            ],
+            format!("--texture {}: no such file", s(&missing)),
+        ),
+        // Not a file.
+        (
+            vec!["mesh".into(), "info".into(), s(&folder)],
+            format!("{}: not a regular file", s(&folder)),
+        ),
+        (
+            vec!["shade".into(), s(&folder)],
+            format!("{}: not a regular file", s(&folder)),
+        ),
+        (
+            vec!["render".into(), s(&folder)],
+            format!("{}: not a regular file", s(&folder)),
+        ),
+        (
+            vec!["cloth".into(), s(&folder)],
+            format!("{}: not a regular file", s(&folder)),
+        ),
+        // A wrong extension (or kind).
+        (
+            vec!["svg".into(), s(&svg), "-o".into(), "x.txt".into()],
+            "--output x.txt: expected a .png or .jpg file".into(),
+        ),
+        (
+            vec![
+                "mesh".into(),
+                "convert".into(),
+                s(&monkey),
+                "-o".into(),
+                "x.png".into(),
+            ],
+            "--output x.png: expected an .obj, .ply or .dae file".into(),
+        ),
+        (
+            vec!["bezier".into(), s(&monkey), "-o".into(), "x.obj".into()],
+            format!("{}: expected a .bzc or .bez file", s(&monkey)),
+        ),
+        (
+            vec!["shade".into(), s(&monkey), "-o".into(), "x.exr".into()],
+            "--output x.exr: expected a ".into(),
+        ),
+        (
+            vec!["cloth".into(), s(&json), "--obj".into(), "x.ply".into()],
+            "--obj x.ply: expected an .obj file".into(),
+        ),
+        (
+            vec![
+                "svg".into(),
+                s(&prism_testkit::shared_asset(
+                    "clothsim/textures/texture_1.png",
+                )),
+                "-o".into(),
+                "x.png".into(),
+            ],
+            "expected an SVG file, and this is a PNG image".into(),
+        ),
+        // A missing output folder.
+        (
+            vec!["svg".into(), s(&svg), "-o".into(), s(&out)],
+            format!("--output {}: no such folder", s(&out)),
+        ),
+        (
+            vec!["bezier".into(), s(&bzc), "-o".into(), s(&out)],
+            format!("--output {}: no such folder", s(&out)),
+        ),
+        (
+            vec!["render".into(), "-o".into(), s(&out)],
+            format!("--output {}: no such folder", s(&out)),
+        ),
+        (
+            vec!["raytrace".into(), "cube".into(), "-o".into(), s(&out)],
+            format!("--output {}: no such folder", s(&out)),
+        ),
+        (
+            vec!["shade".into(), s(&monkey), "-o".into(), s(&out)],
+            format!("--output {}: no such folder", s(&out)),
+        ),
+        (
+            vec![
+                "mesh".into(),
+                "convert".into(),
+                s(&dae),
+                "-o".into(),
+                s(&out).replace(".png", ".obj"),
+            ],
+            "no such folder".into(),
+        ),
+        (
+            vec!["demo".into(), "--data".into(), s(&missing)],
+            format!("--data {}: no such folder", s(&missing)),
+        ),
+        // A bad value, from the parser or from the command's own checks.
+        (
+            vec!["render".into(), "-s".into(), "abc".into()],
+            "--spp: expected a whole number, found \"abc\"".into(),
+        ),
+        (
+            vec!["render".into(), "--integrator".into(), "pth".into()],
+            "--integrator: expected one of path,".into(),
+        ),
+        (
+            vec![
+                "svg".into(),
+                s(&svg),
+                "-o".into(),
+                "x.png".into(),
+                "-s".into(),
+                "8".into(),
+            ],
+            "--spp: expected a perfect square".into(),
+        ),
+        (
+            vec!["raytrace".into(), "cube".into(), "-s".into(), "0".into()],
+            "--spp: expected 1 to".into(),
+        ),
+        (
+            vec![
+                "shade".into(),
+                s(&monkey),
+                "-r".into(),
+                "0".into(),
+                "10".into(),
+            ],
+            "--resolution: expected 1 to 16384".into(),
+        ),
+        (
+            vec!["cloth".into(), s(&json), "--frames".into(), "0".into()],
+            "--frames: expected 1 to".into(),
+        ),
+        // A mistyped name.
+        (
+            vec!["sgv".into()],
+            "sgv: no such subcommand (did you mean svg?)".into(),
+        ),
+        (
+            vec!["raytrace".into(), "cornel-box".into()],
+            "cornel-box: no such file or preset (did you mean cornell-box?)".into(),
+        ),
+    ];
+    for (args, wording) in &cases {
+        let o = prism().current_dir(&dir).args(args).output().unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.lines()
+                .any(|l| l.starts_with("prism: error: ") && l.contains(wording.as_str())),
+            "{args:?}: expected {wording:?} in {err}"
+        );
+    }
+    // Nothing was written, and no folder was made.
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, [std::ffi::OsString::from("a-folder.obj")], "{left:?}");
 }
