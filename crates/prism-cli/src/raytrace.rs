@@ -295,6 +295,26 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     if a.bloom_debug {
         features.bloom = true;
     }
+    // The template samples segment and parallelogram lights only for soft shadows.
+    let area = |l: &prism_scene::Light| {
+        matches!(
+            l,
+            prism_scene::Light::Segment { .. } | prism_scene::Light::Parallelogram { .. }
+        )
+    };
+    let lights = &loaded.scene.lights;
+    if !a.quiet && !features.soft_shadow && lights.iter().any(area) {
+        let all = lights.iter().all(area);
+        eprintln!(
+            "prism: warning: soft-shadow is off, so the scene's segment and parallelogram \
+             lights give no light (the template samples them only for soft shadows){}",
+            if all {
+                "; it has no other light, so the picture is black"
+            } else {
+                ""
+            }
+        );
+    }
     let (w, h) = match (&a.resolution, loaded.window) {
         (Some(r), _) => (r[0], r[1]),
         (None, Some([w, h])) => (w, h),

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 mod bounded;
+mod readme;
 mod split;
 
 fn prism() -> Command {
