@@ -9,7 +9,7 @@ use prism_image::montage;
 use super::index::Entry;
 
 /// The cloth: the course's five scenes, the ks and density series, and a draped sphere with
-/// each shader, drawn by prism-shade with the course app's camera.
+/// each shader, drawn by prism-shade, each framed to hold the whole run.
 pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) -> Result<()> {
     use prism_shade::Shader;
     let Some(assets) = assets else {
@@ -47,21 +47,52 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         .map_err(|e| crate::error::UserError::input(e).into())
     };
     let frames = 90;
-    let save = |name: &str, panels: &[prism_image::RgbImage], cols: usize| -> Result<()> {
-        let img = montage(panels, cols, prism_math::Rgb::BLACK);
-        prism_image::write_png(&output.join(name), &prism_shade::to_bytes(&img))
-            .with_context(|| format!("writing {name}"))
+    // The gallery's camera: along the course app's view direction, raised a little, far
+    // enough that the cloth at the end of the run (with where a hanging cloth started, and
+    // the sphere a falling one drapes) fits the narrower side.
+    let frame = |start: &prism_cloth::Cloth, end: &prism_cloth::Cloth| -> prism_shade::View {
+        // A pinned cloth's pins hold its top where it started; a falling one has left it.
+        let mut mesh = prism_cloth::cloth_mesh(end);
+        if end.scene.sphere.is_none() && end.scene.plane.is_none() {
+            mesh.append(&prism_cloth::cloth_mesh(start));
+        }
+        if let Some(s) = end.scene.sphere {
+            mesh.append(&prism_shade::ShadeMesh::sphere(
+                s.origin.as_vec3(),
+                s.radius as f32,
+                8,
+            ));
+        }
+        let (lo, hi) = mesh.bounds().expect("a cloth has masses");
+        prism_shade::View::fit(
+            (lo + hi) * 0.5,
+            (hi - lo).length() * 0.5,
+            prism_math::Vec3::new(0.0, 0.35, 1.0).normalize(),
+            prism_math::Vec3::Y,
+            35.0,
+            w,
+            h,
+            prism_shade::Framing::NarrowerSide { margin: 1.1 },
+        )
+    };
+    let save = |name: &str,
+                panels: &[prism_image::RgbImage],
+                cols: usize,
+                labels: &[&str]|
+     -> Result<()> {
+        let mut img = prism_shade::to_bytes(&montage(panels, cols, prism_math::Rgb::BLACK));
+        super::labels::label_panels(&mut img, w, h, cols, labels);
+        prism_image::write_png(&output.join(name), &img).with_context(|| format!("writing {name}"))
     };
     // The five scenes after one simulated second.
     let names = ["pinned2", "pinned4", "sphere", "plane", "selfCollision"];
     let mut panels = Vec::new();
     for n in names {
         let start = run(n, &[], 0)?;
-        let view = prism_cloth::course_view(&start, w, h);
         let c = run(n, &[], frames)?;
-        panels.push(draw(&c, &view, &Shader::Phong)?);
+        panels.push(draw(&c, &frame(&start, &c), &Shader::Phong)?);
     }
-    save("cloth_scenes.png", &panels, 5)?;
+    save("cloth_scenes.png", &panels, 5, &names)?;
     entries.push(Entry {
         file: "cloth_scenes.png".into(),
         caption: format!(
@@ -78,10 +109,12 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         for v in values {
             let set = vec![format!("{key}={v}")];
             let start = run("pinned2", &set, 0)?;
-            let view = prism_cloth::course_view(&start, w, h);
-            panels.push(draw(&run("pinned2", &set, frames)?, &view, &Shader::Phong)?);
+            let end = run("pinned2", &set, frames)?;
+            panels.push(draw(&end, &frame(&start, &end), &Shader::Phong)?);
         }
-        save(file, &panels, 3)?;
+        let labels: Vec<String> = values.iter().map(|v| format!("{key} = {v}")).collect();
+        let labels: Vec<&str> = labels.iter().map(String::as_str).collect();
+        save(file, &panels, 3, &labels)?;
         entries.push(Entry {
             file: file.into(),
             caption: format!(
@@ -108,13 +141,14 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         Shader::Mirror(cube),
     ];
     let start = run("sphere", &[], 0)?;
-    let view = prism_cloth::course_view(&start, w, h);
     let c = run("sphere", &[], frames)?;
+    let view = frame(&start, &c);
     let panels: Vec<_> = shaders
         .iter()
         .map(|s| draw(&c, &view, s))
         .collect::<Result<_>>()?;
-    save("cloth_shaders.png", &panels, 4)?;
+    let labels = shaders.iter().map(Shader::name).collect::<Vec<_>>();
+    save("cloth_shaders.png", &panels, 4, &labels)?;
     entries.push(Entry {
         file: "cloth_shaders.png".into(),
         caption:

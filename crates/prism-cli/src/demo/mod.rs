@@ -5,6 +5,7 @@
 
 mod cloth;
 mod index;
+mod labels;
 mod mesh;
 mod raytrace;
 mod render;

@@ -8,6 +8,9 @@ use prism_image::montage;
 
 use super::index::Entry;
 
+/// The luminance above which the gallery's bloom picture blooms.
+const BLOOM_THRESHOLD: f32 = 0.8;
+
 /// The Whitted ray tracer's pictures: the presets, feature switches side by side, bloom
 /// and its layer, a BVH level and a pixel's ray tree over the mirror Cornell box.
 pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) -> Result<()> {
@@ -39,6 +42,14 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         prism_image::write_png(&output.join(name), &img.to_rgb8_truncated())
             .with_context(|| format!("writing {name}"))
     };
+    // A grid of `cols` columns of `size`-pixel panels, each labelled.
+    let write_grid =
+        |name: &str, panels: &[prism_image::RgbImage], cols: usize, size: u32, labels: &[&str]| {
+            let mut img = montage(panels, cols, prism_math::Rgb::BLACK).to_rgb8_truncated();
+            super::labels::label_panels(&mut img, size, size, cols, labels);
+            prism_image::write_png(&output.join(name), &img)
+                .with_context(|| format!("writing {name}"))
+        };
     // Every preset whose file is here (the dragon is never shipped).
     let mut panels = Vec::new();
     let mut names = Vec::new();
@@ -48,18 +59,13 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         panels.push(raytrace(&ws, &cam, &opts(200, on), &|_| {}).image);
         names.push(p.name());
     }
-    write(
-        "raytrace_presets.png",
-        &montage(&panels, 3, prism_math::Rgb::BLACK),
-    )?;
+    write_grid("raytrace_presets.png", &panels, 3, 200, &names)?;
     entries.push(Entry {
         file: "raytrace_presets.png".into(),
         caption: format!("prism raytrace presets: {}", names.join(", ")),
     });
-    // Feature switches on the Cornell box with the four-colour parallelogram light.
-    let scene = Preset::CornellBoxParallelogramLight
-        .load(&dirs)
-        .map_err(user)?;
+    // Feature switches on the mirror Cornell box with its point light.
+    let scene = Preset::CornellBox.load(&dirs).map_err(user)?;
     let ws = WhittedScene::new(&scene, true);
     let switches: [(&str, prism_scene::Features); 4] = [
         ("everything on", on),
@@ -71,9 +77,9 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
             },
         ),
         (
-            "--disable soft-shadow",
+            "--disable hard-shadow",
             prism_scene::Features {
-                soft_shadow: false,
+                hard_shadow: false,
                 ..on
             },
         ),
@@ -89,22 +95,27 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         .iter()
         .map(|(_, f)| raytrace(&ws, &cam, &opts(200, *f), &|_| {}).image)
         .collect();
-    write(
-        "raytrace_toggles.png",
-        &montage(&panels, 4, prism_math::Rgb::BLACK),
-    )?;
+    let labels: Vec<&str> = switches.iter().map(|s| s.0).collect();
+    write_grid("raytrace_toggles.png", &panels, 4, 200, &labels)?;
     entries.push(Entry {
         file: "raytrace_toggles.png".into(),
         caption: format!(
-            "cornell-box-parallelogram-light, left to right: {}",
+            "cornell-box, left to right: {}",
             switches.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
         ),
     });
-    // Bloom on the spheres, and the layer it adds.
-    let spheres = WhittedScene::new(&Preset::Spheres.load(&dirs).map_err(user)?, true);
+    // Bloom on the teapot, and the layer it adds.
+    // The teapot's highlight blooms; without the course's files, the built-in spheres.
+    let (bloomed, scene) = match Preset::Teapot.load(&dirs) {
+        Ok(s) => ("the teapot", s),
+        Err(_) => ("spheres", Preset::Spheres.load(&dirs).map_err(user)?),
+    };
+    let teapot = WhittedScene::new(&scene, true);
     let mut b = opts(300, prism_scene::Features { bloom: true, ..on });
     b.bloom.passes = 2;
-    let out = raytrace(&spheres, &cam, &b, &|_| {});
+    // Only what is brighter than this blooms: the highlights, not the whole picture.
+    b.bloom.threshold = BLOOM_THRESHOLD;
+    let out = raytrace(&teapot, &cam, &b, &|_| {});
     write("raytrace_bloom.png", &out.image)?;
     write(
         "raytrace_bloom_layer.png",
@@ -112,7 +123,10 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
     )?;
     entries.push(Entry {
         file: "raytrace_bloom.png".into(),
-        caption: "spheres with bloom (--enable bloom --bloom-passes 2)".into(),
+        caption: format!(
+            "{bloomed} with bloom: what passes the threshold glows (--enable bloom \
+             --bloom-passes 2 --bloom-threshold {BLOOM_THRESHOLD})"
+        ),
     });
     entries.push(Entry {
         file: "raytrace_bloom_layer.png".into(),
@@ -170,7 +184,8 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
         entries.push(Entry {
             file: "raytrace_debug_pixel.png".into(),
             caption: format!(
-                "the ray tree of pixel {},{} on the mirror box, seen from another orbit                  (--debug-pixel {},{} --debug-camera 10,-15,0,3.2)",
+                "the ray tree of pixel {},{} on the mirror box, seen from another orbit \
+                 (--debug-pixel {},{} --debug-camera 10,-15,0,3.2)",
                 t.pixel.0, t.pixel.1, t.pixel.0, t.pixel.1
             ),
         });
