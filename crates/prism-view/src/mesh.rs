@@ -183,6 +183,11 @@ impl MeshMode {
         match f(&mut copy, e) {
             Ok(()) => {
                 self.commit(copy);
+                // A flipped or split edge keeps its number: it stays highlighted, so that
+                // S right after F splits it. A collapse renumbers, so nothing stays.
+                if what != "collapse" && (e.0 as usize) < self.mesh.edge_count() {
+                    self.hover = Some(Hover::Edge(e));
+                }
                 Response::Message(format!("{what} edge {}", e.0))
             }
             Err(why) => Response::Message(format!("cannot {what} edge {}: {why}", e.0)),

@@ -59,6 +59,12 @@ fn edits_are_the_halfedge_operations_and_undo() {
         prism_view::Response::Message(format!("flip edge {}", e.0))
     );
     assert_eq!(m.mesh().to_polymesh(), direct.to_polymesh());
+    // The flipped edge stays highlighted: S right after F splits that same edge.
+    assert_eq!(m.hover(), Some(Hover::Edge(e)));
+    direct.split(e).unwrap();
+    m.input(&key('s', false), SIZE);
+    assert_eq!(m.mesh().to_polymesh(), direct.to_polymesh());
+    m.input(&key('z', true), SIZE);
     m.input(&key('z', true), SIZE);
     assert_eq!(m.mesh().to_polymesh(), original.to_polymesh());
 
