@@ -50,7 +50,7 @@ cat >tri.svg <<'SVG'
 </svg>
 SVG
 shot() { sleep 0.4; import -window "$wid" "$1"; }
-colours() { convert "$1" -crop 400x280+0+0 +repage -format %k info:; }
+colours() { convert "$1" -crop 400x240+0+0 +repage -format %k info:; }
 # Pixels that differ between two screenshots, in the region WxH+X+Y if one is given.
 differ() {
     if (($# > 2)); then
@@ -163,16 +163,16 @@ echo "view: clicking a pixel changed $rays pixels (its rays over the dimmed pict
 ((rays > 5000)) || { echo "view: a click drew no rays"; exit 1; }
 xdotool key x
 shot w3.png
-back=$(differ w1.png w3.png 300x280+0+0)
+back=$(differ w1.png w3.png 300x240+0+0)
 echo "view: after X, $back pixels differ from the first picture"
 ((back == 0)) || { echo "view: X did not clear the rays"; exit 1; }
 xdotool key Escape
 wait "$pid" || { echo "view: exit code $? after Esc"; exit 1; }
 
-open_window "mesh" "$teapot" --mode mesh -r 480 360
+open_window "mesh (a MeshEdit .dae opens as a mesh by itself)" "$teapot" -r 480 360
 shot m0.png
-# The picture above the status line.
-area() { differ "$1" "$2" 480x340+0+0; }
+# The picture above the status line (two rows when a message wraps it).
+area() { differ "$1" "$2" 480x310+0+0; }
 xdotool mousemove --window "$wid" 236 170
 shot m1.png
 lit=$(area m0.png m1.png)
