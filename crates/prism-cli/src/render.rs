@@ -51,9 +51,10 @@ pub enum CameraArg {
 }
 
 /// Arguments of `prism render`.
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Clone)]
 pub struct RenderArgs {
-    /// A CS184 COLLADA scene (.dae); without one, the built-in Cornell box with two spheres.
+    /// A CS184 COLLADA scene (.dae), a Mitsuba 3 scene (.xml), an OBJ scene or a Delft
+    /// config; without one, the built-in Cornell box with two spheres.
     scene: Option<PathBuf>,
     /// Output image; its extension picks the format: .png or .jpg (sRGB, clamped) or .exr
     /// (linear radiance). The folder must exist.
@@ -62,18 +63,24 @@ pub struct RenderArgs {
     /// Also write linear radiance to this OpenEXR file.
     #[arg(long, value_name = "FILE")]
     exr: Option<PathBuf>,
-    /// Samples per pixel (the most, with --adaptive).
-    #[arg(short = 's', long = "spp", default_value_t = 64)]
-    spp: u32,
+    /// Samples per pixel (the most, with --adaptive) [default: 64, or a Mitsuba scene's
+    /// sample_count].
+    #[arg(short = 's', long = "spp")]
+    spp: Option<u32>,
     /// Samples per area light (and hemisphere light) at each shading point.
     #[arg(short = 'l', long = "light-samples", default_value_t = 1)]
     light_samples: u32,
-    /// Most bounces a path takes: 0 shows emitters only, 1 adds direct light.
-    #[arg(short = 'm', long = "max-bounces", default_value_t = 7)]
-    max_bounces: u32,
-    /// Image size: WIDTH HEIGHT.
-    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"], default_values_t = [512, 384])]
-    resolution: Vec<u32>,
+    /// Most bounces a path takes: 0 shows emitters only, 1 adds direct light [default: 7, or
+    /// a Mitsuba scene's max_depth - 1].
+    #[arg(short = 'm', long = "max-bounces")]
+    max_bounces: Option<u32>,
+    /// Image size: WIDTH HEIGHT [default: 512 384, or a Mitsuba scene's film].
+    #[arg(short = 'r', long = "resolution", num_args = 2, value_names = ["WIDTH", "HEIGHT"])]
+    resolution: Option<Vec<u32>>,
+    /// Set a Mitsuba scene's parameter: `-D spp=64` gives `$spp` its value, over the file's
+    /// `<default>` (as Mitsuba's command line).
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
+    define: Vec<String>,
     /// Worker threads (default: one per core).
     #[arg(short = 't', long)]
     threads: Option<usize>,
@@ -149,7 +156,7 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
     if a.tile.is_none() && a.samples_from.is_none() && a.samples_to.is_none() {
         return Ok(None);
     }
-    let (from, to) = (a.samples_from.unwrap_or(0), a.samples_to.unwrap_or(a.spp));
+    let (from, to) = (a.samples_from.unwrap_or(0), a.samples_to.unwrap_or(a.spp()));
     if a.samples_from.is_some() || a.samples_to.is_some() {
         if adaptive.is_some() {
             return Err(UserError::Refused(
@@ -160,10 +167,10 @@ fn share(a: &RenderArgs, adaptive: Option<f32>) -> Result<Option<Share>> {
             )
             .into());
         }
-        if !(from < to && to <= a.spp) {
+        if !(from < to && to <= a.spp()) {
             return Err(UserError::Refused(format!(
                 "--samples-from {from} --samples-to {to}: expected 0 <= FROM < TO <= --spp ({})",
-                a.spp
+                a.spp()
             ))
             .into());
         }
@@ -256,7 +263,7 @@ fn check_flags(a: &RenderArgs, adaptive: Option<f32>, batch: Option<u32>) -> Res
                 .into())
             }
             IntegratorArg::Direct => 1,
-            IntegratorArg::Path | IntegratorArg::PathScalar => a.max_bounces,
+            IntegratorArg::Path | IntegratorArg::PathScalar => a.max_bounces(),
         };
         if m > most {
             let why = match a.integrator {
@@ -293,6 +300,79 @@ const MAX_SIDE: u32 = 16384;
 /// Most samples of each light at a shading point.
 const MAX_LIGHT_SAMPLES: u32 = 1 << 16;
 
+/// Samples per pixel when neither `-s` nor the scene says.
+const DEFAULT_SPP: u32 = 64;
+
+/// Most bounces when neither `-m` nor the scene says.
+const DEFAULT_BOUNCES: u32 = 7;
+
+/// The bounces of a Mitsuba `max_depth = -1` path: Russian roulette ends paths long before.
+const UNBOUNDED_BOUNCES: u32 = 1024;
+
+impl RenderArgs {
+    /// Samples per pixel.
+    fn spp(&self) -> u32 {
+        self.spp.unwrap_or(DEFAULT_SPP)
+    }
+
+    /// Most bounces.
+    fn max_bounces(&self) -> u32 {
+        self.max_bounces.unwrap_or(DEFAULT_BOUNCES)
+    }
+
+    /// The image's width and height.
+    fn size(&self) -> (u32, u32) {
+        match self.resolution.as_deref() {
+            Some([w, h]) => (*w, *h),
+            _ => (512, 384),
+        }
+    }
+}
+
+/// The arguments with what a Mitsuba scene (`.xml`) says filled in where the flags are
+/// silent (`-r` from its film, `-s` from its sampler, `-m` from its integrator), and the
+/// scene read; other scenes leave them as given.
+fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderArgs)> {
+    let mut defines = Vec::new();
+    for d in &a.define {
+        match d.split_once('=') {
+            Some((name, value)) if !name.is_empty() => {
+                defines.push((name.to_string(), value.to_string()));
+            }
+            _ => {
+                return Err(UserError::bad_value("--define", "NAME=VALUE", format!("{d:?}")).into())
+            }
+        }
+    }
+    let mut r = a.clone();
+    let Some(path) = a
+        .scene
+        .as_ref()
+        .filter(|p| crate::output::extension(p) == "xml")
+    else {
+        if !defines.is_empty() && !a.quiet {
+            eprintln!("prism: warning: -D has no effect: it sets a Mitsuba scene's parameters");
+        }
+        return Ok((None, r));
+    };
+    let m = prism_scene::read_mitsuba(path, &defines).map_err(UserError::input)?;
+    let s = &m.settings;
+    r.spp = r.spp.or(Some(s.spp));
+    r.max_bounces = r
+        .max_bounces
+        .or(Some(s.max_bounces.unwrap_or(UNBOUNDED_BOUNCES)));
+    r.resolution = r.resolution.or(Some(vec![s.size.0, s.size.1]));
+    if s.filter != prism_scene::Filter::Box && !a.quiet {
+        eprintln!(
+            "prism: warning: {}: its reconstruction filter ({:?}) is read as a box filter: \
+             the expected value of a pixel away from edges is Mitsuba's, edges are sharper",
+            path.display(),
+            s.filter
+        );
+    }
+    Ok((Some(m), r))
+}
+
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
     use crate::output::ImageFormat;
@@ -318,10 +398,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if let Some(map) = &a.envmap {
         crate::error::check_input(map, Some("--envmap"))?;
     }
+    let (mitsuba, resolved) = resolve(a)?;
+    let rr_bounces = mitsuba.as_ref().map(|m| m.settings.rr_bounces);
+    let a = &resolved;
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
     let share = share(a, adaptive)?;
-    let (w, h) = (a.resolution[0], a.resolution[1]);
+    let (w, h) = a.size();
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(UserError::Refused(format!(
             "--resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
@@ -339,11 +422,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if let Some(s) = &share {
         crate::split::check_tile_count(s.parts, w, h)?;
     }
-    if a.spp == 0 || a.spp > 1 << 20 {
+    if a.spp() == 0 || a.spp() > 1 << 20 {
         return Err(UserError::Refused(format!(
             "--spp: expected 1 to {}, found {}",
             1 << 20,
-            a.spp
+            a.spp()
         ))
         .into());
     }
@@ -367,12 +450,16 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             CameraArg::File => CameraMode::File,
         },
     };
-    let scene = match &a.scene {
-        None => prism_scene::cornell_box(),
-        Some(path) => prism_scene::load(path, &opts).map_err(UserError::input)?,
+    let scene = match (&a.scene, mitsuba) {
+        (_, Some(m)) => m.scene,
+        (None, None) => prism_scene::cornell_box(),
+        (Some(path), None) => prism_scene::load(path, &opts).map_err(UserError::input)?,
     };
     let mut scene = scene;
-    scene.camera.lens = thin_lens(a, &scene.camera)?;
+    let lens = thin_lens(a, &scene.camera)?;
+    if a.lens_radius.is_some() {
+        scene.camera.lens = lens;
+    }
     if let Some(path) = &a.envmap {
         let map = prism_image::read_exr(path).map_err(UserError::input)?;
         let replaced = scene
@@ -402,18 +489,20 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t1 = Instant::now();
     let prepared = RenderScene::new(&scene);
     let build = t1.elapsed();
+    let rr_bounces = rr_bounces.unwrap_or(PathSettings::default().rr_bounces);
     let options = RenderOptions {
         film: FilmSettings {
             width: w,
             height: h,
-            spp: a.spp,
+            spp: a.spp(),
             adaptive,
             batch: batch.unwrap_or(DEFAULT_BATCH).max(1),
             seed: a.seed,
         },
         path: PathSettings {
+            rr_bounces,
             light_samples: a.light_samples.max(1),
-            max_bounces: a.max_bounces,
+            max_bounces: a.max_bounces(),
             integrator: match a.integrator {
                 IntegratorArg::Path => Integrator::Path,
                 IntegratorArg::PathScalar => Integrator::PathScalar,
@@ -423,7 +512,6 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 IntegratorArg::Normals => Integrator::Normals,
             },
             only_bounce: a.bounce,
-            ..PathSettings::default()
         },
     };
     let pool = crate::resources::pool(a.threads)?;
@@ -474,7 +562,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let bar = crate::progress::samples_bar(u64::from(w) * u64::from(h) * u64::from(a.spp), a.quiet);
+    let bar =
+        crate::progress::samples_bar(u64::from(w) * u64::from(h) * u64::from(a.spp()), a.quiet);
     let t2 = Instant::now();
     let out = pool.install(|| render(&prepared, &options, &|done| bar.set_position(done)));
     let render_time = t2.elapsed();

@@ -57,7 +57,8 @@ pub enum ModeArg {
              W wireframe, Ctrl+Z undo, Ctrl+S save as NAME-edited.obj; drag orbits, wheel
              zooms, arrows pan, R resets the view")]
 pub struct ViewArgs {
-    /// The file to open; its extension chooses the mode (.svg: svg; .json: cloth; .obj,
+    /// The file to open; its extension chooses the mode (.svg: svg; .xml (Mitsuba 3): path;
+    /// .json: cloth; .obj,
     /// .toml or a Delft preset name such as cornell-box: whitted; .ply: mesh; .dae: path if
     /// it has lights of its own, mesh if it is lit only by a modelling tool's default lamp
     /// (a white point or directional light and no emitting material, as every MeshEdit
@@ -123,6 +124,7 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
                 }
             }
             "ply" => ModeArg::Mesh,
+            "xml" => ModeArg::Path,
             "json" => ModeArg::Cloth,
             "obj" | "toml" => ModeArg::Whitted,
             "" if prism_scene::Preset::from_name(&a.file.to_string_lossy()).is_some() => {

@@ -55,6 +55,9 @@ pub struct RenderScene {
     /// Per material, the texture its diffuse albedo is multiplied by.
     textures: Vec<Option<prism_image::Texture>>,
     emission: Vec<Option<Rgb>>,
+    /// Per material: true if it emits from its front side only (where the winding's normal
+    /// points), as a Mitsuba area emitter does.
+    front_only: Vec<bool>,
     /// Lights.
     pub lights: Vec<RenderLight>,
     /// The scene's camera.
@@ -158,7 +161,10 @@ impl RenderScene {
         let mut mesh_light = vec![None; scene.meshes.len()];
         for (mi, m) in scene.meshes.iter().enumerate() {
             let radiance = match scene.materials.get(m.material) {
-                Some(prism_scene::Material::Emission { radiance }) => *radiance,
+                Some(
+                    prism_scene::Material::Emission { radiance }
+                    | prism_scene::Material::EmissiveDiffuse { radiance, .. },
+                ) => *radiance,
                 _ => continue,
             };
             if radiance.max_channel() <= 0.0 {
@@ -169,7 +175,11 @@ impl RenderScene {
                 .iter()
                 .map(|t| t.map(|i| m.positions[i as usize]))
                 .collect();
-            if let Some(light) = MeshLight::new(tris, radiance) {
+            let one_sided = matches!(
+                scene.materials.get(m.material),
+                Some(prism_scene::Material::EmissiveDiffuse { .. })
+            );
+            if let Some(light) = MeshLight::new(tris, radiance).map(|l| l.one_sided(one_sided)) {
                 mesh_light[mi] = Some(lights.len());
                 lights.push(RenderLight::Mesh(std::sync::Arc::new(light)));
             }
@@ -219,11 +229,17 @@ impl RenderScene {
                     _ => None,
                 })
                 .collect(),
+            front_only: scene
+                .materials
+                .iter()
+                .map(|m| matches!(m, prism_scene::Material::EmissiveDiffuse { .. }))
+                .collect(),
             emission: scene
                 .materials
                 .iter()
                 .map(|m| match m {
-                    prism_scene::Material::Emission { radiance } => Some(*radiance),
+                    prism_scene::Material::Emission { radiance }
+                    | prism_scene::Material::EmissiveDiffuse { radiance, .. } => Some(*radiance),
                     _ => None,
                 })
                 .collect(),
@@ -366,7 +382,12 @@ impl RenderScene {
                     ng,
                     ns,
                     bsdf,
-                    emitted: self.emission[m.material].unwrap_or(Rgb::BLACK),
+                    emitted: match self.emission[m.material] {
+                        Some(_) if self.front_only[m.material] && ray.dir.dot(ng) >= 0.0 => {
+                            Rgb::BLACK
+                        }
+                        e => e.unwrap_or(Rgb::BLACK),
+                    },
                     light: m.light,
                     t: hit.t,
                 }
@@ -398,7 +419,10 @@ impl RenderScene {
                     ng: n,
                     ns: n,
                     bsdf: self.bsdfs[material],
-                    emitted: self.emission[material].unwrap_or(Rgb::BLACK),
+                    emitted: match self.emission[material] {
+                        Some(_) if self.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
+                        e => e.unwrap_or(Rgb::BLACK),
+                    },
                     light: None,
                     t: hit.t,
                 }

@@ -17,7 +17,7 @@ pub enum SceneError {
         source: Arc<std::io::Error>,
     },
     /// The file's extension names no scene format prism reads.
-    #[error("{path}: expected a scene file (.dae, .obj, .toml)")]
+    #[error("{path}: expected a scene file (.dae, .obj, .toml, .xml)")]
     UnknownFormat {
         /// The file.
         path: String,

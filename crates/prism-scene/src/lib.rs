@@ -27,6 +27,7 @@ mod environment;
 mod error;
 mod load;
 mod mesh_io;
+pub mod mitsuba;
 mod obj;
 mod presets;
 mod render_config;
@@ -47,6 +48,10 @@ pub use environment::EnvironmentMapError;
 pub use error::SceneError;
 pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
+pub use mitsuba::{
+    read_document, read_mitsuba, to_scene as mitsuba_to_scene, Filter, MitsubaScene,
+    MitsubaSettings,
+};
 pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX_OBJ_BYTES};
 pub use presets::Preset;
 pub use render_config::{

@@ -12,7 +12,8 @@ use crate::scene::{Scene, SceneOptions};
 /// `.dae`, COLLADA (then [`Scene::from_collada`]); `.obj`, a Wavefront OBJ scene with its
 /// MTL materials, unlit and not normalised ([`read_obj_scene`]); `.toml`, a Delft render
 /// configuration, whose scene is loaded with its lights ([`crate::RenderConfig::load_scene`],
-/// presets from the folder its `data_path` names or the copies built into prism).
+/// presets from the folder its `data_path` names or the copies built into prism); `.xml`, a
+/// Mitsuba 3 scene ([`crate::read_mitsuba`], its `$name`s from their `<default>`s).
 ///
 /// # Errors
 /// [`SceneError::UnknownFormat`] for another extension, or the reader's located error.
@@ -28,6 +29,7 @@ pub fn load(path: &Path, opts: &SceneOptions) -> Result<Scene, SceneError> {
         }
         "obj" => read_obj_scene(path, false),
         "toml" => read_render_config(path)?.load_scene(&[]),
+        "xml" => Ok(crate::mitsuba::read_mitsuba(path, &[])?.scene),
         _ => Err(SceneError::UnknownFormat {
             path: path.display().to_string(),
         }),
@@ -44,7 +46,7 @@ mod tests {
         let e = load(Path::new("scene.obj.txt"), &SceneOptions::default()).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "scene.obj.txt: expected a scene file (.dae, .obj, .toml)"
+            "scene.obj.txt: expected a scene file (.dae, .obj, .toml, .xml)"
         );
         let e = load(Path::new("no-such-scene.DAE"), &SceneOptions::default()).unwrap_err();
         assert!(matches!(e, SceneError::Io { .. }), "{e}");

@@ -23,6 +23,14 @@ pub enum Material {
         /// Emitted radiance.
         radiance: Rgb,
     },
+    /// A Lambertian surface that also emits `radiance` from both sides (a Mitsuba shape with
+    /// an area emitter: the emitter does not replace the shape's BSDF).
+    EmissiveDiffuse {
+        /// Emitted radiance.
+        radiance: Rgb,
+        /// Albedo of the surface under the emission.
+        reflectance: Rgb,
+    },
     /// A perfect mirror.
     Mirror {
         /// Reflectance per channel.
@@ -434,7 +442,9 @@ impl Scene {
     pub fn is_lit(&self) -> bool {
         let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
         let emitters = self.materials.iter().any(|m| match m {
-            Material::Emission { radiance } => shines(radiance),
+            Material::Emission { radiance } | Material::EmissiveDiffuse { radiance, .. } => {
+                shines(radiance)
+            }
             _ => false,
         });
         emitters || self.lights.iter().any(Light::gives_off_light)
@@ -448,7 +458,9 @@ impl Scene {
     pub fn lit_only_by_a_default_lamp(&self) -> bool {
         let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
         let emitters = self.materials.iter().any(|m| match m {
-            Material::Emission { radiance } => shines(radiance),
+            Material::Emission { radiance } | Material::EmissiveDiffuse { radiance, .. } => {
+                shines(radiance)
+            }
             _ => false,
         });
         !emitters

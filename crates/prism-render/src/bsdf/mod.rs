@@ -75,6 +75,9 @@ impl Bsdf {
                 albedo: reflectance,
             },
             Material::Emission { .. } => Bsdf::Black,
+            Material::EmissiveDiffuse { reflectance, .. } => Bsdf::Diffuse {
+                albedo: reflectance,
+            },
             Material::Mirror { reflectance } => Bsdf::Mirror { reflectance },
             Material::Glass {
                 reflectance,

@@ -87,8 +87,12 @@ pub(super) fn light_term(
     if f.max_channel() <= 0.0 {
         return None;
     }
+    // The shadow ray starts pushed off the surface; it must stop short of the light by a
+    // margin measured from where it starts, or a light close above a surface facing it
+    // would block its own sample.
+    let shadow = hit.spawn(ls.wi);
     let dist = if ls.dist.is_finite() {
-        ls.dist * (1.0 - 1e-4) - 1e-4
+        (ls.dist - (shadow.origin - hit.p).dot(ls.wi)) * (1.0 - 1e-4) - 1e-4
     } else {
         f32::INFINITY
     };
@@ -97,7 +101,7 @@ pub(super) fn light_term(
     } else {
         1.0
     };
-    Some((hit.spawn(ls.wi), dist, f * ls.li * (w / ls.pdf)))
+    Some((shadow, dist, f * ls.li * (w / ls.pdf)))
 }
 
 /// The course's uniform hemisphere estimator of direct light.

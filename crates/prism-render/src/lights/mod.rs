@@ -61,10 +61,12 @@ pub enum RenderLight {
 }
 
 /// The triangles of an emissive mesh (both sides emit, as the course's emission BSDF
+/// does, or only the front, where the winding's normal points, as a Mitsuba area emitter
 /// does), with the cumulative areas that pick one in proportion to its area.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshLight {
     triangles: Vec<[Vec3; 3]>,
+    front_only: bool,
     /// `cumulative[i]`: the area of triangles `0..=i`.
     cumulative: Vec<f32>,
     area: f32,
@@ -86,10 +88,28 @@ impl MeshLight {
         let area = sum as f32;
         (area > 0.0 && area.is_finite()).then_some(MeshLight {
             triangles,
+            front_only: false,
             cumulative,
             area,
             radiance,
         })
+    }
+
+    /// The light emitting from its front side only (`true`) or from both sides.
+    #[must_use]
+    pub fn one_sided(mut self, front_only: bool) -> MeshLight {
+        self.front_only = front_only;
+        self
+    }
+
+    /// The emitting cosine toward a shading point in direction `wi` from it, at a point of
+    /// normal `n`: `|wi.n|` for both sides, `-wi.n` for the front only.
+    fn cos_toward(&self, wi: Vec3, n: Vec3) -> f32 {
+        if self.front_only {
+            -wi.dot(n)
+        } else {
+            wi.dot(n).abs()
+        }
     }
 
     /// The total area.
@@ -236,8 +256,7 @@ impl RenderLight {
             }
             RenderLight::Mesh(ref mesh) => {
                 let (q, n) = mesh.sample_point(u);
-                // Both sides emit.
-                toward_surface(p, q, |wi| wi.dot(n).abs(), mesh.area, mesh.radiance)
+                toward_surface(p, q, |wi| mesh.cos_toward(wi, n), mesh.area, mesh.radiance)
             }
             RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
@@ -267,7 +286,7 @@ impl RenderLight {
     pub fn pdf(&self, wi: Vec3, dist: f32, ng: Vec3) -> f32 {
         match *self {
             RenderLight::Mesh(ref mesh) => {
-                let cos_l = wi.dot(ng).abs();
+                let cos_l = mesh.cos_toward(wi, ng);
                 if cos_l > 0.0 {
                     dist * dist / (mesh.area * cos_l)
                 } else {

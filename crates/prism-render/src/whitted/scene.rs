@@ -66,6 +66,7 @@ impl PhongMaterial {
                 plain(*reflectance * mean, Rgb::BLACK)
             }
             Material::Emission { radiance } => plain(*radiance, Rgb::BLACK),
+            Material::EmissiveDiffuse { radiance, .. } => plain(*radiance, Rgb::BLACK),
             Material::Mirror { reflectance } => plain(Rgb::BLACK, *reflectance),
             Material::Glass { .. } | Material::Refraction { .. } | Material::Microfacet { .. } => {
                 plain(Rgb::BLACK, Rgb::WHITE)

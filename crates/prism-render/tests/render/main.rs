@@ -1,6 +1,7 @@
 //! prism-render's integration tests: the path tracer against closed forms and Mitsuba
 //! (`paths`), split renders and their merge (`parts`), and the Whitted ray tracer (`whitted`).
 
+mod mitsuba_xml;
 mod parts;
 mod paths;
 mod whitted;

@@ -385,12 +385,13 @@ pub(super) fn step(
                 power(count as f32, pdf, bsdf_pdf) / pdf
             });
             let term = [0, 1, 2].map(|c| f[c] * li[c] * w);
+            // Measured from the pushed-off origin, as the scalar light term measures it.
+            let origin = spawn(p, ng, wi);
             let shadow_dist = F16::select(
                 dist.is_finite(),
-                dist * F16::splat(1.0 - 1e-4) - F16::splat(1e-4),
+                (dist - (origin - p).dot(wi)) * F16::splat(1.0 - 1e-4) - F16::splat(1e-4),
                 F16::splat(f32::INFINITY),
             );
-            let origin = spawn(p, ng, wi);
             cand.push(Candidate {
                 keep: ok.bits(),
                 origin,

@@ -1,0 +1,311 @@
+//! The Mitsuba reader against closed forms: transforms composed in document order, look-at
+//! frames, defaults and `-D` values, includes and references, the camera's field of view on
+//! each axis, and located errors for everything it refuses.
+
+use std::path::PathBuf;
+
+use prism_math::glam::{DMat4, DVec3};
+
+use super::*;
+use crate::scene::Light;
+
+/// A scratch folder holding `files` (name, text); removed when dropped.
+struct Files(PathBuf);
+
+impl Files {
+    fn new(name: &str, files: &[(&str, &str)]) -> Files {
+        let dir = std::env::temp_dir().join(format!("prism-mitsuba-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (f, text) in files {
+            std::fs::write(dir.join(f), text).unwrap();
+        }
+        Files(dir)
+    }
+
+    fn path(&self, f: &str) -> PathBuf {
+        self.0.join(f)
+    }
+}
+
+impl Drop for Files {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A scene file around `body`, with a sensor.
+fn scene(body: &str) -> String {
+    format!(
+        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>\
+         <film type=\"hdrfilm\"><integer name=\"width\" value=\"200\"/><integer name=\"height\" value=\"100\"/></film></sensor>\n{body}\n</scene>\n"
+    )
+}
+
+fn read(
+    name: &str,
+    body: &str,
+    defines: &[(&str, &str)],
+) -> Result<MitsubaScene, crate::SceneError> {
+    let files = Files::new(name, &[("s.xml", &scene(body))]);
+    let d: Vec<(String, String)> = defines
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    read_mitsuba(&files.path("s.xml"), &d)
+}
+
+fn transform_of(body: &str) -> DMat4 {
+    let files = Files::new(
+        "t",
+        &[(
+            "s.xml",
+            &scene(&format!(
+                "<shape type=\"sphere\"><transform name=\"to_world\">{body}</transform></shape>"
+            )),
+        )],
+    );
+    let doc = read_document(&files.path("s.xml"), &[]).unwrap();
+    let shape = doc.objects.iter().find(|o| o.tag == "shape").unwrap();
+    match &shape.prop("to_world").unwrap().value {
+        Value::Transform(m) => *m,
+        v => panic!("{v:?}"),
+    }
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-12
+}
+
+/// Closed forms: each operation applies after the ones before it.
+#[test]
+fn transforms_compose_in_document_order() {
+    let m = transform_of("<translate x=\"1\"/><rotate y=\"1\" angle=\"90\"/>");
+    // (1, 0, 0) moves to (2, 0, 0), then a quarter turn about +y takes x to -z.
+    assert!(
+        close(m.transform_point3(DVec3::X), DVec3::new(0.0, 0.0, -2.0)),
+        "{m:?}"
+    );
+    let m = transform_of("<rotate y=\"1\" angle=\"90\"/><translate x=\"1\"/>");
+    assert!(
+        close(m.transform_point3(DVec3::X), DVec3::new(1.0, 0.0, -1.0)),
+        "{m:?}"
+    );
+    let m = transform_of("<scale value=\"2\"/><scale x=\"3\"/><translate value=\"1, 2, 3\"/>");
+    assert!(
+        close(m.transform_point3(DVec3::ONE), DVec3::new(7.0, 4.0, 5.0)),
+        "{m:?}"
+    );
+    // A matrix is written row by row; nine numbers are the upper 3x3.
+    let m = transform_of("<matrix value=\"1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1\"/>");
+    assert!(close(
+        m.transform_point3(DVec3::ZERO),
+        DVec3::new(5.0, 6.0, 7.0)
+    ));
+    let m = transform_of("<matrix value=\"0 -1 0  1 0 0  0 0 1\"/>");
+    assert!(close(m.transform_point3(DVec3::X), DVec3::Y));
+}
+
+/// Closed form of Mitsuba's look-at: +z towards the target, +y up, +x to the left.
+#[test]
+fn look_at_frames_the_view() {
+    let m = transform_of("<lookat origin=\"0, 0, 5\" target=\"0, 0, 0\" up=\"0, 1, 0\"/>");
+    assert!(close(
+        m.transform_point3(DVec3::ZERO),
+        DVec3::new(0.0, 0.0, 5.0)
+    ));
+    assert!(close(m.transform_vector3(DVec3::Z), -DVec3::Z));
+    assert!(close(m.transform_vector3(DVec3::Y), DVec3::Y));
+    // Seen from +z looking at -z, the viewer's left is -x.
+    assert!(close(m.transform_vector3(DVec3::X), -DVec3::X));
+}
+
+/// `$name` takes its `<default>`, a `-D` value wins, and one with neither is a located
+/// error naming both ways to give it.
+#[test]
+fn defaults_and_defines_fill_parameters() {
+    let body = "<default name=\"r\" value=\"0.5\"/>\n<shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>";
+    let s = read("defaults", body, &[]).unwrap();
+    assert_eq!(s.scene.spheres[0].radius, 0.5);
+    let s = read("defines", body, &[("r", "2")]).unwrap();
+    assert_eq!(s.scene.spheres[0].radius, 2.0);
+    let e = read(
+        "missing",
+        "<shape type=\"sphere\"><float name=\"radius\" value=\"$q\"/></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("s.xml:3") && e.contains("$q: no value") && e.contains("-D q="),
+        "{e}"
+    );
+}
+
+/// Includes read in place, relative to the including file; a file that includes itself
+/// stops at the depth limit with a located error.
+#[test]
+fn includes_read_in_place_and_cycles_stop() {
+    let files = Files::new(
+        "include",
+        &[
+            ("main.xml", &scene("<include filename=\"part.xml\"/>")),
+            (
+                "part.xml",
+                "<scene version=\"3.0.0\"><shape type=\"sphere\"/></scene>",
+            ),
+            (
+                "loop.xml",
+                "<scene version=\"3.0.0\"><include filename=\"loop.xml\"/></scene>",
+            ),
+        ],
+    );
+    let s = read_mitsuba(&files.path("main.xml"), &[]).unwrap();
+    assert_eq!(s.scene.spheres.len(), 1);
+    let e = read_document(&files.path("loop.xml"), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("loop.xml:1") && e.contains("nested more than"),
+        "{e}"
+    );
+}
+
+/// A `<ref>` may come before the object it names; one naming nothing is a located error.
+#[test]
+fn references_resolve_forwards_and_fail_located() {
+    let s = read(
+        "refs",
+        "<shape type=\"sphere\"><ref id=\"red\"/></shape>\n<bsdf type=\"diffuse\" id=\"red\"><rgb name=\"reflectance\" value=\"0.8, 0.1, 0.1\"/></bsdf>",
+        &[],
+    )
+    .unwrap();
+    let m = s.scene.spheres[0].material;
+    assert!(
+        matches!(s.scene.materials[m], crate::Material::Diffuse { reflectance, .. } if reflectance.r == 0.8),
+        "{:?}",
+        s.scene.materials[m]
+    );
+    let e = read(
+        "badref",
+        "<shape type=\"sphere\"><ref id=\"nothing\"/></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("s.xml:3") && e.contains("\"nothing\": no object has this id"),
+        "{e}"
+    );
+}
+
+/// What prism does not render is a located error naming the plugin, never a silent
+/// substitute; so are unknown elements and wrong property kinds.
+#[test]
+fn unsupported_plugins_are_located_errors() {
+    for (body, want) in [
+        (
+            "<shape type=\"sphere\"><bsdf type=\"hair\"/></shape>",
+            "<bsdf>: type=\"hair\": not supported by prism",
+        ),
+        (
+            "<shape type=\"hyperboloid\"/>",
+            "<shape>: type=\"hyperboloid\": not supported by prism",
+        ),
+        (
+            "<emitter type=\"area\"/>",
+            "an area emitter belongs inside a <shape>",
+        ),
+        (
+            "<shape type=\"sphere\"><float name=\"radius\" value=\"x\"/></shape>",
+            "expected a finite number",
+        ),
+        (
+            "<shape type=\"sphere\"><string name=\"radius\" value=\"1\"/></shape>",
+            "radius: expected a <float>, found <string>",
+        ),
+        ("<thing/>", "unknown element <thing>"),
+    ] {
+        let e = read("unsupported", body, &[]).unwrap_err().to_string();
+        assert!(e.contains("s.xml:3") && e.contains(want), "{body}: {e}");
+    }
+    let files = Files::new("version", &[("v.xml", "<scene version=\"0.6.0\"/>")]);
+    let e = read_mitsuba(&files.path("v.xml"), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("expected a Mitsuba 2 or 3 scene"), "{e}");
+}
+
+/// Closed forms of the field of view on each `fov_axis` for a 2:1 film: `x` is the
+/// horizontal angle, `y` the vertical, and the other follows from the aspect ratio.
+#[test]
+fn fov_axes_give_both_angles() {
+    let angle = |fov: f64, axis: &str| {
+        let files = Files::new(
+            &format!("fov-{axis}"),
+            &[(
+                "s.xml",
+                &format!(
+                    "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"{fov}\"/>\
+                     <string name=\"fov_axis\" value=\"{axis}\"/><film type=\"hdrfilm\"><integer name=\"width\" value=\"200\"/>\
+                     <integer name=\"height\" value=\"100\"/></film></sensor></scene>"
+                ),
+            )],
+        );
+        let c = read_mitsuba(&files.path("s.xml"), &[])
+            .unwrap()
+            .scene
+            .camera;
+        (f64::from(c.hfov), f64::from(c.vfov))
+    };
+    let half = |deg: f64| (deg.to_radians() / 2.0).tan();
+    let (h, v) = angle(60.0, "x");
+    assert!((h - 60.0).abs() < 1e-4 && (half(v) - half(60.0) / 2.0).abs() < 1e-6);
+    let (h, v) = angle(30.0, "y");
+    assert!((v - 30.0).abs() < 1e-4 && (half(h) - half(30.0) * 2.0).abs() < 1e-6);
+    // On a wide film the smaller side is the height, the larger the width.
+    assert_eq!(angle(30.0, "smaller"), angle(30.0, "y"));
+    assert_eq!(angle(30.0, "larger"), angle(30.0, "x"));
+    let (h, v) = angle(50.0, "diagonal");
+    let d = (half(h).powi(2) + half(v).powi(2)).sqrt();
+    assert!((d - half(50.0)).abs() < 1e-6 && (half(h) / half(v) - 2.0).abs() < 1e-6);
+}
+
+/// Mitsuba's shapes and lights land where Mitsuba puts them: a scaled rectangle's area and
+/// facing, a point light's position through to_world, a sphere's radius under a uniform
+/// scale; a sphere under a stretch is refused.
+#[test]
+fn shapes_and_lights_are_placed() {
+    let s = read(
+        "shapes",
+        "<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"2\"/><rotate x=\"1\" angle=\"90\"/></transform></shape>\n\
+         <emitter type=\"point\"><transform name=\"to_world\"><translate y=\"3\"/></transform><rgb name=\"intensity\" value=\"2\"/></emitter>\n\
+         <shape type=\"sphere\"><float name=\"radius\" value=\"0.5\"/><transform name=\"to_world\"><scale value=\"4\"/></transform></shape>",
+        &[],
+    )
+    .unwrap();
+    let m = &s.scene.meshes[0];
+    let area: f32 = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    assert!((area - 16.0).abs() < 1e-5, "{area}");
+    // +z turned a quarter about +x faces -y.
+    let [a, b, c] = m.triangles[0].map(|i| m.positions[i as usize]);
+    assert!((b - a).cross(c - a).normalize().dot(-prism_math::Vec3::Y) > 0.999);
+    assert!(
+        matches!(s.scene.lights[0], Light::Point { position, .. } if position == prism_math::Vec3::new(0.0, 3.0, 0.0))
+    );
+    assert_eq!(s.scene.spheres[0].radius, 2.0);
+    let e = read(
+        "stretch",
+        "<shape type=\"sphere\"><transform name=\"to_world\"><scale x=\"2\"/></transform></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("keep the sphere round"), "{e}");
+}
