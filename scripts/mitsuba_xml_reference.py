@@ -4,7 +4,8 @@ file is tested against: the mean image over N renders of P samples (seeds 100, 1
 and the per-pixel variance of one sample's luminance, from the spread of those renders.
 Needs mitsuba 3.9.1, drjit 1.5.0, OpenEXR and libLLVM 19.
 
-Usage: python3 scripts/mitsuba_xml_reference.py SCENE.xml MEAN.exr VARIANCE.exr [N [P]]
+Usage: python3 scripts/mitsuba_xml_reference.py SCENE.xml MEAN.exr VARIANCE.exr [N [P [NAME=VALUE ...]]]
+(NAME=VALUE: the scene's $parameters, as Mitsuba's -D)
 """
 import os, sys, numpy as np
 os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
@@ -14,7 +15,8 @@ import OpenEXR
 scene_path, mean_path, var_path = sys.argv[1:4]
 N = int(sys.argv[4]) if len(sys.argv) > 4 else 256
 P = int(sys.argv[5]) if len(sys.argv) > 5 else 64
-scene = mi.load_file(scene_path)
+params = dict(a.split("=", 1) for a in sys.argv[6:])
+scene = mi.load_file(scene_path, **params)
 w = np.array([0.2126, 0.7152, 0.0722])
 acc = None
 for i in range(N):

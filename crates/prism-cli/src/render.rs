@@ -362,14 +362,6 @@ fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderA
         .max_bounces
         .or(Some(s.max_bounces.unwrap_or(UNBOUNDED_BOUNCES)));
     r.resolution = r.resolution.or(Some(vec![s.size.0, s.size.1]));
-    if s.filter != prism_scene::Filter::Box && !a.quiet {
-        eprintln!(
-            "prism: warning: {}: its reconstruction filter ({:?}) is read as a box filter: \
-             the expected value of a pixel away from edges is Mitsuba's, edges are sharper",
-            path.display(),
-            s.filter
-        );
-    }
     Ok((Some(m), r))
 }
 
@@ -400,6 +392,17 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let (mitsuba, resolved) = resolve(a)?;
     let rr_bounces = mitsuba.as_ref().map(|m| m.settings.rr_bounces);
+    let filter = mitsuba
+        .as_ref()
+        .map_or(prism_scene::Filter::Box, |m| m.settings.filter);
+    if filter != prism_scene::Filter::Box
+        && (a.tile.is_some() || a.samples_from.is_some() || a.samples_to.is_some())
+    {
+        return Err(UserError::Refused(format!(
+            "--tile and --samples-from/--samples-to: a scene whose reconstruction filter is not a box ({filter:?}) cannot be split yet; give it <rfilter type=\"box\"/> or render it whole"
+        ))
+        .into());
+    }
     let a = &resolved;
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
@@ -498,6 +501,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             adaptive,
             batch: batch.unwrap_or(DEFAULT_BATCH).max(1),
             seed: a.seed,
+            filter,
         },
         path: PathSettings {
             rr_bounces,

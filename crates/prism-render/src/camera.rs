@@ -5,11 +5,12 @@ use prism_math::lanes::{F16, V16};
 use prism_math::{warp, Ray, Vec2, Vec3};
 use prism_scene::Camera;
 
+use crate::pixel_filter::PixelFilter;
 use crate::sampler::Sampler;
 
 /// A perspective camera for an image of `width` x `height` pixels: a pinhole, or a thin
 /// lens focused on a plane (the course's thin-lens model).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Perspective {
     eye: Vec3,
     forward: Vec3,
@@ -23,6 +24,8 @@ pub struct Perspective {
     height: f32,
     /// Lens radius and focal distance; `None` for a pinhole.
     lens: Option<(f32, f32)>,
+    /// Where in the image a pixel's samples fall.
+    filter: PixelFilter,
 }
 
 impl Perspective {
@@ -47,7 +50,31 @@ impl Perspective {
                 .lens
                 .filter(|l| l.radius > 0.0)
                 .map(|l| (l.radius, l.focal_distance)),
+            filter: PixelFilter::Box,
         }
+    }
+
+    /// The camera drawing its pixels' sample positions with `filter`.
+    #[must_use]
+    pub fn with_filter(mut self, filter: PixelFilter) -> Perspective {
+        self.filter = filter;
+        self
+    }
+
+    /// True if samples fall uniformly in their pixel (a box filter).
+    #[must_use]
+    pub(crate) fn box_filtered(&self) -> bool {
+        matches!(self.filter, PixelFilter::Box)
+    }
+
+    /// The image position of a sample of pixel `(x, y)` drawn with `u`.
+    #[inline]
+    #[must_use]
+    pub fn image_position(&self, (x, y): (u32, u32), u: Vec2) -> (f32, f32) {
+        (
+            self.filter.position(x, u.x, self.width as u32),
+            self.filter.position(y, u.y, self.height as u32),
+        )
     }
 
     /// True when rays leave a lens, so [`Perspective::ray`] uses its lens sample.
@@ -108,7 +135,8 @@ pub(crate) fn camera_ray(camera: &Perspective, (x, y): (u32, u32), sampler: &mut
     } else {
         prism_math::Vec2::ZERO
     };
-    camera.ray(x as f32 + u.x, y as f32 + u.y, lens)
+    let (px, py) = camera.image_position((x, y), u);
+    camera.ray(px, py, lens)
 }
 
 #[cfg(test)]

@@ -25,6 +25,8 @@ pub struct FilmSettings {
     pub batch: u32,
     /// Seed of every random number.
     pub seed: u64,
+    /// The reconstruction filter: where a pixel's samples fall (a box: in the pixel).
+    pub filter: prism_scene::Filter,
 }
 
 impl Default for FilmSettings {
@@ -36,6 +38,7 @@ impl Default for FilmSettings {
             adaptive: None,
             batch: 32,
             seed: 0,
+            filter: prism_scene::Filter::Box,
         }
     }
 }

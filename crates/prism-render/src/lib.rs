@@ -16,6 +16,7 @@ pub mod integrators;
 pub mod interaction;
 pub mod lights;
 pub mod parts;
+pub mod pixel_filter;
 pub mod profile;
 pub mod render;
 pub mod render_scene;

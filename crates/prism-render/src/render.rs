@@ -103,7 +103,8 @@ pub fn render_share(
         assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
     }
     let skipped = |x: u32, y: u32| skip.is_some_and(|s| s[(y * w + x) as usize]);
-    let camera = Perspective::new(&scene.camera, w, h);
+    let camera = Perspective::new(&scene.camera, w, h)
+        .with_filter(crate::pixel_filter::PixelFilter::new(&opts.film.filter));
     let tiles: Vec<(u32, u32)> = tiles(w, h)
         .into_iter()
         .enumerate()

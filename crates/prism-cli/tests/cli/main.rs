@@ -2394,3 +2394,68 @@ fn every_error_class_has_one_wording_on_every_subcommand() {
         .collect();
     assert_eq!(left, [std::ffi::OsString::from("a-folder.obj")], "{left:?}");
 }
+
+/// A Mitsuba scene renders from the command line with its own film and sample count, `-D`
+/// sets its parameters, and a plugin prism does not render, a malformed `-D` or a split of a
+/// Gaussian-filtered scene is refused with exit 2 and nothing written.
+#[test]
+fn mitsuba_scenes_render_and_refuse_what_they_cannot() {
+    let dir = scratch("mitsuba");
+    let scene = prism_testkit::workspace_root().join("docs/examples/cbox.xml");
+    let out = dir.join("cbox.png");
+    let o = prism()
+        .arg("render")
+        .arg(&scene)
+        .args(["-D", "spp=4", "-D", "res=64", "-q", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let img = prism_image::read_png(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 96));
+    let bad = dir.join("bad.xml");
+    std::fs::write(
+        &bad,
+        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n<shape type=\"sphere\">\n<bsdf type=\"plastic\"/>\n</shape>\n</scene>\n",
+    )
+    .unwrap();
+    for (args, want) in [
+        (
+            vec![bad.display().to_string()],
+            format!(
+                "{}:4: <bsdf>: type=\"plastic\": not supported by prism",
+                bad.display()
+            ),
+        ),
+        (
+            vec![scene.display().to_string(), "-D".into(), "spp".into()],
+            "--define: expected NAME=VALUE, found \"spp\"".to_string(),
+        ),
+        (
+            vec![
+                scene.display().to_string(),
+                "-D".into(),
+                "filter=gaussian".into(),
+                "--tile".into(),
+                "0/2".into(),
+                "-o".into(),
+                dir.join("p.exr").display().to_string(),
+            ],
+            "cannot be split yet".to_string(),
+        ),
+    ] {
+        let o = prism()
+            .arg("render")
+            .args(&args)
+            .arg("-q")
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(&want), "{args:?}: {}", stderr(&o));
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "{left:?}");
+}

@@ -77,7 +77,18 @@ impl Pinhole<'_> {
             let dim = [0; LANES];
             let ux = lane_values(&key, &dim, 0);
             let uy = lane_values(&key, &dim, 1);
-            let (x, y) = (x + ux, y + uy);
+            let (x, y) = if self.camera.box_filtered() {
+                (x + ux, y + uy)
+            } else {
+                // A wider filter places each lane's sample as the scalar camera does.
+                let (mut px, mut py) = (F16::default(), F16::default());
+                for i in 0..LANES {
+                    let k = group[i.min(group.len() - 1)];
+                    let u = prism_math::Vec2::new(ux.0[i], uy.0[i]);
+                    (px.0[i], py.0[i]) = self.camera.image_position(self.pixels[k], u);
+                }
+                (px, py)
+            };
             let d = self.camera.pinhole_dirs(x, y);
             for (i, &pixel) in group.iter().enumerate() {
                 paths.push(PathState::start(pixel, Sampler::from_state(key[i], 2)));
