@@ -60,6 +60,7 @@ fn adaptive_passes_are_the_adaptive_render() {
             seed: 3,
             adaptive: Some(0.05),
             batch: 32,
+            ..FilmSettings::default()
         },
         ..RenderOptions::default()
     };
