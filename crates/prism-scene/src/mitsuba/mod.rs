@@ -2,6 +2,7 @@
 //! includes, defaults, `$` substitution, properties, transforms, references) and the prism
 //! scene it describes ([`to_scene`]), with the film, sampler and integrator settings.
 
+mod conductors;
 mod document;
 mod limits;
 mod to_scene;
@@ -15,6 +16,7 @@ use std::path::Path;
 
 use crate::error::SceneError;
 
+pub use conductors::{conductor, CONDUCTORS};
 pub use document::{read_document, Document, Object, Property, Value};
 pub use limits::{MAX_INCLUDE_DEPTH, MAX_MITSUBA_BYTES, MAX_OBJECTS, MAX_SCENE_FILES};
 pub use to_scene::{to_scene, Filter, MitsubaScene, MitsubaSettings};

@@ -309,3 +309,43 @@ fn shapes_and_lights_are_placed() {
     .to_string();
     assert!(e.contains("keep the sphere round"), "{e}");
 }
+
+/// Mitsuba's conductor presets: `material` names one (Mitsuba's RGB eta and k for gold),
+/// the default is `none` (eta 0, k 1: everything reflected), explicit `eta`/`k` win, and an
+/// unknown name is a located error.
+#[test]
+fn conductor_materials_are_mitsubas() {
+    let material = |body: &str| {
+        let s = read(
+            "conductor",
+            &format!("<shape type=\"sphere\">{body}</shape>"),
+            &[],
+        )
+        .unwrap();
+        s.scene.materials[s.scene.spheres[0].material].clone()
+    };
+    let gold =
+        material("<bsdf type=\"roughconductor\"><string name=\"material\" value=\"Au\"/></bsdf>");
+    assert!(
+        matches!(gold, crate::Material::Microfacet { alpha, eta, k } if alpha == 0.1 && eta.b == 1.44205 && k.r == 3.983),
+        "{gold:?}"
+    );
+    let none = material("<bsdf type=\"roughconductor\"/>");
+    assert!(
+        matches!(none, crate::Material::Microfacet { eta, k, .. } if eta.g == 0.0 && k.g == 1.0),
+        "{none:?}"
+    );
+    let given = material("<bsdf type=\"roughconductor\"><string name=\"material\" value=\"Au\"/><rgb name=\"eta\" value=\"2\"/></bsdf>");
+    assert!(
+        matches!(given, crate::Material::Microfacet { eta, .. } if eta.r == 2.0),
+        "{given:?}"
+    );
+    let e = read("conductor-bad", "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><string name=\"material\" value=\"Unobtainium\"/></bsdf></shape>", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("s.xml:3") && e.contains("no such conductor"),
+        "{e}"
+    );
+    assert_eq!(super::CONDUCTORS.len(), 40);
+}

@@ -541,15 +541,26 @@ impl Builder<'_> {
                         ),
                     ));
                 }
-                let (eta, k) = match o.string("material")? {
-                    Some(m) if m != "none" => {
-                        return Err(error(o, format!("{}: material {m:?}: not supported by prism yet (give eta and k)", o.label())))
+                // `eta` and `k` given win; else the named material, "none" (all reflected) by
+                // default, as Mitsuba 3.
+                let (eta, k) = if o.prop("eta").is_some() || o.prop("k").is_some() {
+                    (o.rgb("eta", [0.0; 3])?, o.rgb("k", [1.0; 3])?)
+                } else {
+                    match o.string("material")?.unwrap_or("none") {
+                        "none" => (Rgb::splat(0.0), Rgb::splat(1.0)),
+                        name => {
+                            let (e, k) = super::conductors::conductor(name).ok_or_else(|| {
+                                error(
+                                    o,
+                                    format!(
+                                        "{}: material {name:?}: Mitsuba names no such conductor",
+                                        o.label()
+                                    ),
+                                )
+                            })?;
+                            (Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2]))
+                        }
                     }
-                    Some(_) => (Rgb::splat(0.0), Rgb::splat(1.0)),
-                    None if o.prop("eta").is_none() && o.prop("k").is_none() => {
-                        return Err(error(o, format!("{}: Mitsuba's default material \"Cu\": not supported by prism yet (give eta and k)", o.label())))
-                    }
-                    None => (o.rgb("eta", [0.0; 3])?, o.rgb("k", [1.0; 3])?),
                 };
                 Material::Microfacet {
                     alpha: alpha as f32,
