@@ -97,6 +97,15 @@ impl RenderScene {
                     position,
                     intensity,
                 }),
+                Light::Spot {
+                    position,
+                    to_local,
+                    intensity,
+                    cutoff,
+                    beam_width,
+                } => lights.push(RenderLight::Spot(crate::lights::Spot::new(
+                    position, to_local, intensity, cutoff, beam_width,
+                ))),
                 Light::Directional {
                     direction,
                     irradiance,

@@ -172,6 +172,21 @@ pub enum Light {
         /// Radiant intensity.
         intensity: Rgb,
     },
+    /// A spot light (Mitsuba's `spot`): a point light whose intensity is full within
+    /// `beam_width` degrees of its axis and falls linearly in angle to 0 at `cutoff`.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// World directions to the light's frame, whose +z is the axis (the inverse of the
+        /// light's `to_world` without its translation).
+        to_local: prism_math::glam::Mat3,
+        /// Radiant intensity on the axis.
+        intensity: Rgb,
+        /// Half-angle of the cone beyond which nothing is emitted, in degrees.
+        cutoff: f32,
+        /// Half-angle of the full-intensity beam, in degrees.
+        beam_width: f32,
+    },
     /// Light arriving from infinitely far along one direction.
     Directional {
         /// The direction the light travels (unit).
@@ -237,6 +252,7 @@ impl Light {
         match self {
             Light::Point { intensity, .. } => shines(intensity),
             Light::Directional { irradiance, .. } => shines(irradiance),
+            Light::Spot { intensity, .. } => shines(intensity),
             Light::Hemisphere { radiance } | Light::Environment { radiance } => shines(radiance),
             Light::EnvironmentMap { radiance } => radiance.pixels().iter().any(shines),
             Light::Segment { colors, .. } => colors.iter().any(shines),

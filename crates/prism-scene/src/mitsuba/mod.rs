@@ -5,6 +5,8 @@
 mod conductors;
 mod document;
 mod limits;
+mod props;
+mod sensor;
 mod to_scene;
 mod transform;
 mod values;

@@ -349,3 +349,28 @@ fn conductor_materials_are_mitsubas() {
     );
     assert_eq!(super::CONDUCTORS.len(), 40);
 }
+
+/// A spot light is read as Mitsuba places it: at its `to_world`'s origin, its axis the
+/// local +z, `beam_width` three quarters of `cutoff_angle` unless given.
+#[test]
+fn spot_lights_are_placed() {
+    let s = read(
+        "spot",
+        "<emitter type=\"spot\"><transform name=\"to_world\"><lookat origin=\"0, 2, 0\" target=\"0, 0, 0\" up=\"0, 0, 1\"/></transform><float name=\"cutoff_angle\" value=\"40\"/></emitter>",
+        &[],
+    )
+    .unwrap();
+    let Light::Spot {
+        position,
+        to_local,
+        cutoff,
+        beam_width,
+        ..
+    } = s.scene.lights[0]
+    else {
+        panic!("{:?}", s.scene.lights[0])
+    };
+    assert_eq!(position, prism_math::Vec3::new(0.0, 2.0, 0.0));
+    assert!((to_local * -prism_math::Vec3::Y - prism_math::Vec3::Z).length() < 1e-6);
+    assert_eq!((cutoff, beam_width), (40.0, 30.0));
+}

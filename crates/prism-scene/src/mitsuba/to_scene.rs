@@ -4,12 +4,13 @@
 //! A plugin prism does not render is a located error naming it.
 
 use prism_math::glam::{DMat4, DVec3};
-use prism_math::{Loc, Rgb, Vec2, Vec3};
+use prism_math::{Rgb, Vec2, Vec3};
 
-use super::document::{Document, Object, Value};
-use super::limits::{DISK_SEGMENTS, MAX_FILM_SIDE, MAX_OBJECT_DEPTH, MAX_SAMPLE_COUNT};
+use super::document::{Document, Object};
+use super::limits::{DISK_SEGMENTS, MAX_OBJECT_DEPTH};
+use super::props::{error, ior, unsupported};
 use crate::error::SceneError;
-use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, ThinLens, TriangleMesh};
+use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, TriangleMesh};
 
 /// How the film turns samples into pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -113,169 +114,13 @@ pub fn to_scene(doc: &Document) -> Result<MitsubaScene, SceneError> {
 }
 
 /// The scene being built.
-struct Builder<'d> {
-    doc: &'d Document,
-    scene: Scene,
-    settings: MitsubaSettings,
-    sensor_seen: bool,
+pub(super) struct Builder<'d> {
+    pub(super) doc: &'d Document,
+    pub(super) scene: Scene,
+    pub(super) settings: MitsubaSettings,
+    pub(super) sensor_seen: bool,
     /// Material index of each BSDF object already translated.
     bsdfs: std::collections::HashMap<usize, usize>,
-}
-
-/// `<tag type="...">: not supported by prism`.
-fn unsupported(o: &Object) -> SceneError {
-    error(o, format!("{}: not supported by prism", o.label()))
-}
-
-/// A located error at object `o`.
-fn error(o: &Object, message: String) -> SceneError {
-    SceneError::Element {
-        at: o.at.clone(),
-        element: o.tag.clone(),
-        message,
-    }
-}
-
-/// Typed property reads, with Mitsuba's defaults.
-impl Object {
-    fn value(&self, name: &str) -> Option<(&Value, &Loc)> {
-        self.prop(name).map(|p| (&p.value, &p.at))
-    }
-
-    fn kind_error(&self, name: &str, want: &str, got: &Value) -> SceneError {
-        error(
-            self,
-            format!(
-                "{}: {name}: expected {want}, found <{}>",
-                self.label(),
-                got.kind()
-            ),
-        )
-    }
-
-    fn float(&self, name: &str, default: f64) -> Result<f64, SceneError> {
-        match self.value(name) {
-            None => Ok(default),
-            Some((Value::Float(v), _)) => Ok(*v),
-            Some((Value::Integer(v), _)) => Ok(*v as f64),
-            Some((v, _)) => Err(self.kind_error(name, "a <float>", v)),
-        }
-    }
-
-    fn integer(&self, name: &str, default: i64) -> Result<i64, SceneError> {
-        match self.value(name) {
-            None => Ok(default),
-            Some((Value::Integer(v), _)) => Ok(*v),
-            Some((v, _)) => Err(self.kind_error(name, "an <integer>", v)),
-        }
-    }
-
-    fn boolean(&self, name: &str, default: bool) -> Result<bool, SceneError> {
-        match self.value(name) {
-            None => Ok(default),
-            Some((Value::Boolean(v), _)) => Ok(*v),
-            Some((v, _)) => Err(self.kind_error(name, "a <boolean>", v)),
-        }
-    }
-
-    fn string(&self, name: &str) -> Result<Option<&str>, SceneError> {
-        match self.value(name) {
-            None => Ok(None),
-            Some((Value::String(v), _)) => Ok(Some(v)),
-            Some((v, _)) => Err(self.kind_error(name, "a <string>", v)),
-        }
-    }
-
-    fn rgb(&self, name: &str, default: [f64; 3]) -> Result<Rgb, SceneError> {
-        let c = match self.value(name) {
-            None => default,
-            Some((Value::Rgb(c), _)) => *c,
-            Some((Value::Float(v), _)) => [*v; 3],
-            Some((v, _)) => return Err(self.kind_error(name, "an <rgb> or <float>", v)),
-        };
-        if c.iter().any(|x| *x < 0.0) {
-            return Err(error(
-                self,
-                format!("{}: {name}: expected values of at least 0", self.label()),
-            ));
-        }
-        Ok(Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32))
-    }
-
-    fn point(&self, name: &str) -> Result<Option<DVec3>, SceneError> {
-        match self.value(name) {
-            None => Ok(None),
-            Some((Value::Point(p) | Value::Vector(p), _)) => Ok(Some(*p)),
-            Some((v, _)) => Err(self.kind_error(name, "a <point>", v)),
-        }
-    }
-
-    fn transform(&self, name: &str) -> Result<DMat4, SceneError> {
-        match self.value(name) {
-            None => Ok(DMat4::IDENTITY),
-            Some((Value::Transform(m), _)) => Ok(*m),
-            Some((v, _)) => Err(self.kind_error(name, "a <transform>", v)),
-        }
-    }
-
-    /// Fails on a property prism would ignore but that changes the picture in Mitsuba.
-    fn refuse(&self, names: &[&str]) -> Result<(), SceneError> {
-        for n in names {
-            if self.prop(n).is_some() {
-                return Err(error(
-                    self,
-                    format!("{}: {n}: not supported by prism", self.label()),
-                ));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A named index of refraction (Mitsuba's table), or a number.
-fn ior(o: &Object, name: &str, default: &str) -> Result<f64, SceneError> {
-    let named = |n: &str| -> Option<f64> {
-        Some(match n {
-            "vacuum" => 1.0,
-            "helium" => 1.000_036,
-            "hydrogen" => 1.000_132,
-            "air" => 1.000_277,
-            "carbon dioxide" => 1.000_45,
-            "water" => 1.3330,
-            "acetone" => 1.36,
-            "ethanol" => 1.361,
-            "carbon tetrachloride" => 1.461,
-            "glycerol" => 1.4729,
-            "benzene" => 1.501,
-            "silicone oil" => 1.520_45,
-            "bromine" => 1.661,
-            "water ice" => 1.31,
-            "fused quartz" => 1.458,
-            "pyrex" => 1.470,
-            "acrylic glass" => 1.49,
-            "polypropylene" => 1.49,
-            "bk7" => 1.5046,
-            "sodium chloride" => 1.544,
-            "amber" => 1.55,
-            "pet" => 1.5750,
-            "diamond" => 2.419,
-            _ => return None,
-        })
-    };
-    match o.value(name) {
-        None => Ok(named(default).expect("a known default")),
-        Some((Value::Float(v), _)) => Ok(*v),
-        Some((Value::String(s), _)) => named(s).ok_or_else(|| {
-            error(
-                o,
-                format!(
-                    "{}: {name}: no index of refraction is named {s:?}",
-                    o.label()
-                ),
-            )
-        }),
-        Some((v, _)) => Err(o.kind_error(name, "a <float> or a named material", v)),
-    }
 }
 
 impl Builder<'_> {
@@ -586,6 +431,29 @@ impl Builder<'_> {
                     intensity: o.rgb("intensity", [1.0; 3])?,
                 }
             }
+            "spot" => {
+                o.refuse(&["texture"])?;
+                let to_world = o.transform("to_world")?;
+                let linear = prism_math::glam::DMat3::from_mat4(to_world);
+                if linear.determinant() == 0.0 {
+                    return Err(error(
+                        o,
+                        format!("{}: to_world: the light's axes are degenerate", o.label()),
+                    ));
+                }
+                let cutoff = o.float("cutoff_angle", 20.0)?;
+                let beam_width = o.float("beam_width", cutoff * 0.75)?;
+                if !(cutoff > 0.0 && cutoff <= 180.0 && beam_width >= 0.0 && beam_width < cutoff) {
+                    return Err(error(o, format!("{}: expected 0 <= beam_width < cutoff_angle <= 180 degrees, found {beam_width} and {cutoff}", o.label())));
+                }
+                Light::Spot {
+                    position: to_world.transform_point3(DVec3::ZERO).as_vec3(),
+                    to_local: linear.inverse().as_mat3(),
+                    intensity: o.rgb("intensity", [1.0; 3])?,
+                    cutoff: cutoff as f32,
+                    beam_width: beam_width as f32,
+                }
+            }
             "constant" => Light::Environment {
                 radiance: o.rgb("radiance", [1.0; 3])?,
             },
@@ -613,234 +481,6 @@ impl Builder<'_> {
             _ => return Err(unsupported(o)),
         };
         self.scene.lights.push(light);
-        Ok(())
-    }
-
-    /// The sensor: the camera, and its film and sampler.
-    fn sensor(&mut self, o: &Object) -> Result<(), SceneError> {
-        if self.sensor_seen {
-            return Err(error(
-                o,
-                format!("{}: a second sensor: not supported by prism yet", o.label()),
-            ));
-        }
-        self.sensor_seen = true;
-        if !matches!(o.kind.as_str(), "perspective" | "thinlens") {
-            return Err(unsupported(o));
-        }
-        for &(_, child) in &o.children {
-            let c = &self.doc.objects[child];
-            match c.tag.as_str() {
-                "film" => self.film(c)?,
-                "sampler" => {
-                    let n = c.integer("sample_count", 4)?;
-                    if !(1..=i64::from(MAX_SAMPLE_COUNT)).contains(&n) {
-                        return Err(error(
-                            c,
-                            format!(
-                                "{}: sample_count: expected 1 to {MAX_SAMPLE_COUNT}, found {n}",
-                                c.label()
-                            ),
-                        ));
-                    }
-                    self.settings.spp = n as u32;
-                }
-                _ => return Err(unsupported(c)),
-            }
-        }
-        let (w, h) = self.settings.size;
-        let aspect = f64::from(w) / f64::from(h);
-        let fov = match o.value("fov") {
-            Some(_) => o.float("fov", 0.0)?,
-            None => {
-                // A 35 mm film's width over the focal length (Mitsuba's "50mm" default).
-                let f = o.string("focal_length")?.unwrap_or("50mm");
-                let mm: f64 = f.trim_end_matches("mm").trim().parse().map_err(|_| {
-                    error(
-                        o,
-                        format!(
-                            "{}: focal_length: expected millimetres such as \"50mm\", found {f:?}",
-                            o.label()
-                        ),
-                    )
-                })?;
-                2.0 * (36.0 / (2.0 * mm)).atan().to_degrees()
-            }
-        };
-        if !(fov > 0.0 && fov < 180.0) {
-            return Err(error(
-                o,
-                format!(
-                    "{}: fov: expected degrees strictly between 0 and 180, found {fov}",
-                    o.label()
-                ),
-            ));
-        }
-        let axis = o.string("fov_axis")?.unwrap_or("x");
-        let t = (fov.to_radians() * 0.5).tan();
-        // The tangents of the half angles across and up the film.
-        let (tx, ty) = match axis {
-            "x" => (t, t / aspect),
-            "y" => (t * aspect, t),
-            "diagonal" => {
-                let d = (1.0 + 1.0 / (aspect * aspect)).sqrt();
-                (t / d, t / d / aspect)
-            }
-            "smaller" if aspect > 1.0 => (t * aspect, t),
-            "smaller" => (t, t / aspect),
-            "larger" if aspect > 1.0 => (t, t / aspect),
-            "larger" => (t * aspect, t),
-            other => {
-                return Err(error(
-                    o,
-                    format!(
-                        "{}: fov_axis: expected x, y, diagonal, smaller or larger, found {other:?}",
-                        o.label()
-                    ),
-                ))
-            }
-        };
-        let to_world = o.transform("to_world")?;
-        let eye = to_world.transform_point3(DVec3::ZERO);
-        let dir = to_world.transform_vector3(DVec3::Z);
-        let up = to_world.transform_vector3(DVec3::Y);
-        let left = to_world.transform_vector3(DVec3::X);
-        if dir.length_squared() == 0.0 || up.length_squared() == 0.0 {
-            return Err(error(
-                o,
-                format!("{}: to_world: the camera's axes are degenerate", o.label()),
-            ));
-        }
-        // Mitsuba's camera has +x to the left; a to_world that mirrors it flips the picture.
-        if up.cross(dir).dot(left) <= 0.0 {
-            return Err(error(
-                o,
-                format!(
-                    "{}: to_world mirrors the image: not supported by prism yet",
-                    o.label()
-                ),
-            ));
-        }
-        let near = o.float("near_clip", 1e-2)?;
-        let far = o.float("far_clip", 1e4)?;
-        if !(near > 0.0 && far > near) {
-            return Err(error(
-                o,
-                format!(
-                    "{}: near_clip and far_clip: expected 0 < near < far, found {near} and {far}",
-                    o.label()
-                ),
-            ));
-        }
-        let lens = if o.kind == "thinlens" {
-            let radius = o.float("aperture_radius", 0.0)?;
-            let focus = o.float("focus_distance", 0.0)?;
-            if !(radius >= 0.0 && focus > 0.0) {
-                return Err(error(
-                    o,
-                    format!(
-                        "{}: expected aperture_radius >= 0 and focus_distance > 0",
-                        o.label()
-                    ),
-                ));
-            }
-            Some(ThinLens {
-                radius: radius as f32,
-                focal_distance: focus as f32,
-            })
-        } else {
-            None
-        };
-        self.scene.camera = Camera {
-            eye: eye.as_vec3(),
-            target: (eye + dir.normalize()).as_vec3(),
-            up: up.normalize().as_vec3(),
-            hfov: (2.0 * tx.atan()).to_degrees() as f32,
-            vfov: (2.0 * ty.atan()).to_degrees() as f32,
-            near: near as f32,
-            far: far as f32,
-            lens,
-        };
-        Ok(())
-    }
-
-    /// The film: its size and reconstruction filter.
-    fn film(&mut self, o: &Object) -> Result<(), SceneError> {
-        if o.kind != "hdrfilm" {
-            return Err(unsupported(o));
-        }
-        o.refuse(&[
-            "crop_offset_x",
-            "crop_offset_y",
-            "crop_width",
-            "crop_height",
-        ])?;
-        let side = |name: &str, default: i64| -> Result<u32, SceneError> {
-            let v = o.integer(name, default)?;
-            if !(1..=i64::from(MAX_FILM_SIDE)).contains(&v) {
-                return Err(error(
-                    o,
-                    format!(
-                        "{}: {name}: expected 1 to {MAX_FILM_SIDE} pixels, found {v}",
-                        o.label()
-                    ),
-                ));
-            }
-            Ok(v as u32)
-        };
-        self.settings.size = (side("width", 768)?, side("height", 576)?);
-        for &(_, child) in &o.children {
-            let c = &self.doc.objects[child];
-            if c.tag != "rfilter" {
-                return Err(unsupported(c));
-            }
-            self.settings.filter = match c.kind.as_str() {
-                "box" => Filter::Box,
-                "gaussian" => Filter::Gaussian {
-                    stddev: c.float("stddev", 0.5)?,
-                },
-                "tent" => Filter::Tent {
-                    radius: c.float("radius", 1.0)?,
-                },
-                _ => return Err(unsupported(c)),
-            };
-        }
-        Ok(())
-    }
-
-    /// The integrator's depth settings.
-    fn integrator(&mut self, o: &Object) -> Result<(), SceneError> {
-        if o.kind != "path" {
-            return Err(unsupported(o));
-        }
-        if o.boolean("hide_emitters", false)? {
-            return Err(error(
-                o,
-                format!("{}: hide_emitters: not supported by prism yet", o.label()),
-            ));
-        }
-        let max_depth = o.integer("max_depth", -1)?;
-        self.settings.max_bounces = match max_depth {
-            -1 => None,
-            d if (1..=1024).contains(&d) => Some(d as u32 - 1),
-            d => {
-                return Err(error(
-                    o,
-                    format!(
-                        "{}: max_depth: expected -1 or 1 to 1024, found {d}",
-                        o.label()
-                    ),
-                ))
-            }
-        };
-        let rr = o.integer("rr_depth", 5)?;
-        if !(1..=1024).contains(&rr) {
-            return Err(error(
-                o,
-                format!("{}: rr_depth: expected 1 to 1024, found {rr}", o.label()),
-            ));
-        }
-        self.settings.rr_bounces = rr as u32;
         Ok(())
     }
 }

@@ -353,6 +353,7 @@ pub(super) fn step(
                     )
                 }
                 RenderLight::Mesh(_)
+                | RenderLight::Spot(_)
                 | RenderLight::Environment { .. }
                 | RenderLight::EnvironmentMap(_) => {
                     // No lane version of the sample: the light's own, lane by lane.
