@@ -31,6 +31,16 @@ pub enum Material {
         /// Albedo of the surface under the emission.
         reflectance: Rgb,
     },
+    /// Mitsuba's smooth `plastic`: a diffuse base under a smooth dielectric coat of index
+    /// `eta`, light scattering inside the coat (its linear model).
+    Plastic {
+        /// Albedo of the base.
+        diffuse: Rgb,
+        /// Scale of the coat's mirror reflection.
+        specular: Rgb,
+        /// Index of refraction of the coat over the outside.
+        eta: f32,
+    },
     /// A perfect mirror.
     Mirror {
         /// Reflectance per channel.

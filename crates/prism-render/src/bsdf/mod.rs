@@ -47,6 +47,19 @@ pub enum Bsdf {
         /// Absorption.
         k: Rgb,
     },
+    /// Mitsuba's smooth plastic: Fresnel-weighted mirror reflection off a dielectric coat
+    /// of index `eta`, over a diffuse base seen through it.
+    Plastic {
+        /// The base's albedo over `(1 - Fdr_int) eta^2`: the diffuse lobe's scale.
+        diffuse: Rgb,
+        /// Scale of the mirror reflection.
+        specular: Rgb,
+        /// Index of refraction of the coat.
+        eta: f32,
+        /// The share of samples the mirror lobe is weighted by (mean specular over mean
+        /// specular plus mean diffuse albedo).
+        specular_weight: f32,
+    },
     /// Absorbs everything (the surface of an emitter).
     Black,
 }
@@ -93,6 +106,20 @@ impl Bsdf {
                 transmittance, ior, ..
             } => Bsdf::Refraction { transmittance, ior },
             Material::Microfacet { alpha, eta, k } => Bsdf::Conductor { alpha, eta, k },
+            Material::Plastic {
+                diffuse,
+                specular,
+                eta,
+            } => {
+                let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
+                let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
+                Bsdf::Plastic {
+                    diffuse: diffuse * (1.0 / ((1.0 - fdr_int) * eta * eta)),
+                    specular,
+                    eta,
+                    specular_weight: mean(specular) / (mean(diffuse) + mean(specular)),
+                }
+            }
             Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
         }
     }
@@ -100,7 +127,10 @@ impl Bsdf {
     /// True if the BSDF has a non-delta part that light sampling can reach.
     #[must_use]
     pub fn is_smooth(&self) -> bool {
-        matches!(self, Bsdf::Diffuse { .. } | Bsdf::Conductor { .. })
+        matches!(
+            self,
+            Bsdf::Diffuse { .. } | Bsdf::Conductor { .. } | Bsdf::Plastic { .. }
+        )
     }
 
     /// True for BSDFs that scatter the same on both sides of the surface.
@@ -118,6 +148,11 @@ impl Bsdf {
         let (wo, wi) = upper(wo, wi);
         match *self {
             Bsdf::Diffuse { albedo } => albedo * (wi.z / PI),
+            Bsdf::Plastic { diffuse, eta, .. } => {
+                let f_i = fresnel_dielectric(wo.z, eta);
+                let f_o = fresnel_dielectric(wi.z, eta);
+                diffuse * (wi.z / PI * (1.0 - f_i) * (1.0 - f_o))
+            }
             Bsdf::Conductor { alpha, eta, k } => {
                 let h = (wo + wi).normalize();
                 let d = beckmann_d(h, alpha);
@@ -147,6 +182,7 @@ impl Bsdf {
                 let f = fresnel_conductor(wi.dot(h), eta, k);
                 (f * (d * g / (4.0 * wo.z)), g1_wo * d / (4.0 * wo.z))
             }
+            Bsdf::Plastic { .. } => (self.eval(wo, wi), self.pdf(wo, wi)),
             _ => (Rgb::splat(0.0), 0.0),
         }
     }
@@ -164,6 +200,14 @@ impl Bsdf {
                 // Visible normals: D_wo(h) / (4 wo.h) = G1(wo, h) D(h) / (4 wo.z).
                 let h = (wo + wi).normalize();
                 smith_g1(wo, h, alpha) * beckmann_d(h, alpha) / (4.0 * wo.z)
+            }
+            Bsdf::Plastic {
+                eta,
+                specular_weight,
+                ..
+            } => {
+                let f_i = fresnel_dielectric(wo.z, eta);
+                cosine_hemisphere_pdf(wi.z) * plastic_diffuse_share(f_i, specular_weight)
             }
             _ => 0.0,
         }
@@ -252,8 +296,58 @@ impl Bsdf {
                     delta: true,
                 })
             }
+            Bsdf::Plastic {
+                diffuse,
+                specular,
+                eta,
+                specular_weight,
+            } => {
+                let wo_up = flip(wo);
+                let f_i = fresnel_dielectric(wo_up.z, eta);
+                let diffuse_share = plastic_diffuse_share(f_i, specular_weight);
+                if u1 >= diffuse_share {
+                    let p = 1.0 - diffuse_share;
+                    return Some(BsdfSample {
+                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                        weight: specular * (f_i / p),
+                        pdf: p,
+                        delta: true,
+                    });
+                }
+                let wi = cosine_hemisphere(u2);
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                let f_o = fresnel_dielectric(wi.z, eta);
+                Some(BsdfSample {
+                    wi: flip(wi),
+                    weight: diffuse * ((1.0 - f_i) * (1.0 - f_o) / diffuse_share),
+                    pdf: diffuse_share * cosine_hemisphere_pdf(wi.z),
+                    delta: false,
+                })
+            }
             Bsdf::Black => None,
         }
+    }
+}
+
+/// The share of a plastic's samples taken by its diffuse lobe, for an incident Fresnel
+/// reflectance `f_i` (Mitsuba's lobe choice).
+fn plastic_diffuse_share(f_i: f32, specular_weight: f32) -> f32 {
+    let specular = f_i * specular_weight;
+    let diffuse = (1.0 - f_i) * (1.0 - specular_weight);
+    diffuse / (specular + diffuse)
+}
+
+/// The hemispherically averaged Fresnel reflectance of a dielectric boundary of relative
+/// index `eta` (Egan and Hilgeman's fit below 1, d'Eon and Irving's above, as Mitsuba uses).
+#[must_use]
+pub fn fresnel_diffuse_reflectance(eta: f32) -> f32 {
+    if eta < 1.0 {
+        0.0636 / eta + eta * (eta * -1.4399 + 0.7099) + 0.6681
+    } else {
+        let x = 1.0 / eta;
+        0.919_317 + x * (-3.4793 + x * (6.75335 + x * (-7.80989 + x * (4.98554 + x * -1.36881))))
     }
 }
 

@@ -374,3 +374,24 @@ fn spot_lights_are_placed() {
     assert!((to_local * -prism_math::Vec3::Y - prism_math::Vec3::Z).length() < 1e-6);
     assert_eq!((cutoff, beam_width), (40.0, 30.0));
 }
+
+/// `plastic` is read with Mitsuba's defaults: diffuse 0.5, specular 1, polypropylene (1.49)
+/// over air (1.000277); `nonlinear` is refused.
+#[test]
+fn plastic_is_read_with_mitsubas_defaults() {
+    let s = read(
+        "plastic",
+        "<shape type=\"sphere\"><bsdf type=\"plastic\"/></shape>",
+        &[],
+    )
+    .unwrap();
+    let m = s.scene.materials[s.scene.spheres[0].material].clone();
+    assert!(
+        matches!(m, crate::Material::Plastic { diffuse, specular, eta } if diffuse.r == 0.5 && specular.g == 1.0 && (eta - 1.49 / 1.000_277).abs() < 1e-6),
+        "{m:?}"
+    );
+    let e = read("plastic-nl", "<shape type=\"sphere\"><bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("nonlinear: not supported"), "{e}");
+}

@@ -359,6 +359,21 @@ impl Builder<'_> {
                     ior: (int / ext) as f32,
                 }
             }
+            "plastic" => {
+                if o.boolean("nonlinear", false)? {
+                    return Err(error(
+                        o,
+                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                    ));
+                }
+                let int = ior(o, "int_ior", "polypropylene")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                Material::Plastic {
+                    diffuse: o.rgb("diffuse_reflectance", [0.5; 3])?,
+                    specular: o.rgb("specular_reflectance", [1.0; 3])?,
+                    eta: (int / ext) as f32,
+                }
+            }
             "conductor" => {
                 o.refuse(&["eta", "k"])?;
                 match o.string("material")?.unwrap_or("none") {
