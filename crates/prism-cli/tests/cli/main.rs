@@ -2416,14 +2416,14 @@ fn mitsuba_scenes_render_and_refuse_what_they_cannot() {
     let bad = dir.join("bad.xml");
     std::fs::write(
         &bad,
-        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n<shape type=\"sphere\">\n<bsdf type=\"plastic\"/>\n</shape>\n</scene>\n",
+        "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n<shape type=\"sphere\">\n<bsdf type=\"hair\"/>\n</shape>\n</scene>\n",
     )
     .unwrap();
     for (args, want) in [
         (
             vec![bad.display().to_string()],
             format!(
-                "{}:4: <bsdf>: type=\"plastic\": not supported by prism",
+                "{}:4: <bsdf>: type=\"hair\": not supported by prism",
                 bad.display()
             ),
         ),
