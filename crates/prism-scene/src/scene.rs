@@ -41,6 +41,16 @@ pub enum Material {
         /// Index of refraction of the coat over the outside.
         eta: f32,
     },
+    /// Mitsuba's `thindielectric`: a thin pane of index `ior` that reflects `2F / (1 + F)`
+    /// of the light (its inner reflections summed) and lets the rest through undeviated.
+    ThinDielectric {
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the transmitted part.
+        transmittance: Rgb,
+        /// Index of refraction of the pane over the outside.
+        ior: f32,
+    },
     /// A perfect mirror.
     Mirror {
         /// Reflectance per channel.

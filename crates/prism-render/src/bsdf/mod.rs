@@ -60,6 +60,16 @@ pub enum Bsdf {
         /// specular plus mean diffuse albedo).
         specular_weight: f32,
     },
+    /// A thin dielectric pane: mirror reflection of `2F / (1 + F)`, the rest passing
+    /// straight through.
+    ThinDielectric {
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the transmitted part.
+        transmittance: Rgb,
+        /// Index of refraction of the pane.
+        ior: f32,
+    },
     /// Absorbs everything (the surface of an emitter).
     Black,
 }
@@ -106,6 +116,15 @@ impl Bsdf {
                 transmittance, ior, ..
             } => Bsdf::Refraction { transmittance, ior },
             Material::Microfacet { alpha, eta, k } => Bsdf::Conductor { alpha, eta, k },
+            Material::ThinDielectric {
+                reflectance,
+                transmittance,
+                ior,
+            } => Bsdf::ThinDielectric {
+                reflectance,
+                transmittance,
+                ior,
+            },
             Material::Plastic {
                 diffuse,
                 specular,
@@ -136,7 +155,10 @@ impl Bsdf {
     /// True for BSDFs that scatter the same on both sides of the surface.
     #[must_use]
     pub fn two_sided(&self) -> bool {
-        !matches!(self, Bsdf::Glass { .. } | Bsdf::Refraction { .. })
+        !matches!(
+            self,
+            Bsdf::Glass { .. } | Bsdf::Refraction { .. } | Bsdf::ThinDielectric { .. }
+        )
     }
 
     /// The BSDF times `|cos wi|`. Zero for delta lobes.
@@ -324,6 +346,29 @@ impl Bsdf {
                     weight: diffuse * ((1.0 - f_i) * (1.0 - f_o) / diffuse_share),
                     pdf: diffuse_share * cosine_hemisphere_pdf(wi.z),
                     delta: false,
+                })
+            }
+            Bsdf::ThinDielectric {
+                reflectance,
+                transmittance,
+                ior,
+            } => {
+                let f = fresnel_dielectric(wo.z.abs(), ior);
+                let r = f * 2.0 / (1.0 + f);
+                Some(if u1 <= r {
+                    BsdfSample {
+                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                        weight: reflectance,
+                        pdf: r,
+                        delta: true,
+                    }
+                } else {
+                    BsdfSample {
+                        wi: -wo,
+                        weight: transmittance,
+                        pdf: 1.0 - r,
+                        delta: true,
+                    }
                 })
             }
             Bsdf::Black => None,

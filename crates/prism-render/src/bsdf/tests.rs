@@ -293,3 +293,36 @@ fn plastic_is_mitsubas_smooth_plastic() {
         mirror / f64::from(n)
     );
 }
+
+/// Closed form of Mitsuba's thin dielectric: it reflects `2F / (1 + F)` of the light (the
+/// pane's inner reflections summed) as a mirror and passes the rest straight through.
+#[test]
+fn thin_dielectric_reflects_2f_over_1_plus_f() {
+    let b = Bsdf::from_material(&prism_scene::Material::ThinDielectric {
+        reflectance: Rgb::splat(1.0),
+        transmittance: Rgb::splat(1.0),
+        ior: 1.5,
+    });
+    let wo = Vec3::new(0.4, 0.1, 0.6).normalize();
+    let f = fresnel_dielectric(wo.z, 1.5);
+    let r = 2.0 * f / (1.0 + f);
+    let n = 10_000;
+    let mut reflected = 0;
+    for i in 0..n {
+        let s = b
+            .sample(wo, (i as f32 + 0.5) / n as f32, Vec2::ZERO)
+            .unwrap();
+        assert!(s.delta && s.weight == Rgb::splat(1.0));
+        if s.wi.z > 0.0 {
+            reflected += 1;
+            assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-6);
+        } else {
+            assert!((s.wi + wo).length() < 1e-6, "straight through");
+        }
+    }
+    assert!(
+        (reflected as f32 / n as f32 - r).abs() < 2e-4,
+        "{reflected} vs {r}"
+    );
+    assert!(!b.two_sided() && !b.is_smooth());
+}

@@ -68,6 +68,7 @@ impl PhongMaterial {
             Material::Emission { radiance } => plain(*radiance, Rgb::BLACK),
             Material::EmissiveDiffuse { radiance, .. } => plain(*radiance, Rgb::BLACK),
             Material::Mirror { reflectance } => plain(Rgb::BLACK, *reflectance),
+            Material::ThinDielectric { reflectance, .. } => plain(Rgb::BLACK, *reflectance),
             Material::Plastic {
                 diffuse, specular, ..
             } => plain(*diffuse, *specular),

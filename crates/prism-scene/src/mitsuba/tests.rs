@@ -395,3 +395,19 @@ fn plastic_is_read_with_mitsubas_defaults() {
         .to_string();
     assert!(e.contains("nonlinear: not supported"), "{e}");
 }
+
+/// `thindielectric` is read with Mitsuba's defaults: bk7 (1.5046) over air (1.000277).
+#[test]
+fn thin_dielectric_is_read_with_mitsubas_defaults() {
+    let s = read(
+        "thin",
+        "<shape type=\"rectangle\"><bsdf type=\"thindielectric\"/></shape>",
+        &[],
+    )
+    .unwrap();
+    let m = s.scene.materials[s.scene.meshes[0].material].clone();
+    assert!(
+        matches!(m, crate::Material::ThinDielectric { ior, .. } if (ior - 1.5046 / 1.000_277).abs() < 1e-6),
+        "{m:?}"
+    );
+}

@@ -359,6 +359,15 @@ impl Builder<'_> {
                     ior: (int / ext) as f32,
                 }
             }
+            "thindielectric" => {
+                let int = ior(o, "int_ior", "bk7")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                Material::ThinDielectric {
+                    reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: o.rgb("specular_transmittance", [1.0; 3])?,
+                    ior: (int / ext) as f32,
+                }
+            }
             "plastic" => {
                 if o.boolean("nonlinear", false)? {
                     return Err(error(
