@@ -411,3 +411,22 @@ fn thin_dielectric_is_read_with_mitsubas_defaults() {
         "{m:?}"
     );
 }
+
+/// Hostile input: a `to_world` that scales a shape past the largest float is a located error,
+/// not infinite geometry handed to the renderer.
+#[test]
+fn shapes_beyond_the_finite_numbers_are_refused() {
+    for shape in ["rectangle", "sphere"] {
+        let e = read(
+            "inf",
+            &format!("<shape type=\"{shape}\"><transform name=\"to_world\"><scale value=\"1e30\"/><scale value=\"1e30\"/></transform></shape>"),
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("s.xml:3") && e.contains("beyond the finite numbers"),
+            "{shape}: {e}"
+        );
+    }
+}

@@ -203,6 +203,15 @@ impl Builder<'_> {
                     return Err(error(o, format!("{}: to_world must keep the sphere round (rotation, uniform scale, translation)", o.label())));
                 }
                 let c = m.w_axis.truncate();
+                if !(c.as_vec3().is_finite() && (r as f32).is_finite()) {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: to_world places the shape beyond the finite numbers",
+                            o.label()
+                        ),
+                    ));
+                }
                 self.scene.spheres.push(SceneSphere {
                     center: c.as_vec3(),
                     radius: r as f32,
@@ -248,6 +257,15 @@ impl Builder<'_> {
             .iter()
             .map(|p| to_world.transform_point3(*p).as_vec3())
             .collect();
+        if !world.iter().all(|p| p.is_finite()) {
+            return Err(error(
+                o,
+                format!(
+                    "{}: to_world places the shape beyond the finite numbers",
+                    o.label()
+                ),
+            ));
+        }
         if flip {
             for t in &mut triangles {
                 t.swap(1, 2);
