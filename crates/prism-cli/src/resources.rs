@@ -44,27 +44,27 @@ fn max_threads() -> usize {
 /// A worker pool of `threads` threads (default: one per core), at least 1 and at most
 /// four a core (at least 16), with a warning when clamped.
 pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    let mut b = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        let most = max_threads();
-        if t > most {
-            eprintln!("prism: warning: --threads {t}: more than four a core; using {most} threads");
-        }
-        b = b.num_threads(t.clamp(1, most));
+    builder(threads).build().context("starting worker threads")
+}
+
+/// A pool builder of `threads` threads as [`pool`] counts them, warning when clamped.
+fn builder(threads: Option<usize>) -> rayon::ThreadPoolBuilder {
+    let b = rayon::ThreadPoolBuilder::new();
+    let Some(t) = threads else { return b };
+    let most = max_threads();
+    if t > most {
+        eprintln!("prism: warning: --threads {t}: more than four a core; using {most} threads");
     }
-    b.build().context("starting worker threads")
+    b.num_threads(t.clamp(1, most))
 }
 
 /// Sets the global worker pool to `threads` threads as [`pool`] counts them, for a command
 /// whose work must start on the main thread (the window's event loop).
 pub fn global_pool(threads: Option<usize>) -> Result<()> {
-    let Some(t) = threads else { return Ok(()) };
-    let most = max_threads();
-    if t > most {
-        eprintln!("prism: warning: --threads {t}: more than four a core; using {most} threads");
+    if threads.is_none() {
+        return Ok(());
     }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(t.clamp(1, most))
+    builder(threads)
         .build_global()
         .context("starting worker threads")
 }

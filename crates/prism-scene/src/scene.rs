@@ -476,14 +476,17 @@ impl Scene {
     /// True if some light or emitting material gives off light (of non-zero power).
     #[must_use]
     pub fn is_lit(&self) -> bool {
-        let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
-        let emitters = self.materials.iter().any(|m| match m {
+        self.has_emitting_material() || self.lights.iter().any(Light::gives_off_light)
+    }
+
+    /// True if some material emits light of non-zero power.
+    fn has_emitting_material(&self) -> bool {
+        self.materials.iter().any(|m| match m {
             Material::Emission { radiance } | Material::EmissiveDiffuse { radiance, .. } => {
-                shines(radiance)
+                radiance.r > 0.0 || radiance.g > 0.0 || radiance.b > 0.0
             }
             _ => false,
-        });
-        emitters || self.lights.iter().any(Light::gives_off_light)
+        })
     }
 
     /// True if the scene is lit only as a modelling tool's export lights a mesh, as every
@@ -492,14 +495,7 @@ impl Scene {
     /// Maya's default lamp). Such a file is a mesh to edit, not a scene to path-trace.
     #[must_use]
     pub fn lit_only_by_a_default_lamp(&self) -> bool {
-        let shines = |c: &Rgb| c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
-        let emitters = self.materials.iter().any(|m| match m {
-            Material::Emission { radiance } | Material::EmissiveDiffuse { radiance, .. } => {
-                shines(radiance)
-            }
-            _ => false,
-        });
-        !emitters
+        !self.has_emitting_material()
             && self
                 .lights
                 .iter()
