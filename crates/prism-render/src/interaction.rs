@@ -22,12 +22,26 @@ pub struct Interaction {
     pub light: Option<usize>,
     /// Distance along the ray.
     pub t: f32,
+    /// The surface's first tangent (Mitsuba's `dp_du`) where an anisotropic BSDF needs it;
+    /// `None` puts the shading frame's tangent where [`Frame::from_normal`] does.
+    pub tangent: Option<Vec3>,
 }
 
 impl Interaction {
     /// The shading frame (around `ns`) and `wo` expressed in it.
     pub(crate) fn shading_frame(&self, wo: Vec3) -> (Frame, Vec3) {
-        let frame = Frame::from_normal(self.ns);
+        let frame = self
+            .tangent
+            .and_then(|dpdu| {
+                // Gram-Schmidt: the tangent made perpendicular to the shading normal.
+                let s = (dpdu - self.ns * self.ns.dot(dpdu)).try_normalize()?;
+                Some(Frame {
+                    s,
+                    t: self.ns.cross(s),
+                    n: self.ns,
+                })
+            })
+            .unwrap_or_else(|| Frame::from_normal(self.ns));
         (frame, frame.to_local(wo))
     }
 

@@ -50,11 +50,17 @@ pub struct RenderScene {
     bvh: Bvh,
     prims: Vec<Prim>,
     meshes: Vec<MeshRec>,
-    spheres: Vec<(Sphere, usize)>,
+    /// Spheres with their material and whether their normals point inwards.
+    spheres: Vec<(Sphere, usize, bool)>,
     bsdfs: Vec<Bsdf>,
     /// Per material, the texture its diffuse albedo is multiplied by.
     textures: Vec<Option<prism_image::Texture>>,
     emission: Vec<Option<Rgb>>,
+    /// Per material: true if it is black from behind (where the winding's normal points
+    /// away from the ray's origin).
+    one_sided: Vec<bool>,
+    /// Per material: true if its BSDF is anisotropic, so hits carry a tangent.
+    anisotropic: Vec<bool>,
     /// Per material: true if it emits from its front side only (where the winding's normal
     /// points), as a Mitsuba area emitter does.
     front_only: Vec<bool>,
@@ -222,9 +228,18 @@ impl RenderScene {
                 .collect(),
             spheres: spheres
                 .into_iter()
-                .zip(scene.spheres.iter().map(|s| s.material))
+                .zip(scene.spheres.iter())
+                .map(|(s, scene_sphere)| (s, scene_sphere.material, scene_sphere.inward))
                 .collect(),
             bsdfs: scene.materials.iter().map(Bsdf::from_material).collect(),
+            one_sided: (0..scene.materials.len())
+                .map(|i| scene.one_sided.get(i).copied().unwrap_or(false))
+                .collect(),
+            anisotropic: scene
+                .materials
+                .iter()
+                .map(|m| Bsdf::from_material(m).anisotropic())
+                .collect(),
             textures: scene
                 .materials
                 .iter()
@@ -373,6 +388,9 @@ impl RenderScene {
                 .unwrap_or(ng);
                 let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
                 let mut bsdf = self.bsdfs[m.material];
+                if self.one_sided[m.material] && ray.dir.dot(ns) >= 0.0 {
+                    bsdf = Bsdf::Black;
+                }
                 if let (Some(tex), Some(uvs), Bsdf::Diffuse { albedo }) =
                     (&self.textures[m.material], &m.uvs, &mut bsdf)
                 {
@@ -399,6 +417,13 @@ impl RenderScene {
                     },
                     light: m.light,
                     t: hit.t,
+                    tangent: self.anisotropic[m.material].then(|| {
+                        mesh_tangent(
+                            [a, b, c],
+                            m.uvs.as_ref().map(|u| t.map(|i| u[i as usize])),
+                            ng,
+                        )
+                    }),
                 }
             }
             Prim::LightQuad { light } => {
@@ -417,27 +442,50 @@ impl RenderScene {
                     emitted: if front { radiance } else { Rgb::BLACK },
                     light: Some(light as usize),
                     t: hit.t,
+                    tangent: None,
                 }
             }
             Prim::Sphere { index } => {
-                let (s, material) = self.spheres[index as usize];
+                let (s, material, inward) = self.spheres[index as usize];
                 let p = ray.at(hit.t);
-                let n = ((p - s.center) / s.radius).normalize();
+                let outward = ((p - s.center) / s.radius).normalize();
+                let n = if inward { -outward } else { outward };
                 Interaction {
-                    p: s.center + n * s.radius,
+                    p: s.center + outward * s.radius,
                     ng: n,
                     ns: n,
-                    bsdf: self.bsdfs[material],
+                    bsdf: if self.one_sided[material] && ray.dir.dot(n) >= 0.0 {
+                        Bsdf::Black
+                    } else {
+                        self.bsdfs[material]
+                    },
                     emitted: match self.emission[material] {
                         Some(_) if self.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
                         e => e.unwrap_or(Rgb::BLACK),
                     },
                     light: None,
                     t: hit.t,
+                    // Along the parallels, as Mitsuba's sphere (axes the world's).
+                    tangent: self.anisotropic[material]
+                        .then(|| Vec3::new(-outward.y, outward.x, 0.0)),
                 }
             }
         }
     }
+}
+
+/// A triangle's first tangent, `dp/du` from its texture coordinates (`v` may run either way:
+/// `dp/du` is the same), or where [`prism_math::Frame::from_normal`] puts it for the
+/// geometric normal when there are none or they are degenerate, as Mitsuba's meshes do.
+fn mesh_tangent(p: [Vec3; 3], uv: Option<[prism_math::Vec2; 3]>, ng: Vec3) -> Vec3 {
+    if let Some([a, b, c]) = uv {
+        let (duv0, duv1) = (b - a, c - a);
+        let det = duv0.x * duv1.y - duv0.y * duv1.x;
+        if det != 0.0 {
+            return ((p[1] - p[0]) * duv1.y - (p[2] - p[0]) * duv0.y) * (1.0 / det);
+        }
+    }
+    prism_math::Frame::from_normal(ng).s
 }
 
 /// How far apart (per coordinate) the corner normals of a face shaded with one normal may be,

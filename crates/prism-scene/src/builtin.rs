@@ -93,11 +93,13 @@ pub fn cornell_box() -> Scene {
             center: Vec3::new(0.4, 0.3, 0.3),
             radius: 0.3,
             material: 0,
+            inward: false,
         },
         SceneSphere {
             center: Vec3::new(-0.4, 0.3, -0.3),
             radius: 0.3,
             material: 0,
+            inward: false,
         },
     ];
     // The ceiling light: 0.6 x 0.8 around (0, 1.49, 0), facing down.
@@ -121,6 +123,7 @@ pub fn cornell_box() -> Scene {
         spheres,
         materials,
         material_names: Vec::new(),
+        one_sided: Vec::new(),
         lights,
         camera: Camera {
             eye: Vec3::new(0.0, 0.75, r),

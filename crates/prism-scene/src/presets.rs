@@ -266,6 +266,7 @@ fn spheres() -> Scene {
         center: Vec3::new(x, y, z),
         radius,
         material,
+        inward: false,
     };
     Scene {
         meshes: Vec::new(),
@@ -280,6 +281,7 @@ fn spheres() -> Scene {
             phong(0.2, 0.2, 0.8),
         ],
         material_names: vec!["red".into(), "green".into(), "blue".into()],
+        one_sided: Vec::new(),
         lights: Vec::new(),
         camera: OrbitCamera::default().to_camera(1.0),
         warnings: Vec::new(),

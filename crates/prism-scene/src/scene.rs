@@ -86,6 +86,30 @@ pub enum Material {
         /// Imaginary part (absorption).
         k: Rgb,
     },
+    /// Mitsuba's `conductor` (smooth, `roughness` none) and `roughconductor` (microfacets
+    /// of `roughness`): the conductor Fresnel term of `eta + i k`, scaled by `specular`.
+    Conductor {
+        /// Distribution and slopes; none for a smooth surface.
+        roughness: Option<Roughness>,
+        /// Real part of the index of refraction.
+        eta: Rgb,
+        /// Imaginary part (absorption).
+        k: Rgb,
+        /// Scale of the reflection.
+        specular: Rgb,
+    },
+    /// Mitsuba's `roughdielectric`: a rough boundary of relative index `ior` (inside over
+    /// outside) that reflects and refracts through microfacets of `roughness`.
+    RoughDielectric {
+        /// Distribution and slopes.
+        roughness: Roughness,
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Index of refraction inside over outside.
+        ior: f32,
+    },
     /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
     /// specular lobe `ks * max(r.v, 0)^shininess` per light.
     Phong {
@@ -100,6 +124,27 @@ pub enum Material {
         /// Opacity: 1 is opaque, 0 is fully transparent (the MTL's `d`).
         transparency: f32,
     },
+}
+
+/// The shape of a microfacet distribution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MicrofacetKind {
+    /// Beckmann's Gaussian distribution of slopes.
+    Beckmann,
+    /// GGX (Trowbridge-Reitz), with longer tails.
+    Ggx,
+}
+
+/// A microfacet surface's roughness: the distribution and its slopes along the shading
+/// frame's first and second tangent (equal for an isotropic surface).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roughness {
+    /// The distribution.
+    pub kind: MicrofacetKind,
+    /// Roughness along the first tangent.
+    pub alpha_u: f32,
+    /// Roughness along the second tangent.
+    pub alpha_v: f32,
 }
 
 /// An image a material reads, with the file it came from.
@@ -180,6 +225,9 @@ pub struct SceneSphere {
     pub radius: f32,
     /// Index into [`Scene::materials`].
     pub material: usize,
+    /// True if its normals point inwards (Mitsuba's `flip_normals`): its front, for a
+    /// one-sided material or an emitter, is the inside.
+    pub inward: bool,
 }
 
 /// A light source.
@@ -409,6 +457,10 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// The materials' names, where the file gives them (may be shorter than `materials`).
     pub material_names: Vec<String>,
+    /// Per material, true if it scatters from its front only (where the winding's normal
+    /// points) and is black from behind, as Mitsuba's opaque BSDFs outside a `twosided`
+    /// are; may be shorter than `materials`, the rest scattering on both sides.
+    pub one_sided: Vec<bool>,
     /// Lights.
     pub lights: Vec<Light>,
     /// The camera.
@@ -426,6 +478,7 @@ impl Scene {
             spheres: Vec::new(),
             materials: Vec::new(),
             material_names: Vec::new(),
+            one_sided: Vec::new(),
             lights: Vec::new(),
             camera,
             warnings: Vec::new(),
@@ -461,6 +514,9 @@ impl Scene {
                 self.camera
             ),
         );
+        if !self.one_sided.is_empty() {
+            let _ = std::fmt::Write::write_fmt(&mut h, format_args!("|{:?}", self.one_sided));
+        }
         h.0
     }
 

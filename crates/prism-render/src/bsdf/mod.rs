@@ -70,6 +70,40 @@ pub enum Bsdf {
         /// Index of refraction of the pane.
         ior: f32,
     },
+    /// A smooth conductor: mirror reflection scaled by the conductor Fresnel term and
+    /// `specular`; two-sided.
+    SmoothConductor {
+        /// Real part of the index of refraction.
+        eta: Rgb,
+        /// Absorption.
+        k: Rgb,
+        /// Scale of the reflection.
+        specular: Rgb,
+    },
+    /// A rough conductor with any microfacet distribution, its reflection scaled by
+    /// `specular`; two-sided.
+    RoughConductor {
+        /// The microfacets.
+        distr: Microfacet,
+        /// Real part of the index of refraction.
+        eta: Rgb,
+        /// Absorption.
+        k: Rgb,
+        /// Scale of the reflection.
+        specular: Rgb,
+    },
+    /// A rough dielectric boundary: reflection and refraction through microfacets. The
+    /// outside is where the normal points.
+    RoughDielectric {
+        /// The microfacets.
+        distr: Microfacet,
+        /// Scale of the reflected part.
+        reflectance: Rgb,
+        /// Scale of the refracted part.
+        transmittance: Rgb,
+        /// Index of refraction inside over outside.
+        ior: f32,
+    },
     /// Absorbs everything (the surface of an emitter).
     Black,
 }
@@ -139,6 +173,34 @@ impl Bsdf {
                     specular_weight: mean(specular) / (mean(diffuse) + mean(specular)),
                 }
             }
+            Material::Conductor {
+                roughness: Some(roughness),
+                eta,
+                k,
+                specular,
+            } => Bsdf::RoughConductor {
+                distr: roughness.into(),
+                eta,
+                k,
+                specular,
+            },
+            Material::Conductor {
+                roughness: None,
+                eta,
+                k,
+                specular,
+            } => Bsdf::SmoothConductor { eta, k, specular },
+            Material::RoughDielectric {
+                roughness,
+                reflectance,
+                transmittance,
+                ior,
+            } => Bsdf::RoughDielectric {
+                distr: roughness.into(),
+                reflectance,
+                transmittance,
+                ior,
+            },
             Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
         }
     }
@@ -148,8 +210,24 @@ impl Bsdf {
     pub fn is_smooth(&self) -> bool {
         matches!(
             self,
-            Bsdf::Diffuse { .. } | Bsdf::Conductor { .. } | Bsdf::Plastic { .. }
+            Bsdf::Diffuse { .. }
+                | Bsdf::Conductor { .. }
+                | Bsdf::Plastic { .. }
+                | Bsdf::RoughConductor { .. }
+                | Bsdf::RoughDielectric { .. }
         )
+    }
+
+    /// True if the BSDF depends on the direction around the normal, so the shading frame's
+    /// tangent matters.
+    #[must_use]
+    pub fn anisotropic(&self) -> bool {
+        match self {
+            Bsdf::RoughConductor { distr, .. } | Bsdf::RoughDielectric { distr, .. } => {
+                distr.alpha_u != distr.alpha_v
+            }
+            _ => false,
+        }
     }
 
     /// True for BSDFs that scatter the same on both sides of the surface.
@@ -157,13 +235,19 @@ impl Bsdf {
     pub fn two_sided(&self) -> bool {
         !matches!(
             self,
-            Bsdf::Glass { .. } | Bsdf::Refraction { .. } | Bsdf::ThinDielectric { .. }
+            Bsdf::Glass { .. }
+                | Bsdf::Refraction { .. }
+                | Bsdf::ThinDielectric { .. }
+                | Bsdf::RoughDielectric { .. }
         )
     }
 
     /// The BSDF times `|cos wi|`. Zero for delta lobes.
     #[must_use]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if let Some((f, _)) = self.rough_eval_pdf(wo, wi) {
+            return f;
+        }
         if wo.z * wi.z <= 0.0 {
             return Rgb::splat(0.0);
         }
@@ -190,6 +274,9 @@ impl Bsdf {
     /// same values, bit for bit).
     #[must_use]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if let Some(fp) = self.rough_eval_pdf(wo, wi) {
+            return fp;
+        }
         if wo.z * wi.z <= 0.0 {
             return (Rgb::splat(0.0), 0.0);
         }
@@ -212,6 +299,9 @@ impl Bsdf {
     /// The density of [`Bsdf::sample`] choosing `wi`. Zero for delta lobes.
     #[must_use]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Some((_, pdf)) = self.rough_eval_pdf(wo, wi) {
+            return pdf;
+        }
         if wo.z * wi.z <= 0.0 {
             return 0.0;
         }
@@ -371,7 +461,53 @@ impl Bsdf {
                     }
                 })
             }
+            Bsdf::SmoothConductor { eta, k, specular } => Some(BsdfSample {
+                wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                weight: fresnel_conductor(wo.z.abs(), eta, k) * specular,
+                pdf: 1.0,
+                delta: true,
+            }),
+            Bsdf::RoughConductor {
+                distr,
+                eta,
+                k,
+                specular,
+            } => rough::conductor_sample(&distr, (eta, k, specular), wo, u2),
+            Bsdf::RoughDielectric {
+                distr,
+                reflectance,
+                transmittance,
+                ior,
+            } => rough::dielectric_sample((distr, reflectance, transmittance, ior), wo, u1, u2),
             Bsdf::Black => None,
+        }
+    }
+
+    /// `eval_pdf` of the rough BSDFs, `None` for the others.
+    fn rough_eval_pdf(&self, wo: Vec3, wi: Vec3) -> Option<(Rgb, f32)> {
+        match *self {
+            Bsdf::RoughConductor {
+                distr,
+                eta,
+                k,
+                specular,
+            } => Some(rough::conductor_eval_pdf(
+                &distr,
+                (eta, k, specular),
+                wo,
+                wi,
+            )),
+            Bsdf::RoughDielectric {
+                distr,
+                reflectance,
+                transmittance,
+                ior,
+            } => Some(rough::dielectric_eval_pdf(
+                (distr, reflectance, transmittance, ior),
+                wo,
+                wi,
+            )),
+            _ => None,
         }
     }
 }
@@ -588,5 +724,11 @@ fn refract(wo: Vec3, ior: f32) -> Option<(Vec3, f32)> {
 }
 
 pub(crate) mod lanes;
+mod microfacet;
+mod rough;
+
+pub use microfacet::Microfacet;
+#[cfg(test)]
+mod rough_tests;
 #[cfg(test)]
 mod tests;

@@ -3,14 +3,14 @@
 use super::*;
 use prism_math::Pcg32;
 
-fn dir(theta_deg: f32, phi: f32) -> Vec3 {
+pub(super) fn dir(theta_deg: f32, phi: f32) -> Vec3 {
     let t = theta_deg.to_radians();
     Vec3::new(t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos())
 }
 
 /// Oracle: chi-square test of `sample` against the integral of `pdf` over (cos theta, phi)
 /// cells of the sphere, for several outgoing directions; then `weight == eval / pdf`.
-fn check_sampling(b: &Bsdf, wo: Vec3) {
+pub(super) fn check_sampling(b: &Bsdf, wo: Vec3) {
     let (nc, np) = (20usize, 40usize);
     let n = 200_000;
     let mut rng = Pcg32::new(11, 7);

@@ -72,9 +72,11 @@ impl PhongMaterial {
             Material::Plastic {
                 diffuse, specular, ..
             } => plain(*diffuse, *specular),
-            Material::Glass { .. } | Material::Refraction { .. } | Material::Microfacet { .. } => {
-                plain(Rgb::BLACK, Rgb::WHITE)
-            }
+            Material::Glass { .. }
+            | Material::Refraction { .. }
+            | Material::Microfacet { .. }
+            | Material::Conductor { .. }
+            | Material::RoughDielectric { .. } => plain(Rgb::BLACK, Rgb::WHITE),
         }
     }
 }

@@ -14,9 +14,11 @@ fn furnace(material: Material) -> Scene {
             center: Vec3::ZERO,
             radius: 1.0,
             material: 0,
+            inward: false,
         }],
         materials: vec![material],
         material_names: vec![],
+        one_sided: vec![],
         lights: vec![Light::Environment {
             radiance: Rgb::WHITE,
         }],
@@ -416,6 +418,7 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
             },
         ],
         material_names: vec![],
+        one_sided: vec![],
         lights: vec![],
         camera: Camera {
             eye: Vec3::new(0.0, 0.5, 0.0),

@@ -62,6 +62,7 @@ fn triangles(tris: &[[Vec3; 3]], material: Material, lights: Vec<Light>) -> Scen
         spheres: vec![],
         materials: vec![material],
         material_names: vec!["m".into()],
+        one_sided: vec![],
         lights,
         camera: OrbitCamera::default().to_camera(1.0),
         warnings: vec![],

@@ -154,6 +154,7 @@ impl Scene {
                                     center: v3(center),
                                     radius: r as f32,
                                     material,
+                                    inward: false,
                                 });
                             }
                             Shape::Empty => {}

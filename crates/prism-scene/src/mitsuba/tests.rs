@@ -430,3 +430,57 @@ fn shapes_beyond_the_finite_numbers_are_refused() {
         );
     }
 }
+
+/// Mitsuba's microfacet parameters: `distribution` (Beckmann by default, GGX), `alpha`
+/// (0.1) or `alpha_u` with `alpha_v`, a zero roughness clamped to 1e-4; `alpha` with
+/// `alpha_u`, or `alpha_u` alone, is a located error, as Mitsuba throws.
+#[test]
+fn microfacet_parameters_are_mitsubas() {
+    let material = |body: &str| {
+        let s = read(
+            "rough",
+            &format!("<shape type=\"sphere\">{body}</shape>"),
+            &[],
+        )
+        .unwrap();
+        s.scene.materials[s.scene.spheres[0].material].clone()
+    };
+    let ggx = material("<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"GGX\"/><float name=\"alpha_u\" value=\"0.2\"/><float name=\"alpha_v\" value=\"0\"/></bsdf>");
+    assert!(
+        matches!(ggx, crate::Material::Conductor { roughness: Some(crate::Roughness { kind: crate::MicrofacetKind::Ggx, alpha_u, alpha_v }), .. } if alpha_u == 0.2 && alpha_v == 1e-4),
+        "{ggx:?}"
+    );
+    let glass = material(
+        "<bsdf type=\"roughdielectric\"><string name=\"int_ior\" value=\"water\"/></bsdf>",
+    );
+    assert!(
+        matches!(glass, crate::Material::RoughDielectric { roughness: crate::Roughness { kind: crate::MicrofacetKind::Beckmann, alpha_u, .. }, ior, .. } if alpha_u == 0.1 && (ior - 1.333 / 1.000_277).abs() < 1e-6),
+        "{glass:?}"
+    );
+    let smooth =
+        material("<bsdf type=\"conductor\"><string name=\"material\" value=\"Ag\"/></bsdf>");
+    assert!(
+        matches!(
+            smooth,
+            crate::Material::Conductor {
+                roughness: None,
+                ..
+            }
+        ),
+        "{smooth:?}"
+    );
+    for bad in [
+        "<float name=\"alpha\" value=\"0.1\"/><float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"0.1\"/>",
+        "<float name=\"alpha_u\" value=\"0.1\"/>",
+        "<string name=\"distribution\" value=\"phong\"/>",
+    ] {
+        let e = read(
+            "rough-bad",
+            &format!("<shape type=\"sphere\"><bsdf type=\"roughdielectric\">{bad}</bsdf></shape>"),
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("s.xml:3:") && e.contains("roughdielectric"), "{e}");
+    }
+}

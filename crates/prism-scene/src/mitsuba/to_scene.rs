@@ -10,7 +10,9 @@ use super::document::{Document, Object};
 use super::limits::{DISK_SEGMENTS, MAX_OBJECT_DEPTH};
 use super::props::{error, ior, unsupported};
 use crate::error::SceneError;
-use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, TriangleMesh};
+use crate::scene::{
+    Camera, Light, Material, MicrofacetKind, Roughness, Scene, SceneSphere, Shading, TriangleMesh,
+};
 
 /// How the film turns samples into pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,6 +159,7 @@ impl Builder<'_> {
             // An area emitter keeps a BSDF given to its shape: light meeting it scatters too.
             (Some(radiance), surface) => {
                 // Without a BSDF of its own an emitter's surface is black, as Mitsuba makes it.
+                let one_sided = surface.is_none_or(|m| self.scene.one_sided[m]);
                 let reflectance = match surface.map(|m| &self.scene.materials[m]) {
                     None => Rgb::splat(0.0),
                     Some(Material::Diffuse {
@@ -173,10 +176,11 @@ impl Builder<'_> {
                         reflectance,
                     },
                     format!("{} area emitter", o.label()),
+                    one_sided,
                 )
             }
             (None, Some(m)) => m,
-            (None, None) => self.push_material(default_diffuse, "default diffuse".into()),
+            (None, None) => self.push_material(default_diffuse, "default diffuse".into(), true),
         };
         let flip = o.boolean("flip_normals", false)?;
         let face_normals = o.boolean("face_normals", false)?;
@@ -216,6 +220,7 @@ impl Builder<'_> {
                     center: c.as_vec3(),
                     radius: r as f32,
                     material,
+                    inward: flip,
                 });
                 return Ok(());
             }
@@ -306,8 +311,9 @@ impl Builder<'_> {
         Ok(())
     }
 
-    fn push_material(&mut self, m: Material, name: String) -> usize {
+    fn push_material(&mut self, m: Material, name: String, one_sided: bool) -> usize {
         self.scene.materials.push(m);
+        self.scene.one_sided.push(one_sided);
         self.scene
             .material_names
             .resize(self.scene.materials.len() - 1, String::new());
@@ -322,8 +328,10 @@ impl Builder<'_> {
         }
         let mut o = &self.doc.objects[index];
         let mut depth = depth;
-        // `twosided` wraps one BSDF; prism's BSDFs scatter alike on both sides.
+        // `twosided` wraps one BSDF, which then scatters alike on both sides.
+        let mut two_sided = false;
         while o.kind == "twosided" {
+            two_sided = true;
             depth += 1;
             if depth > MAX_OBJECT_DEPTH {
                 return Err(error(
@@ -401,63 +409,58 @@ impl Builder<'_> {
                     eta: (int / ext) as f32,
                 }
             }
-            "conductor" => {
-                o.refuse(&["eta", "k"])?;
-                match o.string("material")?.unwrap_or("none") {
-                    "none" => Material::Mirror {
-                        reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+            "conductor" | "roughconductor" => {
+                let roughness = if o.kind == "roughconductor" {
+                    Some(roughness(o)?)
+                } else {
+                    None
+                };
+                let (eta, k) = conductor_index(o)?;
+                let specular = o.rgb("specular_reflectance", [1.0; 3])?;
+                match roughness {
+                    // The collada path's Beckmann conductor, which the lanes run.
+                    Some(Roughness {
+                        kind: MicrofacetKind::Beckmann,
+                        alpha_u,
+                        alpha_v,
+                    }) if alpha_u == alpha_v && specular == Rgb::WHITE => Material::Microfacet {
+                        alpha: alpha_u,
+                        eta,
+                        k,
                     },
-                    other => {
-                        return Err(error(o, format!("{}: material {other:?}: not supported by prism yet (only \"none\", a perfect mirror)", o.label())))
-                    }
+                    // Mitsuba's default conductor reflects everything.
+                    None if eta == Rgb::splat(0.0) && k == Rgb::WHITE => Material::Mirror {
+                        reflectance: specular,
+                    },
+                    _ => Material::Conductor {
+                        roughness,
+                        eta,
+                        k,
+                        specular,
+                    },
                 }
             }
-            "roughconductor" => {
-                o.refuse(&["alpha_u", "alpha_v", "specular_reflectance"])?;
-                let distribution = o.string("distribution")?.unwrap_or("beckmann");
-                if distribution != "beckmann" {
-                    return Err(error(o, format!("{}: distribution {distribution:?}: not supported by prism yet (beckmann)", o.label())));
+            "roughdielectric" => {
+                let int = ior(o, "int_ior", "bk7")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                if !(int > 0.0 && ext > 0.0) || int == ext {
+                    return Err(error(o, format!("{}: int_ior and ext_ior: expected positive indices that differ, found {int} and {ext}", o.label())));
                 }
-                let alpha = o.float("alpha", 0.1)?;
-                if !(alpha > 0.0 && alpha <= 4.0) {
-                    return Err(error(
-                        o,
-                        format!(
-                            "{}: alpha: expected a roughness above 0 and at most 4, found {alpha}",
-                            o.label()
-                        ),
-                    ));
-                }
-                // `eta` and `k` given win; else the named material, "none" (all reflected) by
-                // default, as Mitsuba 3.
-                let (eta, k) = if o.prop("eta").is_some() || o.prop("k").is_some() {
-                    (o.rgb("eta", [0.0; 3])?, o.rgb("k", [1.0; 3])?)
-                } else {
-                    match o.string("material")?.unwrap_or("none") {
-                        "none" => (Rgb::splat(0.0), Rgb::splat(1.0)),
-                        name => {
-                            let (e, k) = super::conductors::conductor(name).ok_or_else(|| {
-                                error(
-                                    o,
-                                    format!(
-                                        "{}: material {name:?}: Mitsuba names no such conductor",
-                                        o.label()
-                                    ),
-                                )
-                            })?;
-                            (Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2]))
-                        }
-                    }
-                };
-                Material::Microfacet {
-                    alpha: alpha as f32,
-                    eta,
-                    k,
+                Material::RoughDielectric {
+                    roughness: roughness(o)?,
+                    reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: o.rgb("specular_transmittance", [1.0; 3])?,
+                    ior: (int / ext) as f32,
                 }
             }
             _ => return Err(unsupported(o)),
         };
-        let m = self.push_material(material, name);
+        // Mitsuba's opaque BSDFs are black from behind unless wrapped in `twosided`.
+        let opaque = matches!(
+            o.kind.as_str(),
+            "diffuse" | "plastic" | "conductor" | "roughconductor"
+        );
+        let m = self.push_material(material, name, opaque && !two_sided);
         self.bsdfs.insert(index, m);
         Ok(m)
     }
@@ -527,6 +530,84 @@ impl Builder<'_> {
     }
 }
 
+/// A microfacet BSDF's `distribution` (Beckmann unless given) and `alpha`, or `alpha_u` and
+/// `alpha_v` together (0.1 unless given), as Mitsuba reads them.
+fn roughness(o: &Object) -> Result<Roughness, SceneError> {
+    let kind = match o
+        .string("distribution")?
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        None | Some("beckmann") => MicrofacetKind::Beckmann,
+        Some("ggx") => MicrofacetKind::Ggx,
+        Some(other) => {
+            return Err(error(
+                o,
+                format!(
+                    "{}: distribution {other:?}: expected \"beckmann\" or \"ggx\"",
+                    o.label()
+                ),
+            ))
+        }
+    };
+    let (has_u, has_v, has_alpha) = (
+        o.prop("alpha_u").is_some(),
+        o.prop("alpha_v").is_some(),
+        o.prop("alpha").is_some(),
+    );
+    if (has_u || has_v) && (!(has_u && has_v) || has_alpha) {
+        return Err(error(
+            o,
+            format!(
+                "{}: expected either alpha or both alpha_u and alpha_v",
+                o.label()
+            ),
+        ));
+    }
+    let (u, v) = if has_u {
+        (o.float("alpha_u", 0.1)?, o.float("alpha_v", 0.1)?)
+    } else {
+        let a = o.float("alpha", 0.1)?;
+        (a, a)
+    };
+    for (name, a) in [("alpha_u", u), ("alpha_v", v)] {
+        if !(0.0..=4.0).contains(&a) {
+            return Err(error(
+                o,
+                format!(
+                    "{}: {name}: expected a roughness of at least 0 and at most 4, found {a}",
+                    o.label()
+                ),
+            ));
+        }
+    }
+    // Mitsuba clamps a zero roughness to 1e-4.
+    Ok(Roughness {
+        kind,
+        alpha_u: u.max(1e-4) as f32,
+        alpha_v: v.max(1e-4) as f32,
+    })
+}
+
+/// A conductor's complex index: `eta` (0) and `k` (1) when `eta` is given or the material is
+/// "none" (the default), else the named material's.
+fn conductor_index(o: &Object) -> Result<(Rgb, Rgb), SceneError> {
+    let material = o.string("material")?.unwrap_or("none");
+    if o.prop("eta").is_some() || material == "none" {
+        return Ok((o.rgb("eta", [0.0; 3])?, o.rgb("k", [1.0; 3])?));
+    }
+    let (e, k) = super::conductors::conductor(material).ok_or_else(|| {
+        error(
+            o,
+            format!(
+                "{}: material {material:?}: Mitsuba names no such conductor",
+                o.label()
+            ),
+        )
+    })?;
+    Ok((Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2])))
+}
+
 /// A mesh in object space: positions, triangles, normals, uvs.
 type ObjectMesh = (
     Vec<DVec3>,
@@ -543,34 +624,32 @@ fn unit_mesh(
     (positions, triangles, None, uvs)
 }
 
-/// Mitsuba's `cube`: [-1, 1]^3, four vertices a face so that each face is flat.
+/// Mitsuba's `cube`: [-1, 1]^3, four vertices a face so that each face is flat, laid out as
+/// Mitsuba lays it out (faces -y, +y, +x, +z, -x, -z; each face's texture coordinates cover
+/// the unit square; corner `c` at the signs of its bits), so that textures and anisotropic
+/// tangents agree.
 fn cube() -> ObjectMesh {
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    for axis in 0..3 {
-        for sign in [-1.0, 1.0] {
-            let n = DVec3::from_array({
-                let mut a = [0.0; 3];
-                a[axis] = sign;
-                a
-            });
-            let (u, v) = super::transform::coordinate_system(n);
-            let base = positions.len() as u32;
-            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                positions.push(n + u * a + v * b);
-            }
-            // Counter-clockwise seen from outside: u x v is n.
-            let ccw = u.cross(v).dot(n) > 0.0;
-            if ccw {
-                triangles.push([base, base + 1, base + 2]);
-                triangles.push([base + 2, base + 3, base]);
-            } else {
-                triangles.push([base, base + 2, base + 1]);
-                triangles.push([base + 2, base, base + 3]);
-            }
-        }
-    }
-    (positions, triangles, None, None)
+    const CORNERS: [u32; 24] = [
+        1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2,
+    ];
+    // Mitsuba's (u, v) per face corner are (0,1) (1,1) (1,0) (0,0), v running down the
+    // image; prism's v runs up it.
+    const UV: [(f32, f32); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let corner = |c: u32| {
+        let sign = |bit: u32| if c & bit != 0 { 1.0 } else { -1.0 };
+        DVec3::new(sign(1), sign(2), sign(4))
+    };
+    let positions = CORNERS.iter().map(|&c| corner(c)).collect();
+    let uvs = (0..24)
+        .map(|i| Vec2::new(UV[i % 4].0, UV[i % 4].1))
+        .collect();
+    let triangles = (0..6u32)
+        .flat_map(|f| {
+            let v = 4 * f;
+            [[v, v + 1, v + 2], [v + 3, v, v + 2]]
+        })
+        .collect();
+    (positions, triangles, None, Some(uvs))
 }
 
 /// Mitsuba's `disk`: radius 1 in the z = 0 plane, facing +z, as a fan of
