@@ -87,14 +87,20 @@ pub(super) fn light_term(
     if f.max_channel() <= 0.0 {
         return None;
     }
-    // The shadow ray starts pushed off the surface; it must stop short of the light by a
-    // margin measured from where it starts, or a light close above a surface facing it
-    // would block its own sample.
-    let shadow = hit.spawn(ls.wi);
-    let dist = if ls.dist.is_finite() {
-        (ls.dist - (shadow.origin - hit.p).dot(ls.wi)) * (1.0 - 1e-4) - 1e-4
+    // The shadow ray starts pushed off the surface and aims at the light's point itself
+    // from there, stopping just short of it (a fraction of its length): aimed along `wi`
+    // from the pushed origin, it would meet a light seen at a grazing angle before the
+    // point sampled, and the light would block its own sample.
+    let origin = hit.spawn(ls.wi).origin;
+    let (shadow, dist) = if ls.dist.is_finite() {
+        let to_light = hit.p + ls.wi * ls.dist - origin;
+        let length = to_light.length();
+        if length <= 0.0 {
+            return None;
+        }
+        (Ray::new(origin, to_light / length), length * (1.0 - 1e-4))
     } else {
-        f32::INFINITY
+        (Ray::new(origin, ls.wi), f32::INFINITY)
     };
     let w = if mis && !ls.delta {
         power(count as f32, ls.pdf, bsdf_pdf)

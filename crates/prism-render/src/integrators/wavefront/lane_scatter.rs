@@ -386,17 +386,27 @@ pub(super) fn step(
                 power(count as f32, pdf, bsdf_pdf) / pdf
             });
             let term = [0, 1, 2].map(|c| f[c] * li[c] * w);
-            // Measured from the pushed-off origin, as the scalar light term measures it.
+            // Aimed at the light's point from the pushed-off origin and stopping just short
+            // of it, as the scalar light term aims it.
             let origin = spawn(p, ng, wi);
+            let finite = dist.is_finite();
+            let to_light = (p + wi * dist) - origin;
+            let length = to_light.dot(to_light).sqrt();
+            ok = ok & (!finite | zero.lt(length));
+            let dir = V16 {
+                x: F16::select(finite, to_light.x / length, wi.x),
+                y: F16::select(finite, to_light.y / length, wi.y),
+                z: F16::select(finite, to_light.z / length, wi.z),
+            };
             let shadow_dist = F16::select(
-                dist.is_finite(),
-                (dist - (origin - p).dot(wi)) * F16::splat(1.0 - 1e-4) - F16::splat(1e-4),
+                finite,
+                length * F16::splat(1.0 - 1e-4),
                 F16::splat(f32::INFINITY),
             );
             cand.push(Candidate {
                 keep: ok.bits(),
                 origin,
-                dir: wi,
+                dir,
                 end: shadow_dist,
                 term,
             });
