@@ -51,6 +51,9 @@ pub enum Wrap {
     Clamp,
     /// The texture repeats: texel `i` of `w` is also texel `i + k w`.
     Repeat,
+    /// The texture repeats mirrored: texel `-1 - i` is texel `i`, and the pattern repeats
+    /// every `2 w` texels.
+    Mirror,
 }
 
 /// Where uv coordinates fall on the texel grid of a level `w` texels wide.
@@ -202,6 +205,10 @@ impl Texture {
             Wrap::Repeat if (0..n).contains(&i) => i as u32,
             Wrap::Repeat if i == n => 0,
             Wrap::Repeat => i.rem_euclid(n) as u32,
+            Wrap::Mirror => {
+                let j = i.rem_euclid(2 * n);
+                (if j < n { j } else { 2 * n - 1 - j }) as u32
+            }
         };
         let clamp_x = |x: i64| fold(x, w, self.wrap[0]);
         let clamp_y = |y: i64| fold(y, h, self.wrap[1]);

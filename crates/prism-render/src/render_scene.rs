@@ -53,8 +53,9 @@ pub struct RenderScene {
     /// Spheres with their material and whether their normals point inwards.
     spheres: Vec<(Sphere, usize, bool)>,
     bsdfs: Vec<Bsdf>,
-    /// Per material, the texture its diffuse albedo is multiplied by.
-    textures: Vec<Option<prism_image::Texture>>,
+    /// Per material, the texture its diffuse albedo is multiplied by, its lookup and its
+    /// `to_uv`.
+    textures: Vec<Option<(prism_image::Texture, prism_image::PixelSampling, [f32; 6])>>,
     emission: Vec<Option<Rgb>>,
     /// Per material: true if it is black from behind (where the winding's normal points
     /// away from the ray's origin).
@@ -246,10 +247,11 @@ impl RenderScene {
                 .map(|m| match m {
                     prism_scene::Material::Diffuse {
                         texture: Some(t), ..
-                    } => Some(
-                        prism_image::Texture::new((*t.image).clone())
-                            .with_wrap(prism_image::Wrap::Repeat, prism_image::Wrap::Repeat),
-                    ),
+                    } => Some((
+                        prism_image::Texture::new((*t.image).clone()).with_wrap(t.wrap, t.wrap),
+                        t.sampling,
+                        t.to_uv,
+                    )),
                     _ => None,
                 })
                 .collect(),
@@ -391,18 +393,14 @@ impl RenderScene {
                 if self.one_sided[m.material] && ray.dir.dot(ns) >= 0.0 {
                     bsdf = Bsdf::Black;
                 }
-                if let (Some(tex), Some(uvs), Bsdf::Diffuse { albedo }) =
-                    (&self.textures[m.material], &m.uvs, &mut bsdf)
-                {
-                    // The texture's rows run down the image; v runs up it.
-                    let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
-                    let uv = b0 * ua + hit.b1 * ub + hit.b2 * uc;
-                    let texel = tex.sample_level(
-                        prism_math::Vec2::new(uv.x, 1.0 - uv.y),
-                        0,
-                        prism_image::PixelSampling::Bilinear,
-                    );
-                    *albedo = *albedo * texel;
+                if let (Some(uvs), Bsdf::Diffuse { albedo }) = (&m.uvs, &mut bsdf) {
+                    if self.textures[m.material].is_some() {
+                        // The texture's rows run down the image; v runs up it.
+                        let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
+                        let uv = b0 * ua + hit.b1 * ub + hit.b2 * uc;
+                        *albedo = *albedo
+                            * self.texel(m.material, prism_math::Vec2::new(uv.x, 1.0 - uv.y));
+                    }
                 }
                 Interaction {
                     p,
@@ -450,15 +448,34 @@ impl RenderScene {
                 let p = ray.at(hit.t);
                 let outward = ((p - s.center) / s.radius).normalize();
                 let n = if inward { -outward } else { outward };
+                let mut bsdf = if self.one_sided[material] && ray.dir.dot(n) >= 0.0 {
+                    Bsdf::Black
+                } else {
+                    self.bsdfs[material]
+                };
+                if let Bsdf::Diffuse { albedo } = &mut bsdf {
+                    if self.textures[material].is_some() {
+                        // Mitsuba's sphere coordinates: the azimuth over 2 pi, the polar angle
+                        // from +z over pi (the world's axes).
+                        let phi = outward.y.atan2(outward.x);
+                        let phi = if phi < 0.0 {
+                            phi + 2.0 * std::f32::consts::PI
+                        } else {
+                            phi
+                        };
+                        let theta = prism_math::acos(outward.z.clamp(-1.0, 1.0));
+                        let uv = prism_math::Vec2::new(
+                            phi / (2.0 * std::f32::consts::PI),
+                            theta / std::f32::consts::PI,
+                        );
+                        *albedo = *albedo * self.texel(material, uv);
+                    }
+                }
                 Interaction {
                     p: s.center + outward * s.radius,
                     ng: n,
                     ns: n,
-                    bsdf: if self.one_sided[material] && ray.dir.dot(n) >= 0.0 {
-                        Bsdf::Black
-                    } else {
-                        self.bsdfs[material]
-                    },
+                    bsdf,
                     emitted: match self.emission[material] {
                         Some(_) if self.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
                         e => e.unwrap_or(Rgb::BLACK),
@@ -471,6 +488,21 @@ impl RenderScene {
                 }
             }
         }
+    }
+}
+
+impl RenderScene {
+    /// The texel of `material`'s texture at surface coordinates `uv` (`v` running down the
+    /// image), through its `to_uv`; white without a texture.
+    fn texel(&self, material: usize, uv: prism_math::Vec2) -> Rgb {
+        let Some((tex, sampling, m)) = &self.textures[material] else {
+            return Rgb::WHITE;
+        };
+        let at = prism_math::Vec2::new(
+            m[0] * uv.x + m[1] * uv.y + m[2],
+            m[3] * uv.x + m[4] * uv.y + m[5],
+        );
+        tex.sample_level(at, 0, *sampling)
     }
 }
 

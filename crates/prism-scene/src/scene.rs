@@ -147,13 +147,34 @@ pub struct Roughness {
     pub alpha_v: f32,
 }
 
-/// An image a material reads, with the file it came from.
+/// An image a material reads, with the file it came from and how it is looked up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialTexture {
     /// The file, for messages.
     pub path: String,
-    /// Linear texel values in `[0, 1]`; row 0 is the file's top row.
+    /// Linear texel values; row 0 is the file's top row.
     pub image: Arc<RgbImage>,
+    /// Nearest texel or bilinear between texel centres.
+    pub sampling: prism_image::PixelSampling,
+    /// What lies beyond the image, across and down.
+    pub wrap: prism_image::Wrap,
+    /// The affine map from the surface's coordinates to the image's (row-major 2x3, in
+    /// coordinates whose `v` runs down the image from its top row, as Mitsuba's `to_uv`).
+    pub to_uv: [f32; 6],
+}
+
+impl MaterialTexture {
+    /// `image` from `path`, bilinear, repeating, with no `to_uv`.
+    #[must_use]
+    pub fn new(path: String, image: Arc<RgbImage>) -> MaterialTexture {
+        MaterialTexture {
+            path,
+            image,
+            sampling: prism_image::PixelSampling::Bilinear,
+            wrap: prism_image::Wrap::Repeat,
+            to_uv: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        }
+    }
 }
 
 /// How shading normals are chosen for meshes.

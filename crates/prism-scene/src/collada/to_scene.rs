@@ -279,10 +279,10 @@ fn effect_material_of(effect: &EffectDef, file: &str) -> Result<Material, SceneE
         .map_err(|e| located(format!("{name}: {e}")))?;
     Ok(Material::Diffuse {
         reflectance: Rgb::WHITE,
-        texture: Some(crate::MaterialTexture {
-            path: name.clone(),
-            image: std::sync::Arc::new(image),
-        }),
+        texture: Some(crate::MaterialTexture::new(
+            name.clone(),
+            std::sync::Arc::new(image),
+        )),
     })
 }
 

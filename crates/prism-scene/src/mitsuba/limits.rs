@@ -23,5 +23,8 @@ pub const MAX_FILM_SIDE: u32 = 16384;
 /// Most samples per pixel a scene may ask for.
 pub const MAX_SAMPLE_COUNT: u32 = 1 << 20;
 
+/// Most triangles in one scene, instances' copies included (about 3 GB to render).
+pub const MAX_SCENE_TRIANGLES: usize = 20_000_000;
+
 /// Segments of the triangle fan a `disk` becomes: its area is within 3e-5 of the disk's.
 pub const DISK_SEGMENTS: u32 = 512;

@@ -5,6 +5,7 @@
 mod conductors;
 mod document;
 mod limits;
+mod meshes;
 mod props;
 mod sensor;
 mod to_scene;

@@ -8,6 +8,7 @@ use prism_math::glam::{DMat4, DVec3};
 
 use super::*;
 use crate::scene::Light;
+use prism_math::Rgb;
 
 /// A scratch folder holding `files` (name, text); removed when dropped.
 struct Files(PathBuf);
@@ -482,5 +483,71 @@ fn microfacet_parameters_are_mitsubas() {
         .unwrap_err()
         .to_string();
         assert!(e.contains("s.xml:3:") && e.contains("roughdielectric"), "{e}");
+    }
+}
+
+/// Mitsuba's textures: a bitmap (with `filter_type`, `wrap_mode`, `to_uv`) or checkerboard
+/// in place of a diffuse reflectance, inline or by reference; the checkerboard is color0
+/// where u and v fall in the same half of the unit square (a 2x2 image looked up nearest).
+/// A texture elsewhere, or a bitmap that is no image, is a located error.
+#[test]
+fn textures_are_read_as_mitsuba_reads_them() {
+    let dir = std::env::temp_dir().join(format!("prism-mitsuba-tex-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = prism_image::encode_png(&prism_image::Rgb8Image::new(2, 1, [255, 0, 0])).unwrap();
+    std::fs::write(dir.join("red.png"), png).unwrap();
+    std::fs::write(dir.join("not.png"), b"not an image").unwrap();
+    let read_in = |body: &str| -> Result<crate::Scene, String> {
+        let file = dir.join("s.xml");
+        std::fs::write(&file, scene(body)).unwrap();
+        crate::mitsuba::read_mitsuba(&file, &[])
+            .map(|m| m.scene)
+            .map_err(|e| e.to_string())
+    };
+    let s = read_in(r#"<texture type="checkerboard" id="c"><rgb name="color0" value="1 0 0"/><transform name="to_uv"><scale x="4" y="2"/></transform></texture>
+        <shape type="rectangle"><bsdf type="diffuse"><ref name="reflectance" id="c"/></bsdf></shape>"#).unwrap();
+    let crate::Material::Diffuse {
+        reflectance,
+        texture: Some(t),
+    } = &s.materials[s.meshes[0].material]
+    else {
+        panic!("{:?}", s.materials);
+    };
+    assert_eq!(*reflectance, Rgb::WHITE);
+    assert_eq!(t.to_uv, [4.0, 0.0, 0.0, 0.0, 2.0, 0.0]);
+    assert_eq!(t.sampling, prism_image::PixelSampling::Nearest);
+    assert_eq!(
+        (t.image.get(0, 0), t.image.get(1, 1)),
+        (Rgb::new(1.0, 0.0, 0.0), Rgb::new(1.0, 0.0, 0.0))
+    );
+    assert_eq!(
+        (t.image.get(1, 0), t.image.get(0, 1)),
+        (Rgb::splat(0.2), Rgb::splat(0.2))
+    );
+    let s = read_in(r#"<shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="red.png"/><string name="wrap_mode" value="mirror"/><string name="filter_type" value="nearest"/></texture></bsdf></shape>"#).unwrap();
+    let crate::Material::Diffuse {
+        texture: Some(t), ..
+    } = &s.materials[s.meshes[0].material]
+    else {
+        panic!("{:?}", s.materials);
+    };
+    assert_eq!(t.wrap, prism_image::Wrap::Mirror);
+    assert_eq!(t.image.get(1, 0), Rgb::new(1.0, 0.0, 0.0));
+    for (body, want) in [
+        (
+            r#"<shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="not.png"/></texture></bsdf></shape>"#,
+            "not.png",
+        ),
+        (
+            r#"<shape type="rectangle"><bsdf type="plastic"><texture type="checkerboard" name="diffuse_reflectance"/></bsdf></shape>"#,
+            "not supported",
+        ),
+        (
+            r#"<shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="missing.png"/></texture></bsdf></shape>"#,
+            "missing.png",
+        ),
+    ] {
+        let e = read_in(body).unwrap_err();
+        assert!(e.contains("s.xml:") && e.contains(want), "{e}");
     }
 }

@@ -7,11 +7,15 @@ use prism_math::glam::{DMat4, DVec3};
 use prism_math::{Rgb, Vec2, Vec3};
 
 use super::document::{Document, Object};
-use super::limits::{DISK_SEGMENTS, MAX_OBJECT_DEPTH};
+use super::limits::{MAX_OBJECT_DEPTH, MAX_SCENE_TRIANGLES};
+use super::meshes;
 use super::props::{error, ior, unsupported};
 use crate::error::SceneError;
+use std::sync::Arc;
+
 use crate::scene::{
-    Camera, Light, Material, MicrofacetKind, Roughness, Scene, SceneSphere, Shading, TriangleMesh,
+    Camera, Light, Material, MaterialTexture, MicrofacetKind, Roughness, Scene, SceneSphere,
+    Shading, TriangleMesh,
 };
 
 /// How the film turns samples into pixels.
@@ -88,16 +92,19 @@ pub fn to_scene(doc: &Document) -> Result<MitsubaScene, SceneError> {
         settings: MitsubaSettings::default(),
         sensor_seen: false,
         bsdfs: std::collections::HashMap::new(),
+        triangles: 0,
     };
     let root = &doc.objects[0];
     for &(_, child) in &root.children {
         let o = &doc.objects[child];
         match o.tag.as_str() {
+            "shape" if o.kind == "shapegroup" => {}
             "shape" => b.shape(child, DMat4::IDENTITY, 0)?,
             "emitter" => b.emitter(o)?,
             "sensor" => b.sensor(o)?,
             "integrator" => b.integrator(o)?,
-            // Objects defined at the top level to be referenced are used where referenced.
+            // Objects defined at the top level to be referenced are used where referenced
+            // (a shapegroup where an instance places it).
             "bsdf" | "texture" => {}
             _ => return Err(unsupported(o)),
         }
@@ -123,6 +130,8 @@ pub(super) struct Builder<'d> {
     pub(super) sensor_seen: bool,
     /// Material index of each BSDF object already translated.
     bsdfs: std::collections::HashMap<usize, usize>,
+    /// Triangles placed so far.
+    triangles: usize,
 }
 
 impl Builder<'_> {
@@ -136,6 +145,9 @@ impl Builder<'_> {
             ));
         }
         let to_world = outer * o.transform("to_world")?;
+        if o.kind == "instance" {
+            return self.instance(o, to_world, depth);
+        }
         // Its BSDF and its area emitter.
         let mut material = None;
         let mut emission = None;
@@ -206,6 +218,25 @@ impl Builder<'_> {
                 if !similar || r <= 0.0 {
                     return Err(error(o, format!("{}: to_world must keep the sphere round (rotation, uniform scale, translation)", o.label())));
                 }
+                // prism's spheres keep the world's axes: the texture coordinates of a turned
+                // sphere would be turned with it.
+                let turned = (0..3).any(|i| (cols[i] - DVec3::AXES[i] * r).length() > 1e-6 * r);
+                let textured = matches!(
+                    self.scene.materials[material],
+                    Material::Diffuse {
+                        texture: Some(_),
+                        ..
+                    }
+                );
+                if turned && textured {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: a textured sphere turned by to_world: not supported by prism yet",
+                            o.label()
+                        ),
+                    ));
+                }
                 let c = m.w_axis.truncate();
                 if !(c.as_vec3().is_finite() && (r as f32).is_finite()) {
                     return Err(error(
@@ -224,7 +255,7 @@ impl Builder<'_> {
                 });
                 return Ok(());
             }
-            "rectangle" => unit_mesh(
+            "rectangle" => meshes::unit_mesh(
                 vec![
                     DVec3::new(-1.0, -1.0, 0.0),
                     DVec3::new(1.0, -1.0, 0.0),
@@ -232,27 +263,42 @@ impl Builder<'_> {
                     DVec3::new(-1.0, 1.0, 0.0),
                 ],
                 vec![[0, 1, 2], [2, 3, 0]],
+                // Mitsuba's (u, v) is ((x + 1) / 2, (y + 1) / 2), v running down the image;
+                // prism's v runs up it.
                 Some(vec![
-                    Vec2::new(0.0, 0.0),
-                    Vec2::new(1.0, 0.0),
-                    Vec2::new(1.0, 1.0),
                     Vec2::new(0.0, 1.0),
+                    Vec2::new(1.0, 1.0),
+                    Vec2::new(1.0, 0.0),
+                    Vec2::new(0.0, 0.0),
                 ]),
             ),
-            "cube" => cube(),
-            "disk" => disk(),
+            "cube" => meshes::cube(),
+            "disk" => meshes::disk(),
             "obj" | "ply" => {
                 let file = o
                     .string("filename")?
                     .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
                 let path = self.doc.folder.join(file);
-                let poly = if o.kind == "obj" {
-                    prism_mesh::read_obj(&path)
+                let failed = |e: String| error(o, format!("{}: {e}", o.label()));
+                if o.kind == "obj" {
+                    let text =
+                        prism_math::limits::read_input_text(&path, prism_mesh::MAX_MESH_FILE_BYTES)
+                            .map_err(|e| failed(format!("{}: {e}", path.display())))?;
+                    let options = prism_mesh::obj::ObjOptions {
+                        attributes: true,
+                        ..Default::default()
+                    };
+                    let doc = prism_mesh::obj::ObjDocument::<f64>::parse(
+                        &text,
+                        &path.display().to_string(),
+                        options,
+                    )
+                    .map_err(|e| failed(e.to_string()))?;
+                    meshes::from_obj(&doc).map_err(failed)?
                 } else {
-                    prism_mesh::read_ply(&path)
+                    let poly = prism_mesh::read_ply(&path).map_err(|e| failed(e.to_string()))?;
+                    meshes::from_polymesh(&poly)
                 }
-                .map_err(|e| error(o, format!("{}: {e}", o.label())))?;
-                from_polymesh(&poly)
             }
             _ => return Err(unsupported(o)),
         };
@@ -276,7 +322,10 @@ impl Builder<'_> {
                 t.swap(1, 2);
             }
         }
-        let shading = match normals {
+        // Mitsuba computes vertex normals for file meshes that have none.
+        let compute_normals =
+            normals.is_none() && !face_normals && matches!(o.kind.as_str(), "obj" | "ply");
+        let mut shading = match normals {
             Some(n) if !face_normals => Shading::Smooth(
                 n.iter()
                     .map(|v| {
@@ -300,6 +349,16 @@ impl Builder<'_> {
                 t.swap(1, 2);
             }
         }
+        if compute_normals {
+            shading = Shading::Smooth(meshes::angle_weighted_normals(&world, &triangles));
+        }
+        self.triangles += triangles.len();
+        if self.triangles > MAX_SCENE_TRIANGLES {
+            return Err(error(
+                o,
+                format!("{}: the scene would hold more than {MAX_SCENE_TRIANGLES} triangles (instances are copies)", o.label()),
+            ));
+        }
         self.scene.meshes.push(TriangleMesh {
             name,
             positions: world,
@@ -308,6 +367,36 @@ impl Builder<'_> {
             material,
             uvs,
         });
+        Ok(())
+    }
+
+    /// An `instance`: the shapes of the one `shapegroup` it references, each placed by the
+    /// instance's `to_world` and then its own (copies of the geometry, within the scene's
+    /// triangle budget).
+    fn instance(&mut self, o: &Object, to_world: DMat4, depth: usize) -> Result<(), SceneError> {
+        let groups: Vec<usize> = o
+            .children
+            .iter()
+            .map(|&(_, c)| c)
+            .filter(|&c| self.doc.objects[c].kind == "shapegroup")
+            .collect();
+        if groups.len() != 1 || groups.len() != o.children.len() {
+            return Err(error(
+                o,
+                format!("{}: expected a reference to one shapegroup", o.label()),
+            ));
+        }
+        let group = &self.doc.objects[groups[0]];
+        for &(_, c) in &group.children {
+            let shape = &self.doc.objects[c];
+            if shape.tag != "shape" || matches!(shape.kind.as_str(), "shapegroup" | "instance") {
+                return Err(error(
+                    shape,
+                    format!("{} in a shapegroup: expected a shape", shape.label()),
+                ));
+            }
+            self.shape(c, to_world, depth + 1)?;
+        }
         Ok(())
     }
 
@@ -358,12 +447,18 @@ impl Builder<'_> {
                 }
             }
         }
-        if let Some(&(_, c)) = o.children.first() {
-            let c = &self.doc.objects[c];
+        // Nested plugins: a texture in place of a diffuse reflectance, nothing else yet.
+        let mut reflectance_texture = None;
+        for (slot, c) in &o.children {
+            let c = &self.doc.objects[*c];
+            if o.kind == "diffuse" && slot.as_deref() == Some("reflectance") && c.tag == "texture" {
+                reflectance_texture = Some(self.texture(c)?);
+                continue;
+            }
             return Err(error(
                 c,
                 format!(
-                    "{} in {}: textures and nested plugins are not supported by prism yet",
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard reflectance of a diffuse BSDF is)",
                     c.label(),
                     o.label()
                 ),
@@ -371,9 +466,15 @@ impl Builder<'_> {
         }
         let name = o.id.clone().unwrap_or_else(|| o.label());
         let material = match o.kind.as_str() {
-            "diffuse" => Material::Diffuse {
-                reflectance: o.rgb("reflectance", [0.5; 3])?,
-                texture: None,
+            "diffuse" => match reflectance_texture {
+                Some(t) => Material::Diffuse {
+                    reflectance: Rgb::WHITE,
+                    texture: Some(t),
+                },
+                None => Material::Diffuse {
+                    reflectance: o.rgb("reflectance", [0.5; 3])?,
+                    texture: None,
+                },
             },
             "dielectric" => {
                 let int = ior(o, "int_ior", "bk7")?;
@@ -463,6 +564,88 @@ impl Builder<'_> {
         let m = self.push_material(material, name, opaque && !two_sided);
         self.bsdfs.insert(index, m);
         Ok(m)
+    }
+
+    /// A `bitmap` (PNG, JPEG or OpenEXR; 8-bit colour decoded from sRGB unless `raw`) or
+    /// `checkerboard` texture, with its `filter_type`, `wrap_mode` and `to_uv`.
+    fn texture(&self, o: &Object) -> Result<MaterialTexture, SceneError> {
+        let m = o.transform("to_uv")?;
+        let to_uv = [
+            m.x_axis.x, m.y_axis.x, m.w_axis.x, m.x_axis.y, m.y_axis.y, m.w_axis.y,
+        ]
+        .map(|x| x as f32);
+        if to_uv.iter().any(|x| !x.is_finite()) {
+            return Err(error(
+                o,
+                format!("{}: to_uv: expected finite numbers", o.label()),
+            ));
+        }
+        match o.kind.as_str() {
+            "checkerboard" => {
+                // Mitsuba's pattern: color0 where u and v fall in the same half of the unit
+                // square, color1 elsewhere; one texel per half, looked up nearest, repeating.
+                let (c0, c1) = (o.rgb("color0", [0.4; 3])?, o.rgb("color1", [0.2; 3])?);
+                let mut image = prism_image::RgbImage::new(2, 2, c1);
+                image.set(0, 0, c0);
+                image.set(1, 1, c0);
+                Ok(MaterialTexture {
+                    to_uv,
+                    sampling: prism_image::PixelSampling::Nearest,
+                    ..MaterialTexture::new("checkerboard".into(), Arc::new(image))
+                })
+            }
+            "bitmap" => {
+                let file = o
+                    .string("filename")?
+                    .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
+                let path = self.doc.folder.join(file);
+                let located =
+                    |message: String| error(o, format!("{}: {file}: {message}", o.label()));
+                let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
+                let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+                    prism_image::decode_exr(&bytes, file).map_err(|e| located(e.to_string()))?
+                } else if o.boolean("raw", false)? {
+                    crate::texture_file::decode_texture(&bytes, file).map_err(|e| {
+                        located(format!("{e} (prism reads PNG, JPEG and OpenEXR bitmaps)"))
+                    })?
+                } else {
+                    crate::texture_file::decode_color_texture(&bytes, file).map_err(|e| {
+                        located(format!("{e} (prism reads PNG, JPEG and OpenEXR bitmaps)"))
+                    })?
+                };
+                let sampling =
+                    match o.string("filter_type")?.unwrap_or("bilinear") {
+                        "bilinear" => prism_image::PixelSampling::Bilinear,
+                        "nearest" => prism_image::PixelSampling::Nearest,
+                        other => return Err(error(
+                            o,
+                            format!(
+                                "{}: filter_type {other:?}: expected \"bilinear\" or \"nearest\"",
+                                o.label()
+                            ),
+                        )),
+                    };
+                let wrap = match o.string("wrap_mode")?.unwrap_or("repeat") {
+                    "repeat" => prism_image::Wrap::Repeat,
+                    "mirror" => prism_image::Wrap::Mirror,
+                    "clamp" => prism_image::Wrap::Clamp,
+                    other => return Err(error(
+                        o,
+                        format!(
+                            "{}: wrap_mode {other:?}: expected \"repeat\", \"mirror\" or \"clamp\"",
+                            o.label()
+                        ),
+                    )),
+                };
+                Ok(MaterialTexture {
+                    sampling,
+                    wrap,
+                    to_uv,
+                    ..MaterialTexture::new(file.to_string(), Arc::new(image))
+                })
+            }
+            _ => Err(unsupported(o)),
+        }
     }
 
     /// A top-level emitter.
@@ -606,85 +789,4 @@ fn conductor_index(o: &Object) -> Result<(Rgb, Rgb), SceneError> {
         )
     })?;
     Ok((Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2])))
-}
-
-/// A mesh in object space: positions, triangles, normals, uvs.
-type ObjectMesh = (
-    Vec<DVec3>,
-    Vec<[u32; 3]>,
-    Option<Vec<DVec3>>,
-    Option<Vec<Vec2>>,
-);
-
-fn unit_mesh(
-    positions: Vec<DVec3>,
-    triangles: Vec<[u32; 3]>,
-    uvs: Option<Vec<Vec2>>,
-) -> ObjectMesh {
-    (positions, triangles, None, uvs)
-}
-
-/// Mitsuba's `cube`: [-1, 1]^3, four vertices a face so that each face is flat, laid out as
-/// Mitsuba lays it out (faces -y, +y, +x, +z, -x, -z; each face's texture coordinates cover
-/// the unit square; corner `c` at the signs of its bits), so that textures and anisotropic
-/// tangents agree.
-fn cube() -> ObjectMesh {
-    const CORNERS: [u32; 24] = [
-        1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2,
-    ];
-    // Mitsuba's (u, v) per face corner are (0,1) (1,1) (1,0) (0,0), v running down the
-    // image; prism's v runs up it.
-    const UV: [(f32, f32); 4] = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
-    let corner = |c: u32| {
-        let sign = |bit: u32| if c & bit != 0 { 1.0 } else { -1.0 };
-        DVec3::new(sign(1), sign(2), sign(4))
-    };
-    let positions = CORNERS.iter().map(|&c| corner(c)).collect();
-    let uvs = (0..24)
-        .map(|i| Vec2::new(UV[i % 4].0, UV[i % 4].1))
-        .collect();
-    let triangles = (0..6u32)
-        .flat_map(|f| {
-            let v = 4 * f;
-            [[v, v + 1, v + 2], [v + 3, v, v + 2]]
-        })
-        .collect();
-    (positions, triangles, None, Some(uvs))
-}
-
-/// Mitsuba's `disk`: radius 1 in the z = 0 plane, facing +z, as a fan of
-/// [`DISK_SEGMENTS`] triangles.
-fn disk() -> ObjectMesh {
-    let mut positions = vec![DVec3::ZERO];
-    let mut uvs = vec![Vec2::new(0.5, 0.5)];
-    let n = DISK_SEGMENTS;
-    for i in 0..n {
-        let phi = std::f64::consts::TAU * f64::from(i) / f64::from(n);
-        positions.push(DVec3::new(phi.cos(), phi.sin(), 0.0));
-        uvs.push(Vec2::new(
-            0.5 + 0.5 * phi.cos() as f32,
-            0.5 + 0.5 * phi.sin() as f32,
-        ));
-    }
-    let triangles = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
-    (positions, triangles, None, Some(uvs))
-}
-
-/// A read mesh as triangles (polygons as fans).
-fn from_polymesh(p: &prism_mesh::PolyMesh) -> ObjectMesh {
-    let mut triangles = Vec::with_capacity(p.face_count());
-    for f in 0..p.face_count() {
-        let v = p.face(f);
-        for i in 1..v.len().saturating_sub(1) {
-            triangles.push([v[0], v[i], v[i + 1]]);
-        }
-    }
-    (
-        p.positions.clone(),
-        triangles,
-        p.normals.clone(),
-        p.uvs
-            .as_ref()
-            .map(|u| u.iter().map(|t| t.as_vec2()).collect()),
-    )
 }

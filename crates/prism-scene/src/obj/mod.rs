@@ -291,10 +291,7 @@ fn to_material(
                     Arc::clone(slot.insert(Arc::new(image)))
                 }
             };
-            Some(MaterialTexture {
-                path: name.clone(),
-                image,
-            })
+            Some(MaterialTexture::new(name.clone(), image))
         }
     };
     Ok(Material::Phong {
