@@ -551,3 +551,38 @@ fn textures_are_read_as_mitsuba_reads_them() {
         assert!(e.contains("s.xml:") && e.contains(want), "{e}");
     }
 }
+
+/// Instancing: each `instance` places the shapes of its `shapegroup` by its own `to_world`
+/// and then theirs (copies of the geometry); the group itself draws nothing; an instance
+/// of anything but one shapegroup is a located error.
+#[test]
+fn instances_place_copies_of_their_shapegroup() {
+    let s = read(
+        "instance",
+        r#"<shape type="shapegroup" id="g">
+            <shape type="rectangle"><transform name="to_world"><translate x="1"/></transform></shape>
+            <shape type="sphere"><float name="radius" value="0.5"/></shape>
+        </shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><translate y="2"/></transform></shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><scale value="2"/></transform></shape>"#,
+        &[],
+    )
+    .unwrap()
+    .scene;
+    assert_eq!((s.meshes.len(), s.spheres.len()), (2, 2));
+    let min_x = |m: &crate::TriangleMesh| m.positions.iter().map(|p| p.x).fold(f32::MAX, f32::min);
+    assert_eq!(min_x(&s.meshes[0]), 0.0);
+    assert_eq!(s.meshes[0].positions[0].y, 1.0);
+    assert_eq!(min_x(&s.meshes[1]), 0.0);
+    assert_eq!(s.meshes[1].positions[0].y, -2.0);
+    assert_eq!((s.spheres[0].center.y, s.spheres[0].radius), (2.0, 0.5));
+    assert_eq!((s.spheres[1].center.y, s.spheres[1].radius), (0.0, 1.0));
+    let e = read(
+        "instance-bad",
+        r#"<bsdf type="diffuse" id="d"/><shape type="instance"><ref id="d"/></shape>"#,
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("s.xml:") && e.contains("shapegroup"), "{e}");
+}
