@@ -392,6 +392,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let (mitsuba, resolved) = resolve(a)?;
     let rr_bounces = mitsuba.as_ref().map(|m| m.settings.rr_bounces);
+    let hide_emitters = mitsuba.as_ref().is_some_and(|m| m.settings.hide_emitters);
     let filter = mitsuba
         .as_ref()
         .map_or(prism_scene::Filter::Box, |m| m.settings.filter);
@@ -505,6 +506,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         },
         path: PathSettings {
             rr_bounces,
+            hide_emitters,
             light_samples: a.light_samples.max(1),
             max_bounces: a.max_bounces(),
             integrator: match a.integrator {

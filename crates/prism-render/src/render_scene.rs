@@ -165,10 +165,13 @@ impl RenderScene {
                 // with colours rather than radiometric units: the path tracer has no use
                 // for them.
                 Light::Segment { .. } | Light::Parallelogram { facing: None, .. } => {}
-                Light::EnvironmentMap { ref radiance } => {
+                Light::EnvironmentMap {
+                    ref radiance,
+                    mapping,
+                } => {
                     infinite = Some(lights.len());
                     lights.push(RenderLight::EnvironmentMap(std::sync::Arc::new(
-                        EnvMap::new(radiance),
+                        EnvMap::with_mapping(radiance, mapping),
                     )));
                 }
             }

@@ -63,7 +63,10 @@ impl Scene {
             .iter()
             .any(|l| infinite(l) && l.gives_off_light());
         self.lights.retain(|l| !infinite(l));
-        self.lights.push(Light::EnvironmentMap { radiance: map });
+        self.lights.push(Light::EnvironmentMap {
+            radiance: map,
+            mapping: crate::EnvMapping::Course,
+        });
         Ok(replaced)
     }
 }
@@ -95,7 +98,10 @@ mod tests {
         let m = map(Rgb::new(1.0, 2.0, 3.0));
         assert_eq!(scene.light_by_environment_map(m.clone()), Ok(true));
         let mut expected = finite;
-        expected.push(Light::EnvironmentMap { radiance: m });
+        expected.push(Light::EnvironmentMap {
+            radiance: m,
+            mapping: crate::EnvMapping::Course,
+        });
         assert_eq!(scene.lights, expected);
         // A second map replaces the first, which gave off light.
         assert_eq!(

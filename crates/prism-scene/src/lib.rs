@@ -59,6 +59,6 @@ pub use render_config::{
     MAX_WINDOW_PIXELS, MAX_WINDOW_SIDE,
 };
 pub use scene::{
-    Camera, CameraMode, Light, Material, MaterialTexture, MicrofacetKind, NormalsMode, OrbitCamera,
-    Roughness, Scene, SceneOptions, SceneSphere, Shading, ThinLens, TriangleMesh,
+    Camera, CameraMode, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind, NormalsMode,
+    OrbitCamera, Roughness, Scene, SceneOptions, SceneSphere, Shading, ThinLens, TriangleMesh,
 };

@@ -323,12 +323,29 @@ pub enum Light {
         radiance: Rgb,
     },
     /// Radiance from every direction, seen by every ray, read from a latitude-longitude
-    /// map (the course's environment light): direction `d` reads the map at
-    /// `u = phi / 2 pi`, `v = theta / pi` (v = 0 the top row), where `theta = acos(d.y)`
-    /// and `phi = atan2(-d.z, d.x) + pi`.
+    /// map laid over the sphere as `mapping` says.
     EnvironmentMap {
         /// Linear radiance, one texel per direction cell.
         radiance: std::sync::Arc<prism_image::RgbImage>,
+        /// How directions find their place in the map.
+        mapping: EnvMapping,
+    },
+}
+
+/// How a latitude-longitude map covers the sphere of directions.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum EnvMapping {
+    /// The course's: direction `d` reads the map at `u = phi / 2 pi`, `v = theta / pi`
+    /// (v = 0 the top row), where `theta = acos(d.y)` and `phi = atan2(-d.z, d.x) + pi`;
+    /// texel centres at `(i + 0.5) / n` both ways.
+    #[default]
+    Course,
+    /// Mitsuba's `envmap`: the direction taken to the map's frame by `to_local`, then
+    /// `u = atan2(x, -z) / 2 pi` (wrapped to [0, 1)) with texel centres at `(i + 0.5) / w`,
+    /// and `v = acos(y) / pi` with the first and last rows at the poles.
+    Mitsuba {
+        /// World directions to the map's frame (the inverse of its `to_world`).
+        to_local: prism_math::glam::Mat3,
     },
 }
 
@@ -343,7 +360,7 @@ impl Light {
             Light::Directional { irradiance, .. } => shines(irradiance),
             Light::Spot { intensity, .. } => shines(intensity),
             Light::Hemisphere { radiance } | Light::Environment { radiance } => shines(radiance),
-            Light::EnvironmentMap { radiance } => radiance.pixels().iter().any(shines),
+            Light::EnvironmentMap { radiance, .. } => radiance.pixels().iter().any(shines),
             Light::Segment { colors, .. } => colors.iter().any(shines),
             Light::Parallelogram { colors, .. } => colors.iter().any(shines),
         }

@@ -157,6 +157,7 @@ pub fn pictures(
         .map_err(crate::error::UserError::input)?;
         scene.lights = vec![prism_scene::Light::EnvironmentMap {
             radiance: std::sync::Arc::new(sky),
+            mapping: prism_scene::EnvMapping::Course,
         }];
         trace(&scene, &base, &output.join("render_envmap.png"), None)?;
         entries.push(Entry {

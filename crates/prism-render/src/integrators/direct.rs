@@ -22,7 +22,11 @@ pub(super) fn direct(
     hemisphere: bool,
 ) -> Rgb {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
-    let mut l = if keep(0) { hit.emitted } else { Rgb::BLACK };
+    let mut l = if keep(0) && !opts.hide_emitters {
+        hit.emitted
+    } else {
+        Rgb::BLACK
+    };
     if opts.max_bounces >= 1 && keep(1) {
         l += if hemisphere {
             direct_hemisphere(scene, hit, -ray.dir, sampler, opts)

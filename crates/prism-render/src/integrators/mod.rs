@@ -20,7 +20,7 @@ use crate::sampler::Sampler;
 /// Radiance arriving along a camera ray.
 pub fn radiance(scene: &RenderScene, ray: &Ray, sampler: &mut Sampler, opts: &PathSettings) -> Rgb {
     let Some(hit) = scene.intersect(ray) else {
-        return if opts.only_bounce.is_none_or(|m| m == 0) {
+        return if opts.only_bounce.is_none_or(|m| m == 0) && !opts.hide_emitters {
             scene.escaped(ray.dir, true)
         } else {
             Rgb::BLACK

@@ -19,7 +19,11 @@ pub(super) fn path(
     opts: &PathSettings,
 ) -> Rgb {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
-    let mut l = if keep(0) { first.emitted } else { Rgb::BLACK };
+    let mut l = if keep(0) && !opts.hide_emitters {
+        first.emitted
+    } else {
+        Rgb::BLACK
+    };
     let mut hit = first;
     let mut wo = -ray.dir;
     let mut beta = Rgb::WHITE;

@@ -40,6 +40,9 @@ pub struct PathSettings {
     /// Russian roulette may end a path once it has this many bounces: after the BSDF sample
     /// at that surface, before its ray is traced (Mitsuba's `rr_depth`, default 5).
     pub rr_bounces: u32,
+    /// Emitters seen straight from the camera (area lights, environments) show black
+    /// (Mitsuba's `hide_emitters`); the light they shed is kept.
+    pub hide_emitters: bool,
 }
 
 impl Default for PathSettings {
@@ -50,6 +53,7 @@ impl Default for PathSettings {
             integrator: Integrator::Path,
             only_bounce: None,
             rr_bounces: 5,
+            hide_emitters: false,
         }
     }
 }

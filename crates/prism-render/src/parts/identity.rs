@@ -50,6 +50,8 @@ pub enum Renderer {
         adaptive: Option<(f32, u32)>,
         /// Bounces before Russian roulette may end a path.
         rr_bounces: u32,
+        /// Emitters hidden from the camera (written only when on).
+        hide_emitters: bool,
     },
     /// The Delft Whitted ray tracer (`prism raytrace`, kind `raytrace`).
     Whitted {
@@ -135,6 +137,7 @@ impl PartIdentity {
                 only_bounce: opts.path.only_bounce,
                 adaptive: opts.film.adaptive.map(|t| (t, opts.film.batch)),
                 rr_bounces: opts.path.rr_bounces,
+                hide_emitters: opts.path.hide_emitters,
             },
         }
     }
@@ -213,6 +216,7 @@ impl PartIdentity {
                 only_bounce,
                 adaptive,
                 rr_bounces,
+                hide_emitters,
             } => {
                 let integrator = match integrator {
                     Integrator::Path | Integrator::PathScalar => "path".to_string(),
@@ -230,6 +234,9 @@ impl PartIdentity {
                     ),
                     ("rr_bounces", rr_bounces.to_string()),
                 ]);
+                if *hide_emitters {
+                    out.push(("hide_emitters", "on".to_string()));
+                }
             }
             Renderer::Whitted {
                 camera,
@@ -277,6 +284,10 @@ impl PartIdentity {
                     parse_off(v, parse_adaptive)
                 })?,
                 rr_bounces: number("rr_bounces")?,
+                hide_emitters: settings.iter().any(|(k, _)| k == "hide_emitters")
+                    && read(settings, "hide_emitters", "on", |v| {
+                        (v == "on").then_some(true)
+                    })?,
             },
             "raytrace" => Renderer::Whitted {
                 camera: text("camera")?,
@@ -397,6 +408,7 @@ mod tests {
                 only_bounce: Some(3),
                 adaptive: Some((0.05, 32)),
                 rr_bounces: 5,
+                hide_emitters: true,
             },
         }
     }
@@ -457,6 +469,7 @@ mod tests {
     fn attributes_are_the_part_file_settings() {
         let a = path().to_attributes();
         let get = |k: &str| a.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
+        let get_path = get;
         assert_eq!(get("kind"), Some("render"));
         assert_eq!(get("scene"), Some("0123456789abcdef"));
         assert_eq!(get("integrator"), Some("direct hemisphere=true"));
@@ -468,7 +481,14 @@ mod tests {
         assert_eq!(get("bloom"), Some("0.75 3"));
         assert_eq!(get("encoding"), Some("truncated"));
         assert_eq!(a.len(), 11);
-        assert_eq!(path().to_attributes().len(), 14);
+        // `hide_emitters` is written only when on, so that older parts still read.
+        assert_eq!(get_path("hide_emitters"), Some("on"));
+        assert_eq!(path().to_attributes().len(), 15);
+        let mut shown = path();
+        if let Renderer::Path { hide_emitters, .. } = &mut shown.renderer {
+            *hide_emitters = false;
+        }
+        assert_eq!(shown.to_attributes().len(), 14);
     }
 
     /// A scalar path render records the same identity as the wavefront one.

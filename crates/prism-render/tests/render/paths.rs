@@ -296,6 +296,7 @@ fn constant_map_renders_as_the_constant_environment() {
     let mut scene = furnace(white.clone());
     scene.lights = vec![Light::EnvironmentMap {
         radiance: std::sync::Arc::new(prism_image::Image::new(64, 32, Rgb::WHITE)),
+        mapping: prism_scene::EnvMapping::Course,
     }];
     let map = render(&RenderScene::new(&scene), &opts, &|_| {});
     let constant = render(&RenderScene::new(&furnace(white)), &opts, &|_| {});
@@ -369,6 +370,7 @@ fn sky_map_lights_like_the_hemisphere_light() {
                 Rgb::BLACK
             }
         })),
+        mapping: prism_scene::EnvMapping::Course,
     }];
     let map = mean_over(&render(&RenderScene::new(&sky), &opts, &|_| {}).image);
     assert!(
@@ -778,6 +780,7 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         radiance: std::sync::Arc::new(prism_image::Image::from_fn(16, 8, |x, y| {
             Rgb::new(0.2 + x as f32 * 0.1, 1.0 / (1.0 + y as f32), 0.5)
         })),
+        mapping: prism_scene::EnvMapping::Course,
     }];
     same(&RenderScene::new(&mapped), small, "environment map");
     let mut lens = prism_scene::cornell_box();

@@ -205,14 +205,17 @@ impl Builder<'_> {
 
     /// The integrator's depth settings.
     pub(super) fn integrator(&mut self, o: &Object) -> Result<(), SceneError> {
-        if o.kind != "path" {
-            return Err(unsupported(o));
-        }
-        if o.boolean("hide_emitters", false)? {
-            return Err(error(
-                o,
-                format!("{}: hide_emitters: not supported by prism yet", o.label()),
-            ));
+        self.settings.hide_emitters = o.boolean("hide_emitters", false)?;
+        match o.kind.as_str() {
+            "path" => {}
+            // Mitsuba's `direct`: emission and one bounce of direct light, by light and BSDF
+            // sampling under multiple importance sampling, as a path of one bounce is; its
+            // sample counts change the noise only.
+            "direct" => {
+                self.settings.max_bounces = Some(1);
+                return Ok(());
+            }
+            _ => return Err(unsupported(o)),
         }
         let max_depth = o.integer("max_depth", -1)?;
         self.settings.max_bounces = match max_depth {

@@ -48,6 +48,8 @@ pub struct MitsubaSettings {
     pub max_bounces: Option<u32>,
     /// Russian roulette's start (`rr_depth`, default 5; prism counts it as Mitsuba does).
     pub rr_bounces: u32,
+    /// The integrator's `hide_emitters`: emitters seen from the camera show black.
+    pub hide_emitters: bool,
 }
 
 impl Default for MitsubaSettings {
@@ -58,6 +60,7 @@ impl Default for MitsubaSettings {
             spp: 4,
             max_bounces: None,
             rr_bounces: 5,
+            hide_emitters: false,
         }
     }
 }
@@ -595,57 +598,68 @@ impl Builder<'_> {
                 })
             }
             "bitmap" => {
-                let file = o
-                    .string("filename")?
-                    .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
-                let path = self.doc.folder.join(file);
-                let located =
-                    |message: String| error(o, format!("{}: {file}: {message}", o.label()));
-                let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
-                let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-                    prism_image::decode_exr(&bytes, file).map_err(|e| located(e.to_string()))?
-                } else if o.boolean("raw", false)? {
-                    crate::texture_file::decode_texture(&bytes, file).map_err(|e| {
-                        located(format!("{e} (prism reads PNG, JPEG and OpenEXR bitmaps)"))
-                    })?
-                } else {
-                    crate::texture_file::decode_color_texture(&bytes, file).map_err(|e| {
-                        located(format!("{e} (prism reads PNG, JPEG and OpenEXR bitmaps)"))
-                    })?
-                };
-                let sampling =
-                    match o.string("filter_type")?.unwrap_or("bilinear") {
-                        "bilinear" => prism_image::PixelSampling::Bilinear,
-                        "nearest" => prism_image::PixelSampling::Nearest,
-                        other => return Err(error(
+                let (file, image) = self.image_file(o, o.boolean("raw", false)?)?;
+                let sampling = match o.string("filter_type")?.unwrap_or("bilinear") {
+                    "bilinear" => prism_image::PixelSampling::Bilinear,
+                    "nearest" => prism_image::PixelSampling::Nearest,
+                    other => {
+                        return Err(error(
                             o,
                             format!(
                                 "{}: filter_type {other:?}: expected \"bilinear\" or \"nearest\"",
                                 o.label()
                             ),
-                        )),
-                    };
+                        ))
+                    }
+                };
                 let wrap = match o.string("wrap_mode")?.unwrap_or("repeat") {
                     "repeat" => prism_image::Wrap::Repeat,
                     "mirror" => prism_image::Wrap::Mirror,
                     "clamp" => prism_image::Wrap::Clamp,
-                    other => return Err(error(
-                        o,
-                        format!(
+                    other => {
+                        return Err(error(
+                            o,
+                            format!(
                             "{}: wrap_mode {other:?}: expected \"repeat\", \"mirror\" or \"clamp\"",
                             o.label()
                         ),
-                    )),
+                        ))
+                    }
                 };
                 Ok(MaterialTexture {
                     sampling,
                     wrap,
                     to_uv,
-                    ..MaterialTexture::new(file.to_string(), Arc::new(image))
+                    ..MaterialTexture::new(file, Arc::new(image))
                 })
             }
             _ => Err(unsupported(o)),
         }
+    }
+
+    /// The image file an object's `filename` names, with that name: OpenEXR as linear
+    /// values; PNG or JPEG as `byte / 255`, decoded from sRGB unless `raw`.
+    fn image_file(
+        &self,
+        o: &Object,
+        raw: bool,
+    ) -> Result<(String, prism_image::RgbImage), SceneError> {
+        let file = o
+            .string("filename")?
+            .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
+        let path = self.doc.folder.join(file);
+        let located = |message: String| error(o, format!("{}: {file}: {message}", o.label()));
+        let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
+        let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+            prism_image::decode_exr(&bytes, file).map_err(|e| located(e.to_string()))?
+        } else if raw {
+            crate::texture_file::decode_texture(&bytes, file)
+                .map_err(|e| located(format!("{e} (prism reads PNG, JPEG and OpenEXR images)")))?
+        } else {
+            crate::texture_file::decode_color_texture(&bytes, file)
+                .map_err(|e| located(format!("{e} (prism reads PNG, JPEG and OpenEXR images)")))?
+        };
+        Ok((file.to_string(), image))
     }
 
     /// A top-level emitter.
@@ -680,6 +694,46 @@ impl Builder<'_> {
                     intensity: o.rgb("intensity", [1.0; 3])?,
                     cutoff: cutoff as f32,
                     beam_width: beam_width as f32,
+                }
+            }
+            "envmap" => {
+                let to_world = o.transform("to_world")?;
+                let linear = prism_math::glam::DMat3::from_mat4(to_world);
+                if !(linear.determinant().is_normal()) {
+                    return Err(error(
+                        o,
+                        format!("{}: to_world: the map's axes are degenerate", o.label()),
+                    ));
+                }
+                let scale = o.float("scale", 1.0)? as f32;
+                let (name, image) = self.image_file(o, false)?;
+                let map = image.map(|c| *c * scale);
+                if let Some(i) = map.pixels().iter().position(|p| {
+                    ![p.r, p.g, p.b]
+                        .iter()
+                        .all(|v| (0.0..prism_math::ExactSum::LIMIT).contains(v))
+                }) {
+                    return Err(error(o, format!("{}: {name}: texel {} (scaled by {scale}) is not finite, non-negative radiance below 2^55", o.label(), i)));
+                }
+                if self
+                    .scene
+                    .lights
+                    .iter()
+                    .any(|l| matches!(l, Light::EnvironmentMap { .. } | Light::Environment { .. }))
+                {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: a second light at infinity: not supported by prism",
+                            o.label()
+                        ),
+                    ));
+                }
+                Light::EnvironmentMap {
+                    radiance: Arc::new(map),
+                    mapping: crate::EnvMapping::Mitsuba {
+                        to_local: linear.inverse().as_mat3(),
+                    },
                 }
             }
             "constant" => Light::Environment {

@@ -37,13 +37,13 @@ fn emitted(
     let hit = if p.bounce == 0 {
         match hit {
             None => {
-                if keep(0) {
+                if keep(0) && !opts.hide_emitters {
                     p.l = scene.escaped(dir, true);
                 }
                 return None;
             }
             Some(h) => {
-                if keep(0) {
+                if keep(0) && !opts.hide_emitters {
                     p.l = h.emitted;
                 }
                 h
