@@ -81,6 +81,11 @@ pub struct RenderArgs {
     /// `<default>` (as Mitsuba's command line).
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
     define: Vec<String>,
+    /// Read past what prism does not render in a Mitsuba scene, with one warning per kind:
+    /// a grey diffuse BSDF stands in for an unsupported one, unsupported shapes and
+    /// emitters are left out.
+    #[arg(long)]
+    lenient: bool,
     /// Worker threads (default: one per core).
     #[arg(short = 't', long)]
     threads: Option<usize>,
@@ -355,7 +360,7 @@ fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderA
         }
         return Ok((None, r));
     };
-    let m = prism_scene::read_mitsuba(path, &defines).map_err(UserError::input)?;
+    let m = prism_scene::read_mitsuba_with(path, &defines, a.lenient).map_err(UserError::input)?;
     let s = &m.settings;
     r.spp = r.spp.or(Some(s.spp));
     r.max_bounces = r

@@ -65,6 +65,16 @@ pub enum SceneError {
         /// The folders searched.
         searched: Vec<String>,
     },
+    /// An element asks for something prism does not render (a plugin or a property).
+    #[error("{at}: <{element}>: {message}")]
+    Unsupported {
+        /// Where: the file and the line of the element's start tag.
+        at: Loc,
+        /// The element's tag name.
+        element: String,
+        /// What is not supported.
+        message: String,
+    },
     /// An element is missing, malformed or refers to something that does not exist.
     #[error("{at}: <{element}>: {message}")]
     Element {

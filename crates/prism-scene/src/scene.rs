@@ -110,6 +110,18 @@ pub enum Material {
         /// Index of refraction inside over outside.
         ior: f32,
     },
+    /// Mitsuba's `roughplastic`: a diffuse base under a rough dielectric coat of index
+    /// `eta` and isotropic `roughness`.
+    RoughPlastic {
+        /// Distribution and slope (`alpha_u` equals `alpha_v`).
+        roughness: Roughness,
+        /// Albedo of the base.
+        diffuse: Rgb,
+        /// Scale of the coat's reflection.
+        specular: Rgb,
+        /// Index of refraction of the coat over the outside.
+        eta: f32,
+    },
     /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
     /// specular lobe `ks * max(r.v, 0)^shininess` per light.
     Phong {

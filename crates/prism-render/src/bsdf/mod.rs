@@ -104,6 +104,21 @@ pub enum Bsdf {
         /// Index of refraction inside over outside.
         ior: f32,
     },
+    /// Mitsuba's rough plastic: a rough dielectric coat over a diffuse base.
+    RoughPlastic {
+        /// The coat's microfacets.
+        distr: Microfacet,
+        /// Index of refraction of the coat.
+        eta: f32,
+        /// The base's albedo over `(1 - internal reflectance) eta^2`.
+        diffuse: Rgb,
+        /// Scale of the coat's reflection.
+        specular: Rgb,
+        /// Mean specular over mean specular plus mean diffuse albedo.
+        specular_weight: f32,
+        /// The coat's transmittance table and internal reflectance.
+        tables: &'static rough_plastic::CoatTables,
+    },
     /// Absorbs everything (the surface of an emitter).
     Black,
 }
@@ -201,6 +216,24 @@ impl Bsdf {
                 transmittance,
                 ior,
             },
+            Material::RoughPlastic {
+                roughness,
+                diffuse,
+                specular,
+                eta,
+            } => {
+                let distr: Microfacet = roughness.into();
+                let tables = rough_plastic::coat_tables(&distr, eta);
+                let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
+                Bsdf::RoughPlastic {
+                    distr,
+                    eta,
+                    diffuse: diffuse * (1.0 / ((1.0 - tables.internal_reflectance) * eta * eta)),
+                    specular,
+                    specular_weight: mean(specular) / (mean(diffuse) + mean(specular)),
+                    tables,
+                }
+            }
             Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
         }
     }
@@ -215,6 +248,7 @@ impl Bsdf {
                 | Bsdf::Plastic { .. }
                 | Bsdf::RoughConductor { .. }
                 | Bsdf::RoughDielectric { .. }
+                | Bsdf::RoughPlastic { .. }
         )
     }
 
@@ -479,6 +513,19 @@ impl Bsdf {
                 transmittance,
                 ior,
             } => rough::dielectric_sample((distr, reflectance, transmittance, ior), wo, u1, u2),
+            Bsdf::RoughPlastic {
+                distr,
+                eta,
+                diffuse,
+                specular,
+                specular_weight,
+                tables,
+            } => rough_plastic::sample(
+                (distr, eta, diffuse, specular, specular_weight, tables),
+                wo,
+                u1,
+                u2,
+            ),
             Bsdf::Black => None,
         }
     }
@@ -504,6 +551,18 @@ impl Bsdf {
                 ior,
             } => Some(rough::dielectric_eval_pdf(
                 (distr, reflectance, transmittance, ior),
+                wo,
+                wi,
+            )),
+            Bsdf::RoughPlastic {
+                distr,
+                eta,
+                diffuse,
+                specular,
+                specular_weight,
+                tables,
+            } => Some(rough_plastic::eval_pdf(
+                (distr, eta, diffuse, specular, specular_weight, tables),
                 wo,
                 wi,
             )),
@@ -726,6 +785,7 @@ fn refract(wo: Vec3, ior: f32) -> Option<(Vec3, f32)> {
 pub(crate) mod lanes;
 mod microfacet;
 mod rough;
+pub mod rough_plastic;
 
 pub use microfacet::Microfacet;
 #[cfg(test)]

@@ -175,3 +175,24 @@ fn rough_bsdfs_are_reciprocal_and_consistent() {
         }
     }
 }
+
+/// Oracle: chi-square of Mitsuba's rough plastic's sampling against its pdf, both
+/// distributions, from above and below.
+#[test]
+fn rough_plastic_sampling_matches_its_pdf() {
+    for kind in [MicrofacetKind::Beckmann, MicrofacetKind::Ggx] {
+        let b = Bsdf::from_material(&prism_scene::Material::RoughPlastic {
+            roughness: prism_scene::Roughness {
+                kind,
+                alpha_u: 0.3,
+                alpha_v: 0.3,
+            },
+            diffuse: Rgb::new(0.6, 0.3, 0.2),
+            specular: Rgb::WHITE,
+            eta: 1.5,
+        });
+        for wo in [dir(15.0, 0.3), dir(70.0, 1.0), -dir(40.0, 2.0)] {
+            check_sampling(&b, wo);
+        }
+    }
+}

@@ -71,6 +71,9 @@ impl PhongMaterial {
             Material::ThinDielectric { reflectance, .. } => plain(Rgb::BLACK, *reflectance),
             Material::Plastic {
                 diffuse, specular, ..
+            }
+            | Material::RoughPlastic {
+                diffuse, specular, ..
             } => plain(*diffuse, *specular),
             Material::Glass { .. }
             | Material::Refraction { .. }

@@ -71,6 +71,18 @@ fn an_environment_map_lights_as_mitsubas_does() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `roughplastic.xml` (beside the references): the example box
+/// with a GGX rough plastic cube and a Beckmann one (its coat's transmittance table and
+/// internal reflectance computed as Mitsuba computes them); compared as the box is.
+#[test]
+fn rough_plastics_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "roughplastic",
+        "crates/prism-render/tests/golden/mitsuba/xml/roughplastic.xml",
+        &[],
+    );
+}
+
 /// prism's render of `scene` (from the workspace's root) with `defines` against the
 /// reference `NAME.exr` and its variance `NAME_variance.exr`.
 fn agrees_with_mitsuba(name: &str, scene: &str, defines: &[(&str, &str)]) {

@@ -31,5 +31,20 @@ pub use transform::{look_at, rotation};
 /// # Errors
 /// As [`read_document`] and [`to_scene`].
 pub fn read_mitsuba(path: &Path, defines: &[(String, String)]) -> Result<MitsubaScene, SceneError> {
-    to_scene(&read_document(path, defines)?)
+    to_scene(&read_document(path, defines)?, false)
+}
+
+/// [`read_mitsuba`], reading past what prism does not render when `lenient`: an
+/// unsupported BSDF becomes a grey diffuse one, an unsupported shape, emitter or other
+/// plugin is left out, an unsupported integrator is the path tracer; one warning per kind,
+/// in the scene's warnings.
+///
+/// # Errors
+/// As [`read_mitsuba`], but for [`SceneError::Unsupported`] when `lenient`.
+pub fn read_mitsuba_with(
+    path: &Path,
+    defines: &[(String, String)],
+    lenient: bool,
+) -> Result<MitsubaScene, SceneError> {
+    to_scene(&read_document(path, defines)?, lenient)
 }

@@ -9,7 +9,17 @@ use crate::error::SceneError;
 
 /// `<tag type="...">: not supported by prism`.
 pub(super) fn unsupported(o: &Object) -> SceneError {
-    error(o, format!("{}: not supported by prism", o.label()))
+    not_supported(o, format!("{}: not supported by prism", o.label()))
+}
+
+/// A located refusal at object `o`: something Mitsuba renders that prism does not
+/// (`--lenient` reads past these).
+pub(super) fn not_supported(o: &Object, message: String) -> SceneError {
+    SceneError::Unsupported {
+        at: o.at.clone(),
+        element: o.tag.clone(),
+        message,
+    }
 }
 
 /// A located error at object `o`.
@@ -107,7 +117,7 @@ impl Object {
     pub(super) fn refuse(&self, names: &[&str]) -> Result<(), SceneError> {
         for n in names {
             if self.prop(n).is_some() {
-                return Err(error(
+                return Err(not_supported(
                     self,
                     format!("{}: {n}: not supported by prism", self.label()),
                 ));

@@ -5,7 +5,7 @@ use prism_math::glam::DVec3;
 
 use super::document::Object;
 use super::limits::{MAX_FILM_SIDE, MAX_SAMPLE_COUNT};
-use super::props::{error, unsupported};
+use super::props::{error, not_supported, unsupported};
 use super::to_scene::{Builder, Filter};
 use crate::error::SceneError;
 use crate::scene::{Camera, ThinLens};
@@ -14,7 +14,7 @@ impl Builder<'_> {
     /// The sensor: the camera, and its film and sampler.
     pub(super) fn sensor(&mut self, o: &Object) -> Result<(), SceneError> {
         if self.sensor_seen {
-            return Err(error(
+            return Err(not_supported(
                 o,
                 format!("{}: a second sensor: not supported by prism yet", o.label()),
             ));
@@ -108,7 +108,7 @@ impl Builder<'_> {
         }
         // Mitsuba's camera has +x to the left; a to_world that mirrors it flips the picture.
         if up.cross(dir).dot(left) <= 0.0 {
-            return Err(error(
+            return Err(not_supported(
                 o,
                 format!(
                     "{}: to_world mirrors the image: not supported by prism yet",

@@ -586,3 +586,44 @@ fn instances_place_copies_of_their_shapegroup() {
     .to_string();
     assert!(e.contains("s.xml:") && e.contains("shapegroup"), "{e}");
 }
+
+/// `--lenient`: what prism does not render is read past with one warning per kind (a grey
+/// diffuse for a BSDF, left out for a shape or other plugin, the path tracer for an
+/// integrator); strict reading refuses the first of them, located; errors that are not
+/// refusals (a missing file) stay errors.
+#[test]
+fn lenient_reading_stands_in_and_warns_once_per_kind() {
+    let body = r#"<integrator type="volpath"/>
+        <bsdf type="hair" id="h"/>
+        <shape type="sphere"><ref id="h"/></shape>
+        <shape type="rectangle"><bsdf type="hair"/></shape>
+        <shape type="hair"/>
+        <shape type="hair"/>
+        <medium type="homogeneous"/>"#;
+    let e = read("lenient", body, &[]).unwrap_err();
+    assert!(matches!(e, crate::SceneError::Unsupported { .. }), "{e}");
+    let dir = std::env::temp_dir().join(format!("prism-mitsuba-lenient-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("s.xml");
+    std::fs::write(&file, scene(body)).unwrap();
+    let s = crate::mitsuba::read_mitsuba_with(&file, &[], true)
+        .unwrap()
+        .scene;
+    assert_eq!((s.spheres.len(), s.meshes.len()), (1, 1));
+    let grey = &s.materials[s.spheres[0].material];
+    assert!(
+        matches!(grey, crate::Material::Diffuse { reflectance, texture: None } if *reflectance == Rgb::splat(0.5))
+    );
+    let messages: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(messages.len(), 4, "{messages:?}");
+    assert!(
+        messages.iter().all(|m| m.ends_with("(--lenient)")),
+        "{messages:?}"
+    );
+    std::fs::write(
+        &file,
+        scene(r#"<shape type="obj"><string name="filename" value="missing.obj"/></shape>"#),
+    )
+    .unwrap();
+    assert!(crate::mitsuba::read_mitsuba_with(&file, &[], true).is_err());
+}

@@ -9,7 +9,7 @@ use prism_math::{Rgb, Vec2, Vec3};
 use super::document::{Document, Object};
 use super::limits::{MAX_OBJECT_DEPTH, MAX_SCENE_TRIANGLES};
 use super::meshes;
-use super::props::{error, ior, unsupported};
+use super::props::{error, ior, not_supported, unsupported};
 use crate::error::SceneError;
 use std::sync::Arc;
 
@@ -77,9 +77,10 @@ pub struct MitsubaScene {
 /// The scene `doc` describes.
 ///
 /// # Errors
-/// [`SceneError::Element`] at the plugin: one prism does not render, a property of the wrong
-/// kind or out of range, a mesh file that cannot be read, a reference cycle.
-pub fn to_scene(doc: &Document) -> Result<MitsubaScene, SceneError> {
+/// [`SceneError::Unsupported`] at a plugin or property prism does not render (unless
+/// `lenient`: see [`super::read_mitsuba_with`]); [`SceneError::Element`] at a property of
+/// the wrong kind or out of range, a mesh file that cannot be read, a reference cycle.
+pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneError> {
     let mut b = Builder {
         doc,
         scene: Scene::new(Camera {
@@ -96,20 +97,34 @@ pub fn to_scene(doc: &Document) -> Result<MitsubaScene, SceneError> {
         sensor_seen: false,
         bsdfs: std::collections::HashMap::new(),
         triangles: 0,
+        lenient,
+        warned: std::collections::HashSet::new(),
     };
     let root = &doc.objects[0];
     for &(_, child) in &root.children {
         let o = &doc.objects[child];
         match o.tag.as_str() {
             "shape" if o.kind == "shapegroup" => {}
-            "shape" => b.shape(child, DMat4::IDENTITY, 0)?,
-            "emitter" => b.emitter(o)?,
+            "shape" => {
+                if let Err(e) = b.shape(child, DMat4::IDENTITY, 0) {
+                    b.tolerate(e, "left out")?;
+                }
+            }
+            "emitter" => {
+                if let Err(e) = b.emitter(o) {
+                    b.tolerate(e, "left out")?;
+                }
+            }
             "sensor" => b.sensor(o)?,
-            "integrator" => b.integrator(o)?,
+            "integrator" => {
+                if let Err(e) = b.integrator(o) {
+                    b.tolerate(e, "the path tracer renders the scene")?;
+                }
+            }
             // Objects defined at the top level to be referenced are used where referenced
             // (a shapegroup where an instance places it).
             "bsdf" | "texture" => {}
-            _ => return Err(unsupported(o)),
+            _ => b.tolerate(unsupported(o), "left out")?,
         }
     }
     if !b.sensor_seen {
@@ -135,9 +150,35 @@ pub(super) struct Builder<'d> {
     bsdfs: std::collections::HashMap<usize, usize>,
     /// Triangles placed so far.
     triangles: usize,
+    /// Read past what prism does not render.
+    lenient: bool,
+    /// The refusals already warned of.
+    warned: std::collections::HashSet<String>,
 }
 
 impl Builder<'_> {
+    /// `e` itself, unless the reading is lenient and `e` is a refusal: then a warning
+    /// (once per message) that says what was done instead.
+    fn tolerate(&mut self, e: SceneError, instead: &str) -> Result<(), SceneError> {
+        match e {
+            SceneError::Unsupported {
+                at,
+                element,
+                message,
+            } if self.lenient => {
+                let what = format!("<{element}>: {message}");
+                if self.warned.insert(what.clone()) {
+                    self.scene.warnings.push(prism_math::Warning::at(
+                        at,
+                        format!("{what}; {instead} (--lenient)"),
+                    ));
+                }
+                Ok(())
+            }
+            e => Err(e),
+        }
+    }
+
     /// The shape object `index`, placed by `outer` (an instance's transform) and then its own.
     fn shape(&mut self, index: usize, outer: DMat4, depth: usize) -> Result<(), SceneError> {
         let o = &self.doc.objects[index];
@@ -162,7 +203,7 @@ impl Builder<'_> {
                     c.refuse(&["to_world"])?;
                     emission = Some(c.rgb("radiance", [1.0; 3])?);
                 }
-                _ => return Err(unsupported(c)),
+                _ => self.tolerate(unsupported(c), "read past")?,
             }
         }
         // Mitsuba's default BSDF: diffuse, reflectance 0.5.
@@ -182,7 +223,9 @@ impl Builder<'_> {
                         texture: None,
                     }) => *reflectance,
                     Some(_) => {
-                        return Err(error(o, format!("{}: an area emitter on a shape whose BSDF is not a plain diffuse one: not supported by prism yet", o.label())))
+                        let refusal = not_supported(o, format!("{}: an area emitter on a shape whose BSDF is not a plain diffuse one: not supported by prism yet", o.label()));
+                        self.tolerate(refusal, "its surface is black")?;
+                        Rgb::splat(0.0)
                     }
                 };
                 self.push_material(
@@ -232,7 +275,7 @@ impl Builder<'_> {
                     }
                 );
                 if turned && textured {
-                    return Err(error(
+                    return Err(not_supported(
                         o,
                         format!(
                             "{}: a textured sphere turned by to_world: not supported by prism yet",
@@ -418,6 +461,26 @@ impl Builder<'_> {
         if let Some(&m) = self.bsdfs.get(&index) {
             return Ok(m);
         }
+        match self.translate_bsdf(index, depth) {
+            Ok(m) => Ok(m),
+            Err(e) => {
+                self.tolerate(e, "a grey diffuse BSDF stands in")?;
+                let m = self.push_material(
+                    Material::Diffuse {
+                        reflectance: Rgb::splat(0.5),
+                        texture: None,
+                    },
+                    "grey diffuse (--lenient)".into(),
+                    true,
+                );
+                self.bsdfs.insert(index, m);
+                Ok(m)
+            }
+        }
+    }
+
+    /// [`Builder::bsdf`]'s translation, without the lenient stand-in.
+    fn translate_bsdf(&mut self, index: usize, depth: usize) -> Result<usize, SceneError> {
         let mut o = &self.doc.objects[index];
         let mut depth = depth;
         // `twosided` wraps one BSDF, which then scatters alike on both sides.
@@ -458,7 +521,7 @@ impl Builder<'_> {
                 reflectance_texture = Some(self.texture(c)?);
                 continue;
             }
-            return Err(error(
+            return Err(not_supported(
                 c,
                 format!(
                     "{} in {}: not supported by prism yet (a bitmap or checkerboard reflectance of a diffuse BSDF is)",
@@ -500,7 +563,7 @@ impl Builder<'_> {
             }
             "plastic" => {
                 if o.boolean("nonlinear", false)? {
-                    return Err(error(
+                    return Err(not_supported(
                         o,
                         format!("{}: nonlinear: not supported by prism yet", o.label()),
                     ));
@@ -544,6 +607,35 @@ impl Builder<'_> {
                     },
                 }
             }
+            "roughplastic" => {
+                if o.boolean("nonlinear", false)? {
+                    return Err(not_supported(
+                        o,
+                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                    ));
+                }
+                let roughness = roughness(o)?;
+                if roughness.alpha_u != roughness.alpha_v {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: an anisotropic roughplastic (Mitsuba refuses it too)",
+                            o.label()
+                        ),
+                    ));
+                }
+                let int = ior(o, "int_ior", "polypropylene")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                if !(int > 0.0 && ext > 0.0) || int == ext {
+                    return Err(error(o, format!("{}: int_ior and ext_ior: expected positive indices that differ, found {int} and {ext}", o.label())));
+                }
+                Material::RoughPlastic {
+                    roughness,
+                    diffuse: o.rgb("diffuse_reflectance", [0.5; 3])?,
+                    specular: o.rgb("specular_reflectance", [1.0; 3])?,
+                    eta: (int / ext) as f32,
+                }
+            }
             "roughdielectric" => {
                 let int = ior(o, "int_ior", "bk7")?;
                 let ext = ior(o, "ext_ior", "air")?;
@@ -562,7 +654,7 @@ impl Builder<'_> {
         // Mitsuba's opaque BSDFs are black from behind unless wrapped in `twosided`.
         let opaque = matches!(
             o.kind.as_str(),
-            "diffuse" | "plastic" | "conductor" | "roughconductor"
+            "diffuse" | "plastic" | "roughplastic" | "conductor" | "roughconductor"
         );
         let m = self.push_material(material, name, opaque && !two_sided);
         self.bsdfs.insert(index, m);
@@ -721,7 +813,7 @@ impl Builder<'_> {
                     .iter()
                     .any(|l| matches!(l, Light::EnvironmentMap { .. } | Light::Environment { .. }))
                 {
-                    return Err(error(
+                    return Err(not_supported(
                         o,
                         format!(
                             "{}: a second light at infinity: not supported by prism",
