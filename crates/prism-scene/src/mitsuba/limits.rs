@@ -26,5 +26,8 @@ pub const MAX_SAMPLE_COUNT: u32 = 1 << 20;
 /// Most triangles in one scene, instances' copies included (about 3 GB to render).
 pub const MAX_SCENE_TRIANGLES: usize = 20_000_000;
 
+/// Segments around a `cylinder`: its silhouette is within 5e-6 of its radius.
+pub const CYLINDER_SEGMENTS: u32 = 1024;
+
 /// Segments of the triangle fan a `disk` becomes: its area is within 3e-5 of the disk's.
 pub const DISK_SEGMENTS: u32 = 512;

@@ -6,7 +6,7 @@
 use prism_math::glam::DVec3;
 use prism_math::{Vec2, Vec3};
 
-use super::limits::DISK_SEGMENTS;
+use super::limits::{CYLINDER_SEGMENTS, DISK_SEGMENTS};
 
 /// A mesh in object space: positions, triangles, normals, uvs.
 pub(super) type ObjectMesh = (
@@ -75,6 +75,38 @@ pub(super) fn disk() -> ObjectMesh {
         triangles.push([base, base + 1, base + 2]);
     }
     (positions, triangles, None, Some(uvs))
+}
+
+/// Mitsuba's `cylinder` from `p0` to `p1` of `radius` (open at both ends), as
+/// [`CYLINDER_SEGMENTS`] quads with the exact outward normal at each vertex; the azimuth
+/// starts along the first tangent Mitsuba's frame of the axis has, and the texture
+/// coordinates are Mitsuba's: `u` the azimuth over 2 pi, `v` along the axis from `p0`
+/// (running down the image; prism's v runs up it).
+pub(super) fn cylinder(p0: DVec3, p1: DVec3, radius: f64) -> ObjectMesh {
+    let axis = p1 - p0;
+    let frame = prism_math::Frame::from_normal(axis.normalize().as_vec3());
+    let (s, t) = (frame.s.as_dvec3(), frame.t.as_dvec3());
+    let n = CYLINDER_SEGMENTS;
+    let mut positions = Vec::with_capacity(2 * (n as usize + 1));
+    let mut normals = Vec::with_capacity(positions.capacity());
+    let mut uvs = Vec::with_capacity(positions.capacity());
+    for i in 0..=n {
+        let phi = std::f64::consts::TAU * f64::from(i) / f64::from(n);
+        let radial = s * phi.cos() + t * phi.sin();
+        for z in [0.0, 1.0] {
+            positions.push(p0 + radial * radius + axis * z);
+            normals.push(radial);
+            uvs.push(Vec2::new(i as f32 / n as f32, 1.0 - z as f32));
+        }
+    }
+    let triangles = (0..n)
+        .flat_map(|i| {
+            let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            // Counter-clockwise seen from outside: the normal points away from the axis.
+            [[a, c, d], [a, d, b]]
+        })
+        .collect();
+    (positions, triangles, Some(normals), Some(uvs))
 }
 
 /// A PLY file's mesh (its polygons as fans from their first vertex, as Mitsuba splits them).
@@ -211,5 +243,29 @@ mod tests {
         assert_eq!(positions.len(), 4);
         assert_eq!(triangles, vec![[0, 1, 2], [3, 2, 1]]);
         assert_eq!(uvs.unwrap()[3], Vec2::new(1.0, 1.0));
+    }
+
+    /// Closed form: every vertex of a cylinder lies at its radius from the axis, between
+    /// its ends, with a unit normal square to the axis pointing away from it; each
+    /// triangle's winding agrees with the normals (it faces outwards).
+    #[test]
+    fn cylinders_are_round_and_face_out() {
+        let (p0, p1, r) = (DVec3::new(1.0, 2.0, 3.0), DVec3::new(2.0, 0.0, 5.0), 0.5);
+        let (positions, triangles, normals, uvs) = cylinder(p0, p1, r);
+        let normals = normals.unwrap();
+        let axis = (p1 - p0).normalize();
+        for (p, n) in positions.iter().zip(&normals) {
+            let along = (*p - p0).dot(axis);
+            let off = (*p - p0) - axis * along;
+            assert!((off.length() - r).abs() < 1e-6);
+            assert!(along > -1e-6 && along < (p1 - p0).length() + 1e-6);
+            assert!((off.normalize() - *n).length() < 1e-6);
+        }
+        for t in &triangles {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            let n = (b - a).cross(c - a);
+            assert!(n.dot(normals[t[0] as usize]) > 0.0);
+        }
+        assert_eq!(uvs.unwrap().len(), positions.len());
     }
 }

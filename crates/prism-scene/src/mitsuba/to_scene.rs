@@ -320,6 +320,21 @@ impl Builder<'_> {
             ),
             "cube" => meshes::cube(),
             "disk" => meshes::disk(),
+            "cylinder" => {
+                let p0 = o.point("p0")?.unwrap_or(DVec3::ZERO);
+                let p1 = o.point("p1")?.unwrap_or(DVec3::Z);
+                let radius = o.float("radius", 1.0)?;
+                if !(radius > 0.0 && radius.is_finite()) || (p1 - p0).length_squared() == 0.0 {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: expected a positive radius and p0 apart from p1",
+                            o.label()
+                        ),
+                    ));
+                }
+                meshes::cylinder(p0, p1, radius)
+            }
             "obj" | "ply" => {
                 let file = o
                     .string("filename")?
