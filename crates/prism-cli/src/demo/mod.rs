@@ -65,7 +65,7 @@ fn run_in_pool(a: &DemoArgs) -> Result<()> {
     let assets = assets.as_deref();
     let mut entries = Vec::new();
     let jobs = svg::jobs()?;
-    let pb = crate::progress::bar(jobs.len() as u64 + 11, "demo", a.quiet);
+    let pb = crate::progress::bar(jobs.len() as u64 + 12, "demo", a.quiet);
     let mut t = std::time::Instant::now();
     let mut stage = |name: &str| {
         if a.stats {

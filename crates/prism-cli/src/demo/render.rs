@@ -1,5 +1,6 @@
 //! The gallery's path-traced pictures: the Cornell box, adaptive sampling and its heat map,
-//! single bounces, and the course's bunnies (one under a procedural sky map) when staged.
+//! single bounces, a Mitsuba 3 scene, and the course's bunnies (one under a procedural sky
+//! map) when staged.
 
 use std::path::Path;
 
@@ -51,8 +52,11 @@ fn sky_map() -> prism_image::RgbImage {
     })
 }
 
-/// The path-traced pictures, seven steps of `pb`; the bunnies only when `assets` holds them.
-/// Writes the sky map, sky.exr, beside the pictures.
+/// The Mitsuba 3 scene the gallery renders (built-in shapes only, so it stands alone).
+const SHOWCASE: &str = include_str!("../../../../docs/examples/mitsuba/showcase.xml");
+
+/// The path-traced pictures, eight steps of `pb`; the bunnies only when `assets` holds them.
+/// Writes the sky map, sky.exr, and the Mitsuba scene, showcase.xml, beside the pictures.
 pub fn pictures(
     output: &Path,
     assets: Option<&Path>,
@@ -129,6 +133,33 @@ pub fn pictures(
         });
         pb.inc(1);
     }
+    // A Mitsuba 3 scene file, rendered with its own film, sampler and depth.
+    let showcase = output.join("showcase.xml");
+    std::fs::write(&showcase, SHOWCASE)
+        .with_context(|| format!("writing {}", showcase.display()))?;
+    let m = prism_scene::read_mitsuba(&showcase, &[]).map_err(crate::error::UserError::input)?;
+    let opts = RenderOptions {
+        film: FilmSettings {
+            width: m.settings.size.0,
+            height: m.settings.size.1,
+            spp: m.settings.spp,
+            filter: m.settings.filter,
+            ..base.film
+        },
+        path: PathSettings {
+            max_bounces: m.settings.max_bounces.unwrap_or(base.path.max_bounces),
+            rr_bounces: m.settings.rr_bounces,
+            ..base.path
+        },
+    };
+    trace(&m.scene, &opts, &output.join("render_mitsuba.png"), None)?;
+    entries.push(Entry {
+        file: "render_mitsuba.png".into(),
+        caption: "A Mitsuba 3 scene file (showcase.xml): rough glass, GGX gold, rough plastic, \
+                  a checkerboard texture and instances"
+            .into(),
+    });
+    pb.inc(1);
     let course = |rel: &str| assets.map(|a| a.join(rel)).filter(|p| p.is_file());
     if let Some(bunny) = course("pathtracer/dae/sky/CBbunny.dae") {
         let doc = prism_scene::read_collada(&bunny).map_err(crate::error::UserError::input)?;
