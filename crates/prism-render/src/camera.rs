@@ -24,6 +24,9 @@ pub struct Perspective {
     height: f32,
     /// Lens radius and focal distance; `None` for a pinhole.
     lens: Option<(f32, f32)>,
+    /// True for parallel rays from the plane through the eye (`right` and `up` are then the
+    /// image's half extents in world units).
+    orthographic: bool,
     /// Where in the image a pixel's samples fall.
     filter: PixelFilter,
 }
@@ -37,13 +40,21 @@ impl Perspective {
         let forward = (c.target - c.eye).normalize();
         let right = c.up.cross(-forward).normalize();
         let up = (-forward).cross(right);
+        let (half_x, half_y) = match c.orthographic {
+            Some((x, y)) => (x, y * height as f32 / width as f32),
+            None => (
+                (hfov.to_radians() / 2.0).tan(),
+                (vfov.to_radians() / 2.0).tan(),
+            ),
+        };
         Perspective {
             eye: c.eye,
             forward,
             right_unit: right,
             up_unit: up,
-            right: right * (hfov.to_radians() / 2.0).tan(),
-            up: up * (vfov.to_radians() / 2.0).tan(),
+            right: right * half_x,
+            up: up * half_y,
+            orthographic: c.orthographic.is_some(),
             width: width as f32,
             height: height as f32,
             lens: c
@@ -90,6 +101,9 @@ impl Perspective {
     pub fn ray(&self, x: f32, y: f32, lens_sample: Vec2) -> Ray {
         let sx = 2.0 * x / self.width - 1.0;
         let sy = 1.0 - 2.0 * y / self.height;
+        if self.orthographic {
+            return Ray::new(self.eye + sx * self.right + sy * self.up, self.forward);
+        }
         // Direction at unit depth along the view axis.
         let d = self.forward + sx * self.right + sy * self.up;
         match self.lens {
@@ -106,7 +120,7 @@ impl Perspective {
     /// The point every ray leaves, for a pinhole camera (none with a lens).
     #[must_use]
     pub(crate) fn pinhole(&self) -> Option<Vec3> {
-        self.lens.is_none().then_some(self.eye)
+        (self.lens.is_none() && !self.orthographic).then_some(self.eye)
     }
 
     /// The directions of a pinhole camera's [`Perspective::ray`] through sixteen image
@@ -154,8 +168,39 @@ mod tests {
             near: 0.001,
             far: 1000.0,
             lens,
+            orthographic: None,
         };
         Perspective::new(&c, 64, 48)
+    }
+
+    /// Closed form: an orthographic camera's rays are parallel to the view and leave the
+    /// plane through the eye; the image's left and right edges lie the half width to either
+    /// side, its top and bottom the half height over the aspect.
+    #[test]
+    fn orthographic_rays_are_parallel_across_the_extents() {
+        let c = Camera {
+            eye: Vec3::new(0.0, 0.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            hfov: 60.0,
+            vfov: 45.0,
+            near: 0.001,
+            far: 1000.0,
+            lens: None,
+            orthographic: Some((2.0, 3.0)),
+        };
+        let cam = Perspective::new(&c, 64, 48);
+        assert!(cam.pinhole().is_none() && !cam.has_lens());
+        for (x, y, want) in [
+            (0.0, 24.0, Vec3::new(-2.0, 0.0, 5.0)),
+            (64.0, 24.0, Vec3::new(2.0, 0.0, 5.0)),
+            (32.0, 0.0, Vec3::new(0.0, 2.25, 5.0)),
+            (32.0, 48.0, Vec3::new(0.0, -2.25, 5.0)),
+        ] {
+            let r = cam.ray(x, y, Vec2::ZERO);
+            assert!((r.origin - want).length() < 1e-5, "{x} {y}: {}", r.origin);
+            assert!((r.dir - Vec3::NEG_Z).length() < 1e-6);
+        }
     }
 
     /// Where a ray meets the plane `z = 5 - depth` (depth along the view axis, -z here).

@@ -134,6 +134,7 @@ pub fn cornell_box() -> Scene {
             near: 0.1,
             far: 100.0,
             lens: None,
+            orthographic: None,
         },
         warnings: Vec::new(),
     }

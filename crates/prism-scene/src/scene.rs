@@ -398,6 +398,10 @@ pub struct Camera {
     pub far: f32,
     /// A thin lens, for depth of field; `None` is a pinhole.
     pub lens: Option<ThinLens>,
+    /// An orthographic view instead of a perspective one: parallel rays along the view
+    /// from the plane `near` ahead of the eye, over half extents `(x, y / aspect)` in world
+    /// units (Mitsuba's `orthographic`: the film's width spans `2 x`).
+    pub orthographic: Option<(f32, f32)>,
 }
 
 /// A thin lens: rays leave a disk of `radius` around the eye, in the plane facing the view,
@@ -492,6 +496,7 @@ impl OrbitCamera {
             near: 1e-3,
             far: 1e4,
             lens: None,
+            orthographic: None,
         }
     }
 }

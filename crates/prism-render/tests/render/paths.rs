@@ -31,6 +31,7 @@ fn furnace(material: Material) -> Scene {
             near: 0.01,
             far: 100.0,
             lens: None,
+            orthographic: None,
         },
         warnings: vec![],
     }
@@ -431,6 +432,7 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
             near: 0.01,
             far: 100.0,
             lens: None,
+            orthographic: None,
         },
         warnings: vec![],
     };
@@ -516,6 +518,7 @@ fn textured_square(image: &prism_image::Rgb8Image, name: &str) -> Scene {
         near: 0.01,
         far: 100.0,
         lens: None,
+        orthographic: None,
     };
     scene
 }

@@ -48,6 +48,7 @@ impl Scene {
             near: 0.001,
             far: 1000.0,
             lens: None,
+            orthographic: None,
         });
         scene.warnings.clone_from(&doc.warnings);
         let err = |line: u32, element: &str, message: String| SceneError::Element {
@@ -443,5 +444,6 @@ fn place_camera(scene: &Scene, file: Option<&(CameraDef, DMat4)>, mode: CameraMo
         near: near as f32,
         far: far as f32,
         lens: None,
+        orthographic: None,
     }
 }

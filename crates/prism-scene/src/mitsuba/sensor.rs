@@ -20,7 +20,7 @@ impl Builder<'_> {
             ));
         }
         self.sensor_seen = true;
-        if !matches!(o.kind.as_str(), "perspective" | "thinlens") {
+        if !matches!(o.kind.as_str(), "perspective" | "thinlens" | "orthographic") {
             return Err(unsupported(o));
         }
         for &(_, child) in &o.children {
@@ -146,6 +146,14 @@ impl Builder<'_> {
         } else {
             None
         };
+        // Mitsuba's orthographic camera: parallel rays from its near plane, the film's width
+        // spanning to_world's x axis twice and its height the y axis twice over the aspect.
+        let (eye, orthographic) = if o.kind == "orthographic" {
+            let plane = to_world.transform_point3(DVec3::new(0.0, 0.0, near));
+            (plane, Some((left.length() as f32, up.length() as f32)))
+        } else {
+            (eye, None)
+        };
         self.scene.camera = Camera {
             eye: eye.as_vec3(),
             target: (eye + dir.normalize()).as_vec3(),
@@ -155,6 +163,7 @@ impl Builder<'_> {
             near: near as f32,
             far: far as f32,
             lens,
+            orthographic,
         };
         Ok(())
     }

@@ -627,3 +627,29 @@ fn lenient_reading_stands_in_and_warns_once_per_kind() {
     .unwrap();
     assert!(crate::mitsuba::read_mitsuba_with(&file, &[], true).is_err());
 }
+
+/// Mitsuba's orthographic sensor: parallel rays from its near plane, its film spanning
+/// to_world's x axis twice across and y axis twice (over the aspect) up.
+#[test]
+fn orthographic_sensors_keep_their_extents() {
+    let dir = std::env::temp_dir().join(format!("prism-mitsuba-ortho-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("s.xml");
+    std::fs::write(
+        &file,
+        r#"<scene version="3.0.0"><sensor type="orthographic"><float name="near_clip" value="0.5"/>
+            <transform name="to_world"><scale x="2" y="3"/><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+            <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="32"/></film></sensor></scene>"#,
+    )
+    .unwrap();
+    let c = crate::mitsuba::read_mitsuba(&file, &[])
+        .unwrap()
+        .scene
+        .camera;
+    assert_eq!(c.orthographic, Some((2.0, 3.0)));
+    assert!(
+        (c.eye - prism_math::Vec3::new(0.0, 0.0, 3.5)).length() < 1e-6,
+        "{}",
+        c.eye
+    );
+}

@@ -92,6 +92,7 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
             near: 0.01,
             far: 1e4,
             lens: None,
+            orthographic: None,
         }),
         settings: MitsubaSettings::default(),
         sensor_seen: false,
