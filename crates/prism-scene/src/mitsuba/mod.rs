@@ -8,6 +8,7 @@ mod limits;
 mod meshes;
 mod props;
 mod sensor;
+mod serialized;
 mod to_scene;
 mod transform;
 mod values;

@@ -321,6 +321,26 @@ impl Builder<'_> {
             ),
             "cube" => meshes::cube(),
             "disk" => meshes::disk(),
+            "serialized" => {
+                let file = o
+                    .string("filename")?
+                    .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
+                let index = o.integer("shape_index", 0)?;
+                let index = u32::try_from(index).map_err(|_| {
+                    error(
+                        o,
+                        format!(
+                            "{}: shape_index: expected 0 or more, found {index}",
+                            o.label()
+                        ),
+                    )
+                })?;
+                let path = self.doc.folder.join(file);
+                let bytes = prism_math::limits::read_input(&path, prism_mesh::MAX_MESH_FILE_BYTES)
+                    .map_err(|e| error(o, format!("{}: {}: {e}", o.label(), path.display())))?;
+                super::serialized::read_serialized(&bytes, index)
+                    .map_err(|e| error(o, format!("{}: {file}: {e}", o.label())))?
+            }
             "cylinder" => {
                 let p0 = o.point("p0")?.unwrap_or(DVec3::ZERO);
                 let p1 = o.point("p1")?.unwrap_or(DVec3::Z);
@@ -385,8 +405,9 @@ impl Builder<'_> {
             }
         }
         // Mitsuba computes vertex normals for file meshes that have none.
-        let compute_normals =
-            normals.is_none() && !face_normals && matches!(o.kind.as_str(), "obj" | "ply");
+        let compute_normals = normals.is_none()
+            && !face_normals
+            && matches!(o.kind.as_str(), "obj" | "ply" | "serialized");
         let mut shading = match normals {
             Some(n) if !face_normals => Shading::Smooth(
                 n.iter()
