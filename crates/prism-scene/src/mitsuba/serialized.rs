@@ -184,7 +184,7 @@ mod tests {
             record.extend(1u64.to_le_bytes());
             for p in [[0.0, 0.0, shift], [1.0, 0.0, shift], [0.0, 1.0, shift]] {
                 for x in p {
-                    record.extend((x as f32).to_le_bytes());
+                    record.extend(x.to_le_bytes());
                 }
             }
             if uv {
