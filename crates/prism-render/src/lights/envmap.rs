@@ -47,9 +47,10 @@ impl EnvMap {
         EnvMap::with_mapping(map, EnvMapping::Course)
     }
 
-    /// Prepares `map` laid over the sphere as `mapping` says. A Mitsuba map is sampled by
-    /// the brightest texel around each cell (its lookups reach across cells), so that no
-    /// direction with radiance has density 0.
+    /// Prepares `map` laid over the sphere as `mapping` says. A Mitsuba map's lookups reach
+    /// across cells: each cell is sampled by the mean of 16 lookups inside it, plus a
+    /// thousandth of the brightest texel around it, so that no direction with radiance has
+    /// density 0.
     #[must_use]
     pub fn with_mapping(map: &RgbImage, mapping: EnvMapping) -> EnvMap {
         let (w, h) = (map.width(), map.height());
@@ -69,7 +70,17 @@ impl EnvMap {
                     most = most.max(map.get(xx, yy).luminance());
                 }
             }
-            most
+            let mut mean = 0.0f32;
+            for j in 0..4 {
+                for i in 0..4 {
+                    let uv = Vec2::new(
+                        (x as f32 + (i as f32 + 0.5) / 4.0) / w as f32,
+                        (y as f32 + (j as f32 + 0.5) / 4.0) / h as f32,
+                    );
+                    mean += mitsuba_lookup(map, uv).luminance() / 16.0;
+                }
+            }
+            mean + 1e-3 * most
         };
         let columns: Vec<Piecewise1D> = (0..h)
             .map(|y| {
@@ -143,20 +154,7 @@ impl EnvMap {
         let Some((_, _, map)) = &self.mitsuba else {
             return self.texture.sample_level(uv, 0, PixelSampling::Bilinear);
         };
-        let (w, h) = (map.width() as i64, map.height() as i64);
-        let gx = uv.x * w as f32 - 0.5;
-        let gy = uv.y.clamp(0.0, 1.0) * (h - 1) as f32;
-        if !(gx.is_finite() && gy.is_finite()) {
-            return map.get(0, 0);
-        }
-        let (x0, y0) = (gx.floor(), gy.floor());
-        let (tx, ty) = (gx - x0, gy - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let xs = [x0.rem_euclid(w) as u32, (x0 + 1).rem_euclid(w) as u32];
-        let ys = [y0.clamp(0, h - 1) as u32, (y0 + 1).clamp(0, h - 1) as u32];
-        let top = map.get(xs[0], ys[0]).lerp(map.get(xs[1], ys[0]), tx);
-        let bottom = map.get(xs[0], ys[1]).lerp(map.get(xs[1], ys[1]), tx);
-        top.lerp(bottom, ty)
+        mitsuba_lookup(map, uv)
     }
 
     /// A direction towards the light for uniform `u`, with its radiance and solid-angle
@@ -201,6 +199,26 @@ impl EnvMap {
         let row = ((uv.y * self.columns.len() as f32) as usize).min(self.columns.len() - 1);
         self.rows.pdf(uv.y) * self.columns[row].pdf(uv.x) / (2.0 * PI * PI * sin)
     }
+}
+
+/// Mitsuba's lookup of a lat-long map at `uv`: bilinear between texel centres at
+/// `(i + 0.5) / w` across (repeating), and between rows whose first and last sit at the
+/// poles down.
+fn mitsuba_lookup(map: &RgbImage, uv: Vec2) -> Rgb {
+    let (w, h) = (map.width() as i64, map.height() as i64);
+    let gx = uv.x * w as f32 - 0.5;
+    let gy = uv.y.clamp(0.0, 1.0) * (h - 1) as f32;
+    if !(gx.is_finite() && gy.is_finite()) {
+        return map.get(0, 0);
+    }
+    let (x0, y0) = (gx.floor(), gy.floor());
+    let (tx, ty) = (gx - x0, gy - y0);
+    let (x0, y0) = (x0 as i64, y0 as i64);
+    let xs = [x0.rem_euclid(w) as u32, (x0 + 1).rem_euclid(w) as u32];
+    let ys = [y0.clamp(0, h - 1) as u32, (y0 + 1).clamp(0, h - 1) as u32];
+    let top = map.get(xs[0], ys[0]).lerp(map.get(xs[1], ys[0]), tx);
+    let bottom = map.get(xs[0], ys[1]).lerp(map.get(xs[1], ys[1]), tx);
+    top.lerp(bottom, ty)
 }
 
 #[cfg(test)]
