@@ -250,6 +250,12 @@ impl RenderScene {
                 .map(|m| match m {
                     prism_scene::Material::Diffuse {
                         texture: Some(t), ..
+                    }
+                    | prism_scene::Material::Plastic {
+                        texture: Some(t), ..
+                    }
+                    | prism_scene::Material::RoughPlastic {
+                        texture: Some(t), ..
                     } => Some((
                         prism_image::Texture::new((*t.image).clone()).with_wrap(t.wrap, t.wrap),
                         t.sampling,
@@ -396,7 +402,7 @@ impl RenderScene {
                 if self.one_sided[m.material] && ray.dir.dot(ns) >= 0.0 {
                     bsdf = Bsdf::Black;
                 }
-                if let (Some(uvs), Bsdf::Diffuse { albedo }) = (&m.uvs, &mut bsdf) {
+                if let (Some(uvs), Some(albedo)) = (&m.uvs, bsdf.albedo_mut()) {
                     if self.textures[m.material].is_some() {
                         // The texture's rows run down the image; v runs up it.
                         let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
@@ -456,7 +462,7 @@ impl RenderScene {
                 } else {
                     self.bsdfs[material]
                 };
-                if let Bsdf::Diffuse { albedo } = &mut bsdf {
+                if let Some(albedo) = bsdf.albedo_mut() {
                     if self.textures[material].is_some() {
                         // Mitsuba's sphere coordinates: the azimuth over 2 pi, the polar angle
                         // from +z over pi (the world's axes).

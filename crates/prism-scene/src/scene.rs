@@ -40,6 +40,8 @@ pub enum Material {
         specular: Rgb,
         /// Index of refraction of the coat over the outside.
         eta: f32,
+        /// An image the base's albedo is multiplied by.
+        texture: Option<MaterialTexture>,
     },
     /// Mitsuba's `thindielectric`: a thin pane of index `ior` that reflects `2F / (1 + F)`
     /// of the light (its inner reflections summed) and lets the rest through undeviated.
@@ -121,6 +123,8 @@ pub enum Material {
         specular: Rgb,
         /// Index of refraction of the coat over the outside.
         eta: f32,
+        /// An image the base's albedo is multiplied by.
+        texture: Option<MaterialTexture>,
     },
     /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
     /// specular lobe `ks * max(r.v, 0)^shininess` per light.

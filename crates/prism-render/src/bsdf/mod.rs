@@ -178,14 +178,16 @@ impl Bsdf {
                 diffuse,
                 specular,
                 eta,
+                ref texture,
             } => {
                 let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
                 let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
+                let albedo = diffuse * texture_mean(texture.as_ref());
                 Bsdf::Plastic {
                     diffuse: diffuse * (1.0 / ((1.0 - fdr_int) * eta * eta)),
                     specular,
                     eta,
-                    specular_weight: mean(specular) / (mean(diffuse) + mean(specular)),
+                    specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
                 }
             }
             Material::Conductor {
@@ -221,16 +223,18 @@ impl Bsdf {
                 diffuse,
                 specular,
                 eta,
+                ref texture,
             } => {
                 let distr: Microfacet = roughness.into();
                 let tables = rough_plastic::coat_tables(&distr, eta);
                 let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
+                let albedo = diffuse * texture_mean(texture.as_ref());
                 Bsdf::RoughPlastic {
                     distr,
                     eta,
                     diffuse: diffuse * (1.0 / ((1.0 - tables.internal_reflectance) * eta * eta)),
                     specular,
-                    specular_weight: mean(specular) / (mean(diffuse) + mean(specular)),
+                    specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
                     tables,
                 }
             }
@@ -250,6 +254,15 @@ impl Bsdf {
                 | Bsdf::RoughDielectric { .. }
                 | Bsdf::RoughPlastic { .. }
         )
+    }
+
+    /// The diffuse albedo a texture multiplies (of a diffuse BSDF or a plastic's base).
+    pub(crate) fn albedo_mut(&mut self) -> Option<&mut Rgb> {
+        match self {
+            Bsdf::Diffuse { albedo } => Some(albedo),
+            Bsdf::Plastic { diffuse, .. } | Bsdf::RoughPlastic { diffuse, .. } => Some(diffuse),
+            _ => None,
+        }
     }
 
     /// True if the BSDF depends on the direction around the normal, so the shading frame's
@@ -569,6 +582,15 @@ impl Bsdf {
             _ => None,
         }
     }
+}
+
+/// The mean texel of a texture (white without one): what Mitsuba weighs a textured
+/// plastic's lobes by.
+fn texture_mean(texture: Option<&prism_scene::MaterialTexture>) -> Rgb {
+    texture.map_or(Rgb::WHITE, |t| {
+        let px = t.image.pixels();
+        px.iter().fold(Rgb::BLACK, |a, &c| a + c) * (1.0 / px.len().max(1) as f32)
+    })
 }
 
 /// The share of a plastic's samples taken by its diffuse lobe, for an incident Fresnel

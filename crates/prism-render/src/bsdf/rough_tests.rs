@@ -190,6 +190,7 @@ fn rough_plastic_sampling_matches_its_pdf() {
             diffuse: Rgb::new(0.6, 0.3, 0.2),
             specular: Rgb::WHITE,
             eta: 1.5,
+            texture: None,
         });
         for wo in [dir(15.0, 0.3), dir(70.0, 1.0), -dir(40.0, 2.0)] {
             check_sampling(&b, wo);

@@ -263,6 +263,7 @@ fn plastic_is_mitsubas_smooth_plastic() {
         diffuse: Rgb::new(0.8, 0.4, 0.2),
         specular: Rgb::splat(1.0),
         eta: 1.49,
+        texture: None,
     });
     let mut rng = Pcg32::new(11, 3);
     let wo = Vec3::new(0.3, -0.2, 0.9).normalize();

@@ -388,7 +388,7 @@ fn plastic_is_read_with_mitsubas_defaults() {
     .unwrap();
     let m = s.scene.materials[s.scene.spheres[0].material].clone();
     assert!(
-        matches!(m, crate::Material::Plastic { diffuse, specular, eta } if diffuse.r == 0.5 && specular.g == 1.0 && (eta - 1.49 / 1.000_277).abs() < 1e-6),
+        matches!(m, crate::Material::Plastic { diffuse, specular, eta, .. } if diffuse.r == 0.5 && specular.g == 1.0 && (eta - 1.49 / 1.000_277).abs() < 1e-6),
         "{m:?}"
     );
     let e = read("plastic-nl", "<shape type=\"sphere\"><bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>", &[])
@@ -487,7 +487,8 @@ fn microfacet_parameters_are_mitsubas() {
 }
 
 /// Mitsuba's textures: a bitmap (with `filter_type`, `wrap_mode`, `to_uv`) or checkerboard
-/// in place of a diffuse reflectance, inline or by reference; the checkerboard is color0
+/// in place of a diffuse reflectance (or a plastic's), inline or by reference; the
+/// checkerboard is color0
 /// where u and v fall in the same half of the unit square (a 2x2 image looked up nearest).
 /// A texture elsewhere, or a bitmap that is no image, is a located error.
 #[test]
@@ -532,6 +533,10 @@ fn textures_are_read_as_mitsuba_reads_them() {
         panic!("{:?}", s.materials);
     };
     assert_eq!(t.wrap, prism_image::Wrap::Mirror);
+    let s = read_in(r#"<shape type="rectangle"><bsdf type="roughplastic"><texture type="checkerboard" name="diffuse_reflectance"/></bsdf></shape>"#).unwrap();
+    assert!(
+        matches!(&s.materials[s.meshes[0].material], crate::Material::RoughPlastic { diffuse, texture: Some(_), .. } if *diffuse == Rgb::WHITE)
+    );
     assert_eq!(t.image.get(1, 0), Rgb::new(1.0, 0.0, 0.0));
     for (body, want) in [
         (
@@ -539,7 +544,7 @@ fn textures_are_read_as_mitsuba_reads_them() {
             "not.png",
         ),
         (
-            r#"<shape type="rectangle"><bsdf type="plastic"><texture type="checkerboard" name="diffuse_reflectance"/></bsdf></shape>"#,
+            r#"<shape type="rectangle"><bsdf type="roughconductor"><texture type="checkerboard" name="specular_reflectance"/></bsdf></shape>"#,
             "not supported",
         ),
         (

@@ -554,14 +554,20 @@ impl Builder<'_> {
         let mut reflectance_texture = None;
         for (slot, c) in &o.children {
             let c = &self.doc.objects[*c];
-            if o.kind == "diffuse" && slot.as_deref() == Some("reflectance") && c.tag == "texture" {
+            let albedo_slot = match o.kind.as_str() {
+                "diffuse" => "reflectance",
+                "plastic" | "roughplastic" => "diffuse_reflectance",
+                _ => "",
+            };
+            if !albedo_slot.is_empty() && slot.as_deref() == Some(albedo_slot) && c.tag == "texture"
+            {
                 reflectance_texture = Some(self.texture(c)?);
                 continue;
             }
             return Err(not_supported(
                 c,
                 format!(
-                    "{} in {}: not supported by prism yet (a bitmap or checkerboard reflectance of a diffuse BSDF is)",
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse reflectance or a plastic's diffuse_reflectance is)",
                     c.label(),
                     o.label()
                 ),
@@ -608,9 +614,14 @@ impl Builder<'_> {
                 let int = ior(o, "int_ior", "polypropylene")?;
                 let ext = ior(o, "ext_ior", "air")?;
                 Material::Plastic {
-                    diffuse: o.rgb("diffuse_reflectance", [0.5; 3])?,
+                    diffuse: if reflectance_texture.is_some() {
+                        Rgb::WHITE
+                    } else {
+                        o.rgb("diffuse_reflectance", [0.5; 3])?
+                    },
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
+                    texture: reflectance_texture.clone(),
                 }
             }
             "conductor" | "roughconductor" => {
@@ -668,9 +679,14 @@ impl Builder<'_> {
                 }
                 Material::RoughPlastic {
                     roughness,
-                    diffuse: o.rgb("diffuse_reflectance", [0.5; 3])?,
+                    diffuse: if reflectance_texture.is_some() {
+                        Rgb::WHITE
+                    } else {
+                        o.rgb("diffuse_reflectance", [0.5; 3])?
+                    },
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
+                    texture: reflectance_texture.clone(),
                 }
             }
             "roughdielectric" => {
