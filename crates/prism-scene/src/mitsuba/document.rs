@@ -102,6 +102,25 @@ pub struct Document {
     pub objects: Vec<Object>,
     /// The scene file's folder, against which file names are resolved.
     pub folder: PathBuf,
+    /// Further folders file names are looked for in (`<path value>`), in order.
+    pub search: Vec<PathBuf>,
+}
+
+impl Document {
+    /// Where file `name` is: under the scene's folder if it is there, else under the first
+    /// search folder that holds it (else under the scene's folder, for the message).
+    #[must_use]
+    pub fn resolve(&self, name: &str) -> PathBuf {
+        let here = self.folder.join(name);
+        if here.exists() {
+            return here;
+        }
+        self.search
+            .iter()
+            .map(|f| f.join(name))
+            .find(|p| p.exists())
+            .unwrap_or(here)
+    }
 }
 
 /// The tags that make plugin objects.
@@ -150,6 +169,7 @@ struct Source {
 /// [`MAX_INCLUDE_DEPTH`] or more than [`MAX_SCENE_FILES`] files, a reference to no object.
 pub fn read_document(path: &Path, defines: &[(String, String)]) -> Result<Document, SceneError> {
     let mut reader = Reader {
+        search: Vec::new(),
         sources: Vec::new(),
         bytes: 0,
         objects: Vec::new(),
@@ -172,6 +192,7 @@ pub fn read_document(path: &Path, defines: &[(String, String)]) -> Result<Docume
     Ok(Document {
         objects: reader.objects,
         folder: reader.sources[main].folder.clone(),
+        search: reader.search,
     })
 }
 
@@ -184,6 +205,8 @@ struct Reader {
     params: HashMap<String, String>,
     /// `<ref>`s met before the object they name: (parent, slot in its children, id, where).
     pending_refs: Vec<(usize, usize, String, Loc)>,
+    /// The `<path>` folders met so far.
+    search: Vec<PathBuf>,
 }
 
 /// A located error at `node` of `file`.
@@ -304,7 +327,16 @@ impl Reader {
                         )));
                     }
                     let name = self.attr(node, "filename", &lines, file)?;
-                    let path = self.sources[src].folder.join(&name);
+                    let here = self.sources[src].folder.join(&name);
+                    let path = if here.exists() {
+                        here
+                    } else {
+                        self.search
+                            .iter()
+                            .map(|f| f.join(&name))
+                            .find(|p| p.exists())
+                            .unwrap_or(here)
+                    };
                     let inc = self.load(&path, Some((file, at.line)))?;
                     self.walk_file(inc, owner, depth + 1)?;
                 }
@@ -356,7 +388,17 @@ impl Reader {
                     let value = self.property(node, &lines, file)?;
                     self.objects[owner].props.push(Property { name, value, at });
                 }
-                "path" => {} // Mitsuba's search-path hint: file names here are relative anyway.
+                "path" => {
+                    // A folder that later file names are also looked for in.
+                    let value = self.attr(node, "value", &lines, file)?;
+                    if self.search.len() >= MAX_SCENE_FILES {
+                        return Err(err(format!(
+                            "more than {MAX_SCENE_FILES} search folders"
+                        )));
+                    }
+                    let folder = self.sources[src].folder.join(value);
+                    self.search.push(folder);
+                }
                 other => {
                     return Err(err(format!(
                         "unknown element <{other}> (expected an object such as <shape>, a property such as <float>, <ref>, <default> or <include>)"

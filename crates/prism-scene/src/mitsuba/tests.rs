@@ -658,3 +658,39 @@ fn orthographic_sensors_keep_their_extents() {
         c.eye
     );
 }
+
+/// `<path value>` adds a folder file names are also looked for in (Mitsuba's docs scenes
+/// keep their meshes in a shared folder), relative to the file it is in; a nested plugin
+/// prism does not read in place of a property (a spot light's texture) is refused, not
+/// ignored.
+#[test]
+fn search_paths_resolve_files_and_nested_plugins_are_refused() {
+    let dir = std::env::temp_dir().join(format!("prism-mitsuba-path-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("common/meshes")).unwrap();
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::write(
+        dir.join("common/meshes/tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let file = dir.join("scenes/s.xml");
+    std::fs::write(
+        &file,
+        scene(r#"<path value="../common"/><shape type="obj"><string name="filename" value="meshes/tri.obj"/></shape>"#),
+    )
+    .unwrap();
+    let s = crate::mitsuba::read_mitsuba(&file, &[]).unwrap().scene;
+    assert_eq!(s.meshes[0].triangles.len(), 1);
+    std::fs::write(
+        &file,
+        scene(r#"<emitter type="spot"><texture type="checkerboard" name="texture"/></emitter>"#),
+    )
+    .unwrap();
+    let e = crate::mitsuba::read_mitsuba(&file, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("s.xml:") && e.contains("checkerboard") && e.contains("spot"),
+        "{e}"
+    );
+}

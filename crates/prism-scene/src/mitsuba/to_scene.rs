@@ -202,6 +202,7 @@ impl Builder<'_> {
                 "bsdf" => material = Some(self.bsdf(child, depth + 1)?),
                 "emitter" if c.kind == "area" => {
                     c.refuse(&["to_world"])?;
+                    self.no_nested_plugins(c)?;
                     emission = Some(c.rgb("radiance", [1.0; 3])?);
                 }
                 _ => self.tolerate(unsupported(c), "read past")?,
@@ -335,7 +336,7 @@ impl Builder<'_> {
                         ),
                     )
                 })?;
-                let path = self.doc.folder.join(file);
+                let path = self.doc.resolve(file);
                 let bytes = prism_math::limits::read_input(&path, prism_mesh::MAX_MESH_FILE_BYTES)
                     .map_err(|e| error(o, format!("{}: {}: {e}", o.label(), path.display())))?;
                 super::serialized::read_serialized(&bytes, index)
@@ -360,7 +361,7 @@ impl Builder<'_> {
                 let file = o
                     .string("filename")?
                     .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
-                let path = self.doc.folder.join(file);
+                let path = self.doc.resolve(file);
                 let failed = |e: String| error(o, format!("{}: {e}", o.label()));
                 if o.kind == "obj" {
                     let text =
@@ -717,6 +718,7 @@ impl Builder<'_> {
     /// A `bitmap` (PNG, JPEG or OpenEXR; 8-bit colour decoded from sRGB unless `raw`) or
     /// `checkerboard` texture, with its `filter_type`, `wrap_mode` and `to_uv`.
     fn texture(&self, o: &Object) -> Result<MaterialTexture, SceneError> {
+        self.no_nested_plugins(o)?;
         let m = o.transform("to_uv")?;
         let to_uv = [
             m.x_axis.x, m.y_axis.x, m.w_axis.x, m.x_axis.y, m.y_axis.y, m.w_axis.y,
@@ -792,7 +794,7 @@ impl Builder<'_> {
         let file = o
             .string("filename")?
             .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
-        let path = self.doc.folder.join(file);
+        let path = self.doc.resolve(file);
         let located = |message: String| error(o, format!("{}: {file}: {message}", o.label()));
         let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
         let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
@@ -807,8 +809,24 @@ impl Builder<'_> {
         Ok((file.to_string(), image))
     }
 
+    /// Refuses a nested plugin (a texture in place of a colour, say) of an object prism
+    /// reads only properties of.
+    fn no_nested_plugins(&self, o: &Object) -> Result<(), SceneError> {
+        match o.children.first() {
+            Some(&(_, c)) => {
+                let c = &self.doc.objects[c];
+                Err(not_supported(
+                    c,
+                    format!("{} in {}: not supported by prism yet", c.label(), o.label()),
+                ))
+            }
+            None => Ok(()),
+        }
+    }
+
     /// A top-level emitter.
     fn emitter(&mut self, o: &Object) -> Result<(), SceneError> {
+        self.no_nested_plugins(o)?;
         let light = match o.kind.as_str() {
             "point" => {
                 let to_world = o.transform("to_world")?;
