@@ -9,6 +9,7 @@ mod meshes;
 mod props;
 mod sensor;
 mod serialized;
+mod textures;
 mod to_scene;
 mod transform;
 mod values;
