@@ -45,6 +45,14 @@ struct MeshRec {
     uvs: Option<Vec<prism_math::Vec2>>,
 }
 
+/// A material's texture (shared by the materials that use its image), its lookup and its
+/// `to_uv`.
+type MaterialLookup = (
+    std::sync::Arc<prism_image::Texture>,
+    prism_image::PixelSampling,
+    [f32; 6],
+);
+
 /// The prepared scene.
 pub struct RenderScene {
     bvh: Bvh,
@@ -55,7 +63,7 @@ pub struct RenderScene {
     bsdfs: Vec<Bsdf>,
     /// Per material, the texture its diffuse albedo is multiplied by, its lookup and its
     /// `to_uv`.
-    textures: Vec<Option<(prism_image::Texture, prism_image::PixelSampling, [f32; 6])>>,
+    textures: Vec<Option<MaterialLookup>>,
     emission: Vec<Option<Rgb>>,
     /// Per material: true if it is black from behind (where the winding's normal points
     /// away from the ray's origin).
@@ -244,26 +252,36 @@ impl RenderScene {
                 .iter()
                 .map(|m| Bsdf::from_material(m).anisotropic())
                 .collect(),
-            textures: scene
-                .materials
-                .iter()
-                .map(|m| match m {
-                    prism_scene::Material::Diffuse {
-                        texture: Some(t), ..
-                    }
-                    | prism_scene::Material::Plastic {
-                        texture: Some(t), ..
-                    }
-                    | prism_scene::Material::RoughPlastic {
-                        texture: Some(t), ..
-                    } => Some((
-                        prism_image::Texture::new((*t.image).clone()).with_wrap(t.wrap, t.wrap),
-                        t.sampling,
-                        t.to_uv,
-                    )),
-                    _ => None,
-                })
-                .collect(),
+            textures: {
+                // Materials that share an image share its prepared texture.
+                let mut built = std::collections::HashMap::new();
+                scene
+                    .materials
+                    .iter()
+                    .map(|m| match m {
+                        prism_scene::Material::Diffuse {
+                            texture: Some(t), ..
+                        }
+                        | prism_scene::Material::Plastic {
+                            texture: Some(t), ..
+                        }
+                        | prism_scene::Material::RoughPlastic {
+                            texture: Some(t), ..
+                        } => {
+                            let texture = built
+                                .entry((std::sync::Arc::as_ptr(&t.image), t.wrap))
+                                .or_insert_with(|| {
+                                    std::sync::Arc::new(
+                                        prism_image::Texture::new((*t.image).clone())
+                                            .with_wrap(t.wrap, t.wrap),
+                                    )
+                                });
+                            Some((std::sync::Arc::clone(texture), t.sampling, t.to_uv))
+                        }
+                        _ => None,
+                    })
+                    .collect()
+            },
             front_only: scene
                 .materials
                 .iter()

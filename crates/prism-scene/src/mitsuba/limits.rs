@@ -23,8 +23,13 @@ pub const MAX_FILM_SIDE: u32 = 16384;
 /// Most samples per pixel a scene may ask for.
 pub const MAX_SAMPLE_COUNT: u32 = 1 << 20;
 
-/// Most triangles in one scene, instances' copies included (about 3 GB to render).
-pub const MAX_SCENE_TRIANGLES: usize = 20_000_000;
+/// Most triangles and spheres in one scene, instances' copies included (about 3 GB to
+/// render).
+pub const MAX_SCENE_PRIMITIVES: usize = 20_000_000;
+
+/// Most distinct rough plastic coats in one scene (each is tabulated by quadrature once, in
+/// tens of milliseconds, and kept for the process).
+pub const MAX_ROUGH_PLASTIC_COATS: usize = 256;
 
 /// Segments around a `cylinder`: its silhouette is within 5e-6 of its radius.
 pub const CYLINDER_SEGMENTS: u32 = 1024;

@@ -13,7 +13,7 @@ use crate::scene::MaterialTexture;
 impl Builder<'_> {
     /// A `bitmap` (PNG, JPEG or OpenEXR; 8-bit colour decoded from sRGB unless `raw`) or
     /// `checkerboard` texture, with its `filter_type`, `wrap_mode` and `to_uv`.
-    pub(super) fn texture(&self, o: &Object) -> Result<MaterialTexture, SceneError> {
+    pub(super) fn texture(&mut self, o: &Object) -> Result<MaterialTexture, SceneError> {
         self.no_nested_plugins(o)?;
         let m = o.transform("to_uv")?;
         let to_uv = [
@@ -73,7 +73,7 @@ impl Builder<'_> {
                     sampling,
                     wrap,
                     to_uv,
-                    ..MaterialTexture::new(file, Arc::new(image))
+                    ..MaterialTexture::new(file, image)
                 })
             }
             _ => Err(unsupported(o)),
@@ -81,27 +81,40 @@ impl Builder<'_> {
     }
 
     /// The image file an object's `filename` names, with that name: OpenEXR as linear
-    /// values; PNG or JPEG as `byte / 255`, decoded from sRGB unless `raw`.
+    /// values; PNG or JPEG as `byte / 255`, decoded from sRGB unless `raw`. A file read
+    /// before is not read again: its image is shared.
     pub(super) fn image_file(
-        &self,
+        &mut self,
         o: &Object,
         raw: bool,
-    ) -> Result<(String, prism_image::RgbImage), SceneError> {
+    ) -> Result<(String, Arc<prism_image::RgbImage>), SceneError> {
         let file = o
             .string("filename")?
             .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
         let path = self.doc.resolve(file);
-        let located = |message: String| error(o, format!("{}: {file}: {message}", o.label()));
+        if let Some(image) = self.images.get(&(path.clone(), raw)) {
+            return Ok((file.to_string(), Arc::clone(image)));
+        }
+        // The readers' messages name the file already.
+        let located = |message: String| error(o, format!("{}: {message}", o.label()));
+        let decoding = |e: crate::texture_file::TextureFileError| {
+            located(match e {
+                crate::texture_file::TextureFileError::NotAnImage => {
+                    format!("{file}: {e} (prism reads PNG, JPEG and OpenEXR images)")
+                }
+                e => e.to_string(),
+            })
+        };
         let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
         let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
             prism_image::decode_exr(&bytes, file).map_err(|e| located(e.to_string()))?
         } else if raw {
-            crate::texture_file::decode_texture(&bytes, file)
-                .map_err(|e| located(format!("{e} (prism reads PNG, JPEG and OpenEXR images)")))?
+            crate::texture_file::decode_texture(&bytes, file).map_err(decoding)?
         } else {
-            crate::texture_file::decode_color_texture(&bytes, file)
-                .map_err(|e| located(format!("{e} (prism reads PNG, JPEG and OpenEXR images)")))?
+            crate::texture_file::decode_color_texture(&bytes, file).map_err(decoding)?
         };
+        let image = Arc::new(image);
+        self.images.insert((path, raw), Arc::clone(&image));
         Ok((file.to_string(), image))
     }
 

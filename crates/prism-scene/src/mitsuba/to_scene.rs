@@ -7,7 +7,7 @@ use prism_math::glam::{DMat4, DVec3};
 use prism_math::{Rgb, Vec2, Vec3};
 
 use super::document::{Document, Object};
-use super::limits::{MAX_OBJECT_DEPTH, MAX_SCENE_TRIANGLES};
+use super::limits::{MAX_OBJECT_DEPTH, MAX_ROUGH_PLASTIC_COATS, MAX_SCENE_PRIMITIVES};
 use super::meshes;
 use super::props::{error, ior, not_supported, unsupported};
 use crate::error::SceneError;
@@ -96,7 +96,10 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
         settings: MitsubaSettings::default(),
         sensor_seen: false,
         bsdfs: std::collections::HashMap::new(),
-        triangles: 0,
+        primitives: 0,
+        default_material: None,
+        coats: std::collections::HashSet::new(),
+        images: std::collections::HashMap::new(),
         lenient,
         warned: std::collections::HashSet::new(),
     };
@@ -148,8 +151,15 @@ pub(super) struct Builder<'d> {
     pub(super) sensor_seen: bool,
     /// Material index of each BSDF object already translated.
     bsdfs: std::collections::HashMap<usize, usize>,
-    /// Triangles placed so far.
-    triangles: usize,
+    /// Triangles and spheres placed so far.
+    primitives: usize,
+    /// The material of shapes without a BSDF, once one needs it.
+    default_material: Option<usize>,
+    /// The distinct rough plastic coats (distribution, alpha, index) read so far.
+    coats: std::collections::HashSet<(bool, u32, u32)>,
+    /// The images read so far, by file and `raw`: one decoded copy however often used.
+    pub(super) images:
+        std::collections::HashMap<(std::path::PathBuf, bool), Arc<prism_image::RgbImage>>,
     /// Read past what prism does not render.
     lenient: bool,
     /// The refusals already warned of.
@@ -239,7 +249,15 @@ impl Builder<'_> {
                 )
             }
             (None, Some(m)) => m,
-            (None, None) => self.push_material(default_diffuse, "default diffuse".into(), true),
+            // One default material, however many shapes lack a BSDF.
+            (None, None) => match self.default_material {
+                Some(m) => m,
+                None => {
+                    let m = self.push_material(default_diffuse, "default diffuse".into(), true);
+                    self.default_material = Some(m);
+                    m
+                }
+            },
         };
         let flip = o.boolean("flip_normals", false)?;
         let face_normals = o.boolean("face_normals", false)?;
@@ -294,6 +312,7 @@ impl Builder<'_> {
                         ),
                     ));
                 }
+                self.place(o, 1)?;
                 self.scene.spheres.push(SceneSphere {
                     center: c.as_vec3(),
                     radius: r as f32,
@@ -385,6 +404,8 @@ impl Builder<'_> {
             _ => return Err(unsupported(o)),
         };
         let (positions, mut triangles, normals, uvs) = mesh;
+        // Each shape counts at least once: an empty mesh instanced without end still costs.
+        self.place(o, triangles.len().max(1))?;
         let normal_matrix = to_world.inverse().transpose();
         let world: Vec<Vec3> = positions
             .iter()
@@ -435,13 +456,6 @@ impl Builder<'_> {
         if compute_normals {
             shading = Shading::Smooth(meshes::angle_weighted_normals(&world, &triangles));
         }
-        self.triangles += triangles.len();
-        if self.triangles > MAX_SCENE_TRIANGLES {
-            return Err(error(
-                o,
-                format!("{}: the scene would hold more than {MAX_SCENE_TRIANGLES} triangles (instances are copies)", o.label()),
-            ));
-        }
         self.scene.meshes.push(TriangleMesh {
             name,
             positions: world,
@@ -479,6 +493,18 @@ impl Builder<'_> {
                 ));
             }
             self.shape(c, to_world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    /// Counts `count` more primitives (triangles or spheres) against the scene's budget.
+    fn place(&mut self, o: &Object, count: usize) -> Result<(), SceneError> {
+        self.primitives = self.primitives.saturating_add(count);
+        if self.primitives > MAX_SCENE_PRIMITIVES {
+            return Err(error(
+                o,
+                format!("{}: the scene would hold more than {MAX_SCENE_PRIMITIVES} triangles and spheres (instances are copies)", o.label()),
+            ));
         }
         Ok(())
     }
@@ -676,6 +702,15 @@ impl Builder<'_> {
                 let ext = ior(o, "ext_ior", "air")?;
                 if !(int > 0.0 && ext > 0.0) || int == ext {
                     return Err(error(o, format!("{}: int_ior and ext_ior: expected positive indices that differ, found {int} and {ext}", o.label())));
+                }
+                // Each distinct coat is tabulated once per process: keep their number small.
+                self.coats.insert((
+                    roughness.kind == MicrofacetKind::Ggx,
+                    roughness.alpha_u.to_bits(),
+                    ((int / ext) as f32).to_bits(),
+                ));
+                if self.coats.len() > MAX_ROUGH_PLASTIC_COATS {
+                    return Err(error(o, format!("{}: more than {MAX_ROUGH_PLASTIC_COATS} distinct rough plastic coats (distribution, alpha, index) in one scene", o.label())));
                 }
                 Material::RoughPlastic {
                     roughness,
