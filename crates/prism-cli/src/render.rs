@@ -396,6 +396,18 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         crate::error::check_input(map, Some("--envmap"))?;
     }
     let (mitsuba, resolved) = resolve(a)?;
+    if let Some(m) = &mitsuba {
+        // No output may replace a file the scene reads (a mesh, a texture, an include).
+        let read: Vec<(&str, &std::path::Path)> = m
+            .inputs
+            .iter()
+            .map(|p| ("a file the scene reads,", p.as_path()))
+            .collect();
+        let mut outputs = vec![("--output", a.output.as_path())];
+        outputs.extend(a.exr.as_deref().map(|p| ("--exr", p)));
+        outputs.extend(a.heatmap.as_deref().map(|p| ("--heatmap", p)));
+        crate::output::check_distinct(&read, &outputs)?;
+    }
     let rr_bounces = mitsuba.as_ref().map(|m| m.settings.rr_bounces);
     let hide_emitters = mitsuba.as_ref().is_some_and(|m| m.settings.hide_emitters);
     let filter = mitsuba

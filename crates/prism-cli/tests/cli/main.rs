@@ -2413,6 +2413,25 @@ fn mitsuba_scenes_render_and_refuse_what_they_cannot() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let img = prism_image::read_png(&out).unwrap();
     assert_eq!((img.width(), img.height()), (64, 96));
+    // No output replaces a file the scene reads: here, a texture beside it.
+    let textured = prism_testkit::workspace_root()
+        .join("crates/prism-render/tests/golden/mitsuba/xml/textures.xml");
+    let texture = textured.with_file_name("pattern.png");
+    let before = std::fs::read(&texture).unwrap();
+    let o = prism()
+        .arg("render")
+        .arg(&textured)
+        .args(["-s", "1", "-q", "-o"])
+        .arg(&texture)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("a file the scene reads"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(&texture).unwrap(), before);
     let bad = dir.join("bad.xml");
     std::fs::write(
         &bad,

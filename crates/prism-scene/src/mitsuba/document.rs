@@ -104,6 +104,8 @@ pub struct Document {
     pub folder: PathBuf,
     /// Further folders file names are looked for in (`<path value>`), in order.
     pub search: Vec<PathBuf>,
+    /// The XML files read: the scene and its includes.
+    pub files: Vec<PathBuf>,
 }
 
 impl Document {
@@ -170,6 +172,7 @@ struct Source {
 pub fn read_document(path: &Path, defines: &[(String, String)]) -> Result<Document, SceneError> {
     let mut reader = Reader {
         search: Vec::new(),
+        files: Vec::new(),
         sources: Vec::new(),
         bytes: 0,
         objects: Vec::new(),
@@ -193,6 +196,7 @@ pub fn read_document(path: &Path, defines: &[(String, String)]) -> Result<Docume
         objects: reader.objects,
         folder: reader.sources[main].folder.clone(),
         search: reader.search,
+        files: reader.files,
     })
 }
 
@@ -207,6 +211,8 @@ struct Reader {
     pending_refs: Vec<(usize, usize, String, Loc)>,
     /// The `<path>` folders met so far.
     search: Vec<PathBuf>,
+    /// The files read so far.
+    files: Vec<PathBuf>,
 }
 
 /// A located error at `node` of `file`.
@@ -235,6 +241,7 @@ impl Reader {
             });
         }
         let name = path.display().to_string();
+        self.files.push(path.to_path_buf());
         let io = |e: std::io::Error| SceneError::Io {
             path: name.clone(),
             source: std::sync::Arc::new(e),

@@ -92,6 +92,7 @@ impl Builder<'_> {
             .string("filename")?
             .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
         let path = self.doc.resolve(file);
+        self.inputs.push(path.clone());
         if let Some(image) = self.images.get(&(path.clone(), raw)) {
             return Ok((file.to_string(), Arc::clone(image)));
         }

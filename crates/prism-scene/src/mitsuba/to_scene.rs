@@ -71,6 +71,9 @@ pub struct MitsubaScene {
     pub scene: Scene,
     /// How the file asks for it to be rendered.
     pub settings: MitsubaSettings,
+    /// Every file the scene reads (its XML files, meshes and images), which no output may
+    /// replace.
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 /// The scene `doc` describes.
@@ -100,6 +103,7 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
         default_material: None,
         coats: std::collections::HashSet::new(),
         images: std::collections::HashMap::new(),
+        inputs: doc.files.clone(),
         lenient,
         warned: std::collections::HashSet::new(),
     };
@@ -140,6 +144,7 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
     Ok(MitsubaScene {
         scene: b.scene,
         settings: b.settings,
+        inputs: b.inputs,
     })
 }
 
@@ -157,6 +162,8 @@ pub(super) struct Builder<'d> {
     default_material: Option<usize>,
     /// The distinct rough plastic coats (distribution, alpha, index) read so far.
     coats: std::collections::HashSet<(bool, u32, u32)>,
+    /// The mesh and image files read so far.
+    pub(super) inputs: Vec<std::path::PathBuf>,
     /// The images read so far, by file and `raw`: one decoded copy however often used.
     pub(super) images:
         std::collections::HashMap<(std::path::PathBuf, bool), Arc<prism_image::RgbImage>>,
@@ -355,6 +362,7 @@ impl Builder<'_> {
                     )
                 })?;
                 let path = self.doc.resolve(file);
+                self.inputs.push(path.clone());
                 let bytes = prism_math::limits::read_input(&path, prism_mesh::MAX_MESH_FILE_BYTES)
                     .map_err(|e| error(o, format!("{}: {}: {e}", o.label(), path.display())))?;
                 super::serialized::read_serialized(&bytes, index)
@@ -380,6 +388,7 @@ impl Builder<'_> {
                     .string("filename")?
                     .ok_or_else(|| error(o, format!("{}: expected a filename", o.label())))?;
                 let path = self.doc.resolve(file);
+                self.inputs.push(path.clone());
                 let failed = |e: String| error(o, format!("{}: {e}", o.label()));
                 if o.kind == "obj" {
                     let text =
