@@ -15,6 +15,7 @@ pub mod film;
 pub mod integrators;
 pub mod interaction;
 pub mod lights;
+mod materials;
 pub mod parts;
 pub mod pixel_filter;
 pub mod profile;

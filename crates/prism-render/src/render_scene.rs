@@ -10,6 +10,7 @@ use crate::bsdf::Bsdf;
 use crate::interaction::Interaction;
 use crate::lights::envmap::EnvMap;
 use crate::lights::{MeshLight, RenderLight};
+use crate::materials::{Chosen, Materials};
 
 /// What a BVH primitive is.
 #[derive(Clone, Copy, Debug)]
@@ -45,14 +46,6 @@ struct MeshRec {
     uvs: Option<Vec<prism_math::Vec2>>,
 }
 
-/// A material's texture (shared by the materials that use its image), its lookup and its
-/// `to_uv`.
-type MaterialLookup = (
-    std::sync::Arc<prism_image::Texture>,
-    prism_image::PixelSampling,
-    [f32; 6],
-);
-
 /// The prepared scene.
 pub struct RenderScene {
     bvh: Bvh,
@@ -60,19 +53,7 @@ pub struct RenderScene {
     meshes: Vec<MeshRec>,
     /// Spheres with their material and whether their normals point inwards.
     spheres: Vec<(Sphere, usize, bool)>,
-    bsdfs: Vec<Bsdf>,
-    /// Per material, the texture its diffuse albedo is multiplied by, its lookup and its
-    /// `to_uv`.
-    textures: Vec<Option<MaterialLookup>>,
-    emission: Vec<Option<Rgb>>,
-    /// Per material: true if it is black from behind (where the winding's normal points
-    /// away from the ray's origin).
-    one_sided: Vec<bool>,
-    /// Per material: true if its BSDF is anisotropic, so hits carry a tangent.
-    anisotropic: Vec<bool>,
-    /// Per material: true if it emits from its front side only (where the winding's normal
-    /// points), as a Mitsuba area emitter does.
-    front_only: Vec<bool>,
+    materials: Materials,
     /// Lights.
     pub lights: Vec<RenderLight>,
     /// The scene's camera.
@@ -243,59 +224,7 @@ impl RenderScene {
                 .zip(scene.spheres.iter())
                 .map(|(s, scene_sphere)| (s, scene_sphere.material, scene_sphere.inward))
                 .collect(),
-            bsdfs: scene.materials.iter().map(Bsdf::from_material).collect(),
-            one_sided: (0..scene.materials.len())
-                .map(|i| scene.one_sided.get(i).copied().unwrap_or(false))
-                .collect(),
-            anisotropic: scene
-                .materials
-                .iter()
-                .map(|m| Bsdf::from_material(m).anisotropic())
-                .collect(),
-            textures: {
-                // Materials that share an image share its prepared texture.
-                let mut built = std::collections::HashMap::new();
-                scene
-                    .materials
-                    .iter()
-                    .map(|m| match m {
-                        prism_scene::Material::Diffuse {
-                            texture: Some(t), ..
-                        }
-                        | prism_scene::Material::Plastic {
-                            texture: Some(t), ..
-                        }
-                        | prism_scene::Material::RoughPlastic {
-                            texture: Some(t), ..
-                        } => {
-                            let texture = built
-                                .entry((std::sync::Arc::as_ptr(&t.image), t.wrap))
-                                .or_insert_with(|| {
-                                    std::sync::Arc::new(
-                                        prism_image::Texture::new((*t.image).clone())
-                                            .with_wrap(t.wrap, t.wrap),
-                                    )
-                                });
-                            Some((std::sync::Arc::clone(texture), t.sampling, t.to_uv))
-                        }
-                        _ => None,
-                    })
-                    .collect()
-            },
-            front_only: scene
-                .materials
-                .iter()
-                .map(|m| matches!(m, prism_scene::Material::EmissiveDiffuse { .. }))
-                .collect(),
-            emission: scene
-                .materials
-                .iter()
-                .map(|m| match m {
-                    prism_scene::Material::Emission { radiance }
-                    | prism_scene::Material::EmissiveDiffuse { radiance, .. } => Some(*radiance),
-                    _ => None,
-                })
-                .collect(),
+            materials: Materials::new(scene),
             lights,
             camera: scene.camera,
             infinite,
@@ -416,17 +345,32 @@ impl RenderScene {
                 }
                 .unwrap_or(ng);
                 let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
-                let mut bsdf = self.bsdfs[m.material];
-                if self.one_sided[m.material] && ray.dir.dot(ns) >= 0.0 {
-                    bsdf = Bsdf::Black;
-                }
-                if let (Some(uvs), Some(albedo)) = (&m.uvs, bsdf.albedo_mut()) {
-                    if self.textures[m.material].is_some() {
-                        // The texture's rows run down the image; v runs up it.
+                let mats = &self.materials;
+                // Texture coordinates as Mitsuba's (v running down the image); (0, 0)
+                // without any, as Mitsuba's.
+                let uv = || {
+                    m.uvs.as_ref().map_or(prism_math::Vec2::ZERO, |uvs| {
                         let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
                         let uv = b0 * ua + hit.b1 * ub + hit.b2 * uc;
-                        *albedo = *albedo
-                            * self.texel(m.material, prism_math::Vec2::new(uv.x, 1.0 - uv.y));
+                        prism_math::Vec2::new(uv.x, 1.0 - uv.y)
+                    })
+                };
+                let (mut bsdf, chosen) = match mats.choose(m.material, ray, uv) {
+                    Chosen::Through => (Bsdf::Null, None),
+                    Chosen::Material { index, one_sided } => (
+                        if one_sided && ray.dir.dot(ns) >= 0.0 {
+                            Bsdf::Black
+                        } else {
+                            mats.bsdf(index)
+                        },
+                        Some(index),
+                    ),
+                };
+                if let (Some(index), true, Some(albedo)) =
+                    (chosen, m.uvs.is_some(), bsdf.albedo_mut())
+                {
+                    if mats.textured(index) {
+                        *albedo = *albedo * mats.texel(index, uv());
                     }
                 }
                 Interaction {
@@ -434,15 +378,15 @@ impl RenderScene {
                     ng,
                     ns,
                     bsdf,
-                    emitted: match self.emission[m.material] {
-                        Some(_) if self.front_only[m.material] && ray.dir.dot(ng) >= 0.0 => {
+                    emitted: match mats.emission[m.material] {
+                        Some(_) if mats.front_only[m.material] && ray.dir.dot(ng) >= 0.0 => {
                             Rgb::BLACK
                         }
                         e => e.unwrap_or(Rgb::BLACK),
                     },
                     light: m.light,
                     t: hit.t,
-                    tangent: self.anisotropic[m.material].then(|| {
+                    tangent: chosen.is_some_and(|i| mats.anisotropic[i]).then(|| {
                         mesh_tangent(
                             [a, b, c],
                             m.uvs.as_ref().map(|u| t.map(|i| u[i as usize])),
@@ -475,27 +419,36 @@ impl RenderScene {
                 let p = ray.at(hit.t);
                 let outward = ((p - s.center) / s.radius).normalize();
                 let n = if inward { -outward } else { outward };
-                let mut bsdf = if self.one_sided[material] && ray.dir.dot(n) >= 0.0 {
-                    Bsdf::Black
-                } else {
-                    self.bsdfs[material]
+                let mats = &self.materials;
+                // Mitsuba's sphere coordinates: the azimuth over 2 pi, the polar angle from
+                // +z over pi (the world's axes).
+                let uv = || {
+                    let phi = outward.y.atan2(outward.x);
+                    let phi = if phi < 0.0 {
+                        phi + 2.0 * std::f32::consts::PI
+                    } else {
+                        phi
+                    };
+                    let theta = prism_math::acos(outward.z.clamp(-1.0, 1.0));
+                    prism_math::Vec2::new(
+                        phi / (2.0 * std::f32::consts::PI),
+                        theta / std::f32::consts::PI,
+                    )
                 };
-                if let Some(albedo) = bsdf.albedo_mut() {
-                    if self.textures[material].is_some() {
-                        // Mitsuba's sphere coordinates: the azimuth over 2 pi, the polar angle
-                        // from +z over pi (the world's axes).
-                        let phi = outward.y.atan2(outward.x);
-                        let phi = if phi < 0.0 {
-                            phi + 2.0 * std::f32::consts::PI
+                let (mut bsdf, chosen) = match mats.choose(material, ray, uv) {
+                    Chosen::Through => (Bsdf::Null, None),
+                    Chosen::Material { index, one_sided } => (
+                        if one_sided && ray.dir.dot(n) >= 0.0 {
+                            Bsdf::Black
                         } else {
-                            phi
-                        };
-                        let theta = prism_math::acos(outward.z.clamp(-1.0, 1.0));
-                        let uv = prism_math::Vec2::new(
-                            phi / (2.0 * std::f32::consts::PI),
-                            theta / std::f32::consts::PI,
-                        );
-                        *albedo = *albedo * self.texel(material, uv);
+                            mats.bsdf(index)
+                        },
+                        Some(index),
+                    ),
+                };
+                if let (Some(index), Some(albedo)) = (chosen, bsdf.albedo_mut()) {
+                    if mats.textured(index) {
+                        *albedo = *albedo * mats.texel(index, uv());
                     }
                 }
                 Interaction {
@@ -503,33 +456,19 @@ impl RenderScene {
                     ng: n,
                     ns: n,
                     bsdf,
-                    emitted: match self.emission[material] {
-                        Some(_) if self.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
+                    emitted: match mats.emission[material] {
+                        Some(_) if mats.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
                         e => e.unwrap_or(Rgb::BLACK),
                     },
                     light: None,
                     t: hit.t,
                     // Along the parallels, as Mitsuba's sphere (axes the world's).
-                    tangent: self.anisotropic[material]
+                    tangent: chosen
+                        .is_some_and(|i| mats.anisotropic[i])
                         .then(|| Vec3::new(-outward.y, outward.x, 0.0)),
                 }
             }
         }
-    }
-}
-
-impl RenderScene {
-    /// The texel of `material`'s texture at surface coordinates `uv` (`v` running down the
-    /// image), through its `to_uv`; white without a texture.
-    fn texel(&self, material: usize, uv: prism_math::Vec2) -> Rgb {
-        let Some((tex, sampling, m)) = &self.textures[material] else {
-            return Rgb::WHITE;
-        };
-        let at = prism_math::Vec2::new(
-            m[0] * uv.x + m[1] * uv.y + m[2],
-            m[3] * uv.x + m[4] * uv.y + m[5],
-        );
-        tex.sample_level(at, 0, *sampling)
     }
 }
 

@@ -60,5 +60,6 @@ pub use render_config::{
 };
 pub use scene::{
     Camera, CameraMode, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind, NormalsMode,
-    OrbitCamera, Roughness, Scene, SceneOptions, SceneSphere, Shading, ThinLens, TriangleMesh,
+    OrbitCamera, Roughness, ScalarTexture, Scene, SceneOptions, SceneSphere, Shading, ThinLens,
+    TriangleMesh,
 };

@@ -126,6 +126,23 @@ pub enum Material {
         /// An image the base's albedo is multiplied by.
         texture: Option<MaterialTexture>,
     },
+    /// Mitsuba's `blendbsdf`: at each hit, `materials[1]` with probability `weight` and
+    /// `materials[0]` otherwise (the mixture `(1 - w) f0 + w f1` in expectation).
+    Blend {
+        /// The second material's share, clamped to [0, 1].
+        weight: ScalarTexture,
+        /// The two materials, as indices into [`Scene::materials`].
+        materials: [usize; 2],
+    },
+    /// Mitsuba's `mask`: at each hit, `material` with probability `opacity`, and otherwise
+    /// no surface at all: the ray passes on unchanged (a bounce, as Mitsuba counts it).
+    /// Shadow rays stop at it, as Mitsuba's do.
+    Mask {
+        /// The probability that the surface is there, clamped to [0, 1].
+        opacity: ScalarTexture,
+        /// The material where it is, as an index into [`Scene::materials`].
+        material: usize,
+    },
     /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
     /// specular lobe `ks * max(r.v, 0)^shininess` per light.
     Phong {
@@ -191,6 +208,16 @@ impl MaterialTexture {
             to_uv: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
         }
     }
+}
+
+/// A number over a surface: a constant, or the luminance of a texture's texel (Mitsuba's
+/// `eval_1`: 0.212671 r + 0.715160 g + 0.072169 b).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ScalarTexture {
+    /// The same everywhere.
+    Constant(f32),
+    /// The texel's luminance.
+    Image(MaterialTexture),
 }
 
 /// How shading normals are chosen for meshes.

@@ -121,6 +121,8 @@ pub enum Bsdf {
     },
     /// Absorbs everything (the surface of an emitter).
     Black,
+    /// No surface: light passes on unchanged (where a mask lets a ray through).
+    Null,
 }
 
 /// The result of sampling a BSDF.
@@ -239,6 +241,9 @@ impl Bsdf {
                 }
             }
             Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
+            // A blend or a mask is a choice among other materials, made at each hit by the
+            // render scene: alone it has no BSDF of its own.
+            Material::Blend { .. } | Material::Mask { .. } => Bsdf::Black,
         }
     }
 
@@ -286,6 +291,7 @@ impl Bsdf {
                 | Bsdf::Refraction { .. }
                 | Bsdf::ThinDielectric { .. }
                 | Bsdf::RoughDielectric { .. }
+                | Bsdf::Null
         )
     }
 
@@ -401,6 +407,12 @@ impl Bsdf {
             Bsdf::Mirror { reflectance } => Some(BsdfSample {
                 wi: Vec3::new(-wo.x, -wo.y, wo.z),
                 weight: reflectance,
+                pdf: 1.0,
+                delta: true,
+            }),
+            Bsdf::Null => Some(BsdfSample {
+                wi: -wo,
+                weight: Rgb::WHITE,
                 pdf: 1.0,
                 delta: true,
             }),

@@ -2,6 +2,7 @@
 //! includes, defaults, `$` substitution, properties, transforms, references) and the prism
 //! scene it describes ([`to_scene`]), with the film, sampler and integrator settings.
 
+mod bsdfs;
 mod conductors;
 mod document;
 mod limits;

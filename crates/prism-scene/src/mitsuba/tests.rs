@@ -694,3 +694,87 @@ fn search_paths_resolve_files_and_nested_plugins_are_refused() {
         "{e}"
     );
 }
+
+/// `blendbsdf` and `mask` are read as choices among their nested BSDFs, which are translated
+/// first: Mitsuba's defaults (opacity 0.5; a blend's weight is required), `twosided` around
+/// a blend making it two-sided, a checkerboard read for a number with its colours swapped
+/// (Mitsuba's `eval_1`), and located errors for a wrong number of nested BSDFs or a cycle.
+#[test]
+fn blends_and_masks_are_read_as_choices() {
+    let s = read(
+        "blend",
+        "<shape type=\"sphere\"><bsdf type=\"twosided\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.25\"/>\
+         <bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf></bsdf></shape>\
+         <shape type=\"sphere\"><bsdf type=\"mask\"><bsdf type=\"diffuse\"/></bsdf></shape>\
+         <shape type=\"sphere\"><bsdf type=\"mask\"><texture type=\"checkerboard\" name=\"opacity\"><float name=\"color0\" value=\"1\"/><float name=\"color1\" value=\"0\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>",
+        &[],
+    )
+    .unwrap();
+    let materials = &s.scene.materials;
+    let blend = s.scene.spheres[0].material;
+    let crate::Material::Blend {
+        weight: crate::ScalarTexture::Constant(w),
+        materials: [a, b],
+    } = materials[blend]
+    else {
+        panic!("{:?}", materials[blend]);
+    };
+    assert_eq!(w, 0.25);
+    assert!(matches!(materials[a], crate::Material::Diffuse { .. }));
+    assert!(matches!(materials[b], crate::Material::Mirror { .. }));
+    assert!(a < blend && b < blend);
+    assert!(!s.scene.one_sided[blend] && s.scene.one_sided[a]);
+    let mask = s.scene.spheres[1].material;
+    assert!(
+        matches!(materials[mask], crate::Material::Mask { opacity: crate::ScalarTexture::Constant(o), .. } if o == 0.5),
+        "{:?}",
+        materials[mask]
+    );
+    let crate::Material::Mask {
+        opacity: crate::ScalarTexture::Image(ref t),
+        ..
+    } = materials[s.scene.spheres[2].material]
+    else {
+        panic!("{:?}", materials[s.scene.spheres[2].material]);
+    };
+    // color0 (1) where u and v fall in different halves: texels (1, 0) and (0, 1).
+    assert_eq!(t.image.get(1, 0), Rgb::splat(1.0));
+    assert_eq!(t.image.get(0, 1), Rgb::splat(1.0));
+    assert_eq!(t.image.get(0, 0), Rgb::splat(0.0));
+
+    for (body, wanted) in [
+        (
+            "<bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/><bsdf type=\"diffuse\"/></bsdf>",
+            "s.xml:4: <bsdf>: type=\"blendbsdf\": expected 2 nested <bsdf>, found 1",
+        ),
+        (
+            "<bsdf type=\"blendbsdf\"><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>",
+            "expected a weight",
+        ),
+        (
+            "<bsdf type=\"mask\"><rgb name=\"opacity\" value=\"0.5\"/><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>",
+            "expected 1 nested <bsdf>, found 2",
+        ),
+        (
+            "<bsdf type=\"mask\"><texture type=\"bitmap\" name=\"weight\"/><bsdf type=\"diffuse\"/></bsdf>",
+            "not supported by prism yet (a bitmap or checkerboard as its opacity is)",
+        ),
+    ] {
+        let e = read(
+            "blend-bad",
+            &format!("<shape type=\"sphere\">\n{body}\n</shape>"),
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains(wanted), "{e}");
+    }
+    let e = read(
+        "mask-cycle",
+        "<bsdf type=\"mask\" id=\"m\"><ref id=\"m\"/></bsdf><shape type=\"sphere\"><ref id=\"m\"/></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("nested more than"), "{e}");
+}

@@ -8,7 +8,7 @@ use super::document::Object;
 use super::props::{error, not_supported, unsupported};
 use super::to_scene::Builder;
 use crate::error::SceneError;
-use crate::scene::MaterialTexture;
+use crate::scene::{MaterialTexture, ScalarTexture};
 
 impl Builder<'_> {
     /// A `bitmap` (PNG, JPEG or OpenEXR; 8-bit colour decoded from sRGB unless `raw`) or
@@ -121,6 +121,25 @@ impl Builder<'_> {
 
     /// Refuses a nested plugin (a texture in place of a colour, say) of an object prism
     /// reads only properties of.
+    /// A texture read for a number (Mitsuba's `eval_1`): the luminance of its texels. A
+    /// checkerboard read so puts `color0` where u and v fall in different halves of the
+    /// unit square, the opposite of its colours, as Mitsuba's does.
+    pub(super) fn scalar_texture(&mut self, o: &Object) -> Result<ScalarTexture, SceneError> {
+        let mut t = self.texture(o)?;
+        if o.kind == "checkerboard" {
+            let mut image = (*t.image).clone();
+            let (same, different) = (image.get(0, 0), image.get(1, 0));
+            for (x, y) in [(0, 0), (1, 1)] {
+                image.set(x, y, different);
+            }
+            for (x, y) in [(1, 0), (0, 1)] {
+                image.set(x, y, same);
+            }
+            t.image = Arc::new(image);
+        }
+        Ok(ScalarTexture::Image(t))
+    }
+
     pub(super) fn no_nested_plugins(&self, o: &Object) -> Result<(), SceneError> {
         match o.children.first() {
             Some(&(_, c)) => {

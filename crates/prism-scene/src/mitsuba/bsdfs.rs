@@ -1,0 +1,401 @@
+//! Mitsuba's BSDFs as prism's materials: each plugin with Mitsuba's defaults and named
+//! indices, `twosided`, the choices of `blendbsdf` and `mask`, and microfacet roughness.
+
+use super::document::Object;
+use super::limits::{MAX_OBJECT_DEPTH, MAX_ROUGH_PLASTIC_COATS};
+use super::props::{error, ior, not_supported, unsupported};
+use super::to_scene::Builder;
+use crate::error::SceneError;
+use crate::scene::{Material, MicrofacetKind, Roughness, ScalarTexture};
+use prism_math::Rgb;
+
+impl Builder<'_> {
+    /// The material of BSDF object `index` (translated once however often it is used).
+    pub(super) fn bsdf(&mut self, index: usize, depth: usize) -> Result<usize, SceneError> {
+        if let Some(&m) = self.bsdfs.get(&index) {
+            return Ok(m);
+        }
+        match self.translate_bsdf(index, depth) {
+            Ok(m) => Ok(m),
+            Err(e) => {
+                self.tolerate(e, "a grey diffuse BSDF stands in")?;
+                let m = self.push_material(
+                    Material::Diffuse {
+                        reflectance: Rgb::splat(0.5),
+                        texture: None,
+                    },
+                    "grey diffuse (--lenient)".into(),
+                    true,
+                );
+                self.bsdfs.insert(index, m);
+                Ok(m)
+            }
+        }
+    }
+
+    /// [`Builder::bsdf`]'s translation, without the lenient stand-in.
+    fn translate_bsdf(&mut self, index: usize, depth: usize) -> Result<usize, SceneError> {
+        let mut o = &self.doc.objects[index];
+        let mut depth = depth;
+        // `twosided` wraps one BSDF, which then scatters alike on both sides.
+        let mut two_sided = false;
+        while o.kind == "twosided" {
+            two_sided = true;
+            depth += 1;
+            if depth > MAX_OBJECT_DEPTH {
+                return Err(error(
+                    o,
+                    format!("objects nested more than {MAX_OBJECT_DEPTH} deep (a <ref> cycle?)"),
+                ));
+            }
+            let inner: Vec<usize> = o
+                .children
+                .iter()
+                .map(|&(_, c)| c)
+                .filter(|&c| self.doc.objects[c].tag == "bsdf")
+                .collect();
+            match inner[..] {
+                [one] => o = &self.doc.objects[one],
+                _ => {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: expected one nested <bsdf> (prism has no two-BSDF twosided)",
+                            o.label()
+                        ),
+                    ))
+                }
+            }
+        }
+        if matches!(o.kind.as_str(), "blendbsdf" | "mask") {
+            return self.choice(index, o, depth, two_sided);
+        }
+        // Nested plugins: a texture in place of a diffuse reflectance, nothing else yet.
+        let mut reflectance_texture = None;
+        for (slot, c) in &o.children {
+            let c = &self.doc.objects[*c];
+            let albedo_slot = match o.kind.as_str() {
+                "diffuse" => "reflectance",
+                "plastic" | "roughplastic" => "diffuse_reflectance",
+                _ => "",
+            };
+            if !albedo_slot.is_empty() && slot.as_deref() == Some(albedo_slot) && c.tag == "texture"
+            {
+                reflectance_texture = Some(self.texture(c)?);
+                continue;
+            }
+            return Err(not_supported(
+                c,
+                format!(
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse reflectance or a plastic's diffuse_reflectance is)",
+                    c.label(),
+                    o.label()
+                ),
+            ));
+        }
+        let name = o.id.clone().unwrap_or_else(|| o.label());
+        let material = match o.kind.as_str() {
+            "diffuse" => match reflectance_texture {
+                Some(t) => Material::Diffuse {
+                    reflectance: Rgb::WHITE,
+                    texture: Some(t),
+                },
+                None => Material::Diffuse {
+                    reflectance: o.rgb("reflectance", [0.5; 3])?,
+                    texture: None,
+                },
+            },
+            "dielectric" => {
+                let int = ior(o, "int_ior", "bk7")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                Material::Glass {
+                    reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: o.rgb("specular_transmittance", [1.0; 3])?,
+                    roughness: 0.0,
+                    ior: (int / ext) as f32,
+                }
+            }
+            "thindielectric" => {
+                let int = ior(o, "int_ior", "bk7")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                Material::ThinDielectric {
+                    reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: o.rgb("specular_transmittance", [1.0; 3])?,
+                    ior: (int / ext) as f32,
+                }
+            }
+            "plastic" => {
+                if o.boolean("nonlinear", false)? {
+                    return Err(not_supported(
+                        o,
+                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                    ));
+                }
+                let int = ior(o, "int_ior", "polypropylene")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                Material::Plastic {
+                    diffuse: if reflectance_texture.is_some() {
+                        Rgb::WHITE
+                    } else {
+                        o.rgb("diffuse_reflectance", [0.5; 3])?
+                    },
+                    specular: o.rgb("specular_reflectance", [1.0; 3])?,
+                    eta: (int / ext) as f32,
+                    texture: reflectance_texture.clone(),
+                }
+            }
+            "conductor" | "roughconductor" => {
+                let roughness = if o.kind == "roughconductor" {
+                    Some(roughness(o)?)
+                } else {
+                    None
+                };
+                let (eta, k) = conductor_index(o)?;
+                let specular = o.rgb("specular_reflectance", [1.0; 3])?;
+                match roughness {
+                    // The collada path's Beckmann conductor, which the lanes run.
+                    Some(Roughness {
+                        kind: MicrofacetKind::Beckmann,
+                        alpha_u,
+                        alpha_v,
+                    }) if alpha_u == alpha_v && specular == Rgb::WHITE => Material::Microfacet {
+                        alpha: alpha_u,
+                        eta,
+                        k,
+                    },
+                    // Mitsuba's default conductor reflects everything.
+                    None if eta == Rgb::splat(0.0) && k == Rgb::WHITE => Material::Mirror {
+                        reflectance: specular,
+                    },
+                    _ => Material::Conductor {
+                        roughness,
+                        eta,
+                        k,
+                        specular,
+                    },
+                }
+            }
+            "roughplastic" => {
+                if o.boolean("nonlinear", false)? {
+                    return Err(not_supported(
+                        o,
+                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                    ));
+                }
+                let roughness = roughness(o)?;
+                if roughness.alpha_u != roughness.alpha_v {
+                    return Err(error(
+                        o,
+                        format!(
+                            "{}: an anisotropic roughplastic (Mitsuba refuses it too)",
+                            o.label()
+                        ),
+                    ));
+                }
+                let int = ior(o, "int_ior", "polypropylene")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                if !(int > 0.0 && ext > 0.0) || int == ext {
+                    return Err(error(o, format!("{}: int_ior and ext_ior: expected positive indices that differ, found {int} and {ext}", o.label())));
+                }
+                // Each distinct coat is tabulated once per process: keep their number small.
+                self.coats.insert((
+                    roughness.kind == MicrofacetKind::Ggx,
+                    roughness.alpha_u.to_bits(),
+                    ((int / ext) as f32).to_bits(),
+                ));
+                if self.coats.len() > MAX_ROUGH_PLASTIC_COATS {
+                    return Err(error(o, format!("{}: more than {MAX_ROUGH_PLASTIC_COATS} distinct rough plastic coats (distribution, alpha, index) in one scene", o.label())));
+                }
+                Material::RoughPlastic {
+                    roughness,
+                    diffuse: if reflectance_texture.is_some() {
+                        Rgb::WHITE
+                    } else {
+                        o.rgb("diffuse_reflectance", [0.5; 3])?
+                    },
+                    specular: o.rgb("specular_reflectance", [1.0; 3])?,
+                    eta: (int / ext) as f32,
+                    texture: reflectance_texture.clone(),
+                }
+            }
+            "roughdielectric" => {
+                let int = ior(o, "int_ior", "bk7")?;
+                let ext = ior(o, "ext_ior", "air")?;
+                if !(int > 0.0 && ext > 0.0) || int == ext {
+                    return Err(error(o, format!("{}: int_ior and ext_ior: expected positive indices that differ, found {int} and {ext}", o.label())));
+                }
+                Material::RoughDielectric {
+                    roughness: roughness(o)?,
+                    reflectance: o.rgb("specular_reflectance", [1.0; 3])?,
+                    transmittance: o.rgb("specular_transmittance", [1.0; 3])?,
+                    ior: (int / ext) as f32,
+                }
+            }
+            _ => return Err(unsupported(o)),
+        };
+        // Mitsuba's opaque BSDFs are black from behind unless wrapped in `twosided`.
+        let opaque = matches!(
+            o.kind.as_str(),
+            "diffuse" | "plastic" | "roughplastic" | "conductor" | "roughconductor"
+        );
+        let m = self.push_material(material, name, opaque && !two_sided);
+        self.bsdfs.insert(index, m);
+        Ok(m)
+    }
+
+    /// A `blendbsdf` (two nested BSDFs and a `weight`) or a `mask` (one nested BSDF and an
+    /// `opacity`), its nested BSDFs translated first. Inside `twosided`, every BSDF it
+    /// chooses scatters on both sides.
+    fn choice(
+        &mut self,
+        index: usize,
+        o: &Object,
+        depth: usize,
+        two_sided: bool,
+    ) -> Result<usize, SceneError> {
+        if depth > MAX_OBJECT_DEPTH {
+            return Err(error(
+                o,
+                format!("objects nested more than {MAX_OBJECT_DEPTH} deep (a <ref> cycle?)"),
+            ));
+        }
+        let (slot, wanted) = if o.kind == "mask" {
+            ("opacity", 1)
+        } else {
+            ("weight", 2)
+        };
+        let mut nested = Vec::new();
+        let mut texture = None;
+        for (name, c) in &o.children {
+            let co = &self.doc.objects[*c];
+            match co.tag.as_str() {
+                "bsdf" => nested.push(self.bsdf(*c, depth + 1)?),
+                "texture" if name.as_deref() == Some(slot) => {
+                    texture = Some(self.scalar_texture(co)?)
+                }
+                _ => {
+                    return Err(not_supported(
+                        co,
+                        format!(
+                            "{} in {}: not supported by prism yet (a bitmap or checkerboard as its {slot} is)",
+                            co.label(),
+                            o.label()
+                        ),
+                    ))
+                }
+            }
+        }
+        if nested.len() != wanted {
+            return Err(error(
+                o,
+                format!(
+                    "{}: expected {wanted} nested <bsdf>, found {}",
+                    o.label(),
+                    nested.len()
+                ),
+            ));
+        }
+        let value = match texture {
+            Some(t) => t,
+            None if o.kind == "mask" => ScalarTexture::Constant(o.float(slot, 0.5)? as f32),
+            None => match o.value(slot) {
+                Some(_) => ScalarTexture::Constant(o.float(slot, 0.0)? as f32),
+                None => return Err(error(o, format!("{}: expected a {slot}", o.label()))),
+            },
+        };
+        let material = if o.kind == "mask" {
+            Material::Mask {
+                opacity: value,
+                material: nested[0],
+            }
+        } else {
+            Material::Blend {
+                weight: value,
+                materials: [nested[0], nested[1]],
+            }
+        };
+        let name = o.id.clone().unwrap_or_else(|| o.label());
+        // A choice's own sidedness only widens its choices': one-sided unless wrapped.
+        let m = self.push_material(material, name, !two_sided);
+        self.bsdfs.insert(index, m);
+        Ok(m)
+    }
+}
+
+/// A microfacet BSDF's `distribution` (Beckmann unless given) and `alpha`, or `alpha_u` and
+/// `alpha_v` together (0.1 unless given), as Mitsuba reads them.
+fn roughness(o: &Object) -> Result<Roughness, SceneError> {
+    let kind = match o
+        .string("distribution")?
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        None | Some("beckmann") => MicrofacetKind::Beckmann,
+        Some("ggx") => MicrofacetKind::Ggx,
+        Some(other) => {
+            return Err(error(
+                o,
+                format!(
+                    "{}: distribution {other:?}: expected \"beckmann\" or \"ggx\"",
+                    o.label()
+                ),
+            ))
+        }
+    };
+    let (has_u, has_v, has_alpha) = (
+        o.prop("alpha_u").is_some(),
+        o.prop("alpha_v").is_some(),
+        o.prop("alpha").is_some(),
+    );
+    if (has_u || has_v) && (!(has_u && has_v) || has_alpha) {
+        return Err(error(
+            o,
+            format!(
+                "{}: expected either alpha or both alpha_u and alpha_v",
+                o.label()
+            ),
+        ));
+    }
+    let (u, v) = if has_u {
+        (o.float("alpha_u", 0.1)?, o.float("alpha_v", 0.1)?)
+    } else {
+        let a = o.float("alpha", 0.1)?;
+        (a, a)
+    };
+    for (name, a) in [("alpha_u", u), ("alpha_v", v)] {
+        if !(0.0..=4.0).contains(&a) {
+            return Err(error(
+                o,
+                format!(
+                    "{}: {name}: expected a roughness of at least 0 and at most 4, found {a}",
+                    o.label()
+                ),
+            ));
+        }
+    }
+    // Mitsuba clamps a zero roughness to 1e-4.
+    Ok(Roughness {
+        kind,
+        alpha_u: u.max(1e-4) as f32,
+        alpha_v: v.max(1e-4) as f32,
+    })
+}
+
+/// A conductor's complex index: `eta` (0) and `k` (1) when `eta` is given or the material is
+/// "none" (the default), else the named material's.
+fn conductor_index(o: &Object) -> Result<(Rgb, Rgb), SceneError> {
+    let material = o.string("material")?.unwrap_or("none");
+    if o.prop("eta").is_some() || material == "none" {
+        return Ok((o.rgb("eta", [0.0; 3])?, o.rgb("k", [1.0; 3])?));
+    }
+    let (e, k) = super::conductors::conductor(material).ok_or_else(|| {
+        error(
+            o,
+            format!(
+                "{}: material {material:?}: Mitsuba names no such conductor",
+                o.label()
+            ),
+        )
+    })?;
+    Ok((Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2])))
+}
