@@ -198,7 +198,44 @@ impl Texture {
                 f64::from(uv.y) * (h - 1) as f64,
             ),
         };
-        let fold = |i: i64, n: i64, wrap: Wrap| match wrap {
+        match mode {
+            PixelSampling::Nearest => {
+                let (x, y) = (floor(gx + 0.5), floor(gy + 0.5));
+                if !x.is_finite() || !y.is_finite() {
+                    return im.get(0, 0);
+                }
+                im.get(self.fold(x as i64, w, 0), self.fold(y as i64, h, 1))
+            }
+            PixelSampling::Bilinear => {
+                let Some(([f00, f10, f01, f11], tx, ty)) = self.corners(level, gx, gy) else {
+                    return im.get(0, 0);
+                };
+                let top = f00.lerp(f10, tx);
+                let bottom = f01.lerp(f11, tx);
+                top.lerp(bottom, ty)
+            }
+        }
+    }
+
+    /// The derivatives of the bilinear lookup of level 0 at `uv` along the image's x and y,
+    /// per texel: `[d/dx, d/dy]` (the standard uv convention).
+    #[must_use]
+    pub fn bilinear_gradient(&self, uv: Vec2) -> [Rgb; 2] {
+        let (w, h) = self.size();
+        let gx = f64::from(uv.x) * f64::from(w) - 0.5;
+        let gy = f64::from(uv.y) * f64::from(h) - 0.5;
+        let Some(([f00, f10, f01, f11], tx, ty)) = self.corners(0, gx, gy) else {
+            return [Rgb::BLACK; 2];
+        };
+        [
+            (f10 - f00) * (1.0 - ty) + (f11 - f01) * ty,
+            (f01 - f00) * (1.0 - tx) + (f11 - f10) * tx,
+        ]
+    }
+
+    /// Texel `i` of `n` along `axis` (0 for x), wrapped as the axis wraps.
+    fn fold(&self, i: i64, n: i64, axis: usize) -> u32 {
+        match self.wrap[axis] {
             Wrap::Clamp => i.clamp(0, n - 1) as u32,
             // Inside the image, or one past its end (a bilinear lookup's second texel), no
             // division is needed.
@@ -209,32 +246,34 @@ impl Texture {
                 let j = i.rem_euclid(2 * n);
                 (if j < n { j } else { 2 * n - 1 - j }) as u32
             }
-        };
-        let clamp_x = |x: i64| fold(x, w, self.wrap[0]);
-        let clamp_y = |y: i64| fold(y, h, self.wrap[1]);
-        match mode {
-            PixelSampling::Nearest => {
-                let (x, y) = (floor(gx + 0.5), floor(gy + 0.5));
-                if !x.is_finite() || !y.is_finite() {
-                    return im.get(0, 0);
-                }
-                im.get(clamp_x(x as i64), clamp_y(y as i64))
-            }
-            PixelSampling::Bilinear => {
-                if !gx.is_finite() || !gy.is_finite() {
-                    return im.get(0, 0);
-                }
-                let (x0, y0) = (floor(gx), floor(gy));
-                let (tx, ty) = ((gx - x0) as f32, (gy - y0) as f32);
-                let (x0, y0) = (x0 as i64, y0 as i64);
-                // (Coordinates far out saturate; the next texel must not overflow past them.)
-                let (xa, xb) = (clamp_x(x0), clamp_x(x0.saturating_add(1)));
-                let (ya, yb) = (clamp_y(y0), clamp_y(y0.saturating_add(1)));
-                let top = im.get(xa, ya).lerp(im.get(xb, ya), tx);
-                let bottom = im.get(xa, yb).lerp(im.get(xb, yb), tx);
-                top.lerp(bottom, ty)
-            }
         }
+    }
+
+    /// The four texels around continuous texel coordinates `(gx, gy)` of `level` (top left,
+    /// top right, bottom left, bottom right) and the position between them; none for
+    /// coordinates that are not finite.
+    fn corners(&self, level: usize, gx: f64, gy: f64) -> Option<([Rgb; 4], f32, f32)> {
+        if !gx.is_finite() || !gy.is_finite() {
+            return None;
+        }
+        let im = &self.levels[level];
+        let (w, h) = (i64::from(im.width()), i64::from(im.height()));
+        let (x0, y0) = (floor(gx), floor(gy));
+        let (tx, ty) = ((gx - x0) as f32, (gy - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        // (Coordinates far out saturate; the next texel must not overflow past them.)
+        let (xa, xb) = (self.fold(x0, w, 0), self.fold(x0.saturating_add(1), w, 0));
+        let (ya, yb) = (self.fold(y0, h, 1), self.fold(y0.saturating_add(1), h, 1));
+        Some((
+            [
+                im.get(xa, ya),
+                im.get(xb, ya),
+                im.get(xa, yb),
+                im.get(xb, yb),
+            ],
+            tx,
+            ty,
+        ))
     }
 
     /// Samples at `uv` with the given level and pixel modes, choosing the level from the
@@ -578,6 +617,34 @@ mod tests {
                     let c = t.sample_level(Vec2::new(v, -v), 0, mode);
                     assert!(c.b == 0.5, "{v} {mode:?} {wrap:?}: {c:?}");
                 }
+            }
+        }
+    }
+
+    /// Brute force: the bilinear gradient equals central differences of the bilinear lookup
+    /// (away from texel centres' lines, where it is piecewise linear), across a repeating
+    /// seam too.
+    #[test]
+    fn bilinear_gradient_equals_finite_differences() {
+        let img = Image::from_fn(5, 3, |x, y| {
+            Rgb::new(
+                (x * x + 2 * y) as f32,
+                (x * y) as f32,
+                (7 * y + x) as f32 * 0.5,
+            )
+        });
+        let tex = Texture::new(img).with_wrap(Wrap::Repeat, Wrap::Repeat);
+        let (w, h) = (5.0, 3.0);
+        for &(u, v) in &[(0.33, 0.41), (0.71, 0.93), (0.02, 0.07), (0.97, 0.5)] {
+            let [dx, dy] = tex.bilinear_gradient(Vec2::new(u, v));
+            let e = 1e-3;
+            let at = |u: f32, v: f32| tex.sample_level(Vec2::new(u, v), 0, PixelSampling::Bilinear);
+            let fx = (at(u + e / w, v) - at(u - e / w, v)) * (0.5 / e);
+            let fy = (at(u, v + e / h) - at(u, v - e / h)) * (0.5 / e);
+            for (a, b) in [(dx, fx), (dy, fy)] {
+                let d = a - b;
+                let worst = d.r.abs().max(d.g.abs()).max(d.b.abs());
+                assert!(worst < 2e-2, "{u} {v}: {a:?} vs {b:?}");
             }
         }
     }

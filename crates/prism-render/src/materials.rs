@@ -1,15 +1,16 @@
 //! [`Materials`], a scene's materials as a hit needs them: each one's BSDF, the texture its
-//! albedo is multiplied by, its emission and sides, and the choice a blend or a mask makes at
-//! every hit.
+//! albedo is multiplied by, its emission and sides, the choice a blend or a mask makes at
+//! every hit, and the frame a bump or normal map tilts the shading normal to.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use prism_image::{PixelSampling, Texture};
-use prism_math::{Ray, Rgb, Vec2};
-use prism_scene::{Material, MaterialTexture, ScalarTexture, Scene};
+use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
+use prism_scene::{Material, MaterialTexture, ScalarTexture, Scene, TiltOptions};
 
 use crate::bsdf::Bsdf;
+use crate::interaction::Tilt;
 
 /// A prepared texture (shared by the materials that use its image), its lookup and its
 /// `to_uv`.
@@ -30,14 +31,39 @@ enum Choice {
     },
     /// `material` with probability `opacity`, else nothing.
     Mask { opacity: Scalar, material: usize },
+    /// `material` under a tilted normal.
+    Tilted { map: TiltMap, material: usize },
+}
+
+/// A bump or normal map, prepared.
+pub(crate) struct TiltMap {
+    kind: TiltKind,
+    options: TiltOptions,
+}
+
+enum TiltKind {
+    /// Normals `2 rgb - 1` in the shading frame.
+    Normal(Lookup),
+    /// Heights times `scale`; `bilinear` false gives them no gradient (Mitsuba's nearest
+    /// lookup).
+    Bump {
+        lookup: Lookup,
+        scale: f32,
+        bilinear: bool,
+    },
 }
 
 /// What a hit scatters with once blends and masks have chosen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Chosen {
+#[derive(Clone, Copy)]
+pub(crate) enum Chosen<'a> {
     /// This material; `one_sided` if it is black from behind (every material on the way to
-    /// it is one-sided: a `twosided` around a blend makes both its choices two-sided).
-    Material { index: usize, one_sided: bool },
+    /// it is one-sided: a `twosided` around a blend makes both its choices two-sided),
+    /// under the map that tilts its normal, if any.
+    Material {
+        index: usize,
+        one_sided: bool,
+        tilt: Option<&'a TiltMap>,
+    },
     /// No surface: a mask let the ray through.
     Through,
 }
@@ -103,6 +129,33 @@ impl Materials {
                     opacity: scalar(opacity),
                     material: *material,
                 }),
+                Material::NormalMap {
+                    normals,
+                    material,
+                    tilt,
+                } if valid(*material) => Some(Choice::Tilted {
+                    map: TiltMap {
+                        kind: TiltKind::Normal(prepare(normals)),
+                        options: *tilt,
+                    },
+                    material: *material,
+                }),
+                Material::BumpMap {
+                    height,
+                    scale,
+                    material,
+                    tilt,
+                } if valid(*material) => Some(Choice::Tilted {
+                    map: TiltMap {
+                        kind: TiltKind::Bump {
+                            lookup: prepare(height),
+                            scale: *scale,
+                            bilinear: height.sampling == PixelSampling::Bilinear,
+                        },
+                        options: *tilt,
+                    },
+                    material: *material,
+                }),
                 _ => None,
             });
         }
@@ -152,18 +205,27 @@ impl Materials {
     /// different rays independently), its weight or opacity read at `uv` (Mitsuba's surface
     /// coordinates, `v` running down the image) where it is a texture.
     #[inline(always)]
-    pub(crate) fn choose(&self, index: usize, ray: &Ray, uv: impl Fn() -> Vec2) -> Chosen {
+    pub(crate) fn choose(&self, index: usize, ray: &Ray, uv: impl Fn() -> Vec2) -> Chosen<'_> {
         let mut index = index;
         let mut one_sided = self.one_sided[index];
+        let mut tilt = None;
         if self.choices[index].is_none() {
-            return Chosen::Material { index, one_sided };
+            return Chosen::Material {
+                index,
+                one_sided,
+                tilt,
+            };
         }
         let mut bits = ray_bits(ray);
         // Blends and masks nest (the reader bounds how deep); a scene built with a cycle
         // stops after as many steps as it has materials.
         for _ in 0..self.choices.len() {
             let Some(choice) = &self.choices[index] else {
-                return Chosen::Material { index, one_sided };
+                return Chosen::Material {
+                    index,
+                    one_sided,
+                    tilt,
+                };
             };
             bits = mix(bits);
             let u = (bits >> 40) as f32 * (1.0 / (1u64 << 24) as f32);
@@ -181,10 +243,94 @@ impl Materials {
                     }
                     *material
                 }
+                Choice::Tilted { map, material } => {
+                    tilt = Some(map);
+                    *material
+                }
             };
             one_sided &= self.one_sided[index];
         }
-        Chosen::Material { index, one_sided }
+        Chosen::Material {
+            index,
+            one_sided,
+            tilt,
+        }
+    }
+
+    /// The frame `map` tilts the shading frame `shading` to at a hit seen from `wo_l` (in
+    /// `shading`'s coordinates), with Mitsuba's `dp_du`, `dp_dv`, geometric normal `ng`
+    /// and surface coordinates `uv`; none where the map gives no direction.
+    pub(crate) fn tilt(
+        &self,
+        map: &TiltMap,
+        uv: Vec2,
+        shading: &Frame,
+        (dpdu, dpdv): (Vec3, Vec3),
+        ng: Vec3,
+        wo_l: Vec3,
+    ) -> Option<Tilt> {
+        // A normal below the outgoing direction has its tangential part mirrored.
+        let flip = |n: Vec3| {
+            if map.options.flip_invalid_normals && wo_l.z * wo_l.dot(n) <= 0.0 {
+                Vec3::new(-n.x, -n.y, n.z)
+            } else {
+                n
+            }
+        };
+        let (n, s) = match &map.kind {
+            TiltKind::Normal(lookup) => {
+                let c = self.lookup(lookup, uv);
+                let n = flip(Vec3::new(c.r, c.g, c.b) * 2.0 - Vec3::ONE).try_normalize()?;
+                (n, (Vec3::X - n * n.x).try_normalize()?)
+            }
+            TiltKind::Bump {
+                lookup,
+                scale,
+                bilinear,
+            } => {
+                let (gu, gv) = if *bilinear {
+                    let (tex, _, m) = lookup;
+                    let at = Vec2::new(
+                        m[0] * uv.x + m[1] * uv.y + m[2],
+                        m[3] * uv.x + m[4] * uv.y + m[5],
+                    );
+                    let [dx, dy] = tex.bilinear_gradient(at).map(luminance);
+                    let (w, h) = tex.size();
+                    // Per unit of the surface's coordinates, through `to_uv` transposed,
+                    // scaled by the resolution after it, as Mitsuba's bitmap does.
+                    (
+                        *scale * w as f32 * (m[0] * dx + m[3] * dy),
+                        *scale * h as f32 * (m[1] * dx + m[4] * dy),
+                    )
+                } else {
+                    (0.0, 0.0)
+                };
+                let ns = shading.n;
+                let du = dpdu + ns * (gu - ns.dot(dpdu));
+                let dv = dpdv + ns * (gv - ns.dot(dpdv));
+                let nw = du.cross(dv).try_normalize()?;
+                let nw = if ng.dot(nw) < 0.0 { -nw } else { nw };
+                let n = flip(shading.to_local(nw));
+                // Mitsuba 3.9.1 makes the tilted frame's tangent from the world's dp/du
+                // against this local normal; only anisotropic BSDFs see which tangent it is.
+                (n, (dpdu - n * n.dot(dpdu)).try_normalize()?)
+            }
+        };
+        let t = n.cross(s);
+        let alpha2 = if map.options.shadowing {
+            let cos2 = n.z * n.z;
+            (0.125 * (1.0 - cos2).max(0.0) / cos2).min(1.0)
+        } else {
+            0.0
+        };
+        Some(Tilt {
+            frame: Frame {
+                s: shading.to_world(s),
+                t: shading.to_world(t),
+                n: shading.to_world(n),
+            },
+            alpha2,
+        })
     }
 
     /// The texel of material `index`'s texture at surface coordinates `uv` (`v` running

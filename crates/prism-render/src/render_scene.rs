@@ -7,7 +7,7 @@ use prism_math::{Ray, Rgb, Vec3};
 use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
-use crate::interaction::Interaction;
+use crate::interaction::{frame_along, Interaction};
 use crate::lights::envmap::EnvMap;
 use crate::lights::{MeshLight, RenderLight};
 use crate::materials::{Chosen, Materials};
@@ -346,25 +346,39 @@ impl RenderScene {
                 .unwrap_or(ng);
                 let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
                 let mats = &self.materials;
-                // Texture coordinates as Mitsuba's (v running down the image); (0, 0)
-                // without any, as Mitsuba's.
-                let uv = || {
-                    m.uvs.as_ref().map_or(prism_math::Vec2::ZERO, |uvs| {
-                        let [ua, ub, uc] = t.map(|i| uvs[i as usize]);
-                        let uv = b0 * ua + hit.b1 * ub + hit.b2 * uc;
-                        prism_math::Vec2::new(uv.x, 1.0 - uv.y)
+                // Texture coordinates as Mitsuba's (v running down the image), at the
+                // corners and here; without any, the barycentric coordinates, as Mitsuba's.
+                let corner_uvs = || {
+                    m.uvs.as_ref().map(|uvs| {
+                        t.map(|i| prism_math::Vec2::new(uvs[i as usize].x, 1.0 - uvs[i as usize].y))
                     })
                 };
-                let (mut bsdf, chosen) = match mats.choose(m.material, ray, uv) {
-                    Chosen::Through => (Bsdf::Null, None),
-                    Chosen::Material { index, one_sided } => (
-                        if one_sided && ray.dir.dot(ns) >= 0.0 {
+                let uv = || {
+                    corner_uvs().map_or(prism_math::Vec2::new(hit.b1, hit.b2), |[ua, ub, uc]| {
+                        b0 * ua + hit.b1 * ub + hit.b2 * uc
+                    })
+                };
+                let (mut bsdf, chosen, tilt) = match mats.choose(m.material, ray, uv) {
+                    Chosen::Through => (Bsdf::Null, None, None),
+                    Chosen::Material {
+                        index,
+                        one_sided,
+                        tilt: map,
+                    } => {
+                        let tilt = map.and_then(|map| {
+                            let (dpdu, dpdv) = mesh_derivatives([a, b, c], corner_uvs(), ng);
+                            let shading = frame_along(ns, Some(dpdu));
+                            let wo_l = shading.to_local(-ray.dir);
+                            mats.tilt(map, uv(), &shading, (dpdu, dpdv), ng, wo_l)
+                        });
+                        let front = tilt.map_or(ns, |t| t.frame.n);
+                        let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
                             Bsdf::Black
                         } else {
                             mats.bsdf(index)
-                        },
-                        Some(index),
-                    ),
+                        };
+                        (bsdf, Some(index), tilt)
+                    }
                 };
                 if let (Some(index), true, Some(albedo)) =
                     (chosen, m.uvs.is_some(), bsdf.albedo_mut())
@@ -386,13 +400,10 @@ impl RenderScene {
                     },
                     light: m.light,
                     t: hit.t,
-                    tangent: chosen.is_some_and(|i| mats.anisotropic[i]).then(|| {
-                        mesh_tangent(
-                            [a, b, c],
-                            m.uvs.as_ref().map(|u| t.map(|i| u[i as usize])),
-                            ng,
-                        )
-                    }),
+                    tangent: chosen
+                        .is_some_and(|i| mats.anisotropic[i])
+                        .then(|| mesh_derivatives([a, b, c], corner_uvs(), ng).0),
+                    tilt,
                 }
             }
             Prim::LightQuad { light } => {
@@ -412,6 +423,7 @@ impl RenderScene {
                     light: Some(light as usize),
                     t: hit.t,
                     tangent: None,
+                    tilt: None,
                 }
             }
             Prim::Sphere { index } => {
@@ -435,16 +447,27 @@ impl RenderScene {
                         theta / std::f32::consts::PI,
                     )
                 };
-                let (mut bsdf, chosen) = match mats.choose(material, ray, uv) {
-                    Chosen::Through => (Bsdf::Null, None),
-                    Chosen::Material { index, one_sided } => (
-                        if one_sided && ray.dir.dot(n) >= 0.0 {
+                let (mut bsdf, chosen, tilt) = match mats.choose(material, ray, uv) {
+                    Chosen::Through => (Bsdf::Null, None, None),
+                    Chosen::Material {
+                        index,
+                        one_sided,
+                        tilt: map,
+                    } => {
+                        let tilt = map.and_then(|map| {
+                            let (dpdu, dpdv) = sphere_derivatives(outward, s.radius);
+                            let shading = frame_along(n, Some(dpdu));
+                            let wo_l = shading.to_local(-ray.dir);
+                            mats.tilt(map, uv(), &shading, (dpdu, dpdv), n, wo_l)
+                        });
+                        let front = tilt.map_or(n, |t| t.frame.n);
+                        let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
                             Bsdf::Black
                         } else {
                             mats.bsdf(index)
-                        },
-                        Some(index),
-                    ),
+                        };
+                        (bsdf, Some(index), tilt)
+                    }
                 };
                 if let (Some(index), Some(albedo)) = (chosen, bsdf.albedo_mut()) {
                     if mats.textured(index) {
@@ -466,24 +489,48 @@ impl RenderScene {
                     tangent: chosen
                         .is_some_and(|i| mats.anisotropic[i])
                         .then(|| Vec3::new(-outward.y, outward.x, 0.0)),
+                    tilt,
                 }
             }
         }
     }
 }
 
-/// A triangle's first tangent, `dp/du` from its texture coordinates (`v` may run either way:
-/// `dp/du` is the same), or where [`prism_math::Frame::from_normal`] puts it for the
-/// geometric normal when there are none or they are degenerate, as Mitsuba's meshes do.
-fn mesh_tangent(p: [Vec3; 3], uv: Option<[prism_math::Vec2; 3]>, ng: Vec3) -> Vec3 {
-    if let Some([a, b, c]) = uv {
-        let (duv0, duv1) = (b - a, c - a);
-        let det = duv0.x * duv1.y - duv0.y * duv1.x;
-        if det != 0.0 {
-            return ((p[1] - p[0]) * duv1.y - (p[2] - p[0]) * duv0.y) * (1.0 / det);
-        }
+/// A triangle's `dp/du` and `dp/dv` as Mitsuba's meshes have them: from texture coordinates
+/// `uv` (Mitsuba's, `v` running down the image) where they are not degenerate, the frame
+/// [`prism_math::Frame::from_normal`] puts around the geometric normal where they are, and
+/// the edges from the first corner (barycentric coordinates) without any.
+fn mesh_derivatives(p: [Vec3; 3], uv: Option<[prism_math::Vec2; 3]>, ng: Vec3) -> (Vec3, Vec3) {
+    let (dp0, dp1) = (p[1] - p[0], p[2] - p[0]);
+    let Some([a, b, c]) = uv else {
+        return (dp0, dp1);
+    };
+    let (duv0, duv1) = (b - a, c - a);
+    let det = duv0.x * duv1.y - duv0.y * duv1.x;
+    if det == 0.0 {
+        let f = prism_math::Frame::from_normal(ng);
+        return (f.s, f.t);
     }
-    prism_math::Frame::from_normal(ng).s
+    let inv = 1.0 / det;
+    (
+        (dp0 * duv1.y - dp1 * duv0.y) * inv,
+        (dp1 * duv0.x - dp0 * duv1.x) * inv,
+    )
+}
+
+/// `dp/du` and `dp/dv` of a sphere of `radius` at the point of unit direction `local` from
+/// its centre, in Mitsuba's coordinates (the azimuth over 2 pi and the polar angle from +z
+/// over pi, the world's axes).
+fn sphere_derivatives(local: Vec3, radius: f32) -> (Vec3, Vec3) {
+    let tau = 2.0 * std::f32::consts::PI;
+    let dpdu = Vec3::new(-local.y, local.x, 0.0) * (tau * radius);
+    let rd = (local.x * local.x + local.y * local.y).sqrt();
+    let dpdv = if rd == 0.0 {
+        Vec3::X
+    } else {
+        Vec3::new(local.z * local.x / rd, local.z * local.y / rd, -rd)
+    };
+    (dpdu, dpdv * (std::f32::consts::PI * radius))
 }
 
 /// How far apart (per coordinate) the corner normals of a face shaded with one normal may be,

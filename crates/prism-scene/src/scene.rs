@@ -143,6 +143,28 @@ pub enum Material {
         /// The material where it is, as an index into [`Scene::materials`].
         material: usize,
     },
+    /// Mitsuba's `normalmap`: `material` under a shading normal read from an image, `2 rgb
+    /// - 1` in the shading frame (x along `dp/du`).
+    NormalMap {
+        /// The normals.
+        normals: MaterialTexture,
+        /// The material under them, as an index into [`Scene::materials`].
+        material: usize,
+        /// How the tilted normal is used.
+        tilt: TiltOptions,
+    },
+    /// Mitsuba's `bumpmap`: `material` under a shading normal tilted by the gradient of a
+    /// height image's luminance (bilinear; flat where the image is looked up nearest).
+    BumpMap {
+        /// The heights.
+        height: MaterialTexture,
+        /// The heights' scale.
+        scale: f32,
+        /// The material under them, as an index into [`Scene::materials`].
+        material: usize,
+        /// How the tilted normal is used.
+        tilt: TiltOptions,
+    },
     /// The Phong model of Whitted ray tracers (the Delft project's): diffuse `kd` plus a
     /// specular lobe `ks * max(r.v, 0)^shininess` per light.
     Phong {
@@ -208,6 +230,17 @@ impl MaterialTexture {
             to_uv: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
         }
     }
+}
+
+/// How a bump or normal map's tilted normal is used, as Mitsuba's options say.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TiltOptions {
+    /// Mirror the tilted normal's tangential part where the outgoing direction would fall
+    /// below it (Mitsuba's `flip_invalid_normals`).
+    pub flip_invalid_normals: bool,
+    /// Darken grazing light by Estevez et al.'s microfacet shadowing term, which hides the
+    /// shading-normal terminator (Mitsuba's `use_shadowing_function`).
+    pub shadowing: bool,
 }
 
 /// A number over a surface: a constant, or the luminance of a texture's texel (Mitsuba's

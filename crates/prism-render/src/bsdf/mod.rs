@@ -241,9 +241,13 @@ impl Bsdf {
                 }
             }
             Material::Phong { kd, .. } => Bsdf::Diffuse { albedo: kd },
-            // A blend or a mask is a choice among other materials, made at each hit by the
-            // render scene: alone it has no BSDF of its own.
-            Material::Blend { .. } | Material::Mask { .. } => Bsdf::Black,
+            // A blend or a mask is a choice among other materials, and a map tilts another
+            // material's normal, at each hit in the render scene: alone they have no BSDF of
+            // their own.
+            Material::Blend { .. }
+            | Material::Mask { .. }
+            | Material::NormalMap { .. }
+            | Material::BumpMap { .. } => Bsdf::Black,
         }
     }
 

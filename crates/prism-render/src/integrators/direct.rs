@@ -91,6 +91,13 @@ pub(super) fn light_term(
     if f.max_channel() <= 0.0 {
         return None;
     }
+    let f = match hit.tilt {
+        None => f,
+        Some(_) => match hit.tilt_factor(ls.wi) {
+            0.0 => return None,
+            g => f * g,
+        },
+    };
     // The shadow ray starts pushed off the surface and aims at the light's point itself
     // from there, stopping just short of it (a fraction of its length): aimed along `wi`
     // from the pushed origin, it would meet a light seen at a grazing angle before the
@@ -137,7 +144,7 @@ fn direct_hemisphere(
         if !hit.consistent(wo, wi) {
             continue;
         }
-        let f = hit.bsdf.eval(wo_l, d);
+        let f = hit.bsdf.eval(wo_l, d) * hit.tilt_factor(wi);
         let ray = hit.spawn(wi);
         let le = match scene.intersect(&ray) {
             Some(h) => h.emitted,

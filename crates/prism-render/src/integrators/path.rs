@@ -47,7 +47,10 @@ pub(super) fn path(
         if !hit.consistent(wo, wi) {
             break;
         }
-        beta = beta * s.weight;
+        beta = match hit.tilt {
+            None => beta * s.weight,
+            Some(_) => beta * s.weight * hit.tilt_factor(wi),
+        };
         if beta.max_channel() <= 0.0 {
             break;
         }

@@ -80,8 +80,12 @@ impl PhongMaterial {
             | Material::Microfacet { .. }
             | Material::Conductor { .. }
             | Material::RoughDielectric { .. } => plain(Rgb::BLACK, Rgb::WHITE),
-            // A choice among other materials, which the path tracer makes at each hit: grey.
-            Material::Blend { .. } | Material::Mask { .. } => plain(Rgb::splat(0.5), Rgb::BLACK),
+            // Choices among other materials and tilts of their normals, which the path tracer
+            // makes at each hit: grey.
+            Material::Blend { .. }
+            | Material::Mask { .. }
+            | Material::NormalMap { .. }
+            | Material::BumpMap { .. } => plain(Rgb::splat(0.5), Rgb::BLACK),
         }
     }
 }

@@ -1,12 +1,13 @@
 //! Mitsuba's BSDFs as prism's materials: each plugin with Mitsuba's defaults and named
-//! indices, `twosided`, the choices of `blendbsdf` and `mask`, and microfacet roughness.
+//! indices, `twosided`, the choices of `blendbsdf` and `mask`, the tilted normals of
+//! `normalmap` and `bumpmap`, and microfacet roughness.
 
 use super::document::Object;
 use super::limits::{MAX_OBJECT_DEPTH, MAX_ROUGH_PLASTIC_COATS};
 use super::props::{error, ior, not_supported, unsupported};
 use super::to_scene::Builder;
 use crate::error::SceneError;
-use crate::scene::{Material, MicrofacetKind, Roughness, ScalarTexture};
+use crate::scene::{Material, MicrofacetKind, Roughness, ScalarTexture, TiltOptions};
 use prism_math::Rgb;
 
 impl Builder<'_> {
@@ -69,6 +70,9 @@ impl Builder<'_> {
         }
         if matches!(o.kind.as_str(), "blendbsdf" | "mask") {
             return self.choice(index, o, depth, two_sided);
+        }
+        if matches!(o.kind.as_str(), "normalmap" | "bumpmap") {
+            return self.tilted(index, o, depth, two_sided);
         }
         // Nested plugins: a texture in place of a diffuse reflectance, nothing else yet.
         let mut reflectance_texture = None;
@@ -239,6 +243,105 @@ impl Builder<'_> {
             "diffuse" | "plastic" | "roughplastic" | "conductor" | "roughconductor"
         );
         let m = self.push_material(material, name, opaque && !two_sided);
+        self.bsdfs.insert(index, m);
+        Ok(m)
+    }
+
+    /// A `normalmap` (a nested BSDF and a `normalmap` texture) or a `bumpmap` (a nested BSDF,
+    /// a bitmap of heights and their `scale`). The nested BSDF must be a plain one: prism
+    /// tilts the shading normal once.
+    fn tilted(
+        &mut self,
+        index: usize,
+        o: &Object,
+        depth: usize,
+        two_sided: bool,
+    ) -> Result<usize, SceneError> {
+        if depth > MAX_OBJECT_DEPTH {
+            return Err(error(
+                o,
+                format!("objects nested more than {MAX_OBJECT_DEPTH} deep (a <ref> cycle?)"),
+            ));
+        }
+        let mut nested = Vec::new();
+        let mut textures = Vec::new();
+        for (name, c) in &o.children {
+            let co = &self.doc.objects[*c];
+            match co.tag.as_str() {
+                "bsdf" => nested.push((self.bsdf(*c, depth + 1)?, co)),
+                "texture" if o.kind == "bumpmap" || name.as_deref() == Some("normalmap") => {
+                    if o.kind == "bumpmap" && co.kind != "bitmap" {
+                        return Err(error(
+                            co,
+                            format!(
+                                "{} in {}: expected a bitmap (Mitsuba has no gradient for others)",
+                                co.label(),
+                                o.label()
+                            ),
+                        ));
+                    }
+                    textures.push(self.texture(co)?);
+                }
+                _ => {
+                    return Err(not_supported(
+                        co,
+                        format!(
+                            "{} in {}: not supported by prism yet",
+                            co.label(),
+                            o.label()
+                        ),
+                    ))
+                }
+            }
+        }
+        let ([(material, inner)], [texture]) = (&nested[..], &textures[..]) else {
+            return Err(error(
+                o,
+                format!(
+                    "{}: expected one nested <bsdf> and one texture, found {} and {}",
+                    o.label(),
+                    nested.len(),
+                    textures.len()
+                ),
+            ));
+        };
+        let (material, texture) = (*material, texture.clone());
+        if matches!(
+            self.scene.materials[material],
+            Material::Blend { .. }
+                | Material::Mask { .. }
+                | Material::NormalMap { .. }
+                | Material::BumpMap { .. }
+        ) {
+            return Err(not_supported(
+                inner,
+                format!(
+                    "{} in {}: a blend, mask or map under a map: not supported by prism yet",
+                    inner.label(),
+                    o.label()
+                ),
+            ));
+        }
+        let tilt = TiltOptions {
+            flip_invalid_normals: o.boolean("flip_invalid_normals", true)?,
+            shadowing: o.boolean("use_shadowing_function", true)?,
+        };
+        let m = if o.kind == "normalmap" {
+            Material::NormalMap {
+                normals: texture,
+                material,
+                tilt,
+            }
+        } else {
+            Material::BumpMap {
+                height: texture,
+                scale: o.float("scale", 1.0)? as f32,
+                material,
+                tilt,
+            }
+        };
+        let name = o.id.clone().unwrap_or_else(|| o.label());
+        let m = self.push_material(m, name, !two_sided);
         self.bsdfs.insert(index, m);
         Ok(m)
     }

@@ -778,3 +778,58 @@ fn blends_and_masks_are_read_as_choices() {
     .to_string();
     assert!(e.contains("nested more than"), "{e}");
 }
+
+/// `normalmap` and `bumpmap` are read with Mitsuba's defaults (`scale` 1, the flip of
+/// invalid normals and the shadowing term on), and refused with located errors where prism
+/// or Mitsuba cannot render them: a bump map's texture other than a bitmap, a map over a
+/// blend, and a wrong number of children.
+#[test]
+fn bump_and_normal_maps_are_read_with_mitsubas_defaults() {
+    let files = Files::new(
+        "maps",
+        &[(
+            "s.xml",
+            &scene(
+                "<shape type=\"sphere\"><bsdf type=\"bumpmap\"><texture type=\"bitmap\"><string name=\"filename\" value=\"h.exr\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>\
+                 <shape type=\"sphere\"><bsdf type=\"normalmap\"><boolean name=\"use_shadowing_function\" value=\"false\"/><texture type=\"bitmap\" name=\"normalmap\"><string name=\"filename\" value=\"h.exr\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>",
+            ),
+        )],
+    );
+    let mut image = prism_image::RgbImage::new(2, 2, Rgb::splat(0.5));
+    image.set(1, 0, Rgb::WHITE);
+    prism_image::write_exr(&files.path("h.exr"), &image).unwrap();
+    let s = read_mitsuba(&files.path("s.xml"), &[]).unwrap();
+    let m = &s.scene.materials;
+    assert!(
+        matches!(&m[s.scene.spheres[0].material], crate::Material::BumpMap { scale, tilt, .. } if *scale == 1.0 && tilt.flip_invalid_normals && tilt.shadowing),
+        "{:?}",
+        m[s.scene.spheres[0].material]
+    );
+    assert!(
+        matches!(&m[s.scene.spheres[1].material], crate::Material::NormalMap { normals, tilt, .. } if normals.image.get(1, 0) == Rgb::WHITE && !tilt.shadowing),
+        "{:?}",
+        m[s.scene.spheres[1].material]
+    );
+    for (body, wanted) in [
+        (
+            "<bsdf type=\"bumpmap\"><texture type=\"checkerboard\"/><bsdf type=\"diffuse\"/></bsdf>",
+            "expected a bitmap (Mitsuba has no gradient for others)",
+        ),
+        (
+            "<bsdf type=\"normalmap\"><bsdf type=\"diffuse\"/></bsdf>",
+            "s.xml:4: <bsdf>: type=\"normalmap\": expected one nested <bsdf> and one texture, found 1 and 0",
+        ),
+        (
+            "<bsdf type=\"bumpmap\"><texture type=\"bitmap\"><string name=\"filename\" value=\"h.exr\"/></texture>\n<bsdf type=\"mask\"><bsdf type=\"diffuse\"/></bsdf></bsdf>",
+            "s.xml:5: <bsdf>: type=\"mask\" in type=\"bumpmap\": a blend, mask or map under a map: not supported by prism yet",
+        ),
+    ] {
+        let files = Files::new(
+            "maps-bad",
+            &[("s.xml", &scene(&format!("<shape type=\"sphere\">\n{body}\n</shape>")))],
+        );
+        prism_image::write_exr(&files.path("h.exr"), &image).unwrap();
+        let e = read_mitsuba(&files.path("s.xml"), &[]).unwrap_err().to_string();
+        assert!(e.contains(wanted), "{e}");
+    }
+}

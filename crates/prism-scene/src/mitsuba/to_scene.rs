@@ -13,7 +13,9 @@ use super::props::{error, not_supported, unsupported};
 use crate::error::SceneError;
 use std::sync::Arc;
 
-use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, TriangleMesh};
+use crate::scene::{
+    Camera, Light, Material, ScalarTexture, Scene, SceneSphere, Shading, TriangleMesh,
+};
 
 /// How the film turns samples into pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -291,13 +293,7 @@ impl Builder<'_> {
                 // prism's spheres keep the world's axes: the texture coordinates of a turned
                 // sphere would be turned with it.
                 let turned = (0..3).any(|i| (cols[i] - DVec3::AXES[i] * r).length() > 1e-6 * r);
-                let textured = matches!(
-                    self.scene.materials[material],
-                    Material::Diffuse {
-                        texture: Some(_),
-                        ..
-                    }
-                );
+                let textured = self.textured(material);
                 if turned && textured {
                     return Err(not_supported(
                         o,
@@ -514,6 +510,41 @@ impl Builder<'_> {
             ));
         }
         Ok(())
+    }
+
+    /// True if material `index`, or any it chooses among or tilts, reads a texture.
+    fn textured(&self, index: usize) -> bool {
+        let mut pending = vec![index];
+        // Nested materials come before the materials that hold them.
+        while let Some(i) = pending.pop() {
+            match &self.scene.materials[i] {
+                Material::Diffuse {
+                    texture: Some(_), ..
+                }
+                | Material::Plastic {
+                    texture: Some(_), ..
+                }
+                | Material::RoughPlastic {
+                    texture: Some(_), ..
+                }
+                | Material::NormalMap { .. }
+                | Material::BumpMap { .. } => return true,
+                Material::Blend {
+                    weight: ScalarTexture::Image(_),
+                    ..
+                }
+                | Material::Mask {
+                    opacity: ScalarTexture::Image(_),
+                    ..
+                } => return true,
+                Material::Blend { materials, .. } => {
+                    pending.extend(materials.iter().filter(|&&m| m < i));
+                }
+                Material::Mask { material, .. } if *material < i => pending.push(*material),
+                _ => {}
+            }
+        }
+        false
     }
 
     /// Adds material `m`, named `name`, black from behind if `one_sided`; its index.

@@ -21,9 +21,13 @@ use crate::interaction::Interaction;
 use crate::lights::RenderLight;
 use crate::sampler::lane_values;
 
-/// The kind of smooth BSDF at a surface this step handles.
+/// The kind of smooth BSDF at a surface this step handles (not under a bump or normal map,
+/// which the one-path step handles).
 pub(super) fn smooth_kind(hit: &Interaction) -> Option<SmoothKind> {
-    SmoothKind::of(&hit.bsdf)
+    match hit.tilt {
+        None => SmoothKind::of(&hit.bsdf),
+        Some(_) => None,
+    }
 }
 
 /// What the step reads and writes besides the paths.

@@ -57,7 +57,10 @@ pub(super) fn scatter(
     if !hit.consistent(wo, wi) {
         return None;
     }
-    p.beta = p.beta * s.weight;
+    p.beta = match hit.tilt {
+        None => p.beta * s.weight,
+        Some(_) => p.beta * s.weight * hit.tilt_factor(wi),
+    };
     if p.beta.max_channel() <= 0.0 {
         return None;
     }
