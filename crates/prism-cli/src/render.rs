@@ -109,10 +109,10 @@ pub struct RenderArgs {
     /// The course's adaptive-sampling flag: --batch BATCH --adaptive TOL in one.
     #[arg(short = 'a', num_args = 2, value_names = ["BATCH", "TOL"], conflicts_with_all = ["adaptive", "batch"])]
     course_adaptive: Option<Vec<String>>,
-    /// Environment light from a latitude-longitude OpenEXR map of linear radiance (the
-    /// course's -e), seen by every ray and importance-sampled; it replaces the scene's
-    /// hemisphere or environment light. Orientation: docs/path-tracer.md.
-    #[arg(short = 'e', long, value_name = "FILE.exr")]
+    /// Environment light from a latitude-longitude OpenEXR or Radiance HDR map of linear
+    /// radiance (the course's -e), seen by every ray and importance-sampled; it replaces the
+    /// scene's hemisphere or environment light. Orientation: docs/path-tracer.md.
+    #[arg(short = 'e', long, value_name = "FILE.exr|FILE.hdr")]
     envmap: Option<PathBuf>,
     /// Thin-lens camera: the lens radius in world units (the course's -b); 0 is a pinhole.
     #[arg(short = 'b', long, value_name = "RADIUS")]
@@ -379,11 +379,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let (format, heatmap_format) =
         crate::output::picture_outputs(&a.output, a.exr.as_deref(), a.heatmap.as_deref(), &inputs)?;
     if let Some(map) = &a.envmap {
-        if crate::output::extension(map) != "exr" {
+        if !matches!(crate::output::extension(map).as_str(), "exr" | "hdr") {
             return Err(UserError::WrongKind {
                 flag: Some("--envmap".into()),
                 path: map.clone(),
-                expected: "an OpenEXR (.exr) map".into(),
+                expected: "an OpenEXR (.exr) or Radiance (.hdr) map".into(),
             }
             .into());
         }
@@ -482,7 +482,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         scene.camera.lens = lens;
     }
     if let Some(path) = &a.envmap {
-        let map = prism_image::read_exr(path).map_err(UserError::input)?;
+        let map = prism_image::read_radiance(path).map_err(UserError::input)?;
         let replaced = scene
             .light_by_environment_map(std::sync::Arc::new(map))
             .map_err(|e| UserError::input(format!("--envmap {}: {e}", path.display())))?;

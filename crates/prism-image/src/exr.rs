@@ -597,6 +597,21 @@ pub fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     decode_exr(&bytes, &path.display().to_string())
 }
 
+/// Reads a file of linear radiance: OpenEXR (see [`decode_exr`]) or Radiance HDR (see
+/// [`crate::decode_hdr`]), told apart by their first bytes.
+///
+/// # Errors
+/// [`ImageError::Io`] if it cannot be read, otherwise as the decoder's.
+pub fn read_radiance(path: &Path) -> Result<RgbImage, ImageError> {
+    let bytes = read_bytes(path)?;
+    let what = path.display().to_string();
+    if crate::hdr::is_hdr(&bytes) {
+        crate::hdr::decode_hdr(&bytes, &what)
+    } else {
+        decode_exr(&bytes, &what)
+    }
+}
+
 /// Reads an OpenEXR file's every channel and string attribute (see [`decode_exr_layers`]).
 ///
 /// # Errors

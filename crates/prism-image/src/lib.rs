@@ -1,7 +1,7 @@
-//! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO,
-//! the one texture sampler (mipmaps, nearest/bilinear/trilinear), image-difference metrics,
-//! cube maps looked up as OpenGL does, heat maps, bloom, BMP output, animated PNGs and
-//! montages (pictures side by side in a grid).
+//! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO
+//! and Radiance HDR input, the one texture sampler (mipmaps, nearest/bilinear/trilinear),
+//! image-difference metrics, cube maps looked up as OpenGL does, heat maps, bloom, BMP
+//! output, animated PNGs and montages (pictures side by side in a grid).
 #![warn(missing_docs)]
 
 mod animation;
@@ -10,6 +10,7 @@ mod cubemap;
 mod diff;
 mod error;
 mod exr;
+mod hdr;
 mod heatmap;
 mod image;
 mod io;
@@ -24,8 +25,9 @@ pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{
     decode_exr, decode_exr_header, decode_exr_layers, encode_exr, encode_exr_layers, read_exr,
-    read_exr_layers, write_exr, write_exr_layers, ExrLayers, ExrSamples,
+    read_exr_layers, read_radiance, write_exr, write_exr_layers, ExrLayers, ExrSamples,
 };
+pub use hdr::{decode_hdr, is_hdr};
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{

@@ -1339,7 +1339,10 @@ fn envmap_lights_the_unlit_bunny() {
     });
     prism_image::write_exr(&nan, &map).unwrap();
     for (map, want) in [
-        (sky.with_extension("png"), "expected an OpenEXR (.exr) map"),
+        (
+            sky.with_extension("png"),
+            "expected an OpenEXR (.exr) or Radiance (.hdr) map",
+        ),
         (bad.clone(), "bad.exr"),
         (nan.clone(), "nan.exr: texel (1, 0) is"),
     ] {

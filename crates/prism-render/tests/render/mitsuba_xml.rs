@@ -517,3 +517,21 @@ fn a_normal_map_tilts_the_shading_normal_as_mitsubas_does() {
     assert!((without - lit).abs() < 1e-4 * lit, "{without} vs {lit}");
     assert_eq!(render("tilt-behind", true, -80.0), 0.0);
 }
+
+/// Oracle: Mitsuba's own RGBE writer. `sky.hdr` is Mitsuba 3's `Bitmap.write` of `sky.exr`
+/// (run-length encoded): each pixel reads back within the 8-bit mantissa's rounding of the
+/// OpenEXR's (1/128 of its largest channel).
+#[test]
+fn a_radiance_file_written_by_mitsuba_reads_as_its_source() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/mitsuba/xml");
+    let exr = prism_image::read_exr(&dir.join("sky.exr")).unwrap();
+    let bytes = std::fs::read(dir.join("sky.hdr")).unwrap();
+    let hdr = prism_image::decode_hdr(&bytes, "sky.hdr").unwrap();
+    assert_eq!((hdr.width(), hdr.height()), (exr.width(), exr.height()));
+    for (a, b) in hdr.pixels().iter().zip(exr.pixels()) {
+        let tolerance = b.max_channel() / 128.0;
+        for (x, y) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)] {
+            assert!((x - y).abs() <= tolerance, "{a:?} vs {b:?}");
+        }
+    }
+}

@@ -80,8 +80,8 @@ impl Builder<'_> {
         }
     }
 
-    /// The image file an object's `filename` names, with that name: OpenEXR as linear
-    /// values; PNG or JPEG as `byte / 255`, decoded from sRGB unless `raw`. A file read
+    /// The image file an object's `filename` names, with that name: OpenEXR and Radiance
+    /// HDR as linear values; PNG or JPEG as `byte / 255`, decoded from sRGB unless `raw`. A file read
     /// before is not read again: its image is shared.
     pub(super) fn image_file(
         &mut self,
@@ -101,7 +101,7 @@ impl Builder<'_> {
         let decoding = |e: crate::texture_file::TextureFileError| {
             located(match e {
                 crate::texture_file::TextureFileError::NotAnImage => {
-                    format!("{file}: {e} (prism reads PNG, JPEG and OpenEXR images)")
+                    format!("{file}: {e} (prism reads PNG, JPEG, OpenEXR and Radiance HDR images)")
                 }
                 e => e.to_string(),
             })
@@ -109,6 +109,8 @@ impl Builder<'_> {
         let bytes = crate::obj::read_bytes(&path).map_err(|e| located(e.to_string()))?;
         let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
             prism_image::decode_exr(&bytes, file).map_err(|e| located(e.to_string()))?
+        } else if prism_image::is_hdr(&bytes) {
+            prism_image::decode_hdr(&bytes, file).map_err(|e| located(e.to_string()))?
         } else if raw {
             crate::texture_file::decode_texture(&bytes, file).map_err(decoding)?
         } else {
@@ -119,8 +121,6 @@ impl Builder<'_> {
         Ok((file.to_string(), image))
     }
 
-    /// Refuses a nested plugin (a texture in place of a colour, say) of an object prism
-    /// reads only properties of.
     /// A texture read for a number (Mitsuba's `eval_1`): the luminance of its texels. A
     /// checkerboard read so puts `color0` where u and v fall in different halves of the
     /// unit square, the opposite of its colours, as Mitsuba's does.
@@ -140,6 +140,8 @@ impl Builder<'_> {
         Ok(ScalarTexture::Image(t))
     }
 
+    /// Refuses a nested plugin (a texture in place of a colour, say) of an object prism
+    /// reads only properties of.
     pub(super) fn no_nested_plugins(&self, o: &Object) -> Result<(), SceneError> {
         match o.children.first() {
             Some(&(_, c)) => {
