@@ -111,6 +111,9 @@ impl Materials {
                 }
                 | Material::RoughPlastic {
                     texture: Some(t), ..
+                }
+                | Material::Principled {
+                    texture: Some(t), ..
                 } => Some(prepare(t)),
                 _ => None,
             });

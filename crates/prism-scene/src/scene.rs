@@ -143,6 +143,40 @@ pub enum Material {
         /// The material where it is, as an index into [`Scene::materials`].
         material: usize,
     },
+    /// Mitsuba's `principled` (Disney's BSDF as Mitsuba 3 writes it).
+    Principled {
+        /// The base colour.
+        base_color: Rgb,
+        /// An image the base colour is multiplied by.
+        texture: Option<MaterialTexture>,
+        /// Perceptual roughness.
+        roughness: f32,
+        /// Anisotropy of the specular lobes.
+        anisotropic: f32,
+        /// Metalness.
+        metallic: f32,
+        /// Share of specular transmission.
+        spec_trans: f32,
+        /// Tint of the dielectric specular lobe towards the base colour.
+        spec_tint: f32,
+        /// Sheen's weight.
+        sheen: f32,
+        /// Tint of the sheen towards the base colour.
+        sheen_tint: f32,
+        /// Blend of the diffuse lobe towards a flat subsurface look.
+        flatness: f32,
+        /// Clearcoat's weight.
+        clearcoat: f32,
+        /// Clearcoat's glossiness.
+        clearcoat_gloss: f32,
+        /// Index of refraction inside over outside.
+        eta: f32,
+        /// Sampling rates of the main specular lobes, the clearcoat and the diffuse lobe.
+        rates: [f32; 3],
+        /// True inside Mitsuba's `twosided` (without transmission): the back scatters as the
+        /// front.
+        two_sided: bool,
+    },
     /// Mitsuba's `normalmap`: `material` under a shading normal read from an image, `2 rgb
     /// - 1` in the shading frame (x along `dp/du`).
     NormalMap {

@@ -119,6 +119,15 @@ pub enum Bsdf {
         /// The coat's transmittance table and internal reflectance.
         tables: &'static rough_plastic::CoatTables,
     },
+    /// Mitsuba's principled BSDF.
+    Principled {
+        /// The base colour (times the texture's texel).
+        base: Rgb,
+        /// The other parameters.
+        params: &'static principled::PrincipledParams,
+        /// True if the back scatters as the front (inside `twosided`, without transmission).
+        two_sided: bool,
+    },
     /// Absorbs everything (the surface of an emitter).
     Black,
     /// No surface: light passes on unchanged (where a mask lets a ray through).
@@ -248,6 +257,41 @@ impl Bsdf {
             | Material::Mask { .. }
             | Material::NormalMap { .. }
             | Material::BumpMap { .. } => Bsdf::Black,
+            Material::Principled {
+                base_color,
+                roughness,
+                anisotropic,
+                metallic,
+                spec_trans,
+                spec_tint,
+                sheen,
+                sheen_tint,
+                flatness,
+                clearcoat,
+                clearcoat_gloss,
+                eta,
+                rates,
+                two_sided,
+                ..
+            } => Bsdf::Principled {
+                base: base_color,
+                params: principled::PrincipledParams {
+                    roughness,
+                    anisotropic,
+                    metallic,
+                    spec_trans,
+                    spec_tint,
+                    sheen,
+                    sheen_tint,
+                    flatness,
+                    clearcoat,
+                    clearcoat_gloss,
+                    eta,
+                    rates,
+                }
+                .interned(),
+                two_sided: two_sided && spec_trans == 0.0,
+            },
         }
     }
 
@@ -262,6 +306,7 @@ impl Bsdf {
                 | Bsdf::RoughConductor { .. }
                 | Bsdf::RoughDielectric { .. }
                 | Bsdf::RoughPlastic { .. }
+                | Bsdf::Principled { .. }
         )
     }
 
@@ -270,6 +315,7 @@ impl Bsdf {
         match self {
             Bsdf::Diffuse { albedo } => Some(albedo),
             Bsdf::Plastic { diffuse, .. } | Bsdf::RoughPlastic { diffuse, .. } => Some(diffuse),
+            Bsdf::Principled { base, .. } => Some(base),
             _ => None,
         }
     }
@@ -282,6 +328,7 @@ impl Bsdf {
             Bsdf::RoughConductor { distr, .. } | Bsdf::RoughDielectric { distr, .. } => {
                 distr.alpha_u != distr.alpha_v
             }
+            Bsdf::Principled { params, .. } => params.anisotropic != 0.0,
             _ => false,
         }
     }
@@ -296,7 +343,7 @@ impl Bsdf {
                 | Bsdf::ThinDielectric { .. }
                 | Bsdf::RoughDielectric { .. }
                 | Bsdf::Null
-        )
+        ) && !matches!(self, Bsdf::Principled { params, .. } if params.spec_trans != 0.0)
     }
 
     /// The BSDF times `|cos wi|`. Zero for delta lobes.
@@ -555,6 +602,21 @@ impl Bsdf {
                 u1,
                 u2,
             ),
+            Bsdf::Principled {
+                base,
+                params,
+                two_sided,
+            } => {
+                if two_sided && wo.z < 0.0 {
+                    let s = principled::sample(params, base, flip(wo), u1, u2)?;
+                    Some(BsdfSample {
+                        wi: flip(s.wi),
+                        ..s
+                    })
+                } else {
+                    principled::sample(params, base, wo, u1, u2)
+                }
+            }
             Bsdf::Black => None,
         }
     }
@@ -595,6 +657,17 @@ impl Bsdf {
                 wo,
                 wi,
             )),
+            Bsdf::Principled {
+                base,
+                params,
+                two_sided,
+            } => {
+                let (wo, wi) = if two_sided { upper(wo, wi) } else { (wo, wi) };
+                Some((
+                    principled::eval(params, base, wo, wi),
+                    principled::pdf(params, wo, wi),
+                ))
+            }
             _ => None,
         }
     }
@@ -822,6 +895,7 @@ fn refract(wo: Vec3, ior: f32) -> Option<(Vec3, f32)> {
 
 pub(crate) mod lanes;
 mod microfacet;
+pub mod principled;
 mod rough;
 pub mod rough_plastic;
 

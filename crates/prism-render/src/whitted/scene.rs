@@ -80,6 +80,7 @@ impl PhongMaterial {
             | Material::Microfacet { .. }
             | Material::Conductor { .. }
             | Material::RoughDielectric { .. } => plain(Rgb::BLACK, Rgb::WHITE),
+            Material::Principled { base_color, .. } => plain(*base_color, Rgb::BLACK),
             // Choices among other materials and tilts of their normals, which the path tracer
             // makes at each hit: grey.
             Material::Blend { .. }

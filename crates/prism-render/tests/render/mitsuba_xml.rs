@@ -122,6 +122,18 @@ fn anisotropy_on_a_mesh_without_uvs_runs_as_mitsubas() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `principled.xml` (beside the references): `principled` with
+/// a textured base colour, metal, specular tint and clearcoat; with transmission; with
+/// anisotropy, sheen and flatness; and inside `twosided`; compared as the box is.
+#[test]
+fn principled_bsdfs_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "principled",
+        "crates/prism-render/tests/golden/mitsuba/xml/principled.xml",
+        &[],
+    );
+}
+
 /// prism's render of `scene` (from the workspace's root) with `defines` against the
 /// reference `NAME.exr` and its variance `NAME_variance.exr`.
 fn agrees_with_mitsuba(name: &str, scene: &str, defines: &[(&str, &str)]) {

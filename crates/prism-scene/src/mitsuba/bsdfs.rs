@@ -81,6 +81,7 @@ impl Builder<'_> {
             let albedo_slot = match o.kind.as_str() {
                 "diffuse" => "reflectance",
                 "plastic" | "roughplastic" => "diffuse_reflectance",
+                "principled" => "base_color",
                 _ => "",
             };
             if !albedo_slot.is_empty() && slot.as_deref() == Some(albedo_slot) && c.tag == "texture"
@@ -91,7 +92,7 @@ impl Builder<'_> {
             return Err(not_supported(
                 c,
                 format!(
-                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse reflectance or a plastic's diffuse_reflectance is)",
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse reflectance, a plastic's diffuse_reflectance or a principled base_color is)",
                     c.label(),
                     o.label()
                 ),
@@ -235,6 +236,7 @@ impl Builder<'_> {
                     ior: (int / ext) as f32,
                 }
             }
+            "principled" => principled(o, reflectance_texture.clone(), two_sided)?,
             _ => return Err(unsupported(o)),
         };
         // Mitsuba's opaque BSDFs are black from behind unless wrapped in `twosided`.
@@ -501,4 +503,78 @@ fn conductor_index(o: &Object) -> Result<(Rgb, Rgb), SceneError> {
         )
     })?;
     Ok((Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2])))
+}
+
+/// A `principled` BSDF with Mitsuba's defaults: `base_color` 0.5, `roughness` 0.5, the
+/// other weights 0, and `eta`, or else `specular` (0.5) mapped to an index as Mitsuba maps
+/// it; transmission moves an index of 1 (or a specular of 0) just off it.
+fn principled(
+    o: &Object,
+    texture: Option<crate::scene::MaterialTexture>,
+    two_sided: bool,
+) -> Result<Material, SceneError> {
+    let f = |name: &str, default: f64| -> Result<f32, SceneError> {
+        let v = o.float(name, default)?;
+        if !v.is_finite() {
+            return Err(error(
+                o,
+                format!("{}: {name}: expected a finite number", o.label()),
+            ));
+        }
+        Ok(v as f32)
+    };
+    let spec_trans = f("spec_trans", 0.0)?;
+    let eta = match (o.value("eta"), o.value("specular")) {
+        (Some(_), Some(_)) => {
+            return Err(error(
+                o,
+                format!(
+                    "{}: eta and specular: expected one of them, not both",
+                    o.label()
+                ),
+            ))
+        }
+        (Some(_), None) => match f("eta", 1.5)? {
+            eta if spec_trans != 0.0 && eta == 1.0 => 1.001,
+            eta => eta,
+        },
+        (None, _) => {
+            let specular = match f("specular", 0.5)? {
+                s if spec_trans != 0.0 && s == 0.0 => 1e-3,
+                s => s,
+            };
+            2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
+        }
+    };
+    if eta.is_nan() || eta <= 0.0 {
+        return Err(error(
+            o,
+            format!("{}: expected a positive index, found {eta}", o.label()),
+        ));
+    }
+    Ok(Material::Principled {
+        base_color: if texture.is_some() {
+            Rgb::WHITE
+        } else {
+            o.rgb("base_color", [0.5; 3])?
+        },
+        texture,
+        roughness: f("roughness", 0.5)?,
+        anisotropic: f("anisotropic", 0.0)?,
+        metallic: f("metallic", 0.0)?,
+        spec_trans,
+        spec_tint: f("spec_tint", 0.0)?,
+        sheen: f("sheen", 0.0)?,
+        sheen_tint: f("sheen_tint", 0.0)?,
+        flatness: f("flatness", 0.0)?,
+        clearcoat: f("clearcoat", 0.0)?,
+        clearcoat_gloss: f("clearcoat_gloss", 0.0)?,
+        eta,
+        rates: [
+            f("main_specular_sampling_rate", 1.0)?,
+            f("clearcoat_sampling_rate", 1.0)?,
+            f("diffuse_reflectance_sampling_rate", 1.0)?,
+        ],
+        two_sided,
+    })
 }

@@ -833,3 +833,44 @@ fn bump_and_normal_maps_are_read_with_mitsubas_defaults() {
         assert!(e.contains(wanted), "{e}");
     }
 }
+
+/// `principled` is read with Mitsuba's defaults (base colour and roughness 0.5, `specular`
+/// 0.5 as an index of 2 / (1 - sqrt(0.04)) - 1 = 1.5), `eta` given directly (an index of 1
+/// moved to 1.001 under transmission), and `eta` with `specular` refused.
+#[test]
+fn principled_is_read_with_mitsubas_defaults() {
+    let s = read(
+        "principled",
+        "<shape type=\"sphere\"><bsdf type=\"principled\"/></shape>\
+         <shape type=\"sphere\"><bsdf type=\"principled\"><float name=\"eta\" value=\"1\"/><float name=\"spec_trans\" value=\"0.5\"/></bsdf></shape>",
+        &[],
+    )
+    .unwrap();
+    let m = &s.scene.materials;
+    let crate::Material::Principled {
+        base_color,
+        roughness,
+        eta,
+        two_sided,
+        ..
+    } = m[s.scene.spheres[0].material]
+    else {
+        panic!("{:?}", m[s.scene.spheres[0].material]);
+    };
+    assert_eq!(
+        (base_color, roughness, two_sided),
+        (Rgb::splat(0.5), 0.5, false)
+    );
+    assert!((eta - 1.5).abs() < 1e-6, "{eta}");
+    assert!(
+        matches!(m[s.scene.spheres[1].material], crate::Material::Principled { eta, .. } if eta == 1.001)
+    );
+    let e = read(
+        "principled-both",
+        "<shape type=\"sphere\"><bsdf type=\"principled\"><float name=\"eta\" value=\"1.3\"/><float name=\"specular\" value=\"0.3\"/></bsdf></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("eta and specular: expected one of them"), "{e}");
+}

@@ -527,6 +527,9 @@ impl Builder<'_> {
                 | Material::RoughPlastic {
                     texture: Some(_), ..
                 }
+                | Material::Principled {
+                    texture: Some(_), ..
+                }
                 | Material::NormalMap { .. }
                 | Material::BumpMap { .. } => return true,
                 Material::Blend {
