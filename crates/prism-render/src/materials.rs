@@ -33,6 +33,8 @@ enum Choice {
     Mask { opacity: Scalar, material: usize },
     /// `material` under a tilted normal.
     Tilted { map: TiltMap, material: usize },
+    /// `material`, the surface under an area emitter.
+    Surface { material: usize },
 }
 
 /// A bump or normal map, prepared.
@@ -132,6 +134,12 @@ impl Materials {
                     opacity: scalar(opacity),
                     material: *material,
                 }),
+                Material::AreaEmitter {
+                    surface: Some(material),
+                    ..
+                } if valid(*material) => Some(Choice::Surface {
+                    material: *material,
+                }),
                 Material::NormalMap {
                     normals,
                     material,
@@ -170,8 +178,9 @@ impl Materials {
                 .materials
                 .iter()
                 .map(|m| match m {
-                    Material::Emission { radiance }
-                    | Material::EmissiveDiffuse { radiance, .. } => Some(*radiance),
+                    Material::Emission { radiance } | Material::AreaEmitter { radiance, .. } => {
+                        Some(*radiance)
+                    }
                     _ => None,
                 })
                 .collect(),
@@ -186,7 +195,7 @@ impl Materials {
             front_only: scene
                 .materials
                 .iter()
-                .map(|m| matches!(m, Material::EmissiveDiffuse { .. }))
+                .map(|m| matches!(m, Material::AreaEmitter { .. }))
                 .collect(),
         }
     }
@@ -219,7 +228,14 @@ impl Materials {
                 tilt,
             };
         }
-        let mut bits = ray_bits(ray);
+        // The numbers blends and masks choose by, drawn one after another from the ray's
+        // bits (only where a blend or a mask needs one).
+        let mut bits = None;
+        let mut next_u = || {
+            let b = mix(bits.unwrap_or_else(|| ray_bits(ray)));
+            bits = Some(b);
+            (b >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+        };
         // Blends and masks nest (the reader bounds how deep); a scene built with a cycle
         // stops after as many steps as it has materials.
         for _ in 0..self.choices.len() {
@@ -230,18 +246,17 @@ impl Materials {
                     tilt,
                 };
             };
-            bits = mix(bits);
-            let u = (bits >> 40) as f32 * (1.0 / (1u64 << 24) as f32);
             let value = |s: &Scalar| match s {
                 Scalar::Constant(v) => *v,
                 Scalar::Image(lookup) => luminance(self.lookup(lookup, uv())),
             };
             index = match choice {
                 Choice::Blend { weight, materials } => {
+                    let u = next_u();
                     materials[usize::from(u < value(weight).clamp(0.0, 1.0))]
                 }
                 Choice::Mask { opacity, material } => {
-                    if u >= value(opacity).clamp(0.0, 1.0) {
+                    if next_u() >= value(opacity).clamp(0.0, 1.0) {
                         return Chosen::Through;
                     }
                     *material
@@ -250,6 +265,7 @@ impl Materials {
                     tilt = Some(map);
                     *material
                 }
+                Choice::Surface { material } => *material,
             };
             one_sided &= self.one_sided[index];
         }

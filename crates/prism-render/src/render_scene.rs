@@ -171,7 +171,7 @@ impl RenderScene {
             let radiance = match scene.materials.get(m.material) {
                 Some(
                     prism_scene::Material::Emission { radiance }
-                    | prism_scene::Material::EmissiveDiffuse { radiance, .. },
+                    | prism_scene::Material::AreaEmitter { radiance, .. },
                 ) => *radiance,
                 _ => continue,
             };
@@ -185,7 +185,7 @@ impl RenderScene {
                 .collect();
             let one_sided = matches!(
                 scene.materials.get(m.material),
-                Some(prism_scene::Material::EmissiveDiffuse { .. })
+                Some(prism_scene::Material::AreaEmitter { .. })
             );
             if let Some(light) = MeshLight::new(tris, radiance).map(|l| l.one_sided(one_sided)) {
                 mesh_light[mi] = Some(lights.len());

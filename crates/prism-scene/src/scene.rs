@@ -23,13 +23,14 @@ pub enum Material {
         /// Emitted radiance.
         radiance: Rgb,
     },
-    /// A Lambertian surface that also emits `radiance` from both sides (a Mitsuba shape with
-    /// an area emitter: the emitter does not replace the shape's BSDF).
-    EmissiveDiffuse {
+    /// A Mitsuba area emitter: `radiance` from the front (where the winding's normal
+    /// points) of a surface that still scatters light as its own BSDF does (black without
+    /// one).
+    AreaEmitter {
         /// Emitted radiance.
         radiance: Rgb,
-        /// Albedo of the surface under the emission.
-        reflectance: Rgb,
+        /// The surface's material, as an index into [`Scene::materials`], if it has one.
+        surface: Option<usize>,
     },
     /// Mitsuba's smooth `plastic`: a diffuse base under a smooth dielectric coat of index
     /// `eta`, light scattering inside the coat (its linear model).
@@ -691,7 +692,7 @@ impl Scene {
     /// True if some material emits light of non-zero power.
     fn has_emitting_material(&self) -> bool {
         self.materials.iter().any(|m| match m {
-            Material::Emission { radiance } | Material::EmissiveDiffuse { radiance, .. } => {
+            Material::Emission { radiance } | Material::AreaEmitter { radiance, .. } => {
                 radiance.r > 0.0 || radiance.g > 0.0 || radiance.b > 0.0
             }
             _ => false,

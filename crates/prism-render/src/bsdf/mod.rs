@@ -158,9 +158,9 @@ impl Bsdf {
                 albedo: reflectance,
             },
             Material::Emission { .. } => Bsdf::Black,
-            Material::EmissiveDiffuse { reflectance, .. } => Bsdf::Diffuse {
-                albedo: reflectance,
-            },
+            // An area emitter's surface scatters as its own material does (the render scene
+            // takes that at each hit); without one it is black.
+            Material::AreaEmitter { .. } => Bsdf::Black,
             Material::Mirror { reflectance } => Bsdf::Mirror { reflectance },
             Material::Glass {
                 reflectance,

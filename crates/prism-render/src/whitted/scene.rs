@@ -66,7 +66,7 @@ impl PhongMaterial {
                 plain(*reflectance * mean, Rgb::BLACK)
             }
             Material::Emission { radiance } => plain(*radiance, Rgb::BLACK),
-            Material::EmissiveDiffuse { radiance, .. } => plain(*radiance, Rgb::BLACK),
+            Material::AreaEmitter { radiance, .. } => plain(*radiance, Rgb::BLACK),
             Material::Mirror { reflectance } => plain(Rgb::BLACK, *reflectance),
             Material::ThinDielectric { reflectance, .. } => plain(Rgb::BLACK, *reflectance),
             Material::Plastic {

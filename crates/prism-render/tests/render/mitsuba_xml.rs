@@ -547,3 +547,63 @@ fn a_radiance_file_written_by_mitsuba_reads_as_its_source() {
         }
     }
 }
+
+/// Closed form: an area emitter keeps its shape's BSDF, whatever it is. A plate that emits
+/// 0.25 and is a perfect mirror (Mitsuba's default conductor), seen head-on under a constant
+/// emitter of 1, shows 1.25; a textured diffuse emitter is lit and textured as well (0.25
+/// plus its albedo 0.6 times 1).
+#[test]
+fn area_emitters_keep_their_surfaces_bsdf() {
+    let mean = |name: &str, bsdf: &str| -> f32 {
+        let dir = tempfile_dir(name);
+        prism_image::write_exr(
+            &dir.join("albedo.exr"),
+            &prism_image::RgbImage::new(2, 2, prism_math::Rgb::splat(0.6)),
+        )
+        .unwrap();
+        let file = dir.join("s.xml");
+        std::fs::write(
+            &file,
+            format!(
+                r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="10"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="rectangle">
+        <emitter type="area"><rgb name="radiance" value="0.25"/></emitter>
+        {bsdf}
+    </shape>
+</scene>"#
+            ),
+        )
+        .unwrap();
+        let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
+        let scene = RenderScene::new(&m.scene);
+        let opts = RenderOptions {
+            film: FilmSettings {
+                width: 8,
+                height: 8,
+                spp: 256,
+                ..FilmSettings::default()
+            },
+            path: PathSettings {
+                max_bounces: 1,
+                ..PathSettings::default()
+            },
+        };
+        let share = prism_render::film::Share::whole(opts.film.spp);
+        let job = prism_render::render::Job::share(&share);
+        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 64.0
+    };
+    let mirror = mean("emitter-mirror", r#"<bsdf type="conductor"/>"#);
+    assert!((mirror - 1.25).abs() < 1e-4, "{mirror}");
+    let textured = mean(
+        "emitter-textured",
+        r#"<bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="albedo.exr"/></texture></bsdf>"#,
+    );
+    assert!((textured - 0.85).abs() < 0.01, "{textured}");
+}

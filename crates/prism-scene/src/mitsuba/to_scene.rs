@@ -231,30 +231,12 @@ impl Builder<'_> {
         };
         let material = match (emission, material) {
             // An area emitter keeps a BSDF given to its shape: light meeting it scatters too.
-            (Some(radiance), surface) => {
-                // Without a BSDF of its own an emitter's surface is black, as Mitsuba makes it.
-                let one_sided = surface.is_none_or(|m| self.scene.one_sided[m]);
-                let reflectance = match surface.map(|m| &self.scene.materials[m]) {
-                    None => Rgb::splat(0.0),
-                    Some(Material::Diffuse {
-                        reflectance,
-                        texture: None,
-                    }) => *reflectance,
-                    Some(_) => {
-                        let refusal = not_supported(o, format!("{}: an area emitter on a shape whose BSDF is not a plain diffuse one: not supported by prism yet", o.label()));
-                        self.tolerate(refusal, "its surface is black")?;
-                        Rgb::splat(0.0)
-                    }
-                };
-                self.push_material(
-                    Material::EmissiveDiffuse {
-                        radiance,
-                        reflectance,
-                    },
-                    format!("{} area emitter", o.label()),
-                    one_sided,
-                )
-            }
+            (Some(radiance), surface) => self.push_material(
+                Material::AreaEmitter { radiance, surface },
+                format!("{} area emitter", o.label()),
+                // The surface's BSDF says which of its sides scatter.
+                true,
+            ),
             (None, Some(m)) => m,
             // One default material, however many shapes lack a BSDF.
             (None, None) => match self.default_material {
