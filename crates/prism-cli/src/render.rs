@@ -421,6 +421,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
+    // A size given on the command line replaces a Mitsuba film's, crop and all.
+    let film_replaced = a.resolution.is_some();
     let a = &resolved;
     let (adaptive, batch) = adaptive_settings(a)?;
     check_flags(a, adaptive, batch)?;
@@ -472,7 +474,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         },
     };
     let scene = match (&a.scene, mitsuba) {
-        (_, Some(m)) => m.scene,
+        (_, Some(m)) => {
+            let mut scene = m.scene;
+            if film_replaced {
+                scene.camera.crop = None;
+            }
+            scene
+        }
         (None, None) => prism_scene::cornell_box(),
         (Some(path), None) => prism_scene::load(path, &opts).map_err(UserError::input)?,
     };

@@ -20,6 +20,9 @@ pub struct Perspective {
     /// The same, scaled to the half-extent of the image at unit depth.
     right: Vec3,
     up: Vec3,
+    /// The image's centre off the view axis at unit depth (world units for an orthographic
+    /// view): zero unless the image is a crop of a larger film.
+    centre: Vec3,
     width: f32,
     height: f32,
     /// Lens radius and focal distance; `None` for a pinhole.
@@ -36,24 +39,37 @@ impl Perspective {
     /// along `normalize(up x (eye - target))`, image rows go down.
     #[must_use]
     pub fn new(c: &Camera, width: u32, height: u32) -> Perspective {
-        let (hfov, vfov) = c.fov_for(width, height);
+        // A crop sees the part of the whole film's view that its window covers.
+        let (fw, fh) = c.crop.map_or((width, height), |crop| crop.full);
+        let (hfov, vfov) = c.fov_for(fw, fh);
         let forward = (c.target - c.eye).normalize();
         let right = c.up.cross(-forward).normalize();
         let up = (-forward).cross(right);
         let (half_x, half_y) = match c.orthographic {
-            Some((x, y)) => (x, y * height as f32 / width as f32),
+            Some((x, y)) => (x, y * fh as f32 / fw as f32),
             None => (
                 (hfov.to_radians() / 2.0).tan(),
                 (vfov.to_radians() / 2.0).tan(),
             ),
         };
+        let (mut right_half, mut up_half, mut centre) = (right * half_x, up * half_y, Vec3::ZERO);
+        if let Some(crop) = c.crop {
+            let (ox, oy) = (crop.offset.0 as f32, crop.offset.1 as f32);
+            let (w, h) = (width as f32, height as f32);
+            let cx = (2.0 * ox + w) / fw as f32 - 1.0;
+            let cy = 1.0 - (2.0 * oy + h) / fh as f32;
+            centre = cx * right_half + cy * up_half;
+            right_half *= w / fw as f32;
+            up_half *= h / fh as f32;
+        }
         Perspective {
             eye: c.eye,
             forward,
             right_unit: right,
             up_unit: up,
-            right: right * half_x,
-            up: up * half_y,
+            right: right_half,
+            up: up_half,
+            centre,
             orthographic: c.orthographic.is_some(),
             width: width as f32,
             height: height as f32,
@@ -102,10 +118,13 @@ impl Perspective {
         let sx = 2.0 * x / self.width - 1.0;
         let sy = 1.0 - 2.0 * y / self.height;
         if self.orthographic {
-            return Ray::new(self.eye + sx * self.right + sy * self.up, self.forward);
+            return Ray::new(
+                self.eye + self.centre + sx * self.right + sy * self.up,
+                self.forward,
+            );
         }
         // Direction at unit depth along the view axis.
-        let d = self.forward + sx * self.right + sy * self.up;
+        let d = self.forward + self.centre + sx * self.right + sy * self.up;
         match self.lens {
             None => Ray::new(self.eye, d.normalize()),
             Some((radius, focal_distance)) => {
@@ -129,7 +148,7 @@ impl Perspective {
     pub(crate) fn pinhole_dirs(&self, x: F16, y: F16) -> V16 {
         let sx = x * 2.0 / self.width - 1.0;
         let sy = F16::splat(1.0) - y * 2.0 / self.height;
-        let (f, r, u) = (self.forward, self.right, self.up);
+        let (f, r, u) = (self.forward + self.centre, self.right, self.up);
         V16 {
             x: F16::splat(f.x) + sx * r.x + sy * u.x,
             y: F16::splat(f.y) + sx * r.y + sy * u.y,
@@ -169,6 +188,7 @@ mod tests {
             far: 1000.0,
             lens,
             orthographic: None,
+            crop: None,
         };
         Perspective::new(&c, 64, 48)
     }
@@ -188,6 +208,7 @@ mod tests {
             far: 1000.0,
             lens: None,
             orthographic: Some((2.0, 3.0)),
+            crop: None,
         };
         let cam = Perspective::new(&c, 64, 48);
         assert!(cam.pinhole().is_none() && !cam.has_lens());

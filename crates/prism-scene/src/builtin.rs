@@ -135,6 +135,7 @@ pub fn cornell_box() -> Scene {
             far: 100.0,
             lens: None,
             orthographic: None,
+            crop: None,
         },
         warnings: Vec::new(),
     }

@@ -59,7 +59,7 @@ pub use render_config::{
     MAX_WINDOW_PIXELS, MAX_WINDOW_SIDE,
 };
 pub use scene::{
-    Camera, CameraMode, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind, NormalsMode,
-    OrbitCamera, Roughness, ScalarTexture, Scene, SceneOptions, SceneSphere, Shading, ThinLens,
-    TiltOptions, TriangleMesh,
+    Camera, CameraMode, Crop, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind,
+    NormalsMode, OrbitCamera, Roughness, ScalarTexture, Scene, SceneOptions, SceneSphere, Shading,
+    ThinLens, TiltOptions, TriangleMesh,
 };

@@ -501,6 +501,19 @@ pub struct Camera {
     /// from the plane `near` ahead of the eye, over half extents `(x, y / aspect)` in world
     /// units (Mitsuba's `orthographic`: the film's width spans `2 x`).
     pub orthographic: Option<(f32, f32)>,
+    /// The image is a window of a larger film (Mitsuba's `crop_*`); the view is the whole
+    /// film's.
+    pub crop: Option<Crop>,
+}
+
+/// A window of a larger film: the image's pixel `(x, y)` is the film's pixel
+/// `(x + offset.0, y + offset.1)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    /// The window's top-left pixel in the film.
+    pub offset: (u32, u32),
+    /// The whole film's width and height.
+    pub full: (u32, u32),
 }
 
 /// A thin lens: rays leave a disk of `radius` around the eye, in the plane facing the view,
@@ -596,6 +609,7 @@ impl OrbitCamera {
             far: 1e4,
             lens: None,
             orthographic: None,
+            crop: None,
         }
     }
 }

@@ -32,6 +32,7 @@ fn furnace(material: Material) -> Scene {
             far: 100.0,
             lens: None,
             orthographic: None,
+            crop: None,
         },
         warnings: vec![],
     }
@@ -433,6 +434,7 @@ fn emissive_mesh_lights_the_floor_as_the_form_factor_says() {
             far: 100.0,
             lens: None,
             orthographic: None,
+            crop: None,
         },
         warnings: vec![],
     };
@@ -519,6 +521,7 @@ fn textured_square(image: &prism_image::Rgb8Image, name: &str) -> Scene {
         far: 100.0,
         lens: None,
         orthographic: None,
+        crop: None,
     };
     scene
 }

@@ -49,6 +49,7 @@ impl Scene {
             far: 1000.0,
             lens: None,
             orthographic: None,
+            crop: None,
         });
         scene.warnings.clone_from(&doc.warnings);
         let err = |line: u32, element: &str, message: String| SceneError::Element {
@@ -445,5 +446,6 @@ fn place_camera(scene: &Scene, file: Option<&(CameraDef, DMat4)>, mode: CameraMo
         far: far as f32,
         lens: None,
         orthographic: None,
+        crop: None,
     }
 }

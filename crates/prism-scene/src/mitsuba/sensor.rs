@@ -8,7 +8,7 @@ use super::limits::{MAX_FILM_SIDE, MAX_SAMPLE_COUNT};
 use super::props::{error, not_supported, unsupported};
 use super::to_scene::{Builder, Filter};
 use crate::error::SceneError;
-use crate::scene::{Camera, ThinLens};
+use crate::scene::{Camera, Crop, ThinLens};
 
 impl Builder<'_> {
     /// The sensor: the camera, and its film and sampler.
@@ -23,10 +23,11 @@ impl Builder<'_> {
         if !matches!(o.kind.as_str(), "perspective" | "thinlens" | "orthographic") {
             return Err(unsupported(o));
         }
+        let mut crop = None;
         for &(_, child) in &o.children {
             let c = &self.doc.objects[child];
             match c.tag.as_str() {
-                "film" => self.film(c)?,
+                "film" => crop = self.film(c)?,
                 "sampler" => {
                     let n = c.integer("sample_count", 4)?;
                     if !(1..=i64::from(MAX_SAMPLE_COUNT)).contains(&n) {
@@ -43,7 +44,8 @@ impl Builder<'_> {
                 _ => return Err(unsupported(c)),
             }
         }
-        let (w, h) = self.settings.size;
+        // The view is the whole film's, however it is cropped.
+        let (w, h) = crop.map_or(self.settings.size, |c: Crop| c.full);
         let aspect = f64::from(w) / f64::from(h);
         let fov = match o.value("fov") {
             Some(_) => o.float("fov", 0.0)?,
@@ -164,21 +166,17 @@ impl Builder<'_> {
             far: far as f32,
             lens,
             orthographic,
+            crop,
         };
         Ok(())
     }
 
-    /// The film: its size and reconstruction filter.
-    fn film(&mut self, o: &Object) -> Result<(), SceneError> {
+    /// The film: its size, its crop window (the image's size then) and its reconstruction
+    /// filter.
+    fn film(&mut self, o: &Object) -> Result<Option<Crop>, SceneError> {
         if o.kind != "hdrfilm" {
             return Err(unsupported(o));
         }
-        o.refuse(&[
-            "crop_offset_x",
-            "crop_offset_y",
-            "crop_width",
-            "crop_height",
-        ])?;
         let side = |name: &str, default: i64| -> Result<u32, SceneError> {
             let v = o.integer(name, default)?;
             if !(1..=i64::from(MAX_FILM_SIDE)).contains(&v) {
@@ -192,7 +190,53 @@ impl Builder<'_> {
             }
             Ok(v as u32)
         };
-        self.settings.size = (side("width", 768)?, side("height", 576)?);
+        let full = (side("width", 768)?, side("height", 576)?);
+        let cropped = [
+            "crop_offset_x",
+            "crop_offset_y",
+            "crop_width",
+            "crop_height",
+        ]
+        .iter()
+        .any(|n| o.value(n).is_some());
+        let crop = if cropped {
+            let at = |name: &str, default: u32| -> Result<u32, SceneError> {
+                let v = o.integer(name, i64::from(default))?;
+                u32::try_from(v).map_err(|_| {
+                    error(
+                        o,
+                        format!(
+                            "{}: {name}: expected a whole number of pixels, found {v}",
+                            o.label()
+                        ),
+                    )
+                })
+            };
+            let offset = (at("crop_offset_x", 0)?, at("crop_offset_y", 0)?);
+            let size = (at("crop_width", full.0)?, at("crop_height", full.1)?);
+            let fits =
+                |o: u32, s: u32, f: u32| s >= 1 && u64::from(o) + u64::from(s) <= u64::from(f);
+            if !fits(offset.0, size.0, full.0) || !fits(offset.1, size.1, full.1) {
+                return Err(error(
+                    o,
+                    format!(
+                        "{}: the crop window ({}x{} at {}, {}) must lie within the {}x{} film",
+                        o.label(),
+                        size.0,
+                        size.1,
+                        offset.0,
+                        offset.1,
+                        full.0,
+                        full.1
+                    ),
+                ));
+            }
+            self.settings.size = size;
+            Some(Crop { offset, full })
+        } else {
+            self.settings.size = full;
+            None
+        };
         for &(_, child) in &o.children {
             let c = &self.doc.objects[child];
             if c.tag != "rfilter" {
@@ -209,7 +253,7 @@ impl Builder<'_> {
                 _ => return Err(unsupported(c)),
             };
         }
-        Ok(())
+        Ok(crop)
     }
 
     /// The integrator's depth settings.

@@ -874,3 +874,45 @@ fn principled_is_read_with_mitsubas_defaults() {
     .to_string();
     assert!(e.contains("eta and specular: expected one of them"), "{e}");
 }
+
+/// A film's crop window is read as Mitsuba's (`crop_width` and `crop_height` default to the
+/// film's size, the offsets to 0) and refused, located, where it leaves the film.
+#[test]
+fn film_crops_must_lie_within_the_film() {
+    let film = |crop: &str| {
+        format!(
+            "<scene version=\"3.0.0\">\n<sensor type=\"perspective\">\
+             <film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"32\"/>{crop}</film></sensor>\n</scene>\n"
+        )
+    };
+    let files = Files::new(
+        "crop",
+        &[(
+            "s.xml",
+            &film("<integer name=\"crop_offset_y\" value=\"8\"/><integer name=\"crop_height\" value=\"24\"/>"),
+        )],
+    );
+    let s = read_mitsuba(&files.path("s.xml"), &[]).unwrap();
+    assert_eq!(s.settings.size, (64, 24));
+    assert_eq!(
+        s.scene.camera.crop,
+        Some(crate::Crop {
+            offset: (0, 8),
+            full: (64, 32)
+        })
+    );
+    let files = Files::new(
+        "crop-out",
+        &[(
+            "s.xml",
+            &film("<integer name=\"crop_offset_x\" value=\"8\"/>"),
+        )],
+    );
+    let e = read_mitsuba(&files.path("s.xml"), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("s.xml:2: <film>: type=\"hdrfilm\": the crop window (64x32 at 8, 0) must lie within the 64x32 film"),
+        "{e}"
+    );
+}

@@ -95,6 +95,7 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
             far: 1e4,
             lens: None,
             orthographic: None,
+            crop: None,
         }),
         settings: MitsubaSettings::default(),
         sensor_seen: false,
