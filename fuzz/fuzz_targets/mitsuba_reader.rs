@@ -13,7 +13,8 @@ fuzz_target!(|data: &[u8]| {
     let file = dir.join("fuzz.xml");
     std::fs::write(&file, data).unwrap();
     for lenient in [false, true] {
-        match prism_scene::read_mitsuba_with(&file, &[], lenient) {
+        let options = prism_scene::MitsubaOptions { lenient, sensor: 0 };
+        match prism_scene::read_mitsuba_with(&file, &[], options) {
             Ok(m) => {
                 let triangles: usize = m.scene.meshes.iter().map(|x| x.triangles.len()).sum();
                 if triangles > 4096 {

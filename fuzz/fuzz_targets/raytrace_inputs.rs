@@ -104,6 +104,7 @@ fuzz_target!(|data: &[u8]| {
                         transparency: 0.5,
                     }],
                     material_names: vec![],
+                    one_sided: vec![false],
                     lights: cfg.lights.clone(),
                     camera: OrbitCamera::default().to_camera(1.0),
                     warnings: vec![],

@@ -86,6 +86,10 @@ pub struct RenderArgs {
     /// emitters are left out.
     #[arg(long)]
     lenient: bool,
+    /// Which of a Mitsuba scene's sensors to render (from 0). Without it, a scene with
+    /// several renders each to its own files, `_N` before each output's extension.
+    #[arg(long, value_name = "N")]
+    sensor: Option<usize>,
     /// Worker threads (default: one per core).
     #[arg(short = 't', long)]
     threads: Option<usize>,
@@ -337,7 +341,8 @@ impl RenderArgs {
 /// The arguments with what a Mitsuba scene (`.xml`) says filled in where the flags are
 /// silent (`-r` from its film, `-s` from its sampler, `-m` from its integrator), and the
 /// scene read; other scenes leave them as given.
-fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderArgs)> {
+/// The `-D` settings, parsed.
+fn defines(a: &RenderArgs) -> Result<Vec<(String, String)>> {
     let mut defines = Vec::new();
     for d in &a.define {
         match d.split_once('=') {
@@ -349,6 +354,49 @@ fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderA
             }
         }
     }
+    Ok(defines)
+}
+
+/// How many sensors the Mitsuba scene `a` renders has (none for other scenes).
+fn sensor_count(a: &RenderArgs) -> Result<Option<usize>> {
+    let Some(path) = a
+        .scene
+        .as_ref()
+        .filter(|p| crate::output::extension(p) == "xml")
+    else {
+        return Ok(None);
+    };
+    crate::error::check_input(path, None)?;
+    let doc = prism_scene::read_document(path, &defines(a)?).map_err(UserError::input)?;
+    let root = &doc.objects[0];
+    Ok(Some(
+        root.children
+            .iter()
+            .filter(|&&(_, c)| doc.objects[c].tag == "sensor")
+            .count(),
+    ))
+}
+
+/// `a` for sensor `i` of several: each output named with `_i` before its extension.
+fn for_sensor(a: &RenderArgs, i: usize) -> RenderArgs {
+    let suffixed = |p: &std::path::Path| {
+        let stem = p.file_stem().unwrap_or_default().to_string_lossy();
+        let name = match p.extension() {
+            Some(ext) => format!("{stem}_{i}.{}", ext.to_string_lossy()),
+            None => format!("{stem}_{i}"),
+        };
+        p.with_file_name(name)
+    };
+    let mut r = a.clone();
+    r.sensor = Some(i);
+    r.output = suffixed(&a.output);
+    r.exr = a.exr.as_deref().map(suffixed);
+    r.heatmap = a.heatmap.as_deref().map(suffixed);
+    r
+}
+
+fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderArgs)> {
+    let defines = defines(a)?;
     let mut r = a.clone();
     let Some(path) = a
         .scene
@@ -358,9 +406,16 @@ fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderA
         if !defines.is_empty() && !a.quiet {
             eprintln!("prism: warning: -D has no effect: it sets a Mitsuba scene's parameters");
         }
+        if a.sensor.is_some() && !a.quiet {
+            eprintln!("prism: warning: --sensor has no effect: it picks a Mitsuba scene's sensor");
+        }
         return Ok((None, r));
     };
-    let m = prism_scene::read_mitsuba_with(path, &defines, a.lenient).map_err(UserError::input)?;
+    let options = prism_scene::MitsubaOptions {
+        lenient: a.lenient,
+        sensor: a.sensor.unwrap_or(0),
+    };
+    let m = prism_scene::read_mitsuba_with(path, &defines, options).map_err(UserError::input)?;
     let s = &m.settings;
     r.spp = r.spp.or(Some(s.spp));
     r.max_bounces = r
@@ -373,6 +428,11 @@ fn resolve(a: &RenderArgs) -> Result<(Option<prism_scene::MitsubaScene>, RenderA
 /// Runs `prism render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
     use crate::output::ImageFormat;
+    if a.sensor.is_none() {
+        if let Some(count @ 2..) = sensor_count(a)? {
+            return (0..count).try_for_each(|i| run(&for_sensor(a, i)));
+        }
+    }
     let mut inputs = Vec::new();
     inputs.extend(a.scene.as_deref().map(|p| ("the scene", p)));
     inputs.extend(a.envmap.as_deref().map(|p| ("--envmap", p)));

@@ -50,7 +50,7 @@ pub use load::load;
 pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
 pub use mitsuba::{
     read_document, read_mitsuba, read_mitsuba_with, to_scene as mitsuba_to_scene, Filter,
-    MitsubaScene, MitsubaSettings,
+    MitsubaOptions, MitsubaScene, MitsubaSettings,
 };
 pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX_OBJ_BYTES};
 pub use presets::Preset;

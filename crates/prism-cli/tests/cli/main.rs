@@ -2481,3 +2481,63 @@ fn mitsuba_scenes_render_and_refuse_what_they_cannot() {
         .collect();
     assert_eq!(left.len(), 2, "{left:?}");
 }
+
+/// A Mitsuba scene with two sensors renders one image for each, `_0` and `_1` before the
+/// extension, each the same bytes as `--sensor N` renders alone; a sensor the scene does
+/// not have is refused with exit 2, naming the file, and nothing written.
+#[test]
+fn each_sensor_of_a_mitsuba_scene_renders_its_own_image() {
+    let dir = scratch("sensors");
+    let scene = dir.join("two.xml");
+    std::fs::write(
+        &scene,
+        r#"<scene version="3.0.0">
+    <sensor type="perspective"><float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="12"/><rfilter type="box"/></film>
+    </sensor>
+    <sensor type="orthographic">
+        <transform name="to_world"><lookat origin="3, 1, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="10"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="sphere"><bsdf type="diffuse"/></shape>
+</scene>"#,
+    )
+    .unwrap();
+    let render = |extra: &[&str], out: &std::path::Path| {
+        prism()
+            .arg("render")
+            .arg(&scene)
+            .args(["-s", "2", "-q", "-o"])
+            .arg(out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = render(&[], &dir.join("img.png"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (first, second) = (dir.join("img_0.png"), dir.join("img_1.png"));
+    assert_eq!(prism_image::read_png(&first).unwrap().width(), 16);
+    assert_eq!(prism_image::read_png(&second).unwrap().width(), 10);
+    assert!(!dir.join("img.png").exists());
+    let alone = dir.join("alone.png");
+    let o = render(&["--sensor", "1"], &alone);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(
+        std::fs::read(&alone).unwrap(),
+        std::fs::read(&second).unwrap()
+    );
+    let missing = dir.join("missing.png");
+    let o = render(&["--sensor", "2"], &missing);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains(&format!(
+            "{}:1: <scene>: sensor 2: the scene has 2 (0 to 1)",
+            scene.display()
+        )),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!missing.exists());
+}

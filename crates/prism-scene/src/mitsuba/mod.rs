@@ -25,7 +25,7 @@ use crate::error::SceneError;
 pub use conductors::{conductor, CONDUCTORS};
 pub use document::{read_document, Document, Object, Property, Value};
 pub use limits::{MAX_INCLUDE_DEPTH, MAX_MITSUBA_BYTES, MAX_OBJECTS, MAX_SCENE_FILES};
-pub use to_scene::{to_scene, Filter, MitsubaScene, MitsubaSettings};
+pub use to_scene::{to_scene, Filter, MitsubaOptions, MitsubaScene, MitsubaSettings};
 pub use transform::{look_at, rotation};
 
 /// Reads a Mitsuba scene file and the scene it describes; `defines` are `-D name=value`
@@ -34,20 +34,17 @@ pub use transform::{look_at, rotation};
 /// # Errors
 /// As [`read_document`] and [`to_scene`].
 pub fn read_mitsuba(path: &Path, defines: &[(String, String)]) -> Result<MitsubaScene, SceneError> {
-    to_scene(&read_document(path, defines)?, false)
+    to_scene(&read_document(path, defines)?, MitsubaOptions::default())
 }
 
-/// [`read_mitsuba`], reading past what prism does not render when `lenient`: an
-/// unsupported BSDF becomes a grey diffuse one, an unsupported shape, emitter or other
-/// plugin is left out, an unsupported integrator is the path tracer; one warning per kind,
-/// in the scene's warnings.
+/// [`read_mitsuba`] with `options`: leniently, or with another sensor as the camera.
 ///
 /// # Errors
-/// As [`read_mitsuba`], but for [`SceneError::Unsupported`] when `lenient`.
+/// As [`read_mitsuba`], but for [`SceneError::Unsupported`] when lenient.
 pub fn read_mitsuba_with(
     path: &Path,
     defines: &[(String, String)],
-    lenient: bool,
+    options: MitsubaOptions,
 ) -> Result<MitsubaScene, SceneError> {
-    to_scene(&read_document(path, defines)?, lenient)
+    to_scene(&read_document(path, defines)?, options)
 }

@@ -11,15 +11,23 @@ use crate::error::SceneError;
 use crate::scene::{Camera, Crop, ThinLens};
 
 impl Builder<'_> {
-    /// The sensor: the camera, and its film and sampler.
+    /// A sensor: the camera, and its film and sampler, if it is the one asked for (each is
+    /// read, so that an error in any is reported).
     pub(super) fn sensor(&mut self, o: &Object) -> Result<(), SceneError> {
-        if self.sensor_seen {
-            return Err(not_supported(
-                o,
-                format!("{}: a second sensor: not supported by prism yet", o.label()),
-            ));
+        let index = self.sensors;
+        self.sensors += 1;
+        let s = &self.settings;
+        let kept = (self.scene.camera, s.size, s.filter, s.spp);
+        self.read_sensor(o)?;
+        if index != self.sensor_wanted {
+            let s = &mut self.settings;
+            (self.scene.camera, s.size, s.filter, s.spp) = kept;
         }
-        self.sensor_seen = true;
+        Ok(())
+    }
+
+    /// [`Builder::sensor`]'s reading.
+    fn read_sensor(&mut self, o: &Object) -> Result<(), SceneError> {
         if !matches!(o.kind.as_str(), "perspective" | "thinlens" | "orthographic") {
             return Err(unsupported(o));
         }

@@ -611,7 +611,7 @@ fn lenient_reading_stands_in_and_warns_once_per_kind() {
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("s.xml");
     std::fs::write(&file, scene(body)).unwrap();
-    let s = crate::mitsuba::read_mitsuba_with(&file, &[], true)
+    let s = crate::mitsuba::read_mitsuba_with(&file, &[], lenient())
         .unwrap()
         .scene;
     assert_eq!((s.spheres.len(), s.meshes.len()), (1, 1));
@@ -630,7 +630,7 @@ fn lenient_reading_stands_in_and_warns_once_per_kind() {
         scene(r#"<shape type="obj"><string name="filename" value="missing.obj"/></shape>"#),
     )
     .unwrap();
-    assert!(crate::mitsuba::read_mitsuba_with(&file, &[], true).is_err());
+    assert!(crate::mitsuba::read_mitsuba_with(&file, &[], lenient()).is_err());
 }
 
 /// Mitsuba's orthographic sensor: parallel rays from its near plane, its film spanning
@@ -915,4 +915,12 @@ fn film_crops_must_lie_within_the_film() {
         e.contains("s.xml:2: <film>: type=\"hdrfilm\": the crop window (64x32 at 8, 0) must lie within the 64x32 film"),
         "{e}"
     );
+}
+
+/// Lenient reading, of the first sensor.
+fn lenient() -> crate::mitsuba::MitsubaOptions {
+    crate::mitsuba::MitsubaOptions {
+        lenient: true,
+        sensor: 0,
+    }
 }

@@ -74,15 +74,30 @@ pub struct MitsubaScene {
     /// Every file the scene reads (its XML files, meshes and images), which no output may
     /// replace.
     pub inputs: Vec<std::path::PathBuf>,
+    /// How many sensors the file has (the camera and settings are those of the one asked
+    /// for).
+    pub sensors: usize,
+}
+
+/// How a Mitsuba scene is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MitsubaOptions {
+    /// Read past what prism does not render: an unsupported BSDF becomes a grey diffuse one,
+    /// an unsupported shape, emitter or other plugin is left out, an unsupported integrator
+    /// is the path tracer; one warning per kind, in the scene's warnings.
+    pub lenient: bool,
+    /// Which sensor (in document order, from 0) is the camera.
+    pub sensor: usize,
 }
 
 /// The scene `doc` describes.
 ///
 /// # Errors
 /// [`SceneError::Unsupported`] at a plugin or property prism does not render (unless
-/// `lenient`: see [`super::read_mitsuba_with`]); [`SceneError::Element`] at a property of
-/// the wrong kind or out of range, a mesh file that cannot be read, a reference cycle.
-pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneError> {
+/// `lenient`); [`SceneError::Element`] at a property of the wrong kind or out of range, a
+/// mesh file that cannot be read, a reference cycle, a sensor the file does not have.
+pub fn to_scene(doc: &Document, options: MitsubaOptions) -> Result<MitsubaScene, SceneError> {
+    let MitsubaOptions { lenient, sensor } = options;
     let mut b = Builder {
         doc,
         scene: Scene::new(Camera {
@@ -98,7 +113,8 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
             crop: None,
         }),
         settings: MitsubaSettings::default(),
-        sensor_seen: false,
+        sensors: 0,
+        sensor_wanted: sensor,
         bsdfs: std::collections::HashMap::new(),
         primitives: 0,
         default_material: None,
@@ -135,17 +151,29 @@ pub fn to_scene(doc: &Document, lenient: bool) -> Result<MitsubaScene, SceneErro
             _ => b.tolerate(unsupported(o), "left out")?,
         }
     }
-    if !b.sensor_seen {
+    if b.sensors == 0 {
         return Err(SceneError::Element {
             at: root.at.clone(),
             element: "scene".into(),
             message: "no <sensor>: the scene has no camera".into(),
         });
     }
+    if sensor >= b.sensors {
+        return Err(SceneError::Element {
+            at: root.at.clone(),
+            element: "scene".into(),
+            message: format!(
+                "sensor {sensor}: the scene has {} (0 to {})",
+                b.sensors,
+                b.sensors - 1
+            ),
+        });
+    }
     Ok(MitsubaScene {
         scene: b.scene,
         settings: b.settings,
         inputs: b.inputs,
+        sensors: b.sensors,
     })
 }
 
@@ -154,7 +182,10 @@ pub(super) struct Builder<'d> {
     pub(super) doc: &'d Document,
     pub(super) scene: Scene,
     pub(super) settings: MitsubaSettings,
-    pub(super) sensor_seen: bool,
+    /// Sensors read so far.
+    pub(super) sensors: usize,
+    /// The sensor whose camera and settings the scene takes.
+    pub(super) sensor_wanted: usize,
     /// Material index of each BSDF object already translated.
     pub(super) bsdfs: std::collections::HashMap<usize, usize>,
     /// Triangles and spheres placed so far.
