@@ -1,10 +1,10 @@
-//! Fuzz the image decoders (PNG, JPEG, OpenEXR) under a small memory budget: any bytes give
+//! Fuzz the image decoders (PNG, JPEG, OpenEXR, Radiance HDR) under a small memory budget: any bytes give
 //! an image or an error naming the source, never a panic, and a decoded image never holds
 //! more than one image's budget allows.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use prism_image::{decode_exr, decode_exr_layers, decode_jpeg, decode_png, ImageError};
+use prism_image::{decode_exr, decode_exr_layers, decode_hdr, decode_jpeg, decode_png, ImageError};
 use prism_math::limits;
 
 /// 64 MiB in all, 16 MiB an image: far below libFuzzer's own memory limit, so a decoder
@@ -30,4 +30,5 @@ fuzz_target!(|data: &[u8]| {
         (size(l.width, l.height), 4 * l.channels.len() as u64)
     });
     check("f.exr", decode_exr(data, "f.exr"), |i| (size(i.width(), i.height()), 0));
+    check("f.hdr", decode_hdr(data, "f.hdr"), |i| (size(i.width(), i.height()), 12));
 });

@@ -7,7 +7,9 @@ use std::sync::Arc;
 
 use prism_image::{PixelSampling, Texture};
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
-use prism_scene::{Material, MaterialTexture, ScalarTexture, Scene, TiltOptions};
+use prism_scene::{
+    Material, MaterialTexture, ScalarTexture, Scene, TexturedParameter, TiltOptions,
+};
 
 use crate::bsdf::Bsdf;
 use crate::interaction::Tilt;
@@ -35,7 +37,15 @@ enum Choice {
     Tilted { map: TiltMap, material: usize },
     /// `material`, the surface under an area emitter.
     Surface { material: usize },
+    /// `material` with parameters read from textures.
+    Textured {
+        params: Vec<(TexturedParameter, Lookup)>,
+        material: usize,
+    },
 }
+
+/// Parameters of a material and the textures that give them, prepared.
+pub(crate) type Textures = [(TexturedParameter, Lookup)];
 
 /// A bump or normal map, prepared.
 pub(crate) struct TiltMap {
@@ -65,6 +75,8 @@ pub(crate) enum Chosen<'a> {
         index: usize,
         one_sided: bool,
         tilt: Option<&'a TiltMap>,
+        /// Parameters textures give it.
+        textured: Option<&'a Textures>,
     },
     /// No surface: a mask let the ray through.
     Through,
@@ -140,6 +152,12 @@ impl Materials {
                 } if valid(*material) => Some(Choice::Surface {
                     material: *material,
                 }),
+                Material::Textured { material, textures } if valid(*material) => {
+                    Some(Choice::Textured {
+                        params: textures.iter().map(|(p, t)| (*p, prepare(t))).collect(),
+                        material: *material,
+                    })
+                }
                 Material::NormalMap {
                     normals,
                     material,
@@ -187,11 +205,31 @@ impl Materials {
             one_sided: (0..count)
                 .map(|i| scene.one_sided.get(i).copied().unwrap_or(false))
                 .collect(),
-            anisotropic: scene
-                .materials
-                .iter()
-                .map(|m| Bsdf::from_material(m).anisotropic())
-                .collect(),
+            anisotropic: {
+                let mut a: Vec<bool> = scene
+                    .materials
+                    .iter()
+                    .map(|m| Bsdf::from_material(m).anisotropic())
+                    .collect();
+                // Alphas a texture gives apart may differ at any hit.
+                for m in &scene.materials {
+                    if let Material::Textured { material, textures } = m {
+                        let alpha = |p| textures.iter().find(|(q, _)| *q == p).map(|(_, t)| t);
+                        let apart = match (
+                            alpha(TexturedParameter::AlphaU),
+                            alpha(TexturedParameter::AlphaV),
+                        ) {
+                            (None, None) => false,
+                            (Some(u), Some(v)) => u != v,
+                            _ => true,
+                        };
+                        if valid(*material) && apart {
+                            a[*material] = true;
+                        }
+                    }
+                }
+                a
+            },
             front_only: scene
                 .materials
                 .iter()
@@ -221,11 +259,13 @@ impl Materials {
         let mut index = index;
         let mut one_sided = self.one_sided[index];
         let mut tilt = None;
+        let mut textured = None;
         if self.choices[index].is_none() {
             return Chosen::Material {
                 index,
                 one_sided,
                 tilt,
+                textured,
             };
         }
         // The numbers blends and masks choose by, drawn one after another from the ray's
@@ -244,6 +284,7 @@ impl Materials {
                     index,
                     one_sided,
                     tilt,
+                    textured,
                 };
             };
             let value = |s: &Scalar| match s {
@@ -266,6 +307,10 @@ impl Materials {
                     *material
                 }
                 Choice::Surface { material } => *material,
+                Choice::Textured { params, material } => {
+                    textured = Some(params.as_slice());
+                    *material
+                }
             };
             one_sided &= self.one_sided[index];
         }
@@ -273,6 +318,15 @@ impl Materials {
             index,
             one_sided,
             tilt,
+            textured,
+        }
+    }
+
+    /// `bsdf` with the parameters `textures` give at surface coordinates `uv`: colours as
+    /// the texel, alphas as its luminance (at least 1e-4, as Mitsuba's microfacets).
+    pub(crate) fn apply(&self, bsdf: &mut Bsdf, textures: &Textures, uv: Vec2) {
+        for (param, lookup) in textures {
+            bsdf.set(*param, self.lookup(lookup, uv));
         }
     }
 

@@ -364,6 +364,7 @@ impl RenderScene {
                         index,
                         one_sided,
                         tilt: map,
+                        textured,
                     } => {
                         let tilt = map.and_then(|map| {
                             let (dpdu, dpdv) = mesh_derivatives([a, b, c], corner_uvs(), ng);
@@ -375,7 +376,11 @@ impl RenderScene {
                         let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
                             Bsdf::Black
                         } else {
-                            mats.bsdf(index)
+                            let mut bsdf = mats.bsdf(index);
+                            if let Some(textures) = textured {
+                                mats.apply(&mut bsdf, textures, uv());
+                            }
+                            bsdf
                         };
                         (bsdf, Some(index), tilt)
                     }
@@ -453,6 +458,7 @@ impl RenderScene {
                         index,
                         one_sided,
                         tilt: map,
+                        textured,
                     } => {
                         let tilt = map.and_then(|map| {
                             let (dpdu, dpdv) = sphere_derivatives(outward, s.radius);
@@ -464,7 +470,11 @@ impl RenderScene {
                         let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
                             Bsdf::Black
                         } else {
-                            mats.bsdf(index)
+                            let mut bsdf = mats.bsdf(index);
+                            if let Some(textures) = textured {
+                                mats.apply(&mut bsdf, textures, uv());
+                            }
+                            bsdf
                         };
                         (bsdf, Some(index), tilt)
                     }

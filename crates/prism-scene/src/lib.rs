@@ -61,5 +61,5 @@ pub use render_config::{
 pub use scene::{
     Camera, CameraMode, Crop, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind,
     NormalsMode, OrbitCamera, Roughness, ScalarTexture, Scene, SceneOptions, SceneSphere, Shading,
-    ThinLens, TiltOptions, TriangleMesh,
+    TexturedParameter, ThinLens, TiltOptions, TriangleMesh,
 };

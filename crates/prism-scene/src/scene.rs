@@ -178,6 +178,14 @@ pub enum Material {
         /// front.
         two_sided: bool,
     },
+    /// `material` with some of its parameters read from textures at each hit (Mitsuba's
+    /// textured `specular_reflectance`, `specular_transmittance` and `alpha`s).
+    Textured {
+        /// The material, as an index into [`Scene::materials`].
+        material: usize,
+        /// Each parameter a texture gives, and the texture (its luminance for a number).
+        textures: Vec<(TexturedParameter, MaterialTexture)>,
+    },
     /// Mitsuba's `normalmap`: `material` under a shading normal read from an image, `2 rgb
     /// - 1` in the shading frame (x along `dp/du`).
     NormalMap {
@@ -265,6 +273,19 @@ impl MaterialTexture {
             to_uv: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
         }
     }
+}
+
+/// A material parameter a texture may give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexturedParameter {
+    /// The scale of the specular reflection.
+    SpecularReflectance,
+    /// The scale of the specular transmission.
+    SpecularTransmittance,
+    /// The microfacet roughness along the first tangent.
+    AlphaU,
+    /// The microfacet roughness along the second tangent.
+    AlphaV,
 }
 
 /// How a bump or normal map's tilted normal is used, as Mitsuba's options say.

@@ -4,7 +4,7 @@
 
 use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use prism_math::{acos, exp, ln, Rgb, Vec2, Vec3};
-use prism_scene::Material;
+use prism_scene::{Material, TexturedParameter};
 use std::f32::consts::PI;
 
 /// A BSDF ready to evaluate.
@@ -256,7 +256,8 @@ impl Bsdf {
             Material::Blend { .. }
             | Material::Mask { .. }
             | Material::NormalMap { .. }
-            | Material::BumpMap { .. } => Bsdf::Black,
+            | Material::BumpMap { .. }
+            | Material::Textured { .. } => Bsdf::Black,
             Material::Principled {
                 base_color,
                 roughness,
@@ -317,6 +318,52 @@ impl Bsdf {
             Bsdf::Plastic { diffuse, .. } | Bsdf::RoughPlastic { diffuse, .. } => Some(diffuse),
             Bsdf::Principled { base, .. } => Some(base),
             _ => None,
+        }
+    }
+
+    /// Sets `param` to `value` (its luminance for an alpha, at least 1e-4), where the BSDF
+    /// has it.
+    pub(crate) fn set(&mut self, param: TexturedParameter, value: Rgb) {
+        let alpha = || (0.212671 * value.r + 0.715160 * value.g + 0.072169 * value.b).max(1e-4);
+        match (self, param) {
+            (
+                Bsdf::Mirror { reflectance }
+                | Bsdf::Glass { reflectance, .. }
+                | Bsdf::ThinDielectric { reflectance, .. }
+                | Bsdf::RoughDielectric { reflectance, .. }
+                | Bsdf::SmoothConductor {
+                    specular: reflectance,
+                    ..
+                }
+                | Bsdf::RoughConductor {
+                    specular: reflectance,
+                    ..
+                }
+                | Bsdf::Plastic {
+                    specular: reflectance,
+                    ..
+                }
+                | Bsdf::RoughPlastic {
+                    specular: reflectance,
+                    ..
+                },
+                TexturedParameter::SpecularReflectance,
+            ) => *reflectance = value,
+            (
+                Bsdf::Glass { transmittance, .. }
+                | Bsdf::ThinDielectric { transmittance, .. }
+                | Bsdf::RoughDielectric { transmittance, .. },
+                TexturedParameter::SpecularTransmittance,
+            ) => *transmittance = value,
+            (
+                Bsdf::RoughConductor { distr, .. } | Bsdf::RoughDielectric { distr, .. },
+                TexturedParameter::AlphaU,
+            ) => distr.alpha_u = alpha(),
+            (
+                Bsdf::RoughConductor { distr, .. } | Bsdf::RoughDielectric { distr, .. },
+                TexturedParameter::AlphaV,
+            ) => distr.alpha_v = alpha(),
+            _ => {}
         }
     }
 

@@ -86,7 +86,8 @@ impl PhongMaterial {
             Material::Blend { .. }
             | Material::Mask { .. }
             | Material::NormalMap { .. }
-            | Material::BumpMap { .. } => plain(Rgb::splat(0.5), Rgb::BLACK),
+            | Material::BumpMap { .. }
+            | Material::Textured { .. } => plain(Rgb::splat(0.5), Rgb::BLACK),
         }
     }
 }

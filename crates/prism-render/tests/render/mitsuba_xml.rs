@@ -134,6 +134,19 @@ fn principled_bsdfs_render_as_mitsuba_renders_them() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `parameters.xml` (beside the references): textures as a
+/// rough conductor's alpha, a glass's specular_transmittance, a plastic's
+/// specular_reflectance and a rough dielectric's alpha_u alone (anisotropic, a checkerboard
+/// read as a number); compared as the box is.
+#[test]
+fn textured_parameters_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "parameters",
+        "crates/prism-render/tests/golden/mitsuba/xml/parameters.xml",
+        &[],
+    );
+}
+
 /// prism's render of `scene` (from the workspace's root) with `defines` against the
 /// reference `NAME.exr` and its variance `NAME_variance.exr`.
 fn agrees_with_mitsuba(name: &str, scene: &str, defines: &[(&str, &str)]) {

@@ -7,7 +7,9 @@ use super::limits::{MAX_OBJECT_DEPTH, MAX_ROUGH_PLASTIC_COATS};
 use super::props::{error, ior, not_supported, unsupported};
 use super::to_scene::Builder;
 use crate::error::SceneError;
-use crate::scene::{Material, MicrofacetKind, Roughness, ScalarTexture, TiltOptions};
+use crate::scene::{
+    Material, MicrofacetKind, Roughness, ScalarTexture, TexturedParameter, TiltOptions,
+};
 use prism_math::Rgb;
 
 impl Builder<'_> {
@@ -74,8 +76,10 @@ impl Builder<'_> {
         if matches!(o.kind.as_str(), "normalmap" | "bumpmap") {
             return self.tilted(index, o, depth, two_sided);
         }
-        // Nested plugins: a texture in place of a diffuse reflectance, nothing else yet.
+        // Nested plugins: textures in place of a diffuse albedo, specular scales and
+        // microfacet roughness, where Mitsuba takes them.
         let mut reflectance_texture = None;
+        let mut param_textures = Vec::new();
         for (slot, c) in &o.children {
             let c = &self.doc.objects[*c];
             let albedo_slot = match o.kind.as_str() {
@@ -84,15 +88,43 @@ impl Builder<'_> {
                 "principled" => "base_color",
                 _ => "",
             };
-            if !albedo_slot.is_empty() && slot.as_deref() == Some(albedo_slot) && c.tag == "texture"
-            {
+            let slot = slot.as_deref().unwrap_or("");
+            if c.tag == "texture" && !albedo_slot.is_empty() && slot == albedo_slot {
                 reflectance_texture = Some(self.texture(c)?);
+                continue;
+            }
+            let specular = !matches!(o.kind.as_str(), "diffuse" | "principled");
+            let transmits = matches!(
+                o.kind.as_str(),
+                "dielectric" | "thindielectric" | "roughdielectric"
+            );
+            let rough = matches!(o.kind.as_str(), "roughconductor" | "roughdielectric");
+            let params: &[TexturedParameter] = match slot {
+                "specular_reflectance" if specular => &[TexturedParameter::SpecularReflectance],
+                "specular_transmittance" if transmits => {
+                    &[TexturedParameter::SpecularTransmittance]
+                }
+                "alpha" if rough => &[TexturedParameter::AlphaU, TexturedParameter::AlphaV],
+                "alpha_u" if rough => &[TexturedParameter::AlphaU],
+                "alpha_v" if rough => &[TexturedParameter::AlphaV],
+                _ => &[],
+            };
+            if c.tag == "texture" && !params.is_empty() {
+                // An alpha is a number: Mitsuba reads its texture with `eval_1`.
+                let t = match (params[0], self.scalar_texture(c)?) {
+                    (
+                        TexturedParameter::AlphaU | TexturedParameter::AlphaV,
+                        ScalarTexture::Image(t),
+                    ) => t,
+                    _ => self.texture(c)?,
+                };
+                param_textures.extend(params.iter().map(|&p| (p, t.clone())));
                 continue;
             }
             return Err(not_supported(
                 c,
                 format!(
-                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse reflectance, a plastic's diffuse_reflectance or a principled base_color is)",
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse albedo, a specular scale or a microfacet alpha is)",
                     c.label(),
                     o.label()
                 ),
@@ -163,11 +195,16 @@ impl Builder<'_> {
                         kind: MicrofacetKind::Beckmann,
                         alpha_u,
                         alpha_v,
-                    }) if alpha_u == alpha_v && specular == Rgb::WHITE => Material::Microfacet {
-                        alpha: alpha_u,
-                        eta,
-                        k,
-                    },
+                    }) if alpha_u == alpha_v
+                        && specular == Rgb::WHITE
+                        && param_textures.is_empty() =>
+                    {
+                        Material::Microfacet {
+                            alpha: alpha_u,
+                            eta,
+                            k,
+                        }
+                    }
                     // Mitsuba's default conductor reflects everything.
                     None if eta == Rgb::splat(0.0) && k == Rgb::WHITE => Material::Mirror {
                         reflectance: specular,
@@ -244,7 +281,32 @@ impl Builder<'_> {
             o.kind.as_str(),
             "diffuse" | "plastic" | "roughplastic" | "conductor" | "roughconductor"
         );
-        let m = self.push_material(material, name, opaque && !two_sided);
+        let mut material = material;
+        // A plastic weighs its lobes by its specular scale's mean, as Mitsuba does.
+        if let (
+            Material::Plastic { specular, .. } | Material::RoughPlastic { specular, .. },
+            Some((_, t)),
+        ) = (
+            &mut material,
+            param_textures
+                .iter()
+                .find(|(p, _)| *p == TexturedParameter::SpecularReflectance),
+        ) {
+            let px = t.image.pixels();
+            *specular = px.iter().fold(Rgb::BLACK, |a, &c| a + c) * (1.0 / px.len().max(1) as f32);
+        }
+        let mut m = self.push_material(material, name.clone(), opaque && !two_sided);
+        if !param_textures.is_empty() {
+            m = self.push_material(
+                Material::Textured {
+                    material: m,
+                    textures: param_textures,
+                },
+                name,
+                // The material's own sides decide.
+                true,
+            );
+        }
         self.bsdfs.insert(index, m);
         Ok(m)
     }
@@ -447,11 +509,11 @@ fn roughness(o: &Object) -> Result<Roughness, SceneError> {
             ))
         }
     };
-    let (has_u, has_v, has_alpha) = (
-        o.prop("alpha_u").is_some(),
-        o.prop("alpha_v").is_some(),
-        o.prop("alpha").is_some(),
-    );
+    // Given as a number or as a texture (whose value each hit reads).
+    let given = |name: &str| {
+        o.prop(name).is_some() || o.children.iter().any(|(s, _)| s.as_deref() == Some(name))
+    };
+    let (has_u, has_v, has_alpha) = (given("alpha_u"), given("alpha_v"), given("alpha"));
     if (has_u || has_v) && (!(has_u && has_v) || has_alpha) {
         return Err(error(
             o,
@@ -523,7 +585,18 @@ fn principled(
         }
         Ok(v as f32)
     };
-    let spec_trans = f("spec_trans", 0.0)?;
+    // Weights outside [0, 1] would make light negative: refused.
+    let weight = |name: &str, default: f64| -> Result<f32, SceneError> {
+        let v = f(name, default)?;
+        if !(0.0..=1.0).contains(&v) {
+            return Err(error(
+                o,
+                format!("{}: {name}: expected 0 to 1, found {v}", o.label()),
+            ));
+        }
+        Ok(v)
+    };
+    let spec_trans = weight("spec_trans", 0.0)?;
     let eta = match (o.value("eta"), o.value("specular")) {
         (Some(_), Some(_)) => {
             return Err(error(
@@ -546,11 +619,24 @@ fn principled(
             2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
         }
     };
-    if eta.is_nan() || eta <= 0.0 {
+    if !eta.is_finite() || eta <= 0.0 {
         return Err(error(
             o,
             format!("{}: expected a positive index, found {eta}", o.label()),
         ));
+    }
+    // The sampling rates choose among the lobes: none negative, the main one positive.
+    let rates = [
+        f("main_specular_sampling_rate", 1.0)?,
+        f("clearcoat_sampling_rate", 1.0)?,
+        f("diffuse_reflectance_sampling_rate", 1.0)?,
+    ];
+    if rates.iter().any(|&r| r < 0.0) || rates[0] <= 0.0 {
+        return Err(error(o, format!("{}: sampling rates: expected none negative and main_specular_sampling_rate positive, found {rates:?}", o.label())));
+    }
+    let (sheen, clearcoat) = (f("sheen", 0.0)?, f("clearcoat", 0.0)?);
+    if sheen < 0.0 || clearcoat < 0.0 {
+        return Err(error(o, format!("{}: sheen and clearcoat: expected no negative weight, found {sheen} and {clearcoat}", o.label())));
     }
     Ok(Material::Principled {
         base_color: if texture.is_some() {
@@ -559,22 +645,18 @@ fn principled(
             o.rgb("base_color", [0.5; 3])?
         },
         texture,
-        roughness: f("roughness", 0.5)?,
-        anisotropic: f("anisotropic", 0.0)?,
-        metallic: f("metallic", 0.0)?,
+        roughness: weight("roughness", 0.5)?,
+        anisotropic: weight("anisotropic", 0.0)?,
+        metallic: weight("metallic", 0.0)?,
         spec_trans,
-        spec_tint: f("spec_tint", 0.0)?,
-        sheen: f("sheen", 0.0)?,
-        sheen_tint: f("sheen_tint", 0.0)?,
-        flatness: f("flatness", 0.0)?,
-        clearcoat: f("clearcoat", 0.0)?,
-        clearcoat_gloss: f("clearcoat_gloss", 0.0)?,
+        spec_tint: weight("spec_tint", 0.0)?,
+        sheen,
+        sheen_tint: weight("sheen_tint", 0.0)?,
+        flatness: weight("flatness", 0.0)?,
+        clearcoat,
+        clearcoat_gloss: weight("clearcoat_gloss", 0.0)?,
         eta,
-        rates: [
-            f("main_specular_sampling_rate", 1.0)?,
-            f("clearcoat_sampling_rate", 1.0)?,
-            f("diffuse_reflectance_sampling_rate", 1.0)?,
-        ],
+        rates,
         two_sided,
     })
 }

@@ -544,7 +544,7 @@ fn textures_are_read_as_mitsuba_reads_them() {
             "not.png",
         ),
         (
-            r#"<shape type="rectangle"><bsdf type="roughconductor"><texture type="checkerboard" name="specular_reflectance"/></bsdf></shape>"#,
+            r#"<shape type="rectangle"><bsdf type="roughconductor"><texture type="checkerboard" name="k"/></bsdf></shape>"#,
             "not supported",
         ),
         (
@@ -923,4 +923,46 @@ fn lenient() -> crate::mitsuba::MitsubaOptions {
         lenient: true,
         sensor: 0,
     }
+}
+
+/// Textures as specular scales and alphas are read as a textured wrapper around the plain
+/// material: `alpha` gives both alphas, a plastic's placeholder specular scale is its
+/// texture's mean (what Mitsuba weighs its lobes by), and a texture where Mitsuba takes
+/// none (a conductor's `eta`) is refused, located.
+#[test]
+fn textured_parameters_wrap_the_plain_material() {
+    let s = read(
+        "params",
+        "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><texture type=\"checkerboard\" name=\"alpha\"/><texture type=\"checkerboard\" name=\"specular_reflectance\"><rgb name=\"color0\" value=\"1\"/><rgb name=\"color1\" value=\"0\"/></texture></bsdf></shape>\
+         <shape type=\"sphere\"><bsdf type=\"plastic\"><texture type=\"checkerboard\" name=\"specular_reflectance\"><rgb name=\"color0\" value=\"1\"/><rgb name=\"color1\" value=\"0\"/></texture></bsdf></shape>",
+        &[],
+    )
+    .unwrap();
+    let m = &s.scene.materials;
+    let crate::Material::Textured { material, textures } = &m[s.scene.spheres[0].material] else {
+        panic!("{:?}", m[s.scene.spheres[0].material]);
+    };
+    let params: Vec<_> = textures.iter().map(|(p, _)| *p).collect();
+    use crate::TexturedParameter::*;
+    assert_eq!(params, [AlphaU, AlphaV, SpecularReflectance]);
+    assert!(matches!(m[*material], crate::Material::Conductor { .. }));
+    let crate::Material::Textured { material, .. } = &m[s.scene.spheres[1].material] else {
+        panic!("{:?}", m[s.scene.spheres[1].material]);
+    };
+    assert!(
+        matches!(m[*material], crate::Material::Plastic { specular, .. } if specular == Rgb::splat(0.5)),
+        "{:?}",
+        m[*material]
+    );
+    let e = read(
+        "params-eta",
+        "<shape type=\"sphere\">\n<bsdf type=\"conductor\">\n<texture type=\"checkerboard\" name=\"eta\"/></bsdf></shape>",
+        &[],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("s.xml:5: <texture>: type=\"checkerboard\" in"),
+        "{e}"
+    );
 }

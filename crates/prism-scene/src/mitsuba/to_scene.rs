@@ -545,7 +545,8 @@ impl Builder<'_> {
                     texture: Some(_), ..
                 }
                 | Material::NormalMap { .. }
-                | Material::BumpMap { .. } => return true,
+                | Material::BumpMap { .. }
+                | Material::Textured { .. } => return true,
                 Material::Blend {
                     weight: ScalarTexture::Image(_),
                     ..
