@@ -43,6 +43,9 @@ pub enum Material {
         eta: f32,
         /// An image the base's albedo is multiplied by.
         texture: Option<MaterialTexture>,
+        /// Mitsuba's `nonlinear`: light scattered inside the coat shifts the base's colour
+        /// (`albedo / (1 - albedo Fdr)` rather than `albedo / (1 - Fdr)`).
+        nonlinear: bool,
     },
     /// Mitsuba's `thindielectric`: a thin pane of index `ior` that reflects `2F / (1 + F)`
     /// of the light (its inner reflections summed) and lets the rest through undeviated.
@@ -126,6 +129,9 @@ pub enum Material {
         eta: f32,
         /// An image the base's albedo is multiplied by.
         texture: Option<MaterialTexture>,
+        /// Mitsuba's `nonlinear`: light scattered inside the coat shifts the base's colour
+        /// (`albedo / (1 - albedo Fdr)` rather than `albedo / (1 - Fdr)`).
+        nonlinear: bool,
     },
     /// Mitsuba's `blendbsdf`: at each hit, `materials[1]` with probability `weight` and
     /// `materials[0]` otherwise (the mixture `(1 - w) f0 + w f1` in expectation).

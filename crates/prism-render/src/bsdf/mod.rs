@@ -190,12 +190,13 @@ impl Bsdf {
                 specular,
                 eta,
                 ref texture,
+                nonlinear,
             } => {
                 let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
                 let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
                 let albedo = diffuse * texture_mean(texture.as_ref());
                 Bsdf::Plastic {
-                    diffuse: diffuse * (1.0 / ((1.0 - fdr_int) * eta * eta)),
+                    diffuse: coat_scaled(diffuse, fdr_int, eta, nonlinear),
                     specular,
                     eta,
                     specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
@@ -235,6 +236,7 @@ impl Bsdf {
                 specular,
                 eta,
                 ref texture,
+                nonlinear,
             } => {
                 let distr: Microfacet = roughness.into();
                 let tables = rough_plastic::coat_tables(&distr, eta);
@@ -243,7 +245,7 @@ impl Bsdf {
                 Bsdf::RoughPlastic {
                     distr,
                     eta,
-                    diffuse: diffuse * (1.0 / ((1.0 - tables.internal_reflectance) * eta * eta)),
+                    diffuse: coat_scaled(diffuse, tables.internal_reflectance, eta, nonlinear),
                     specular,
                     specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
                     tables,
@@ -717,6 +719,18 @@ impl Bsdf {
             }
             _ => None,
         }
+    }
+}
+
+/// A plastic base's albedo `diffuse` seen through its coat of index `eta` and internal
+/// reflectance `fdr`: over `(1 - fdr) eta^2`, or channel by channel over
+/// `(1 - diffuse fdr) eta^2` when `nonlinear` (Mitsuba's two models).
+fn coat_scaled(diffuse: Rgb, fdr: f32, eta: f32, nonlinear: bool) -> Rgb {
+    if nonlinear {
+        let f = |d: f32| d / ((1.0 - d * fdr) * eta * eta);
+        Rgb::new(f(diffuse.r), f(diffuse.g), f(diffuse.b))
+    } else {
+        diffuse * (1.0 / ((1.0 - fdr) * eta * eta))
     }
 }
 

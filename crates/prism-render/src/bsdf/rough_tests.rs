@@ -191,6 +191,7 @@ fn rough_plastic_sampling_matches_its_pdf() {
             specular: Rgb::WHITE,
             eta: 1.5,
             texture: None,
+            nonlinear: false,
         });
         for wo in [dir(15.0, 0.3), dir(70.0, 1.0), -dir(40.0, 2.0)] {
             check_sampling(&b, wo);

@@ -264,6 +264,7 @@ fn plastic_is_mitsubas_smooth_plastic() {
         specular: Rgb::splat(1.0),
         eta: 1.49,
         texture: None,
+        nonlinear: false,
     });
     let mut rng = Pcg32::new(11, 3);
     let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
@@ -326,4 +327,44 @@ fn thin_dielectric_reflects_2f_over_1_plus_f() {
         "{reflected} vs {r}"
     );
     assert!(!b.two_sided() && !b.is_smooth());
+}
+
+/// Closed form (Mitsuba's two plastic models): with `nonlinear`, a plastic's diffuse lobe
+/// at a direction pair is the linear model's times `(1 - Fdr) / (1 - albedo Fdr)` per
+/// channel, the same for a white base and darker for a coloured one.
+#[test]
+fn nonlinear_plastics_shift_colour_by_internal_scattering() {
+    let plastic = |diffuse: Rgb, nonlinear: bool| {
+        Bsdf::from_material(&prism_scene::Material::Plastic {
+            diffuse,
+            specular: Rgb::splat(1.0),
+            eta: 1.5,
+            texture: None,
+            nonlinear,
+        })
+    };
+    let (wo, wi) = (
+        Vec3::new(0.3, -0.2, 0.9).normalize(),
+        Vec3::new(-0.4, 0.1, 0.8).normalize(),
+    );
+    let fdr = fresnel_diffuse_reflectance(1.0 / 1.5);
+    let albedo = Rgb::new(0.8, 0.4, 0.2);
+    let (linear, shifted) = (
+        plastic(albedo, false).eval(wo, wi),
+        plastic(albedo, true).eval(wo, wi),
+    );
+    for (l, s, a) in [
+        (linear.r, shifted.r, albedo.r),
+        (linear.g, shifted.g, albedo.g),
+        (linear.b, shifted.b, albedo.b),
+    ] {
+        let want = l * (1.0 - fdr) / (1.0 - a * fdr);
+        assert!((s - want).abs() <= 1e-6 * want, "{s} vs {want}");
+        assert!(s < l);
+    }
+    let white = (
+        plastic(Rgb::WHITE, false).eval(wo, wi),
+        plastic(Rgb::WHITE, true).eval(wo, wi),
+    );
+    assert!((white.0.r - white.1.r).abs() <= 1e-6 * white.0.r);
 }

@@ -162,10 +162,14 @@ impl Builder<'_> {
                 }
             }
             "plastic" => {
-                if o.boolean("nonlinear", false)? {
+                let nonlinear = o.boolean("nonlinear", false)?;
+                if nonlinear && reflectance_texture.is_some() {
                     return Err(not_supported(
                         o,
-                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                        format!(
+                            "{}: nonlinear with a textured diffuse_reflectance: not supported by prism yet",
+                            o.label()
+                        ),
                     ));
                 }
                 let int = ior(o, "int_ior", "polypropylene")?;
@@ -179,6 +183,7 @@ impl Builder<'_> {
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
                     texture: reflectance_texture.clone(),
+                    nonlinear,
                 }
             }
             "conductor" | "roughconductor" => {
@@ -218,10 +223,14 @@ impl Builder<'_> {
                 }
             }
             "roughplastic" => {
-                if o.boolean("nonlinear", false)? {
+                let nonlinear = o.boolean("nonlinear", false)?;
+                if nonlinear && reflectance_texture.is_some() {
                     return Err(not_supported(
                         o,
-                        format!("{}: nonlinear: not supported by prism yet", o.label()),
+                        format!(
+                            "{}: nonlinear with a textured diffuse_reflectance: not supported by prism yet",
+                            o.label()
+                        ),
                     ));
                 }
                 let roughness = roughness(o)?;
@@ -258,6 +267,7 @@ impl Builder<'_> {
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
                     texture: reflectance_texture.clone(),
+                    nonlinear,
                 }
             }
             "roughdielectric" => {

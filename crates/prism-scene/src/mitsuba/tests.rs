@@ -391,10 +391,26 @@ fn plastic_is_read_with_mitsubas_defaults() {
         matches!(m, crate::Material::Plastic { diffuse, specular, eta, .. } if diffuse.r == 0.5 && specular.g == 1.0 && (eta - 1.49 / 1.000_277).abs() < 1e-6),
         "{m:?}"
     );
-    let e = read("plastic-nl", "<shape type=\"sphere\"><bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>", &[])
+    let s = read("plastic-nl", "<shape type=\"sphere\"><bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"true\"/></bsdf></shape>", &[])
+        .unwrap();
+    let m = &s.scene.materials[s.scene.spheres[0].material];
+    assert!(
+        matches!(
+            m,
+            crate::Material::Plastic {
+                nonlinear: true,
+                ..
+            }
+        ),
+        "{m:?}"
+    );
+    let e = read("plastic-nl-tex", "<shape type=\"sphere\"><bsdf type=\"plastic\"><boolean name=\"nonlinear\" value=\"true\"/><texture type=\"checkerboard\" name=\"diffuse_reflectance\"/></bsdf></shape>", &[])
         .unwrap_err()
         .to_string();
-    assert!(e.contains("nonlinear: not supported"), "{e}");
+    assert!(
+        e.contains("nonlinear with a textured diffuse_reflectance: not supported"),
+        "{e}"
+    );
 }
 
 /// `thindielectric` is read with Mitsuba's defaults: bk7 (1.5046) over air (1.000277).
