@@ -12,7 +12,7 @@ use prism_scene::{
 };
 
 use crate::bsdf::Bsdf;
-use crate::interaction::Tilt;
+use crate::interaction::{frame_along, Tilt};
 
 /// A prepared texture (shared by the materials that use its image), its lookup and its
 /// `to_uv`.
@@ -67,7 +67,7 @@ enum TiltKind {
 
 /// What a hit scatters with once blends and masks have chosen.
 #[derive(Clone, Copy)]
-pub(crate) enum Chosen<'a> {
+enum Chosen<'a> {
     /// This material; `one_sided` if it is black from behind (every material on the way to
     /// it is one-sided: a `twosided` around a blend makes both its choices two-sided),
     /// under the map that tilts its normal, if any.
@@ -238,15 +238,9 @@ impl Materials {
         }
     }
 
-    /// The BSDF of material `index`, before its texture.
-    #[inline(always)]
-    pub(crate) fn bsdf(&self, index: usize) -> Bsdf {
-        self.bsdfs[index]
-    }
-
     /// True if material `index` has a texture its albedo is multiplied by.
     #[inline(always)]
-    pub(crate) fn textured(&self, index: usize) -> bool {
+    fn textured(&self, index: usize) -> bool {
         self.textures[index].is_some()
     }
 
@@ -255,7 +249,7 @@ impl Materials {
     /// different rays independently), its weight or opacity read at `uv` (Mitsuba's surface
     /// coordinates, `v` running down the image) where it is a texture.
     #[inline(always)]
-    pub(crate) fn choose(&self, index: usize, ray: &Ray, uv: impl Fn() -> Vec2) -> Chosen<'_> {
+    fn choose(&self, index: usize, ray: &Ray, uv: impl Fn() -> Vec2) -> Chosen<'_> {
         let mut index = index;
         let mut one_sided = self.one_sided[index];
         let mut tilt = None;
@@ -322,9 +316,56 @@ impl Materials {
         }
     }
 
+    /// What a hit on material `index` along `ray` scatters with: the BSDF (black from
+    /// behind where it is one-sided, [`Bsdf::Null`] where a mask lets the ray through, its
+    /// textures applied), the material chosen, and the frame a map tilts the shading frame
+    /// to. `(ns, ng)` are the shading and geometric normals, `uv` gives the surface
+    /// coordinates (Mitsuba's), `derivatives` gives `dp/du` and `dp/dv`; an albedo texture
+    /// applies only with `albedo_texture` (a mesh without uvs has none).
+    #[inline(always)]
+    pub(crate) fn scatterer(
+        &self,
+        index: usize,
+        ray: &Ray,
+        (ns, ng): (Vec3, Vec3),
+        uv: &impl Fn() -> Vec2,
+        derivatives: impl FnOnce() -> (Vec3, Vec3),
+        albedo_texture: bool,
+    ) -> (Bsdf, Option<usize>, Option<Tilt>) {
+        let Chosen::Material {
+            index,
+            one_sided,
+            tilt: map,
+            textured,
+        } = self.choose(index, ray, uv)
+        else {
+            return (Bsdf::Null, None, None);
+        };
+        let tilt = map.and_then(|map| {
+            let (dpdu, dpdv) = derivatives();
+            let shading = frame_along(ns, Some(dpdu));
+            let wo_l = shading.to_local(-ray.dir);
+            self.tilt(map, uv(), &shading, (dpdu, dpdv), ng, wo_l)
+        });
+        let front = tilt.map_or(ns, |t| t.frame.n);
+        if one_sided && ray.dir.dot(front) >= 0.0 {
+            return (Bsdf::Black, Some(index), tilt);
+        }
+        let mut bsdf = self.bsdfs[index];
+        if let Some(textures) = textured {
+            self.apply(&mut bsdf, textures, uv());
+        }
+        if let (true, true, Some(albedo)) =
+            (albedo_texture, self.textured(index), bsdf.albedo_mut())
+        {
+            *albedo = *albedo * self.texel(index, uv());
+        }
+        (bsdf, Some(index), tilt)
+    }
+
     /// `bsdf` with the parameters `textures` give at surface coordinates `uv`: colours as
     /// the texel, alphas as its luminance (at least 1e-4, as Mitsuba's microfacets).
-    pub(crate) fn apply(&self, bsdf: &mut Bsdf, textures: &Textures, uv: Vec2) {
+    fn apply(&self, bsdf: &mut Bsdf, textures: &Textures, uv: Vec2) {
         for (param, lookup) in textures {
             bsdf.set(*param, self.lookup(lookup, uv));
         }
@@ -333,7 +374,7 @@ impl Materials {
     /// The frame `map` tilts the shading frame `shading` to at a hit seen from `wo_l` (in
     /// `shading`'s coordinates), with Mitsuba's `dp_du`, `dp_dv`, geometric normal `ng`
     /// and surface coordinates `uv`; none where the map gives no direction.
-    pub(crate) fn tilt(
+    fn tilt(
         &self,
         map: &TiltMap,
         uv: Vec2,
@@ -409,7 +450,7 @@ impl Materials {
     /// The texel of material `index`'s texture at surface coordinates `uv` (`v` running
     /// down the image), through its `to_uv`; white without a texture.
     #[inline(always)]
-    pub(crate) fn texel(&self, index: usize, uv: Vec2) -> Rgb {
+    fn texel(&self, index: usize, uv: Vec2) -> Rgb {
         match &self.textures[index] {
             Some(lookup) => self.lookup(lookup, uv),
             None => Rgb::WHITE,

@@ -7,10 +7,10 @@ use prism_math::{Ray, Rgb, Vec3};
 use prism_scene::{Light, Scene, Shading};
 
 use crate::bsdf::Bsdf;
-use crate::interaction::{frame_along, Interaction};
+use crate::interaction::Interaction;
 use crate::lights::envmap::EnvMap;
 use crate::lights::{MeshLight, RenderLight};
-use crate::materials::{Chosen, Materials};
+use crate::materials::Materials;
 
 /// What a BVH primitive is.
 #[derive(Clone, Copy, Debug)]
@@ -358,40 +358,14 @@ impl RenderScene {
                         b0 * ua + hit.b1 * ub + hit.b2 * uc
                     })
                 };
-                let (mut bsdf, chosen, tilt) = match mats.choose(m.material, ray, uv) {
-                    Chosen::Through => (Bsdf::Null, None, None),
-                    Chosen::Material {
-                        index,
-                        one_sided,
-                        tilt: map,
-                        textured,
-                    } => {
-                        let tilt = map.and_then(|map| {
-                            let (dpdu, dpdv) = mesh_derivatives([a, b, c], corner_uvs(), ng);
-                            let shading = frame_along(ns, Some(dpdu));
-                            let wo_l = shading.to_local(-ray.dir);
-                            mats.tilt(map, uv(), &shading, (dpdu, dpdv), ng, wo_l)
-                        });
-                        let front = tilt.map_or(ns, |t| t.frame.n);
-                        let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
-                            Bsdf::Black
-                        } else {
-                            let mut bsdf = mats.bsdf(index);
-                            if let Some(textures) = textured {
-                                mats.apply(&mut bsdf, textures, uv());
-                            }
-                            bsdf
-                        };
-                        (bsdf, Some(index), tilt)
-                    }
-                };
-                if let (Some(index), true, Some(albedo)) =
-                    (chosen, m.uvs.is_some(), bsdf.albedo_mut())
-                {
-                    if mats.textured(index) {
-                        *albedo = *albedo * mats.texel(index, uv());
-                    }
-                }
+                let (bsdf, chosen, tilt) = mats.scatterer(
+                    m.material,
+                    ray,
+                    (ns, ng),
+                    &uv,
+                    || mesh_derivatives([a, b, c], corner_uvs(), ng),
+                    m.uvs.is_some(),
+                );
                 Interaction {
                     p,
                     ng,
@@ -452,38 +426,14 @@ impl RenderScene {
                         theta / std::f32::consts::PI,
                     )
                 };
-                let (mut bsdf, chosen, tilt) = match mats.choose(material, ray, uv) {
-                    Chosen::Through => (Bsdf::Null, None, None),
-                    Chosen::Material {
-                        index,
-                        one_sided,
-                        tilt: map,
-                        textured,
-                    } => {
-                        let tilt = map.and_then(|map| {
-                            let (dpdu, dpdv) = sphere_derivatives(outward, s.radius);
-                            let shading = frame_along(n, Some(dpdu));
-                            let wo_l = shading.to_local(-ray.dir);
-                            mats.tilt(map, uv(), &shading, (dpdu, dpdv), n, wo_l)
-                        });
-                        let front = tilt.map_or(n, |t| t.frame.n);
-                        let bsdf = if one_sided && ray.dir.dot(front) >= 0.0 {
-                            Bsdf::Black
-                        } else {
-                            let mut bsdf = mats.bsdf(index);
-                            if let Some(textures) = textured {
-                                mats.apply(&mut bsdf, textures, uv());
-                            }
-                            bsdf
-                        };
-                        (bsdf, Some(index), tilt)
-                    }
-                };
-                if let (Some(index), Some(albedo)) = (chosen, bsdf.albedo_mut()) {
-                    if mats.textured(index) {
-                        *albedo = *albedo * mats.texel(index, uv());
-                    }
-                }
+                let (bsdf, chosen, tilt) = mats.scatterer(
+                    material,
+                    ray,
+                    (n, n),
+                    &uv,
+                    || sphere_derivatives(outward, s.radius),
+                    true,
+                );
                 Interaction {
                     p: s.center + outward * s.radius,
                     ng: n,

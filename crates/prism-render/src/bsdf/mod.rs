@@ -193,13 +193,11 @@ impl Bsdf {
                 nonlinear,
             } => {
                 let fdr_int = fresnel_diffuse_reflectance(1.0 / eta);
-                let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
-                let albedo = diffuse * texture_mean(texture.as_ref());
                 Bsdf::Plastic {
                     diffuse: coat_scaled(diffuse, fdr_int, eta, nonlinear),
                     specular,
                     eta,
-                    specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
+                    specular_weight: specular_weight(diffuse, texture.as_ref(), specular),
                 }
             }
             Material::Conductor {
@@ -240,14 +238,12 @@ impl Bsdf {
             } => {
                 let distr: Microfacet = roughness.into();
                 let tables = rough_plastic::coat_tables(&distr, eta);
-                let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
-                let albedo = diffuse * texture_mean(texture.as_ref());
                 Bsdf::RoughPlastic {
                     distr,
                     eta,
                     diffuse: coat_scaled(diffuse, tables.internal_reflectance, eta, nonlinear),
                     specular,
-                    specular_weight: mean(specular) / (mean(albedo) + mean(specular)),
+                    specular_weight: specular_weight(diffuse, texture.as_ref(), specular),
                     tables,
                 }
             }
@@ -732,6 +728,18 @@ fn coat_scaled(diffuse: Rgb, fdr: f32, eta: f32, nonlinear: bool) -> Rgb {
     } else {
         diffuse * (1.0 / ((1.0 - fdr) * eta * eta))
     }
+}
+
+/// A plastic's share of samples for its specular lobe: the mean specular scale over it plus
+/// the mean albedo (times the texture's mean), as Mitsuba weighs them.
+fn specular_weight(
+    diffuse: Rgb,
+    texture: Option<&prism_scene::MaterialTexture>,
+    specular: Rgb,
+) -> f32 {
+    let mean = |c: Rgb| (c.r + c.g + c.b) / 3.0;
+    let albedo = diffuse * texture_mean(texture);
+    mean(specular) / (mean(albedo) + mean(specular))
 }
 
 /// The mean texel of a texture (white without one): what Mitsuba weighs a textured

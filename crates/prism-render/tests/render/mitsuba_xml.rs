@@ -444,24 +444,7 @@ fn masks_pass_and_blends_mix_in_expectation() {
             ),
         )
         .unwrap();
-        let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
-        let scene = RenderScene::new(&m.scene);
-        let opts = RenderOptions {
-            film: FilmSettings {
-                width: 8,
-                height: 8,
-                spp: 512,
-                ..FilmSettings::default()
-            },
-            path: PathSettings {
-                max_bounces,
-                ..PathSettings::default()
-            },
-        };
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
-        sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 64.0
+        mean_green(&file, 8, 512, max_bounces)
     };
     let mask = r#"<bsdf type="mask"><float name="opacity" value="0.3"/><bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf></bsdf>"#;
     assert_eq!(mean("mask0", mask, 0), 0.0);
@@ -510,24 +493,7 @@ fn a_normal_map_tilts_the_shading_normal_as_mitsubas_does() {
             ),
         )
         .unwrap();
-        let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
-        let scene = RenderScene::new(&m.scene);
-        let opts = RenderOptions {
-            film: FilmSettings {
-                width: 4,
-                height: 4,
-                spp: 4,
-                ..FilmSettings::default()
-            },
-            path: PathSettings {
-                max_bounces: 1,
-                ..PathSettings::default()
-            },
-        };
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
-        sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 16.0
+        mean_green(&file, 4, 4, 1)
     };
     let lit = 2.0 * 15f32.to_radians().cos() / std::f32::consts::PI;
     let a = 30f32.to_radians().tan().powi(2) / 8.0;
@@ -593,24 +559,7 @@ fn area_emitters_keep_their_surfaces_bsdf() {
             ),
         )
         .unwrap();
-        let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
-        let scene = RenderScene::new(&m.scene);
-        let opts = RenderOptions {
-            film: FilmSettings {
-                width: 8,
-                height: 8,
-                spp: 256,
-                ..FilmSettings::default()
-            },
-            path: PathSettings {
-                max_bounces: 1,
-                ..PathSettings::default()
-            },
-        };
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
-        sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 64.0
+        mean_green(&file, 8, 256, 1)
     };
     let mirror = mean("emitter-mirror", r#"<bsdf type="conductor"/>"#);
     assert!((mirror - 1.25).abs() < 1e-4, "{mirror}");
@@ -667,4 +616,27 @@ fn a_film_crop_is_a_window_of_the_whole_films_view() {
             );
         }
     }
+}
+
+/// The mean green of prism's render of the Mitsuba scene `file` at `size` x `size` pixels,
+/// `spp` samples and at most `max_bounces` bounces.
+fn mean_green(file: &std::path::Path, size: u32, spp: u32, max_bounces: u32) -> f32 {
+    let m = prism_scene::read_mitsuba(file, &[]).expect("the scene reads");
+    let scene = RenderScene::new(&m.scene);
+    let opts = RenderOptions {
+        film: FilmSettings {
+            width: size,
+            height: size,
+            spp,
+            ..FilmSettings::default()
+        },
+        path: PathSettings {
+            max_bounces,
+            ..PathSettings::default()
+        },
+    };
+    let share = prism_render::film::Share::whole(spp);
+    let job = prism_render::render::Job::share(&share);
+    let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+    sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / (size * size) as f32
 }

@@ -162,24 +162,11 @@ impl Builder<'_> {
                 }
             }
             "plastic" => {
-                let nonlinear = o.boolean("nonlinear", false)?;
-                if nonlinear && reflectance_texture.is_some() {
-                    return Err(not_supported(
-                        o,
-                        format!(
-                            "{}: nonlinear with a textured diffuse_reflectance: not supported by prism yet",
-                            o.label()
-                        ),
-                    ));
-                }
+                let (diffuse, nonlinear) = plastic_base(o, reflectance_texture.is_some())?;
                 let int = ior(o, "int_ior", "polypropylene")?;
                 let ext = ior(o, "ext_ior", "air")?;
                 Material::Plastic {
-                    diffuse: if reflectance_texture.is_some() {
-                        Rgb::WHITE
-                    } else {
-                        o.rgb("diffuse_reflectance", [0.5; 3])?
-                    },
+                    diffuse,
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
                     texture: reflectance_texture.clone(),
@@ -223,16 +210,7 @@ impl Builder<'_> {
                 }
             }
             "roughplastic" => {
-                let nonlinear = o.boolean("nonlinear", false)?;
-                if nonlinear && reflectance_texture.is_some() {
-                    return Err(not_supported(
-                        o,
-                        format!(
-                            "{}: nonlinear with a textured diffuse_reflectance: not supported by prism yet",
-                            o.label()
-                        ),
-                    ));
-                }
+                let (diffuse, nonlinear) = plastic_base(o, reflectance_texture.is_some())?;
                 let roughness = roughness(o)?;
                 if roughness.alpha_u != roughness.alpha_v {
                     return Err(error(
@@ -259,11 +237,7 @@ impl Builder<'_> {
                 }
                 Material::RoughPlastic {
                     roughness,
-                    diffuse: if reflectance_texture.is_some() {
-                        Rgb::WHITE
-                    } else {
-                        o.rgb("diffuse_reflectance", [0.5; 3])?
-                    },
+                    diffuse,
                     specular: o.rgb("specular_reflectance", [1.0; 3])?,
                     eta: (int / ext) as f32,
                     texture: reflectance_texture.clone(),
@@ -575,6 +549,27 @@ fn conductor_index(o: &Object) -> Result<(Rgb, Rgb), SceneError> {
         )
     })?;
     Ok((Rgb::new(e[0], e[1], e[2]), Rgb::new(k[0], k[1], k[2])))
+}
+
+/// A plastic's base: its `diffuse_reflectance` (white under a texture, which gives it) and
+/// `nonlinear`, which prism reads for an untextured base only.
+fn plastic_base(o: &Object, textured: bool) -> Result<(Rgb, bool), SceneError> {
+    let nonlinear = o.boolean("nonlinear", false)?;
+    if nonlinear && textured {
+        return Err(not_supported(
+            o,
+            format!(
+                "{}: nonlinear with a textured diffuse_reflectance: not supported by prism yet",
+                o.label()
+            ),
+        ));
+    }
+    let diffuse = if textured {
+        Rgb::WHITE
+    } else {
+        o.rgb("diffuse_reflectance", [0.5; 3])?
+    };
+    Ok((diffuse, nonlinear))
 }
 
 /// A `principled` BSDF with Mitsuba's defaults: `base_color` 0.5, `roughness` 0.5, the
