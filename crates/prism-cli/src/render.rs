@@ -29,6 +29,16 @@ pub enum IntegratorArg {
     Normals,
 }
 
+/// Which lights a light sample reaches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LightChoiceArg {
+    /// Every shading point samples every light (the course's estimator).
+    Every,
+    /// Each light sample picks one light, uniformly (Mitsuba's estimator): one shadow ray
+    /// per sample however many lights the scene has.
+    One,
+}
+
 /// Where shading normals come from.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum NormalsArg {
@@ -67,9 +77,14 @@ pub struct RenderArgs {
     /// sample_count].
     #[arg(short = 's', long = "spp")]
     spp: Option<u32>,
-    /// Samples per area light (and hemisphere light) at each shading point.
+    /// Samples per area light (and hemisphere light) at each shading point; with
+    /// `--light-choice one`, light samples at each shading point.
     #[arg(short = 'l', long = "light-samples", default_value_t = 1)]
     light_samples: u32,
+    /// Which lights a light sample reaches [default: one for a Mitsuba scene with a box
+    /// filter, else every].
+    #[arg(long, value_enum, value_name = "CHOICE")]
+    light_choice: Option<LightChoiceArg>,
     /// Most bounces a path takes: 0 shows emitters only, 1 adds direct light [default: 7, or
     /// a Mitsuba scene's max_depth - 1].
     #[arg(short = 'm', long = "max-bounces")]
@@ -473,6 +488,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let filter = mitsuba
         .as_ref()
         .map_or(prism_scene::Filter::Box, |m| m.settings.filter);
+    // Mitsuba's estimator under a box filter; see `RenderOptions::mitsuba`.
+    let one_light = match a.light_choice {
+        Some(choice) => choice == LightChoiceArg::One,
+        None => mitsuba.is_some() && filter == prism_scene::Filter::Box,
+    };
     if filter != prism_scene::Filter::Box
         && (a.tile.is_some() || a.samples_from.is_some() || a.samples_to.is_some())
     {
@@ -592,6 +612,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         path: PathSettings {
             rr_bounces,
             hide_emitters,
+            one_light,
             light_samples: a.light_samples.max(1),
             max_bounces: a.max_bounces(),
             integrator: match a.integrator {

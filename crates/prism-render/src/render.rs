@@ -24,6 +24,34 @@ pub struct RenderOptions {
     pub path: PathSettings,
 }
 
+impl RenderOptions {
+    /// The options a Mitsuba scene file asks for, over `base`: its film's size, samples and
+    /// filter, and its integrator's depth (`base`'s when unbounded), Russian roulette and
+    /// hidden emitters. Under a box filter one light is picked per light sample, as Mitsuba
+    /// samples lights; under a wider filter every light is sampled, which keeps the noise
+    /// per pixel at Mitsuba's level (Mitsuba splats each sample over the filter's pixels,
+    /// prism draws each sample's position from the filter), at one shadow ray per light.
+    #[must_use]
+    pub fn mitsuba(settings: &prism_scene::MitsubaSettings, base: RenderOptions) -> RenderOptions {
+        RenderOptions {
+            film: FilmSettings {
+                width: settings.size.0,
+                height: settings.size.1,
+                spp: settings.spp,
+                filter: settings.filter,
+                ..base.film
+            },
+            path: PathSettings {
+                max_bounces: settings.max_bounces.unwrap_or(base.path.max_bounces),
+                rr_bounces: settings.rr_bounces,
+                hide_emitters: settings.hide_emitters,
+                one_light: settings.filter == prism_scene::Filter::Box,
+                ..base.path
+            },
+        }
+    }
+}
+
 /// A rendered picture.
 pub struct Rendered {
     /// Linear radiance per pixel.

@@ -138,20 +138,7 @@ pub fn pictures(
     std::fs::write(&showcase, SHOWCASE)
         .with_context(|| format!("writing {}", showcase.display()))?;
     let m = prism_scene::read_mitsuba(&showcase, &[]).map_err(crate::error::UserError::input)?;
-    let opts = RenderOptions {
-        film: FilmSettings {
-            width: m.settings.size.0,
-            height: m.settings.size.1,
-            spp: m.settings.spp,
-            filter: m.settings.filter,
-            ..base.film
-        },
-        path: PathSettings {
-            max_bounces: m.settings.max_bounces.unwrap_or(base.path.max_bounces),
-            rr_bounces: m.settings.rr_bounces,
-            ..base.path
-        },
-    };
+    let opts = RenderOptions::mitsuba(&m.settings, base);
     trace(&m.scene, &opts, &output.join("render_mitsuba.png"), None)?;
     entries.push(Entry {
         file: "render_mitsuba.png".into(),

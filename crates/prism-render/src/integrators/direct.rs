@@ -2,7 +2,7 @@
 //! hemisphere sampling or by light sampling; light sampling is also the path integrator's
 //! next-event estimate.
 
-use prism_math::{Frame, Ray, Rgb, Vec3};
+use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 
 use super::mis::power;
 use super::settings::PathSettings;
@@ -39,7 +39,8 @@ pub(super) fn direct(
 }
 
 /// Light sampling at a hit: every light, `light_samples` samples each (one for delta
-/// lights); with `mis`, weighted against BSDF sampling by the power heuristic.
+/// lights), or with [`PathSettings::one_light`] `light_samples` samples that each pick one
+/// light; with `mis`, weighted against BSDF sampling by the power heuristic.
 pub(super) fn direct_lights(
     scene: &RenderScene,
     hit: &Interaction,
@@ -51,6 +52,25 @@ pub(super) fn direct_lights(
     if !hit.bsdf.is_smooth() {
         return Rgb::BLACK;
     }
+    if opts.one_light {
+        if scene.lights.is_empty() {
+            return Rgb::BLACK;
+        }
+        let count = opts.light_samples.max(1);
+        let mut acc = Rgb::BLACK;
+        for _ in 0..count {
+            let (light, u, pmf) = picked(&scene.lights, sampler.next_2d());
+            let Some((shadow, dist, term)) =
+                light_term(hit, light, u, (frame, wo, wo_l), (count, pmf), mis)
+            else {
+                continue;
+            };
+            if !scene.occluded(&shadow, dist) {
+                acc += term;
+            }
+        }
+        return acc * (1.0 / count as f32);
+    }
     let mut total = Rgb::BLACK;
     for light in &scene.lights {
         let count = light.sample_count(opts.light_samples);
@@ -58,7 +78,7 @@ pub(super) fn direct_lights(
         for _ in 0..count {
             let u = sampler.next_2d();
             let Some((shadow, dist, term)) =
-                light_term(hit, light, u, (frame, wo, wo_l), count, mis)
+                light_term(hit, light, u, (frame, wo, wo_l), (count, 1.0), mis)
             else {
                 continue;
             };
@@ -71,15 +91,22 @@ pub(super) fn direct_lights(
     total
 }
 
-/// One sample `u` of `light` at `hit`, one of `count`: its shadow ray, where that ray must
-/// reach unblocked, and the term it adds then (weighted against BSDF sampling with `mis`);
-/// none if the sample cannot contribute.
+/// The light a sample's numbers `u` pick among `lights` (not empty), the numbers left for
+/// sampling it, and the chance it was picked ([`PathSettings::pick_light`]).
+pub(super) fn picked(lights: &[RenderLight], u: Vec2) -> (&RenderLight, Vec2, f32) {
+    let (i, ux, pmf) = PathSettings::pick_light(u.x, lights.len());
+    (&lights[i], Vec2::new(ux, u.y), pmf)
+}
+
+/// One sample `u` of `light` at `hit`, one of `count`, the light picked with chance `pmf`:
+/// its shadow ray, where that ray must reach unblocked, and the term it adds then
+/// (weighted against BSDF sampling with `mis`); none if the sample cannot contribute.
 pub(super) fn light_term(
     hit: &Interaction,
     light: &RenderLight,
-    u: prism_math::Vec2,
+    u: Vec2,
     (frame, wo, wo_l): (&Frame, Vec3, Vec3),
-    count: u32,
+    (count, pmf): (u32, f32),
     mis: bool,
 ) -> Option<(Ray, f32, Rgb)> {
     let ls = light.sample(hit.p, u)?;
@@ -113,12 +140,14 @@ pub(super) fn light_term(
     } else {
         (Ray::new(origin, ls.wi), f32::INFINITY)
     };
+    // The density of the sample, its pick included (a delta light's is its pick alone).
+    let pdf = pmf * ls.pdf;
     let w = if mis && !ls.delta {
-        power(count as f32, ls.pdf, bsdf_pdf)
+        power(count as f32, pdf, bsdf_pdf)
     } else {
         1.0
     };
-    Some((shadow, dist, f * ls.li * (w / ls.pdf)))
+    Some((shadow, dist, f * ls.li * (w / pdf)))
 }
 
 /// The course's uniform hemisphere estimator of direct light.

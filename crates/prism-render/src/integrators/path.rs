@@ -64,6 +64,7 @@ pub(super) fn path(
         }
         let next = hit.spawn(wi);
         let nlights = opts.light_samples.max(1) as f32;
+        let pmf = opts.light_pmf(scene.lights.len());
         match scene.intersect(&next) {
             None => {
                 if let (Some(i), true) = (scene.infinite, keep(bounce)) {
@@ -75,7 +76,8 @@ pub(super) fn path(
                             power(
                                 1.0,
                                 s.pdf,
-                                nlights * scene.lights[i].pdf(wi, f32::INFINITY, Vec3::ZERO),
+                                nlights
+                                    * (pmf * scene.lights[i].pdf(wi, f32::INFINITY, Vec3::ZERO)),
                             )
                         };
                         l += beta * le * w;
@@ -86,9 +88,11 @@ pub(super) fn path(
             Some(h) => {
                 if keep(bounce) && h.emitted.max_channel() > 0.0 {
                     let w = match h.light {
-                        Some(li) if !s.delta && hit.bsdf.is_smooth() => {
-                            power(1.0, s.pdf, nlights * scene.lights[li].pdf(wi, h.t, h.ng))
-                        }
+                        Some(li) if !s.delta && hit.bsdf.is_smooth() => power(
+                            1.0,
+                            s.pdf,
+                            nlights * (pmf * scene.lights[li].pdf(wi, h.t, h.ng)),
+                        ),
                         _ => 1.0,
                     };
                     l += beta * h.emitted * w;

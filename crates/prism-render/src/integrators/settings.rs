@@ -1,6 +1,6 @@
 //! [`PathSettings`], what the path-space integrators are told: which estimator
 //! ([`Integrator`]), how many light samples, how many bounces, which bounce to keep, and
-//! when Russian roulette starts.
+//! when Russian roulette starts, whether light samples pick one light.
 
 /// Which estimator computes radiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,6 +43,33 @@ pub struct PathSettings {
     /// Emitters seen straight from the camera (area lights, environments) show black
     /// (Mitsuba's `hide_emitters`); the light they shed is kept.
     pub hide_emitters: bool,
+    /// Next-event estimation picks one light per sample, uniformly (Mitsuba's rule), instead
+    /// of sampling every light at every shading point.
+    pub one_light: bool,
+}
+
+impl PathSettings {
+    /// The light that the light sample with first number `u` picks among `lights` when
+    /// [`PathSettings::one_light`] is on, with `u` stretched back over `[0, 1)` for reuse,
+    /// and the chance of picking it (Mitsuba's uniform emitter choice).
+    #[must_use]
+    pub fn pick_light(u: f32, lights: usize) -> (usize, f32, f32) {
+        let n = lights as f32;
+        let scaled = u * n;
+        let i = (scaled as usize).min(lights - 1);
+        (i, scaled - i as f32, 1.0 / n)
+    }
+
+    /// The chance that next-event estimation picks a given light of `lights`: `1 / lights`
+    /// with [`PathSettings::one_light`], else 1 (every light is sampled).
+    #[must_use]
+    pub fn light_pmf(&self, lights: usize) -> f32 {
+        if self.one_light && lights > 0 {
+            1.0 / lights as f32
+        } else {
+            1.0
+        }
+    }
 }
 
 impl Default for PathSettings {
@@ -54,6 +81,7 @@ impl Default for PathSettings {
             only_bounce: None,
             rr_bounces: 5,
             hide_emitters: false,
+            one_light: false,
         }
     }
 }

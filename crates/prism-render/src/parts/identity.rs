@@ -52,6 +52,8 @@ pub enum Renderer {
         rr_bounces: u32,
         /// Emitters hidden from the camera (written only when on).
         hide_emitters: bool,
+        /// One light picked per light sample (written only when on).
+        one_light: bool,
     },
     /// The Delft Whitted ray tracer (`prism raytrace`, kind `raytrace`).
     Whitted {
@@ -138,6 +140,7 @@ impl PartIdentity {
                 adaptive: opts.film.adaptive.map(|t| (t, opts.film.batch)),
                 rr_bounces: opts.path.rr_bounces,
                 hide_emitters: opts.path.hide_emitters,
+                one_light: opts.path.one_light,
             },
         }
     }
@@ -193,7 +196,7 @@ impl PartIdentity {
     /// `width`, `height`, `spp`, `seed`, `encoding`, then the renderer's own: for the path
     /// tracer `light_samples`, `max_bounces`, `integrator` (`path`, `normals` or
     /// `direct hemisphere=B`), `only_bounce` and `adaptive` (`TOL batch=N`; both `off` when
-    /// not set), `rr_bounces`; for Whitted `camera`, `settings` and `bloom`
+    /// not set), `rr_bounces`, and when on `hide_emitters` (`on`) and `light_choice` (`one`); for Whitted `camera`, `settings` and `bloom`
     /// (`THRESHOLD PASSES`, or `off`).
     #[must_use]
     pub fn to_attributes(&self) -> Vec<(String, String)> {
@@ -217,6 +220,7 @@ impl PartIdentity {
                 adaptive,
                 rr_bounces,
                 hide_emitters,
+                one_light,
             } => {
                 let integrator = match integrator {
                     Integrator::Path | Integrator::PathScalar => "path".to_string(),
@@ -236,6 +240,9 @@ impl PartIdentity {
                 ]);
                 if *hide_emitters {
                     out.push(("hide_emitters", "on".to_string()));
+                }
+                if *one_light {
+                    out.push(("light_choice", "one".to_string()));
                 }
             }
             Renderer::Whitted {
@@ -287,6 +294,10 @@ impl PartIdentity {
                 hide_emitters: settings.iter().any(|(k, _)| k == "hide_emitters")
                     && read(settings, "hide_emitters", "on", |v| {
                         (v == "on").then_some(true)
+                    })?,
+                one_light: settings.iter().any(|(k, _)| k == "light_choice")
+                    && read(settings, "light_choice", "one", |v| {
+                        (v == "one").then_some(true)
                     })?,
             },
             "raytrace" => Renderer::Whitted {
@@ -409,6 +420,7 @@ mod tests {
                 adaptive: Some((0.05, 32)),
                 rr_bounces: 5,
                 hide_emitters: true,
+                one_light: true,
             },
         }
     }
@@ -481,12 +493,20 @@ mod tests {
         assert_eq!(get("bloom"), Some("0.75 3"));
         assert_eq!(get("encoding"), Some("truncated"));
         assert_eq!(a.len(), 11);
-        // `hide_emitters` is written only when on, so that older parts still read.
+        // `hide_emitters` and `light_choice` are written only when on, so that older parts
+        // still read.
         assert_eq!(get_path("hide_emitters"), Some("on"));
-        assert_eq!(path().to_attributes().len(), 15);
+        assert_eq!(get_path("light_choice"), Some("one"));
+        assert_eq!(path().to_attributes().len(), 16);
         let mut shown = path();
-        if let Renderer::Path { hide_emitters, .. } = &mut shown.renderer {
+        if let Renderer::Path {
+            hide_emitters,
+            one_light,
+            ..
+        } = &mut shown.renderer
+        {
             *hide_emitters = false;
+            *one_light = false;
         }
         assert_eq!(shown.to_attributes().len(), 14);
     }

@@ -165,20 +165,7 @@ fn agrees_with_mitsuba(name: &str, scene: &str, defines: &[(&str, &str)]) {
     assert_eq!(m.settings.spp, 64);
     assert_eq!(m.settings.max_bounces, Some(5));
     let scene = RenderScene::new(&m.scene);
-    let opts = RenderOptions {
-        film: FilmSettings {
-            width: m.settings.size.0,
-            height: m.settings.size.1,
-            spp: m.settings.spp,
-            filter: m.settings.filter,
-            ..FilmSettings::default()
-        },
-        path: PathSettings {
-            max_bounces: m.settings.max_bounces.unwrap_or(1024),
-            rr_bounces: m.settings.rr_bounces,
-            ..PathSettings::default()
-        },
-    };
+    let opts = RenderOptions::mitsuba(&m.settings, RenderOptions::default());
     let share = prism_render::film::Share::whole(opts.film.spp);
     let job = prism_render::render::Job::share(&share);
     let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
@@ -639,4 +626,55 @@ fn mean_green(file: &std::path::Path, size: u32, spp: u32, max_bounces: u32) -> 
     let job = prism_render::render::Job::share(&share);
     let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
     sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / (size * size) as f32
+}
+
+/// Closed form: a white diffuse plate (albedo 0.5) facing the camera, under a constant
+/// emitter of radiance 0.2 (behind the camera, seen by the plate's upper hemisphere only)
+/// and two directional lights of irradiance 2 (head-on) and 3 (at 60 degrees), one bounce:
+/// `0.5 * 0.2 + 0.5 / pi * (2 + 3 cos 60)`. With one light picked per light sample (the
+/// options Mitsuba scenes render with) as with every light sampled.
+#[test]
+fn one_light_per_sample_keeps_the_expectation() {
+    let dir = tempfile_dir("one-light");
+    let file = dir.join("s.xml");
+    std::fs::write(
+        &file,
+        r#"<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="20"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="512"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="constant"><rgb name="radiance" value="0.2"/></emitter>
+    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="2"/></emitter>
+    <emitter type="directional"><vector name="direction" value="0, -0.8660254, -0.5"/><rgb name="irradiance" value="3"/></emitter>
+    <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+</scene>"#,
+    )
+    .unwrap();
+    let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
+    let scene = RenderScene::new(&m.scene);
+    let expected = 0.5 * 0.2 + 0.5 / std::f32::consts::PI * (2.0 + 3.0 * 0.5);
+    let picked = RenderOptions::mitsuba(&m.settings, RenderOptions::default());
+    assert!(picked.path.one_light);
+    let every = RenderOptions {
+        path: PathSettings {
+            one_light: false,
+            ..picked.path
+        },
+        ..picked
+    };
+    for (what, opts) in [("one light", picked), ("every light", every)] {
+        let share = prism_render::film::Share::whole(opts.film.spp);
+        let job = prism_render::render::Job::share(&share);
+        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let mean = sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 64.0;
+        assert!(
+            (mean / expected - 1.0).abs() < 0.01,
+            "{what}: {mean} against {expected}"
+        );
+    }
 }

@@ -733,7 +733,11 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
     for (what, lights, samples) in [
         ("point light", vec![point.clone()], 1),
         ("directional light", vec![sun.clone()], 1),
-        ("area, point and directional lights", vec![point, sun], 3),
+        (
+            "area, point and directional lights",
+            vec![point.clone(), sun.clone()],
+            3,
+        ),
     ] {
         let mut lit = prism_scene::cornell_box();
         if what.starts_with("area") {
@@ -778,6 +782,27 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         ..small
     };
     same(&RenderScene::new(&glowing), opts, "emissive mesh");
+    // One light picked per light sample (Mitsuba's estimator) among the area light, the
+    // emissive mesh, a point and a directional light: the lanes of a group pick different
+    // lights.
+    let mut four = glowing.clone();
+    four.lights.extend([point.clone(), sun.clone()]);
+    let four = RenderScene::new(&four);
+    for samples in [1, 3] {
+        let opts = RenderOptions {
+            path: PathSettings {
+                light_samples: samples,
+                one_light: true,
+                ..small.path
+            },
+            ..small
+        };
+        same(
+            &four,
+            opts,
+            &format!("one light of four, {samples} samples"),
+        );
+    }
     let mut mapped = furnace(Material::Diffuse {
         reflectance: Rgb::splat(0.6),
         texture: None,

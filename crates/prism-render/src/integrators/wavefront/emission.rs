@@ -33,6 +33,7 @@ fn emitted(
 ) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
     let nlights = opts.light_samples.max(1) as f32;
+    let pmf = opts.light_pmf(scene.lights.len());
     // Emission along the ray.
     let hit = if p.bounce == 0 {
         match hit {
@@ -57,7 +58,7 @@ fn emitted(
                     let (le, light_pdf) = scene.escaped_mis(dir);
                     if le.max_channel() > 0.0 {
                         let w = if p.mis {
-                            power(1.0, p.pdf, nlights * light_pdf)
+                            power(1.0, p.pdf, nlights * (pmf * light_pdf))
                         } else {
                             1.0
                         };
@@ -69,9 +70,11 @@ fn emitted(
             Some(h) => {
                 if keep(bounce) && h.emitted.max_channel() > 0.0 {
                     let w = match h.light {
-                        Some(li) if p.mis => {
-                            power(1.0, p.pdf, nlights * scene.lights[li].pdf(dir, h.t, h.ng))
-                        }
+                        Some(li) if p.mis => power(
+                            1.0,
+                            p.pdf,
+                            nlights * (pmf * scene.lights[li].pdf(dir, h.t, h.ng)),
+                        ),
                         _ => 1.0,
                     };
                     p.l += p.beta * h.emitted * w;

@@ -222,6 +222,182 @@ fn power(nf: f32, f: F16, g: F16) -> F16 {
     F16::select(both, zero, a * a / (a * a + g * g))
 }
 
+/// A shading point on sixteen lanes, as a light sample's term needs it.
+struct At {
+    p: V16,
+    ng: V16,
+    frame: (V16, V16, V16),
+    wo_l: V16,
+    wo_front: M16,
+}
+
+/// Adds to `cand` the light sample toward `wi` at distance `dist` on the lanes `ok`, with
+/// incident radiance `li` weighted as `w` says, for the BSDF `bsdf` at `at`.
+#[inline(always)]
+fn candidate(
+    at: &At,
+    bsdf: &SmoothLanes,
+    cand: &mut Vec<Candidate>,
+    (wi, dist, mut ok): (V16, F16, M16),
+    li: [F16; 3],
+    w: Weight,
+) {
+    let zero = F16::splat(0.0);
+    let At {
+        p,
+        ng,
+        frame,
+        wo_l,
+        wo_front,
+    } = *at;
+    ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
+    let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi, frame));
+    ok = ok & !max_channel(&f).le(zero);
+    // `f li (w / pdf)`, the density with the light's pick; a delta light's weight is 1
+    // and its density the pick's alone.
+    let w = match w {
+        Weight::Delta => F16::splat(1.0),
+        Weight::Mis { count, pdf } => power(count as f32, pdf, bsdf_pdf) / pdf,
+        Weight::Picked {
+            count,
+            pmf,
+            pdf,
+            delta,
+        } => {
+            let pdf = F16::splat(pmf) * pdf;
+            F16::select(delta, F16::splat(1.0), power(count as f32, pdf, bsdf_pdf)) / pdf
+        }
+    };
+    let term = [0, 1, 2].map(|c| f[c] * li[c] * w);
+    // Aimed at the light's point from the pushed-off origin and stopping just short
+    // of it, as the scalar light term aims it.
+    let origin = spawn(p, ng, wi);
+    let finite = dist.is_finite();
+    let to_light = (p + wi * dist) - origin;
+    let length = to_light.dot(to_light).sqrt();
+    ok = ok & (!finite | zero.lt(length));
+    let dir = V16 {
+        x: F16::select(finite, to_light.x / length, wi.x),
+        y: F16::select(finite, to_light.y / length, wi.y),
+        z: F16::select(finite, to_light.z / length, wi.z),
+    };
+    let shadow_dist = F16::select(
+        finite,
+        length * F16::splat(1.0 - 1e-4),
+        F16::splat(f32::INFINITY),
+    );
+    cand.push(Candidate {
+        keep: ok.bits(),
+        origin,
+        dir,
+        end: shadow_dist,
+        term,
+    });
+}
+
+/// How a light sample's term is weighted: a delta light's (by 1), an MIS weight against
+/// the BSDF for a sample of density `pdf`, one of `count` of its light, or a sample of a
+/// light picked with chance `pmf` (density `pdf`, or a delta light where `delta`).
+#[derive(Clone, Copy)]
+enum Weight {
+    Delta,
+    Mis {
+        count: u32,
+        pdf: F16,
+    },
+    Picked {
+        count: u32,
+        pmf: f32,
+        pdf: F16,
+        delta: M16,
+    },
+}
+
+/// Sixteen samples `u` of `light` seen from points `p`, on the lanes `lanes`: per lane the
+/// direction to the light, its distance, the lanes with a sample, the incident radiance and
+/// the density (none: a delta light). Area, point, directional and hemisphere lights are
+/// sampled on the lanes, the others by their own code, lane by lane.
+#[inline(always)]
+fn sample_lanes(
+    light: &RenderLight,
+    p: V16,
+    (ux, uy): (F16, F16),
+    lanes: M16,
+    sky: &Frame,
+) -> (V16, F16, M16, [F16; 3], Option<F16>) {
+    let zero = F16::splat(0.0);
+    match *light {
+        RenderLight::Area {
+            corner,
+            e1,
+            e2,
+            normal,
+            area,
+            radiance,
+        } => {
+            let q = V16::splat(corner) + V16::splat(e1) * ux + V16::splat(e2) * uy;
+            let (wi, dist, dist2) = toward(p, q);
+            let cos_l = -dot1(wi, normal);
+            let ok = zero.lt(dist) & lanes & zero.lt(cos_l);
+            let pdf = dist2 / (F16::splat(area) * cos_l);
+            (wi, dist, ok, rgb(radiance), Some(pdf))
+        }
+        RenderLight::Point {
+            position,
+            intensity,
+        } => {
+            let (wi, dist, dist2) = toward(p, V16::splat(position));
+            let inv = F16::splat(1.0) / dist2;
+            let li = rgb(intensity).map(|c| c * inv);
+            (wi, dist, zero.lt(dist) & lanes, li, None)
+        }
+        RenderLight::Directional {
+            to_light,
+            irradiance,
+        } => {
+            let dist = F16::splat(f32::INFINITY);
+            (V16::splat(to_light), dist, lanes, rgb(irradiance), None)
+        }
+        RenderLight::Hemisphere { radiance } => {
+            // `cosine_hemisphere` about world +Y, in `Frame::to_world`'s order.
+            let local = cosine_hemisphere_lanes(ux, uy);
+            let wi = V16::splat(sky.s) * local.x
+                + V16::splat(sky.t) * local.y
+                + V16::splat(sky.n) * local.z;
+            let pdf = local.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
+            let dist = F16::splat(f32::INFINITY);
+            (wi, dist, lanes & zero.lt(local.z), rgb(radiance), Some(pdf))
+        }
+        RenderLight::Mesh(_)
+        | RenderLight::Spot(_)
+        | RenderLight::Environment { .. }
+        | RenderLight::EnvironmentMap(_) => {
+            // No lane version of the sample: the light's own, lane by lane.
+            let (mut wi, mut dist) = (V16::splat(Vec3::Z), F16::splat(1.0));
+            let (mut li, mut pdf) = (rgb(Rgb::BLACK), F16::splat(1.0));
+            let mut found = 0;
+            let mut bits = lanes.bits();
+            while bits != 0 {
+                let lane = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let at = Vec3::new(p.x.0[lane], p.y.0[lane], p.z.0[lane]);
+                let uv = Vec2::new(ux.0[lane], uy.0[lane]);
+                if let Some(ls) = light.sample(at, uv) {
+                    put(&mut wi, lane, ls.wi);
+                    dist.0[lane] = ls.dist;
+                    pdf.0[lane] = ls.pdf;
+                    for (c, v) in li.iter_mut().zip([ls.li.r, ls.li.g, ls.li.b]) {
+                        c.0[lane] = v;
+                    }
+                    found |= 1 << lane;
+                }
+            }
+            let pdf = (!light.is_delta()).then_some(pdf);
+            (wi, dist, M16::from_bits(found), li, pdf)
+        }
+    }
+}
+
 /// One step of up to sixteen paths `group` (indices into `paths`), whose surfaces have
 /// smooth BSDFs of kind `kind`, in a scene lit by `lights`, with light sampling kept at
 /// this bounce.
@@ -290,130 +466,90 @@ pub(super) fn step(
     // shadow ray.
     let cand = &mut *out.samples;
     cand.clear();
-    cand.reserve(
+    cand.reserve(if opts.one_light {
+        opts.light_samples.max(1) as usize
+    } else {
         lights
             .iter()
             .map(|l| l.sample_count(opts.light_samples) as usize)
-            .sum(),
-    );
+            .sum()
+    });
     let sky = Frame::from_normal(Vec3::Y);
     let mut draw = 0;
-    for light in lights {
-        let count = light.sample_count(opts.light_samples);
+    let at = At {
+        p,
+        ng,
+        frame: (s, t, n),
+        wo_l,
+        wo_front,
+    };
+    if opts.one_light && !lights.is_empty() {
+        // Each sample picks one light per lane, then samples it with the numbers left.
+        let count = opts.light_samples.max(1);
         for _ in 0..count {
-            // The sample's two numbers, drawn only where used (a delta light needs none).
-            let u = draw;
+            let (ux, uy) = pair(&key, &dim, draw);
             draw += 2;
-            // Per lane: the direction to the light, its distance, the lanes with a sample,
-            // the incident radiance, and the density with its MIS weight (none: delta).
-            let (wi, dist, mut ok, li, pdf) = match *light {
-                RenderLight::Area {
-                    corner,
-                    e1,
-                    e2,
-                    normal,
-                    area,
-                    radiance,
-                } => {
-                    let (ux, uy) = pair(&key, &dim, u);
-                    let q = V16::splat(corner) + V16::splat(e1) * ux + V16::splat(e2) * uy;
-                    let (wi, dist, dist2) = toward(p, q);
-                    let cos_l = -dot1(wi, normal);
-                    let ok = zero.lt(dist) & lane_in & zero.lt(cos_l);
-                    let pdf = dist2 / (F16::splat(area) * cos_l);
-                    (wi, dist, ok, rgb(radiance), Some(pdf))
+            let mut which = [0usize; LANES];
+            let mut rest = ux;
+            let mut pmf = 1.0;
+            for lane in 0..LANES {
+                (which[lane], rest.0[lane], pmf) =
+                    PathSettings::pick_light(ux.0[lane], lights.len());
+            }
+            let (mut wi, mut dist) = (V16::splat(Vec3::Z), F16::splat(1.0));
+            let (mut ok, mut delta) = (M16::splat(false), M16::splat(false));
+            let (mut li, mut pdf) = (rgb(Rgb::BLACK), F16::splat(1.0));
+            for (i, light) in lights.iter().enumerate() {
+                let mut bits = 0u32;
+                for lane in 0..m {
+                    bits |= u32::from(which[lane] == i) << lane;
                 }
-                RenderLight::Point {
-                    position,
-                    intensity,
-                } => {
-                    let (wi, dist, dist2) = toward(p, V16::splat(position));
-                    let inv = F16::splat(1.0) / dist2;
-                    let li = rgb(intensity).map(|c| c * inv);
-                    (wi, dist, zero.lt(dist) & lane_in, li, None)
+                if bits == 0 {
+                    continue;
                 }
-                RenderLight::Directional {
-                    to_light,
-                    irradiance,
-                } => {
-                    let dist = F16::splat(f32::INFINITY);
-                    (V16::splat(to_light), dist, lane_in, rgb(irradiance), None)
+                let sel = M16::from_bits(bits);
+                let (wi_i, dist_i, ok_i, li_i, pdf_i) =
+                    sample_lanes(light, p, (rest, uy), sel, &sky);
+                wi = V16 {
+                    x: F16::select(sel, wi_i.x, wi.x),
+                    y: F16::select(sel, wi_i.y, wi.y),
+                    z: F16::select(sel, wi_i.z, wi.z),
+                };
+                dist = F16::select(sel, dist_i, dist);
+                ok = ok | (ok_i & sel);
+                for c in 0..3 {
+                    li[c] = F16::select(sel, li_i[c], li[c]);
                 }
-                RenderLight::Hemisphere { radiance } => {
-                    // `cosine_hemisphere` about world +Y, in `Frame::to_world`'s order.
-                    let (ux, uy) = pair(&key, &dim, u);
-                    let local = cosine_hemisphere_lanes(ux, uy);
-                    let wi = V16::splat(sky.s) * local.x
-                        + V16::splat(sky.t) * local.y
-                        + V16::splat(sky.n) * local.z;
-                    let pdf = local.z.max_num(zero) * F16::splat(std::f32::consts::FRAC_1_PI);
-                    let dist = F16::splat(f32::INFINITY);
-                    (
-                        wi,
-                        dist,
-                        lane_in & zero.lt(local.z),
-                        rgb(radiance),
-                        Some(pdf),
-                    )
+                match pdf_i {
+                    Some(d) => pdf = F16::select(sel, d, pdf),
+                    None => delta = delta | sel,
                 }
-                RenderLight::Mesh(_)
-                | RenderLight::Spot(_)
-                | RenderLight::Environment { .. }
-                | RenderLight::EnvironmentMap(_) => {
-                    // No lane version of the sample: the light's own, lane by lane.
-                    let (ux, uy) = pair(&key, &dim, u);
-                    let (mut wi, mut dist) = (V16::splat(Vec3::Z), F16::splat(1.0));
-                    let (mut li, mut pdf) = (rgb(Rgb::BLACK), F16::splat(1.0));
-                    let mut found = 0;
-                    for lane in 0..m {
-                        let at = Vec3::new(p.x.0[lane], p.y.0[lane], p.z.0[lane]);
-                        let uv = Vec2::new(ux.0[lane], uy.0[lane]);
-                        if let Some(ls) = light.sample(at, uv) {
-                            put(&mut wi, lane, ls.wi);
-                            dist.0[lane] = ls.dist;
-                            pdf.0[lane] = ls.pdf;
-                            for (c, v) in li.iter_mut().zip([ls.li.r, ls.li.g, ls.li.b]) {
-                                c.0[lane] = v;
-                            }
-                            found |= 1 << lane;
-                        }
-                    }
-                    let pdf = (!light.is_delta()).then_some(pdf);
-                    (wi, dist, M16::from_bits(found), li, pdf)
-                }
+            }
+            let w = Weight::Picked {
+                count,
+                pmf,
+                pdf,
+                delta,
             };
-            ok = ok & !(wo_front ^ zero.lt(wi.dot(ng)));
-            let (f, bsdf_pdf) = bsdf.eval_pdf(wo_l, local(wi, (s, t, n)));
-            ok = ok & !max_channel(&f).le(zero);
-            // `f li (w / pdf)`; a delta light's weight and density are both 1.
-            let w = pdf.map_or(F16::splat(1.0), |pdf| {
-                power(count as f32, pdf, bsdf_pdf) / pdf
-            });
-            let term = [0, 1, 2].map(|c| f[c] * li[c] * w);
-            // Aimed at the light's point from the pushed-off origin and stopping just short
-            // of it, as the scalar light term aims it.
-            let origin = spawn(p, ng, wi);
-            let finite = dist.is_finite();
-            let to_light = (p + wi * dist) - origin;
-            let length = to_light.dot(to_light).sqrt();
-            ok = ok & (!finite | zero.lt(length));
-            let dir = V16 {
-                x: F16::select(finite, to_light.x / length, wi.x),
-                y: F16::select(finite, to_light.y / length, wi.y),
-                z: F16::select(finite, to_light.z / length, wi.z),
-            };
-            let shadow_dist = F16::select(
-                finite,
-                length * F16::splat(1.0 - 1e-4),
-                F16::splat(f32::INFINITY),
-            );
-            cand.push(Candidate {
-                keep: ok.bits(),
-                origin,
-                dir,
-                end: shadow_dist,
-                term,
-            });
+            candidate(&at, &bsdf, cand, (wi, dist, ok), li, w);
+        }
+    } else if !opts.one_light {
+        // Per light, `count` samples (one for a delta light), each a possible shadow ray.
+        for light in lights {
+            let count = light.sample_count(opts.light_samples);
+            for _ in 0..count {
+                // The sample's two numbers, drawn only where used (a delta light needs none).
+                let u = draw;
+                draw += 2;
+                let uv = if light.is_delta() {
+                    (zero, zero)
+                } else {
+                    pair(&key, &dim, u)
+                };
+                let (wi, dist, ok, li, pdf) = sample_lanes(light, p, uv, lane_in, &sky);
+                let w = pdf.map_or(Weight::Delta, |pdf| Weight::Mis { count, pdf });
+                candidate(&at, &bsdf, cand, (wi, dist, ok), li, w);
+            }
         }
     }
     let first = out.waiting.len();

@@ -4,7 +4,7 @@
 use prism_math::Ray;
 
 use super::queues::{LightTerms, PathState, Pending, Shadows};
-use crate::integrators::direct::light_term;
+use crate::integrators::direct::{light_term, picked};
 use crate::integrators::PathSettings;
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
@@ -27,14 +27,29 @@ pub(super) fn scatter(
     let (frame, wo_l) = hit.shading_frame(wo);
     if keep(bounce) {
         let first_light = light_terms.len();
-        if hit.bsdf.is_smooth() {
+        if hit.bsdf.is_smooth() && opts.one_light && !scene.lights.is_empty() {
+            let count = opts.light_samples.max(1);
+            let first = shadows.len();
+            for _ in 0..count {
+                let (light, u, pmf) = picked(&scene.lights, p.sampler.next_2d());
+                if let Some((ray, dist, term)) =
+                    light_term(hit, light, u, (&frame, wo, wo_l), (count, pmf), true)
+                {
+                    shadows.push(ray, dist, term);
+                }
+            }
+            light_terms.push(LightTerms {
+                shadows: (first, shadows.len()),
+                count,
+            });
+        } else if hit.bsdf.is_smooth() && !opts.one_light {
             for light in &scene.lights {
                 let count = light.sample_count(opts.light_samples);
                 let first = shadows.len();
                 for _ in 0..count {
                     let u = p.sampler.next_2d();
                     if let Some((ray, dist, term)) =
-                        light_term(hit, light, u, (&frame, wo, wo_l), count, true)
+                        light_term(hit, light, u, (&frame, wo, wo_l), (count, 1.0), true)
                     {
                         shadows.push(ray, dist, term);
                     }
