@@ -19,7 +19,7 @@ mod transform;
 pub mod warp;
 
 pub use color::Rgb;
-pub use elementary::{acos, exp, ln};
+pub use elementary::{acos, atan2, exp, ln};
 pub use exact::ExactSum;
 pub use geometry::{Aabb, Frame, Ray};
 pub use glam;

@@ -139,6 +139,9 @@ pub struct Piecewise1D {
     cdf: Vec<f32>,
     /// The weights' mean: the density of cell `i` is `weights[i] / mean`.
     mean: f32,
+    /// `guide[k]`: how many entries of `cdf` are at or below `k / n` (`k` in `0..=n`), so
+    /// that a sample searches a few entries, not the whole table.
+    guide: Vec<u32>,
 }
 
 impl Piecewise1D {
@@ -167,10 +170,15 @@ impl Piecewise1D {
             cdf.push((acc / total) as f32);
         }
         *cdf.last_mut().expect("non-empty") = 1.0;
+        let cells = weights.len();
+        let guide = (0..=cells)
+            .map(|k| cdf.partition_point(|&c| c <= k as f32 / cells as f32) as u32)
+            .collect();
         Piecewise1D {
             weights,
             cdf,
             mean: (total / n) as f32,
+            guide,
         }
     }
 
@@ -191,11 +199,7 @@ impl Piecewise1D {
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         let n = self.weights.len();
         // The last cell whose start is at or below u, skipping empty cells.
-        let mut i = self
-            .cdf
-            .partition_point(|&c| c <= u)
-            .saturating_sub(1)
-            .min(n - 1);
+        let mut i = self.count_at_or_below(u).saturating_sub(1).min(n - 1);
         while self.weights[i] == 0.0 && i + 1 < n {
             i += 1;
         }
@@ -210,6 +214,19 @@ impl Piecewise1D {
         };
         let x = ((i as f32 + t) / n as f32).min(1.0 - f32::EPSILON);
         (x, self.weights[i] / self.mean, i)
+    }
+
+    /// How many entries of the cumulative table are at or below `u` (`partition_point`),
+    /// searched between the guide's entries around `u`: `u` lies at or above `(k - 1) / n`
+    /// and below `(k + 2) / n` for `k = floor(u n)`, whatever the rounding.
+    #[inline]
+    fn count_at_or_below(&self, u: f32) -> usize {
+        let g = self.guide.len() - 1;
+        // A cast saturates: negative u and NaN give cell 0.
+        let k = ((u * g as f32) as usize).min(g - 1);
+        let lo = k.checked_sub(1).map_or(0, |j| self.guide[j] as usize);
+        let hi = self.guide[(k + 2).min(g)] as usize;
+        lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
     }
 
     /// The density at `x` in `[0, 1)`.
@@ -228,6 +245,40 @@ mod tests {
     /// Oracle: double-precision sine and cosine. Over a million angles across
     /// `[-pi/4, pi/4]`, the polynomials are within one ulp of the correctly rounded values,
     /// and exact at 0.
+    /// Oracle: a search of the whole cumulative table. The guided search finds the same
+    /// cell for numbers across [0, 1), at cell edges, outside the range and NaN, with empty
+    /// cells and a very uneven density.
+    #[test]
+    fn guided_search_equals_whole_table_search() {
+        let mut rng = crate::Pcg32::new(3, 5);
+        for n in [1usize, 2, 3, 7, 64, 1000] {
+            let weights: Vec<f32> = (0..n)
+                .map(|i| match i % 5 {
+                    0 => 0.0,
+                    1 => 1e-6,
+                    _ => rng.next_f32() * 100.0,
+                })
+                .collect();
+            let d = Piecewise1D::new(&weights);
+            let mut us: Vec<f32> = (0..20_000).map(|_| rng.next_f32()).collect();
+            us.extend(d.cdf.iter().flat_map(|&c| [c, c.next_up(), c.next_down()]));
+            us.extend((0..=n).map(|k| k as f32 / n as f32));
+            us.extend([
+                -1.0,
+                -0.0,
+                1.0,
+                1.5,
+                f32::NAN,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+            ]);
+            for u in us {
+                let whole = d.cdf.partition_point(|&c| c <= u);
+                assert_eq!(d.count_at_or_below(u), whole, "n {n}, u {u}");
+            }
+        }
+    }
+
     #[test]
     fn sin_cos_quarter_is_within_one_ulp() {
         let ulps = |got: f32, want: f64| {

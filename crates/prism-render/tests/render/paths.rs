@@ -814,6 +814,19 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
         mapping: prism_scene::EnvMapping::Course,
     }];
     same(&RenderScene::new(&mapped), small, "environment map");
+    // The same map laid as Mitsuba lays one, turned: its lookups are made for a whole pass
+    // at once on lanes.
+    if let Some(Light::EnvironmentMap { mapping, .. }) = mapped.lights.first_mut() {
+        *mapping = prism_scene::EnvMapping::Mitsuba {
+            to_local: prism_math::glam::Mat3::from_rotation_y(0.7)
+                * prism_math::glam::Mat3::from_rotation_x(-0.3),
+        };
+    }
+    same(
+        &RenderScene::new(&mapped),
+        small,
+        "Mitsuba's environment map",
+    );
     let mut lens = prism_scene::cornell_box();
     lens.camera.lens = Some(prism_scene::ThinLens {
         radius: 0.05,

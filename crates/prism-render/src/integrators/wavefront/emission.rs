@@ -1,7 +1,7 @@
 //! The wavefront's emission stage: the light a path's ray found (emission at its hit, or
 //! what it sees escaping), weighted against light sampling, and whether the path goes on.
 
-use prism_math::Vec3;
+use prism_math::{Rgb, Vec3};
 
 use super::queues::PathState;
 use crate::integrators::mis::power;
@@ -9,16 +9,17 @@ use crate::integrators::PathSettings;
 use crate::interaction::Interaction;
 use crate::render_scene::RenderScene;
 
-/// Adds the emission a path's ray (along `dir`) found, or what it sees escaping; leaves in
-/// `hit` the surface the path scatters from next, or none if it ends there.
+/// Adds the emission a path's ray (along `dir`) found, or what it sees escaping (with
+/// `seen`, the environment map's radiance and density along `dir`, if already looked up);
+/// leaves in `hit` the surface the path scatters from next, or none if it ends there.
 pub(super) fn emit(
     scene: &RenderScene,
     opts: &PathSettings,
     p: &mut PathState,
-    dir: Vec3,
+    (dir, seen): (Vec3, Option<(Rgb, f32)>),
     hit: &mut Option<Interaction>,
 ) {
-    if emitted(scene, opts, p, dir, hit.as_ref()).is_none() {
+    if emitted(scene, opts, p, (dir, seen), hit.as_ref()).is_none() {
         *hit = None;
     }
 }
@@ -28,7 +29,7 @@ fn emitted(
     scene: &RenderScene,
     opts: &PathSettings,
     p: &mut PathState,
-    dir: Vec3,
+    (dir, seen): (Vec3, Option<(Rgb, f32)>),
     hit: Option<&Interaction>,
 ) -> Option<()> {
     let keep = |bounces: u32| opts.only_bounce.is_none_or(|m| m == bounces);
@@ -39,7 +40,7 @@ fn emitted(
         match hit {
             None => {
                 if keep(0) && !opts.hide_emitters {
-                    p.l = scene.escaped(dir, true);
+                    p.l = seen.map_or_else(|| scene.escaped(dir, true), |(le, _)| le);
                 }
                 return None;
             }
@@ -55,7 +56,7 @@ fn emitted(
         match hit {
             None => {
                 if let (Some(_), true) = (scene.infinite, keep(bounce)) {
-                    let (le, light_pdf) = scene.escaped_mis(dir);
+                    let (le, light_pdf) = seen.unwrap_or_else(|| scene.escaped_mis(dir));
                     if le.max_channel() > 0.0 {
                         let w = if p.mis {
                             power(1.0, p.pdf, nlights * (pmf * light_pdf))

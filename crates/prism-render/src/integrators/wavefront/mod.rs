@@ -50,6 +50,10 @@ struct Buffers {
     shadows: Shadows,
     lights: Vec<LightTerms>,
     pending: Vec<Option<Pending>>,
+    /// The directions of the rays that leave the scene, and the map's radiance and density
+    /// along each (a scene lit by a map).
+    dirs: Vec<prism_math::Vec3>,
+    escaped: Vec<(Rgb, f32)>,
     alive: Vec<bool>,
     blocked: Vec<bool>,
 }
@@ -133,8 +137,22 @@ fn sample_pass(
         laps.lap(Stage::HitRecords);
         b.shadows.clear();
         b.lights.clear();
+        // What the rays that leave the scene see of a map, looked up together.
+        b.escaped.clear();
+        if let Some(RenderLight::EnvironmentMap(map)) = scene.infinite.map(|i| &scene.lights[i]) {
+            b.dirs.clear();
+            let escaping = b.rays.iter().zip(&b.hits).filter(|(_, h)| h.is_none());
+            b.dirs.extend(escaping.map(|(ray, _)| ray.dir));
+            map.radiance_pdf_batch(&b.dirs, &mut b.escaped);
+        }
+        let mut escaped = b.escaped.iter();
         for ((p, ray), hit) in b.paths.iter_mut().zip(&b.rays).zip(b.hits.iter_mut()) {
-            emit(scene, opts, p, ray.dir, hit);
+            let seen = if hit.is_none() {
+                escaped.next().copied()
+            } else {
+                None
+            };
+            emit(scene, opts, p, (ray.dir, seen), hit);
         }
         laps.lap(Stage::Emission);
         let count = b.paths.len();
