@@ -8,7 +8,8 @@ use std::sync::Arc;
 use prism_image::{PixelSampling, Texture};
 use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
 use prism_scene::{
-    Material, MaterialTexture, ScalarTexture, Scene, TexturedParameter, TiltOptions,
+    Material, MaterialTexture, PrincipledWeight, ScalarTexture, Scene, TexturedParameter,
+    TiltOptions,
 };
 
 use crate::bsdf::Bsdf;
@@ -223,6 +224,10 @@ impl Materials {
                             (Some(u), Some(v)) => u != v,
                             _ => true,
                         };
+                        // So may a principled material's anisotropy.
+                        let apart = apart
+                            || alpha(TexturedParameter::Principled(PrincipledWeight::Anisotropic))
+                                .is_some();
                         if valid(*material) && apart {
                             a[*material] = true;
                         }

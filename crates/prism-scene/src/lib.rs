@@ -60,6 +60,6 @@ pub use render_config::{
 };
 pub use scene::{
     Camera, CameraMode, Crop, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind,
-    NormalsMode, OrbitCamera, Roughness, ScalarTexture, Scene, SceneOptions, SceneSphere, Shading,
-    TexturedParameter, ThinLens, TiltOptions, TriangleMesh,
+    NormalsMode, OrbitCamera, PrincipledWeight, Roughness, ScalarTexture, Scene, SceneOptions,
+    SceneSphere, Shading, TexturedParameter, ThinLens, TiltOptions, TriangleMesh,
 };

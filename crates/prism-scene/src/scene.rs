@@ -164,6 +164,9 @@ pub enum Material {
         metallic: f32,
         /// Share of specular transmission.
         spec_trans: f32,
+        /// True if the material transmits at all: `spec_trans` given as a number other than
+        /// 0 or by a texture (Mitsuba's `has_spec_trans`).
+        transmits: bool,
         /// Tint of the dielectric specular lobe towards the base colour.
         spec_tint: f32,
         /// Sheen's weight.
@@ -185,7 +188,8 @@ pub enum Material {
         two_sided: bool,
     },
     /// `material` with some of its parameters read from textures at each hit (Mitsuba's
-    /// textured `specular_reflectance`, `specular_transmittance` and `alpha`s).
+    /// textured `specular_reflectance`, `specular_transmittance`, `alpha`s and principled
+    /// weights).
     Textured {
         /// The material, as an index into [`Scene::materials`].
         material: usize,
@@ -292,6 +296,60 @@ pub enum TexturedParameter {
     AlphaU,
     /// The microfacet roughness along the second tangent.
     AlphaV,
+    /// One of a principled material's weights (its texture's luminance).
+    Principled(PrincipledWeight),
+}
+
+/// A principled material's weights that a texture may give, as Mitsuba's principled BSDF
+/// takes them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrincipledWeight {
+    /// `roughness`.
+    Roughness,
+    /// `anisotropic`.
+    Anisotropic,
+    /// `metallic`.
+    Metallic,
+    /// `spec_trans`.
+    SpecTrans,
+    /// `spec_tint`.
+    SpecTint,
+    /// `sheen`.
+    Sheen,
+    /// `sheen_tint`.
+    SheenTint,
+    /// `flatness`.
+    Flatness,
+    /// `clearcoat`.
+    Clearcoat,
+    /// `clearcoat_gloss`.
+    ClearcoatGloss,
+}
+
+impl PrincipledWeight {
+    /// The weight named `name` in Mitsuba's principled BSDF.
+    #[must_use]
+    pub fn named(name: &str) -> Option<PrincipledWeight> {
+        Some(match name {
+            "roughness" => PrincipledWeight::Roughness,
+            "anisotropic" => PrincipledWeight::Anisotropic,
+            "metallic" => PrincipledWeight::Metallic,
+            "spec_trans" => PrincipledWeight::SpecTrans,
+            "spec_tint" => PrincipledWeight::SpecTint,
+            "sheen" => PrincipledWeight::Sheen,
+            "sheen_tint" => PrincipledWeight::SheenTint,
+            "flatness" => PrincipledWeight::Flatness,
+            "clearcoat" => PrincipledWeight::Clearcoat,
+            "clearcoat_gloss" => PrincipledWeight::ClearcoatGloss,
+            _ => return None,
+        })
+    }
+
+    /// True for the weights that may exceed 1 (`sheen`, `clearcoat`).
+    #[must_use]
+    pub fn unbounded(self) -> bool {
+        matches!(self, PrincipledWeight::Sheen | PrincipledWeight::Clearcoat)
+    }
 }
 
 /// How a bump or normal map's tilted normal is used, as Mitsuba's options say.

@@ -4,7 +4,7 @@
 
 use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use prism_math::{acos, exp, ln, Rgb, Vec2, Vec3};
-use prism_scene::{Material, TexturedParameter};
+use prism_scene::{Material, PrincipledWeight, TexturedParameter};
 use std::f32::consts::PI;
 
 /// A BSDF ready to evaluate.
@@ -124,7 +124,7 @@ pub enum Bsdf {
         /// The base colour (times the texture's texel).
         base: Rgb,
         /// The other parameters.
-        params: &'static principled::PrincipledParams,
+        params: principled::PrincipledParams,
         /// True if the back scatters as the front (inside `twosided`, without transmission).
         two_sided: bool,
     },
@@ -262,6 +262,7 @@ impl Bsdf {
                 anisotropic,
                 metallic,
                 spec_trans,
+                transmits,
                 spec_tint,
                 sheen,
                 sheen_tint,
@@ -279,6 +280,7 @@ impl Bsdf {
                     anisotropic,
                     metallic,
                     spec_trans,
+                    transmits,
                     spec_tint,
                     sheen,
                     sheen_tint,
@@ -287,9 +289,8 @@ impl Bsdf {
                     clearcoat_gloss,
                     eta,
                     rates,
-                }
-                .interned(),
-                two_sided: two_sided && spec_trans == 0.0,
+                },
+                two_sided: two_sided && !transmits,
             },
         }
     }
@@ -319,10 +320,12 @@ impl Bsdf {
         }
     }
 
-    /// Sets `param` to `value` (its luminance for an alpha, at least 1e-4), where the BSDF
-    /// has it.
+    /// Sets `param` to `value` (its luminance for a number: at least 1e-4 for an alpha,
+    /// within 0 to 1 for a principled weight, at least 0 for sheen and clearcoat), where
+    /// the BSDF has it.
     pub(crate) fn set(&mut self, param: TexturedParameter, value: Rgb) {
-        let alpha = || (0.212671 * value.r + 0.715160 * value.g + 0.072169 * value.b).max(1e-4);
+        let luminance = 0.212671 * value.r + 0.715160 * value.g + 0.072169 * value.b;
+        let alpha = || luminance.max(1e-4);
         match (self, param) {
             (
                 Bsdf::Mirror { reflectance }
@@ -361,6 +364,24 @@ impl Bsdf {
                 Bsdf::RoughConductor { distr, .. } | Bsdf::RoughDielectric { distr, .. },
                 TexturedParameter::AlphaV,
             ) => distr.alpha_v = alpha(),
+            (Bsdf::Principled { params, .. }, TexturedParameter::Principled(w)) => {
+                // Weights as Mitsuba's `eval_1` reads them, kept where they are defined.
+                let v = luminance.max(0.0);
+                let v = if w.unbounded() { v } else { v.min(1.0) };
+                let slot = match w {
+                    PrincipledWeight::Roughness => &mut params.roughness,
+                    PrincipledWeight::Anisotropic => &mut params.anisotropic,
+                    PrincipledWeight::Metallic => &mut params.metallic,
+                    PrincipledWeight::SpecTrans => &mut params.spec_trans,
+                    PrincipledWeight::SpecTint => &mut params.spec_tint,
+                    PrincipledWeight::Sheen => &mut params.sheen,
+                    PrincipledWeight::SheenTint => &mut params.sheen_tint,
+                    PrincipledWeight::Flatness => &mut params.flatness,
+                    PrincipledWeight::Clearcoat => &mut params.clearcoat,
+                    PrincipledWeight::ClearcoatGloss => &mut params.clearcoat_gloss,
+                };
+                *slot = v;
+            }
             _ => {}
         }
     }
@@ -388,7 +409,7 @@ impl Bsdf {
                 | Bsdf::ThinDielectric { .. }
                 | Bsdf::RoughDielectric { .. }
                 | Bsdf::Null
-        ) && !matches!(self, Bsdf::Principled { params, .. } if params.spec_trans != 0.0)
+        ) && !matches!(self, Bsdf::Principled { params, .. } if params.transmits)
     }
 
     /// The BSDF times `|cos wi|`. Zero for delta lobes.
@@ -653,13 +674,13 @@ impl Bsdf {
                 two_sided,
             } => {
                 if two_sided && wo.z < 0.0 {
-                    let s = principled::sample(params, base, flip(wo), u1, u2)?;
+                    let s = principled::sample(&params, base, flip(wo), u1, u2)?;
                     Some(BsdfSample {
                         wi: flip(s.wi),
                         ..s
                     })
                 } else {
-                    principled::sample(params, base, wo, u1, u2)
+                    principled::sample(&params, base, wo, u1, u2)
                 }
             }
             Bsdf::Black => None,
@@ -709,8 +730,8 @@ impl Bsdf {
             } => {
                 let (wo, wi) = if two_sided { upper(wo, wi) } else { (wo, wi) };
                 Some((
-                    principled::eval(params, base, wo, wi),
-                    principled::pdf(params, wo, wi),
+                    principled::eval(&params, base, wo, wi),
+                    principled::pdf(&params, wo, wi),
                 ))
             }
             _ => None,

@@ -3,9 +3,7 @@
 //! `spec_tint`, a GGX transmission lobe, and a GTR1 clearcoat, each lobe chosen and weighed
 //! as Mitsuba chooses and weighs it, so that images agree with Mitsuba's in expectation.
 
-use std::collections::HashMap;
 use std::f32::consts::{FRAC_1_PI, PI};
-use std::sync::{Mutex, OnceLock};
 
 use prism_math::warp::cosine_hemisphere;
 use prism_math::{Rgb, Vec2, Vec3};
@@ -25,6 +23,9 @@ pub struct PrincipledParams {
     pub metallic: f32,
     /// Share of specular transmission, 0 to 1.
     pub spec_trans: f32,
+    /// True if the material transmits at all (Mitsuba's `has_spec_trans`): `spec_trans`
+    /// given other than 0, or by a texture, whose value here may be 0.
+    pub transmits: bool,
     /// Tint of the dielectric specular lobe towards the base colour.
     pub spec_tint: f32,
     /// Sheen's weight.
@@ -45,39 +46,6 @@ pub struct PrincipledParams {
 }
 
 impl PrincipledParams {
-    /// The parameters, interned for the process: a BSDF holds them by reference and stays
-    /// `Copy`.
-    #[must_use]
-    pub fn interned(self) -> &'static PrincipledParams {
-        static TABLE: OnceLock<Mutex<HashMap<[u32; 14], &'static PrincipledParams>>> =
-            OnceLock::new();
-        let p = self;
-        let key = [
-            p.roughness,
-            p.anisotropic,
-            p.metallic,
-            p.spec_trans,
-            p.spec_tint,
-            p.sheen,
-            p.sheen_tint,
-            p.flatness,
-            p.clearcoat,
-            p.clearcoat_gloss,
-            p.eta,
-            p.rates[0],
-            p.rates[1],
-            p.rates[2],
-        ]
-        .map(f32::to_bits);
-        let mut table = TABLE
-            .get_or_init(Default::default)
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        table
-            .entry(key)
-            .or_insert_with(|| Box::leak(Box::new(self)))
-    }
-
     /// The GGX distribution of the specular lobes (Mitsuba's `calc_dist_params`).
     fn distribution(&self) -> Microfacet {
         let r2 = self.roughness * self.roughness;
@@ -111,7 +79,7 @@ impl PrincipledParams {
         } else {
             f
         };
-        let trans = match (self.spec_trans != 0.0, front) {
+        let trans = match (self.transmits, front) {
             (false, _) => 0.0,
             (true, true) => spec_rate * bsdf * (1.0 - f),
             (true, false) => 1.0 - f,
@@ -280,7 +248,7 @@ pub(super) fn eval(p: &PrincipledParams, base: Rgb, v: Vec3, l: Vec3) -> Rgb {
         };
         value += fp * (d * g / (4.0 * cos_v.abs()));
     }
-    if p.spec_trans != 0.0 && bsdf > 0.0 && refract && compat_t && f < 1.0 {
+    if p.transmits && bsdf > 0.0 && refract && compat_t && f < 1.0 {
         let (dv, dl) = (v.dot(wh), l.dot(wh));
         let scale = inv_eta_path * inv_eta_path;
         let denom = dv + eta_path * dl;
@@ -341,7 +309,7 @@ pub(super) fn pdf(p: &PrincipledParams, v: Vec3, l: Vec3) -> f32 {
     let (f, _, _) = fresnel(v.dot(wh), p.eta);
     let [diffuse, clearcoat, trans, spec] = p.lobe_probabilities(f, front);
     let (dv, dl) = (v.dot(wh), l.dot(wh));
-    let dwh_dl = if p.spec_trans != 0.0 && !reflect {
+    let dwh_dl = if p.transmits && !reflect {
         (eta_path * eta_path * dl / ((dv + eta_path * dl) * (dv + eta_path * dl))).abs()
     } else {
         (1.0 / (4.0 * dl)).abs()
@@ -355,7 +323,7 @@ pub(super) fn pdf(p: &PrincipledParams, v: Vec3, l: Vec3) -> f32 {
     if reflect {
         pdf += diffuse * FRAC_1_PI * l.z;
     }
-    if p.spec_trans != 0.0 && compatible(wh, v, l, cos_v, false) && refract {
+    if p.transmits && compatible(wh, v, l, cos_v, false) && refract {
         pdf += trans * visible() * dwh_dl;
     }
     if p.clearcoat != 0.0 && compat_r {
@@ -404,7 +372,7 @@ pub(super) fn sample(
         let mcc = Vec3::new(cos_phi * sin_t, sin_phi * sin_t, cos_t);
         let l = reflect_about(mcc);
         (compatible(mcc, v, l, cos_v, true) && cos_v * l.z > 0.0).then_some(l)?
-    } else if p.spec_trans != 0.0 && u1 < diffuse + clearcoat + trans {
+    } else if p.transmits && u1 < diffuse + clearcoat + trans {
         let l = m * (v.dot(m) * eta_ti + cos_t) - v * eta_ti;
         (compatible(m, v, l, cos_v, false) && cos_v * l.z < 0.0).then_some(l)?
     } else {
@@ -435,6 +403,7 @@ mod tests {
             anisotropic: 0.3,
             metallic: 0.2,
             spec_trans: 0.3,
+            transmits: true,
             spec_tint: 0.4,
             sheen: 0.5,
             sheen_tint: 0.5,

@@ -134,6 +134,18 @@ fn principled_bsdfs_render_as_mitsuba_renders_them() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `weights.xml` (beside the references): `principled` with its
+/// roughness, metallic, clearcoat, transmission, anisotropy, sheen and flatness given by
+/// bitmaps (raw and sRGB) and checkerboards; compared as the box is.
+#[test]
+fn textured_principled_weights_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "weights",
+        "crates/prism-render/tests/golden/mitsuba/xml/weights.xml",
+        &[],
+    );
+}
+
 /// Oracle: Mitsuba 3 rendering `parameters.xml` (beside the references): textures as a
 /// rough conductor's alpha, a glass's specular_transmittance, a plastic's
 /// specular_reflectance and a rough dielectric's alpha_u alone (anisotropic, a checkerboard

@@ -8,7 +8,8 @@ use super::props::{error, ior, not_supported, unsupported};
 use super::to_scene::Builder;
 use crate::error::SceneError;
 use crate::scene::{
-    Material, MicrofacetKind, Roughness, ScalarTexture, TexturedParameter, TiltOptions,
+    Material, MicrofacetKind, PrincipledWeight, Roughness, ScalarTexture, TexturedParameter,
+    TiltOptions,
 };
 use prism_math::Rgb;
 
@@ -99,7 +100,11 @@ impl Builder<'_> {
                 "dielectric" | "thindielectric" | "roughdielectric"
             );
             let rough = matches!(o.kind.as_str(), "roughconductor" | "roughdielectric");
+            let weight = PrincipledWeight::named(slot)
+                .filter(|_| o.kind == "principled")
+                .map(TexturedParameter::Principled);
             let params: &[TexturedParameter] = match slot {
+                _ if weight.is_some() => std::slice::from_ref(weight.as_ref().expect("a weight")),
                 "specular_reflectance" if specular => &[TexturedParameter::SpecularReflectance],
                 "specular_transmittance" if transmits => {
                     &[TexturedParameter::SpecularTransmittance]
@@ -113,7 +118,9 @@ impl Builder<'_> {
                 // An alpha is a number: Mitsuba reads its texture with `eval_1`.
                 let t = match (params[0], self.scalar_texture(c)?) {
                     (
-                        TexturedParameter::AlphaU | TexturedParameter::AlphaV,
+                        TexturedParameter::AlphaU
+                        | TexturedParameter::AlphaV
+                        | TexturedParameter::Principled(_),
                         ScalarTexture::Image(t),
                     ) => t,
                     _ => self.texture(c)?,
@@ -124,7 +131,7 @@ impl Builder<'_> {
             return Err(not_supported(
                 c,
                 format!(
-                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse albedo, a specular scale or a microfacet alpha is)",
+                    "{} in {}: not supported by prism yet (a bitmap or checkerboard as a diffuse albedo, a specular scale, a microfacet alpha or a principled weight is)",
                     c.label(),
                     o.label()
                 ),
@@ -257,7 +264,14 @@ impl Builder<'_> {
                     ior: (int / ext) as f32,
                 }
             }
-            "principled" => principled(o, reflectance_texture.clone(), two_sided)?,
+            "principled" => {
+                let textured = |w: PrincipledWeight| {
+                    param_textures
+                        .iter()
+                        .any(|(p, _)| *p == TexturedParameter::Principled(w))
+                };
+                principled(o, reflectance_texture.clone(), two_sided, &textured)?
+            }
             _ => return Err(unsupported(o)),
         };
         // Mitsuba's opaque BSDFs are black from behind unless wrapped in `twosided`.
@@ -579,6 +593,7 @@ fn principled(
     o: &Object,
     texture: Option<crate::scene::MaterialTexture>,
     two_sided: bool,
+    textured: &dyn Fn(PrincipledWeight) -> bool,
 ) -> Result<Material, SceneError> {
     let f = |name: &str, default: f64| -> Result<f32, SceneError> {
         let v = o.float(name, default)?;
@@ -602,6 +617,8 @@ fn principled(
         Ok(v)
     };
     let spec_trans = weight("spec_trans", 0.0)?;
+    // Mitsuba's `has_spec_trans`: a number other than 0, or a texture.
+    let transmits = spec_trans != 0.0 || textured(PrincipledWeight::SpecTrans);
     let eta = match (o.value("eta"), o.value("specular")) {
         (Some(_), Some(_)) => {
             return Err(error(
@@ -613,12 +630,12 @@ fn principled(
             ))
         }
         (Some(_), None) => match f("eta", 1.5)? {
-            eta if spec_trans != 0.0 && eta == 1.0 => 1.001,
+            eta if transmits && eta == 1.0 => 1.001,
             eta => eta,
         },
         (None, _) => {
             let specular = match f("specular", 0.5)? {
-                s if spec_trans != 0.0 && s == 0.0 => 1e-3,
+                s if transmits && s == 0.0 => 1e-3,
                 s => s,
             };
             2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
@@ -654,6 +671,7 @@ fn principled(
         anisotropic: weight("anisotropic", 0.0)?,
         metallic: weight("metallic", 0.0)?,
         spec_trans,
+        transmits,
         spec_tint: weight("spec_tint", 0.0)?,
         sheen,
         sheen_tint: weight("sheen_tint", 0.0)?,
