@@ -17,7 +17,7 @@ use crate::interaction::{frame_along, Tilt};
 
 /// A prepared texture (shared by the materials that use its image), its lookup and its
 /// `to_uv`.
-type Lookup = (Arc<Texture>, PixelSampling, [f32; 6]);
+pub(crate) type Lookup = (Arc<Texture>, PixelSampling, [f32; 6]);
 
 /// A number over the surface, prepared.
 enum Scalar {
@@ -128,6 +128,9 @@ impl Materials {
                     texture: Some(t), ..
                 }
                 | Material::Principled {
+                    texture: Some(t), ..
+                }
+                | Material::AreaEmitter {
                     texture: Some(t), ..
                 } => Some(prepare(t)),
                 _ => None,
@@ -462,13 +465,34 @@ impl Materials {
         }
     }
 
-    fn lookup(&self, (tex, sampling, m): &Lookup, uv: Vec2) -> Rgb {
-        let at = Vec2::new(
-            m[0] * uv.x + m[1] * uv.y + m[2],
-            m[3] * uv.x + m[4] * uv.y + m[5],
-        );
-        tex.sample_level(at, 0, *sampling)
+    fn lookup(&self, lookup: &Lookup, uv: Vec2) -> Rgb {
+        look_up(lookup, uv)
     }
+
+    /// The radiance material `index` emits at surface coordinates `uv` (Mitsuba's), if it
+    /// emits: its radiance, times its texture's texel where it has one.
+    #[inline(always)]
+    pub(crate) fn emission_at(&self, index: usize, uv: impl Fn() -> Vec2) -> Option<Rgb> {
+        let radiance = self.emission[index]?;
+        Some(match &self.textures[index] {
+            Some(lookup) => radiance * look_up(lookup, uv()),
+            None => radiance,
+        })
+    }
+
+    /// The texture an emitting material `index` multiplies its radiance by, if any.
+    pub(crate) fn emission_texture(&self, index: usize) -> Option<&Lookup> {
+        self.emission[index].and(self.textures[index].as_ref())
+    }
+}
+
+/// A texture's texel at surface coordinates `uv`, through its `to_uv` transform.
+pub(crate) fn look_up((tex, sampling, m): &Lookup, uv: Vec2) -> Rgb {
+    let at = Vec2::new(
+        m[0] * uv.x + m[1] * uv.y + m[2],
+        m[3] * uv.x + m[4] * uv.y + m[5],
+    );
+    tex.sample_level(at, 0, *sampling)
 }
 
 /// Mitsuba's luminance of a linear sRGB colour.

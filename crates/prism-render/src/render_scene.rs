@@ -67,6 +67,7 @@ impl RenderScene {
     /// facing side (the Whitted ray tracer's, given as colours, not radiance) are left out.
     #[must_use]
     pub fn new(scene: &Scene) -> RenderScene {
+        let materials = Materials::new(scene);
         let mut tris = Vec::new();
         let mut prims = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
@@ -187,7 +188,33 @@ impl RenderScene {
                 scene.materials.get(m.material),
                 Some(prism_scene::Material::AreaEmitter { .. })
             );
-            if let Some(light) = MeshLight::new(tris, radiance).map(|l| l.one_sided(one_sided)) {
+            let light = MeshLight::new(tris, radiance).map(|l| {
+                let l = l.one_sided(one_sided);
+                match materials.emission_texture(m.material) {
+                    // Mitsuba's surface coordinates at the corners: the file's (v running
+                    // down the image), else the barycentric coordinates.
+                    Some(texture) => {
+                        let uvs = m
+                            .triangles
+                            .iter()
+                            .map(|t| match &m.uvs {
+                                Some(uvs) => t.map(|i| {
+                                    let uv = uvs[i as usize];
+                                    prism_math::Vec2::new(uv.x, 1.0 - uv.y)
+                                }),
+                                None => [
+                                    prism_math::Vec2::ZERO,
+                                    prism_math::Vec2::X,
+                                    prism_math::Vec2::Y,
+                                ],
+                            })
+                            .collect();
+                        l.textured(texture.clone(), uvs)
+                    }
+                    None => l,
+                }
+            });
+            if let Some(light) = light {
                 mesh_light[mi] = Some(lights.len());
                 lights.push(RenderLight::Mesh(std::sync::Arc::new(light)));
             }
@@ -224,7 +251,7 @@ impl RenderScene {
                 .zip(scene.spheres.iter())
                 .map(|(s, scene_sphere)| (s, scene_sphere.material, scene_sphere.inward))
                 .collect(),
-            materials: Materials::new(scene),
+            materials,
             lights,
             camera: scene.camera,
             infinite,
@@ -371,11 +398,10 @@ impl RenderScene {
                     ng,
                     ns,
                     bsdf,
-                    emitted: match mats.emission[m.material] {
-                        Some(_) if mats.front_only[m.material] && ray.dir.dot(ng) >= 0.0 => {
-                            Rgb::BLACK
-                        }
-                        e => e.unwrap_or(Rgb::BLACK),
+                    emitted: if mats.front_only[m.material] && ray.dir.dot(ng) >= 0.0 {
+                        Rgb::BLACK
+                    } else {
+                        mats.emission_at(m.material, uv).unwrap_or(Rgb::BLACK)
                     },
                     light: m.light,
                     t: hit.t,
@@ -439,9 +465,10 @@ impl RenderScene {
                     ng: n,
                     ns: n,
                     bsdf,
-                    emitted: match mats.emission[material] {
-                        Some(_) if mats.front_only[material] && ray.dir.dot(n) >= 0.0 => Rgb::BLACK,
-                        e => e.unwrap_or(Rgb::BLACK),
+                    emitted: if mats.front_only[material] && ray.dir.dot(n) >= 0.0 {
+                        Rgb::BLACK
+                    } else {
+                        mats.emission_at(material, uv).unwrap_or(Rgb::BLACK)
                     },
                     light: None,
                     t: hit.t,

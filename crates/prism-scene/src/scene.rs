@@ -29,6 +29,9 @@ pub enum Material {
     AreaEmitter {
         /// Emitted radiance.
         radiance: Rgb,
+        /// An image the radiance is multiplied by, at the surface's coordinates (Mitsuba's
+        /// textured `radiance`).
+        texture: Option<MaterialTexture>,
         /// The surface's material, as an index into [`Scene::materials`], if it has one.
         surface: Option<usize>,
     },

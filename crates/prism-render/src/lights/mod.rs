@@ -12,6 +12,8 @@ use prism_math::{Frame, Rgb, Vec2, Vec3};
 
 use envmap::EnvMap;
 
+use crate::materials::{look_up, Lookup};
+
 /// A light source ready to sample: the renderer's form of a [`prism_scene::Light`].
 #[derive(Clone, Debug)]
 pub enum RenderLight {
@@ -65,7 +67,7 @@ pub enum RenderLight {
 /// The triangles of an emissive mesh (both sides emit, as the course's emission BSDF
 /// does, or only the front, where the winding's normal points, as a Mitsuba area emitter
 /// does), with the cumulative areas that pick one in proportion to its area.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct MeshLight {
     triangles: Vec<[Vec3; 3]>,
     front_only: bool,
@@ -73,6 +75,9 @@ pub struct MeshLight {
     cumulative: Vec<f32>,
     area: f32,
     radiance: Rgb,
+    /// A texture the radiance is multiplied by, and each triangle's surface coordinates
+    /// (Mitsuba's) at its corners.
+    map: Option<(Lookup, Vec<[Vec2; 3]>)>,
 }
 
 impl MeshLight {
@@ -94,7 +99,30 @@ impl MeshLight {
             cumulative,
             area,
             radiance,
+            map: None,
         })
+    }
+
+    /// The light with its radiance multiplied by the texel of `texture` at each point's
+    /// surface coordinates, which are `uvs` at each triangle's corners (one entry per
+    /// triangle, in order).
+    #[must_use]
+    pub(crate) fn textured(mut self, texture: Lookup, uvs: Vec<[Vec2; 3]>) -> MeshLight {
+        debug_assert_eq!(uvs.len(), self.triangles.len());
+        self.map = Some((texture, uvs));
+        self
+    }
+
+    /// The radiance at barycentric coordinates `(b1, b2)` of triangle `i`.
+    fn radiance_at(&self, i: usize, b1: f32, b2: f32) -> Rgb {
+        match &self.map {
+            None => self.radiance,
+            Some((texture, uvs)) => {
+                let [a, b, c] = uvs[i];
+                let uv = a * (1.0 - b1 - b2) + b * b1 + c * b2;
+                self.radiance * look_up(texture, uv)
+            }
+        }
     }
 
     /// The light emitting from its front side only (`true`) or from both sides.
@@ -122,7 +150,7 @@ impl MeshLight {
 
     /// A point uniform over the mesh's area and its unit normal: a triangle chosen by area
     /// with `u.x`, which is then reused, stretched, inside it.
-    fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
+    fn sample_point(&self, u: Vec2) -> (Vec3, Vec3, Rgb) {
         let target = u.x * self.area;
         let i = self
             .cumulative
@@ -138,7 +166,8 @@ impl MeshLight {
         let [a, b, c] = self.triangles[i];
         let r = ux.sqrt();
         let point = a * (1.0 - r) + b * (r * (1.0 - u.y)) + c * (r * u.y);
-        (point, (b - a).cross(c - a).normalize_or_zero())
+        let radiance = self.radiance_at(i, r * (1.0 - u.y), r * u.y);
+        (point, (b - a).cross(c - a).normalize_or_zero(), radiance)
     }
 }
 
@@ -258,8 +287,8 @@ impl RenderLight {
                 toward_surface(p, q, |wi| -wi.dot(normal), area, radiance)
             }
             RenderLight::Mesh(ref mesh) => {
-                let (q, n) = mesh.sample_point(u);
-                toward_surface(p, q, |wi| mesh.cos_toward(wi, n), mesh.area, mesh.radiance)
+                let (q, n, radiance) = mesh.sample_point(u);
+                toward_surface(p, q, |wi| mesh.cos_toward(wi, n), mesh.area, radiance)
             }
             RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
@@ -390,6 +419,60 @@ mod tests {
         let num = a.dot(b.cross(c)).abs();
         let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
         2.0 * num.atan2(den)
+    }
+
+    /// Oracle: geometry. A square light in the plane z = 1 whose surface coordinates are
+    /// its x and y, under a 2x2 nearest texture (a colour per quadrant): each sample's
+    /// radiance is the light's radiance times the texel of the quadrant its direction from
+    /// the point (0.3, 0.4, 0) meets the plane in.
+    #[test]
+    fn textured_mesh_light_emits_the_texel_where_it_samples() {
+        let colours = [
+            Rgb::new(1.0, 0.0, 0.0),
+            Rgb::new(0.0, 1.0, 0.0),
+            Rgb::new(0.0, 0.0, 1.0),
+            Rgb::new(1.0, 1.0, 0.0),
+        ];
+        let image = prism_image::Image::from_fn(2, 2, |x, y| colours[(y * 2 + x) as usize]);
+        let texture = std::sync::Arc::new(prism_image::Texture::new(image));
+        let lookup: Lookup = (
+            texture,
+            prism_image::PixelSampling::Nearest,
+            [1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        );
+        let quad = [
+            [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)],
+            [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0)],
+        ];
+        let tris = quad
+            .iter()
+            .map(|t| t.map(|(x, y)| Vec3::new(x, y, 1.0)))
+            .collect();
+        let uvs = quad
+            .iter()
+            .map(|t| t.map(|(x, y)| Vec2::new(x, y)))
+            .collect();
+        let light = MeshLight::new(tris, Rgb::splat(2.0))
+            .unwrap()
+            .textured(lookup, uvs);
+        let light = RenderLight::Mesh(std::sync::Arc::new(light));
+        let from = Vec3::new(0.3, 0.4, 0.0);
+        let mut rng = Pcg32::new(1, 2);
+        let mut seen = [0; 4];
+        for _ in 0..4000 {
+            let u = Vec2::new(rng.next_f32(), rng.next_f32());
+            let ls = light.sample(from, u).unwrap();
+            let q = from + ls.wi * (1.0 / ls.wi.z);
+            let (x, y) = ((q.x * 2.0) as usize, (q.y * 2.0) as usize);
+            // Points within rounding of a texel's edge could go either way.
+            if (q.x * 2.0 - x as f32).abs() < 1e-3 || (q.y * 2.0 - y as f32).abs() < 1e-3 {
+                continue;
+            }
+            let k = y.min(1) * 2 + x.min(1);
+            seen[k] += 1;
+            assert_eq!(ls.li, colours[k] * 2.0, "at {q}");
+        }
+        assert!(seen.iter().all(|&n| n > 800), "{seen:?}");
     }
 
     /// Oracles for area sampling of an emissive mesh, from a point that sees both sides of

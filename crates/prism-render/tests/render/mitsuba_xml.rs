@@ -146,6 +146,18 @@ fn textured_principled_weights_render_as_mitsuba_renders_them() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `emitters.xml` (beside the references): area emitters whose
+/// radiance is a texture (an OpenEXR bitmap on a rectangle, a checkerboard on a cube),
+/// seen directly and lighting the box; compared as the box is.
+#[test]
+fn textured_emitters_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "emitters",
+        "crates/prism-render/tests/golden/mitsuba/xml/emitters.xml",
+        &[],
+    );
+}
+
 /// Oracle: Mitsuba 3 rendering `parameters.xml` (beside the references): textures as a
 /// rough conductor's alpha, a glass's specular_transmittance, a plastic's
 /// specular_reflectance and a rough dielectric's alpha_u alone (anisotropic, a checkerboard

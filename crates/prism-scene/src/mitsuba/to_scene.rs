@@ -250,8 +250,23 @@ impl Builder<'_> {
                 "bsdf" => material = Some(self.bsdf(child, depth + 1)?),
                 "emitter" if c.kind == "area" => {
                     c.refuse(&["to_world"])?;
-                    self.no_nested_plugins(c)?;
-                    emission = Some(c.rgb("radiance", [1.0; 3])?);
+                    // The radiance may be a texture, as in Mitsuba.
+                    let mut texture = None;
+                    for (slot, t) in &c.children {
+                        let t = &self.doc.objects[*t];
+                        if t.tag != "texture" || slot.as_deref() != Some("radiance") {
+                            return Err(not_supported(
+                                t,
+                                format!("{} in {}: not supported by prism yet (a texture as the radiance is)", t.label(), c.label()),
+                            ));
+                        }
+                        texture = Some(self.texture(t)?);
+                    }
+                    let radiance = match texture {
+                        Some(_) => Rgb::WHITE,
+                        None => c.rgb("radiance", [1.0; 3])?,
+                    };
+                    emission = Some((radiance, texture));
                 }
                 _ => self.tolerate(unsupported(c), "read past")?,
             }
@@ -263,8 +278,12 @@ impl Builder<'_> {
         };
         let material = match (emission, material) {
             // An area emitter keeps a BSDF given to its shape: light meeting it scatters too.
-            (Some(radiance), surface) => self.push_material(
-                Material::AreaEmitter { radiance, surface },
+            (Some((radiance, texture)), surface) => self.push_material(
+                Material::AreaEmitter {
+                    radiance,
+                    texture,
+                    surface,
+                },
                 format!("{} area emitter", o.label()),
                 // The surface's BSDF says which of its sides scatter.
                 true,
@@ -544,6 +563,9 @@ impl Builder<'_> {
                 | Material::Principled {
                     texture: Some(_), ..
                 }
+                | Material::AreaEmitter {
+                    texture: Some(_), ..
+                }
                 | Material::NormalMap { .. }
                 | Material::BumpMap { .. }
                 | Material::Textured { .. } => return true,
@@ -559,6 +581,9 @@ impl Builder<'_> {
                     pending.extend(materials.iter().filter(|&&m| m < i));
                 }
                 Material::Mask { material, .. } if *material < i => pending.push(*material),
+                Material::AreaEmitter {
+                    surface: Some(m), ..
+                } if *m < i => pending.push(*m),
                 _ => {}
             }
         }
