@@ -493,14 +493,6 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         Some(choice) => choice == LightChoiceArg::One,
         None => mitsuba.is_some() && filter == prism_scene::Filter::Box,
     };
-    if filter != prism_scene::Filter::Box
-        && (a.tile.is_some() || a.samples_from.is_some() || a.samples_to.is_some())
-    {
-        return Err(UserError::Refused(format!(
-            "--tile and --samples-from/--samples-to: a scene whose reconstruction filter is not a box ({filter:?}) cannot be split yet; give it <rfilter type=\"box\"/> or render it whole"
-        ))
-        .into());
-    }
     // A size given on the command line replaces a Mitsuba film's, crop and all.
     let film_replaced = a.resolution.is_some();
     let a = &resolved;

@@ -2453,18 +2453,6 @@ fn mitsuba_scenes_render_and_refuse_what_they_cannot() {
             vec![scene.display().to_string(), "-D".into(), "spp".into()],
             "--define: expected NAME=VALUE, found \"spp\"".to_string(),
         ),
-        (
-            vec![
-                scene.display().to_string(),
-                "-D".into(),
-                "filter=gaussian".into(),
-                "--tile".into(),
-                "0/2".into(),
-                "-o".into(),
-                dir.join("p.exr").display().to_string(),
-            ],
-            "cannot be split yet".to_string(),
-        ),
     ] {
         let o = prism()
             .arg("render")

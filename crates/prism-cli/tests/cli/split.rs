@@ -104,6 +104,51 @@ fn tile_splits_merge_to_the_single_render_byte_for_byte() {
     }
 }
 
+/// Oracle: the single render. A Mitsuba scene under its Gaussian and tent filters (each
+/// sample's position drawn around its own pixel) split into 3 tile shares crossed with 2
+/// sample ranges merges to its EXR byte for byte; the filter is part of the parts'
+/// identity, so parts of different filters do not merge.
+#[test]
+fn filtered_mitsuba_splits_merge_to_the_single_render_byte_for_byte() {
+    let dir = scratch("filtered");
+    let scene = prism_testkit::workspace_root().join("docs/examples/cbox.xml");
+    let scene = scene.to_str().unwrap();
+    for filter in ["filter=gaussian", "filter=tent"] {
+        let args = ["render", scene, "-D", filter, "-s", "6", "-r", "70", "50"];
+        let whole = dir.join("whole.exr");
+        ok(run(args[0], &args[1..], &[], &whole));
+        let mut parts = Vec::new();
+        for t in 0..3 {
+            for (from, to) in [("0", "2"), ("2", "6")] {
+                let p = dir.join(format!("t{t}-{from}.exr"));
+                let tile = format!("{t}/3");
+                let extra = ["--tile", &tile, "--samples-from", from, "--samples-to", to];
+                ok(run(args[0], &args[1..], &extra, &p));
+                parts.push(p);
+            }
+        }
+        let merged = dir.join("merged.exr");
+        ok(merge(&parts, &merged, &[]));
+        assert!(
+            std::fs::read(&merged).unwrap() == std::fs::read(&whole).unwrap(),
+            "{filter}: the merged EXR differs"
+        );
+        // A part rendered under a box filter does not join them.
+        let boxed = dir.join("boxed.exr");
+        let extra = ["--tile", "0/3", "--samples-from", "0", "--samples-to", "2"];
+        let box_args = ["render", scene, "-s", "6", "-r", "70", "50"];
+        ok(run(box_args[0], &box_args[1..], &extra, &boxed));
+        let mut mixed = parts.clone();
+        mixed[0] = boxed;
+        let o = merge(&mixed, &dir.join("mixed.exr"), &[]);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{filter}: parts of two filters merged"
+        );
+    }
+}
+
 /// Oracle: the single render. Sample-range splits into N = 1, 2, 3 and 7 ranges (of 13
 /// samples, so ranges differ in length), alone and crossed with a 3-way tile split, merge
 /// to its PNG and EXR byte for byte: pixel sums are exact, so their order does not matter.

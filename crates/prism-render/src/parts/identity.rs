@@ -3,7 +3,7 @@
 //! and `prism merge` reads it back ([`PartIdentity::from_attributes`]).
 
 use prism_image::Bloom;
-use prism_scene::OrbitCamera;
+use prism_scene::{Filter, OrbitCamera};
 
 use crate::integrators::Integrator;
 use crate::render::RenderOptions;
@@ -54,6 +54,8 @@ pub enum Renderer {
         hide_emitters: bool,
         /// One light picked per light sample (written only when on).
         one_light: bool,
+        /// The reconstruction filter (written only when not a box).
+        filter: Filter,
     },
     /// The Delft Whitted ray tracer (`prism raytrace`, kind `raytrace`).
     Whitted {
@@ -141,6 +143,7 @@ impl PartIdentity {
                 rr_bounces: opts.path.rr_bounces,
                 hide_emitters: opts.path.hide_emitters,
                 one_light: opts.path.one_light,
+                filter: opts.film.filter,
             },
         }
     }
@@ -196,7 +199,8 @@ impl PartIdentity {
     /// `width`, `height`, `spp`, `seed`, `encoding`, then the renderer's own: for the path
     /// tracer `light_samples`, `max_bounces`, `integrator` (`path`, `normals` or
     /// `direct hemisphere=B`), `only_bounce` and `adaptive` (`TOL batch=N`; both `off` when
-    /// not set), `rr_bounces`, and when on `hide_emitters` (`on`) and `light_choice` (`one`); for Whitted `camera`, `settings` and `bloom`
+    /// not set), `rr_bounces`, and when on `hide_emitters` (`on`), `light_choice` (`one`) and `filter`
+    /// (`gaussian STDDEV` or `tent RADIUS`, for other than a box); for Whitted `camera`, `settings` and `bloom`
     /// (`THRESHOLD PASSES`, or `off`).
     #[must_use]
     pub fn to_attributes(&self) -> Vec<(String, String)> {
@@ -221,6 +225,7 @@ impl PartIdentity {
                 rr_bounces,
                 hide_emitters,
                 one_light,
+                filter,
             } => {
                 let integrator = match integrator {
                     Integrator::Path | Integrator::PathScalar => "path".to_string(),
@@ -243,6 +248,13 @@ impl PartIdentity {
                 }
                 if *one_light {
                     out.push(("light_choice", "one".to_string()));
+                }
+                match filter {
+                    Filter::Box => {}
+                    Filter::Gaussian { stddev } => {
+                        out.push(("filter", format!("gaussian {stddev}")))
+                    }
+                    Filter::Tent { radius } => out.push(("filter", format!("tent {radius}"))),
                 }
             }
             Renderer::Whitted {
@@ -299,6 +311,16 @@ impl PartIdentity {
                     && read(settings, "light_choice", "one", |v| {
                         (v == "one").then_some(true)
                     })?,
+                filter: if settings.iter().any(|(k, _)| k == "filter") {
+                    read(
+                        settings,
+                        "filter",
+                        "gaussian STDDEV or tent RADIUS",
+                        parse_filter,
+                    )?
+                } else {
+                    Filter::Box
+                },
             },
             "raytrace" => Renderer::Whitted {
                 camera: text("camera")?,
@@ -371,6 +393,20 @@ fn parse_off<T>(v: &str, parse: impl Fn(&str) -> Option<T>) -> Option<Option<T>>
     }
 }
 
+/// `gaussian STDDEV` or `tent RADIUS` (positive and finite).
+fn parse_filter(v: &str) -> Option<Filter> {
+    let (kind, size) = v.split_once(' ')?;
+    let size: f64 = size
+        .parse()
+        .ok()
+        .filter(|s: &f64| s.is_finite() && *s > 0.0)?;
+    match kind {
+        "gaussian" => Some(Filter::Gaussian { stddev: size }),
+        "tent" => Some(Filter::Tent { radius: size }),
+        _ => None,
+    }
+}
+
 /// `path`, `normals` or `direct hemisphere=B`.
 fn parse_integrator(v: &str) -> Option<Integrator> {
     match v {
@@ -421,6 +457,7 @@ mod tests {
                 rr_bounces: 5,
                 hide_emitters: true,
                 one_light: true,
+                filter: Filter::Gaussian { stddev: 0.5 },
             },
         }
     }
@@ -497,16 +534,19 @@ mod tests {
         // still read.
         assert_eq!(get_path("hide_emitters"), Some("on"));
         assert_eq!(get_path("light_choice"), Some("one"));
-        assert_eq!(path().to_attributes().len(), 16);
+        assert_eq!(get_path("filter"), Some("gaussian 0.5"));
+        assert_eq!(path().to_attributes().len(), 17);
         let mut shown = path();
         if let Renderer::Path {
             hide_emitters,
             one_light,
+            filter,
             ..
         } = &mut shown.renderer
         {
             *hide_emitters = false;
             *one_light = false;
+            *filter = Filter::Box;
         }
         assert_eq!(shown.to_attributes().len(), 14);
     }
