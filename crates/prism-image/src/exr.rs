@@ -1,8 +1,9 @@
 //! OpenEXR 2.0, the single-part scanline subset: the writer makes uncompressed 32-bit float
 //! B, G, R channels (alphabetical order, as the format requires) of linear values, or any
 //! named float and uint channels with string attributes, ZIP-compressed ([`ExrLayers`]); the
-//! reader takes 16- or 32-bit float and 32-bit uint channels, uncompressed or ZIP-compressed
-//! (one or sixteen lines per block), the forms most tools write.
+//! reader takes 16- or 32-bit float and 32-bit uint channels, uncompressed, ZIP-compressed
+//! (one or sixteen lines per block) or PIZ-compressed (Mitsuba's default; `piz`), the forms
+//! most tools write.
 
 use std::io::Write;
 use std::path::Path;
@@ -442,6 +443,7 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
     let lines_per_block = match compression {
         Some(0) | Some(2) => 1,
         Some(3) => 16,
+        Some(4) => crate::piz::PIZ_LINES,
         Some(c) => {
             let name = [
                 "none", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB",
@@ -451,7 +453,7 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
             .unwrap_or("unknown");
             return Err(decode_err(
                 what,
-                format!("{name} compression is not read (uncompressed, ZIPS and ZIP are)"),
+                format!("{name} compression is not read (uncompressed, ZIPS, ZIP and PIZ are)"),
             ));
         }
         None => return Err(decode_err(what, "expected a compression attribute")),
@@ -507,6 +509,11 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
             attributes,
         });
     }
+    // 16-bit words a sample, channel by channel (PIZ works on words).
+    let words: Vec<usize> = channels
+        .iter()
+        .map(|(_, ty)| if *ty == 1 { 1 } else { 2 })
+        .collect();
     let blocks = h.div_ceil(lines_per_block);
     // Each offset takes 8 bytes of the file: a short file cannot ask for a long table.
     let mut offsets = Vec::with_capacity(blocks.min(data.len() / 8));
@@ -543,6 +550,8 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
             stored.to_vec()
         } else if compression == Some(0) {
             return Err(decode_err(what, "an uncompressed block has the wrong size"));
+        } else if compression == Some(4) {
+            crate::piz::unpiz(stored, &words, (w, lines), what)?
         } else {
             unzip(stored, expected, what)?
         };

@@ -15,6 +15,7 @@ mod heatmap;
 mod image;
 mod io;
 mod montage;
+mod piz;
 mod srgb;
 mod texture;
 
