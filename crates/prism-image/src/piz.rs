@@ -44,7 +44,7 @@ pub(crate) fn unpiz(
     let length = usize::try_from(length).map_err(|_| bad("has a negative length"))?;
     let coded = take(at + 4, length)?;
     let mut buf = vec![0u16; total];
-    huffman_decode(coded, &mut buf).map_err(|m| bad(m))?;
+    huffman_decode(coded, &mut buf).map_err(bad)?;
     let mut start = 0;
     for &w in words {
         let n = w * width * lines;
