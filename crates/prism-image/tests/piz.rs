@@ -33,20 +33,20 @@ fn same_as_uncompressed(name: &str) {
 }
 
 /// Half floats of a smooth gradient with a bright spot: few distinct words, so the
-/// 14-bit wavelet; 70 lines, three blocks.
+/// 14-bit wavelet; 70 lines, three blocks, the last of 6 lines (an odd line at a level).
 #[test]
 fn piz_half_gradient() {
     same_as_uncompressed("half_gradient");
 }
 
-/// Half floats of wide-ranging noise at odd sizes: many distinct words, so the 16-bit
-/// wavelet, and odd columns and lines at every level.
+/// Half floats of smooth data with a little noise, 151 samples wide (an odd column at
+/// every level).
 #[test]
 fn piz_half_noise() {
     same_as_uncompressed("half_noise");
 }
 
-/// 32-bit floats with a constant run (the Huffman code's repeats), three blocks.
+/// 32-bit floats mostly constant (the Huffman code's repeats), three blocks.
 #[test]
 fn piz_float_runs() {
     same_as_uncompressed("float_runs");
@@ -59,7 +59,7 @@ fn piz_mixed_channel_types() {
     same_as_uncompressed("mixed");
 }
 
-/// A single pixel.
+/// A single pixel (stored as is).
 #[test]
 fn piz_one_pixel() {
     same_as_uncompressed("one_pixel");
@@ -71,8 +71,8 @@ fn piz_written_by_mitsuba() {
     same_as_uncompressed("mitsuba");
 }
 
-/// 32-bit float noise 200 samples wide: over 16,384 distinct words in a block, so the
-/// 16-bit (modular) wavelet.
+/// One channel of 32-bit floats with random low halves, 800 samples wide: over 16,384
+/// distinct words in the block, so the 16-bit (modular) wavelet.
 #[test]
 fn piz_float_wide_sixteen_bit_wavelet() {
     same_as_uncompressed("float_wide");
