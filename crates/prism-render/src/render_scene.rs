@@ -52,7 +52,7 @@ pub struct RenderScene {
     prims: Vec<Prim>,
     meshes: Vec<MeshRec>,
     /// Spheres with their material and whether their normals point inwards.
-    spheres: Vec<(Sphere, usize, bool)>,
+    spheres: Vec<(Sphere, usize, bool, Option<prism_math::glam::Mat3>)>,
     materials: Materials,
     /// Lights.
     pub lights: Vec<RenderLight>,
@@ -249,7 +249,10 @@ impl RenderScene {
             spheres: spheres
                 .into_iter()
                 .zip(scene.spheres.iter())
-                .map(|(s, scene_sphere)| (s, scene_sphere.material, scene_sphere.inward))
+                .map(|(s, scene_sphere)| {
+                    let sphere = scene_sphere;
+                    (s, sphere.material, sphere.inward, sphere.to_local)
+                })
                 .collect(),
             materials,
             lights,
@@ -432,21 +435,23 @@ impl RenderScene {
                 }
             }
             Prim::Sphere { index } => {
-                let (s, material, inward) = self.spheres[index as usize];
+                let (s, material, inward, to_local) = self.spheres[index as usize];
                 let p = ray.at(hit.t);
                 let outward = ((p - s.center) / s.radius).normalize();
                 let n = if inward { -outward } else { outward };
                 let mats = &self.materials;
                 // Mitsuba's sphere coordinates: the azimuth over 2 pi, the polar angle from
-                // +z over pi (the world's axes).
+                // +z over pi, about the sphere's own axes (the world's unless turned).
+                let local = to_local.map_or(outward, |m| m * outward);
+                let to_world = |v: Vec3| to_local.map_or(v, |m| m.transpose() * v);
                 let uv = || {
-                    let phi = outward.y.atan2(outward.x);
+                    let phi = local.y.atan2(local.x);
                     let phi = if phi < 0.0 {
                         phi + 2.0 * std::f32::consts::PI
                     } else {
                         phi
                     };
-                    let theta = prism_math::acos(outward.z.clamp(-1.0, 1.0));
+                    let theta = prism_math::acos(local.z.clamp(-1.0, 1.0));
                     prism_math::Vec2::new(
                         phi / (2.0 * std::f32::consts::PI),
                         theta / std::f32::consts::PI,
@@ -457,7 +462,10 @@ impl RenderScene {
                     ray,
                     (n, n),
                     &uv,
-                    || sphere_derivatives(outward, s.radius),
+                    || {
+                        let (du, dv) = sphere_derivatives(local, s.radius);
+                        (to_world(du), to_world(dv))
+                    },
                     true,
                 );
                 Interaction {
@@ -472,10 +480,10 @@ impl RenderScene {
                     },
                     light: None,
                     t: hit.t,
-                    // Along the parallels, as Mitsuba's sphere (axes the world's).
+                    // Along the parallels, as Mitsuba's sphere.
                     tangent: chosen
                         .is_some_and(|i| mats.anisotropic[i])
-                        .then(|| Vec3::new(-outward.y, outward.x, 0.0)),
+                        .then(|| to_world(Vec3::new(-local.y, local.x, 0.0))),
                     tilt,
                 }
             }

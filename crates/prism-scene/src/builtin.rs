@@ -94,12 +94,14 @@ pub fn cornell_box() -> Scene {
             radius: 0.3,
             material: 0,
             inward: false,
+            to_local: None,
         },
         SceneSphere {
             center: Vec3::new(-0.4, 0.3, -0.3),
             radius: 0.3,
             material: 0,
             inward: false,
+            to_local: None,
         },
     ];
     // The ceiling light: 0.6 x 0.8 around (0, 1.49, 0), facing down.

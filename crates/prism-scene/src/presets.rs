@@ -267,6 +267,7 @@ fn spheres() -> Scene {
         radius,
         material,
         inward: false,
+        to_local: None,
     };
     Scene {
         meshes: Vec::new(),

@@ -448,6 +448,9 @@ pub struct SceneSphere {
     /// True if its normals point inwards (Mitsuba's `flip_normals`): its front, for a
     /// one-sided material or an emitter, is the inside.
     pub inward: bool,
+    /// The rotation from the world's axes to the sphere's own, where its `to_world` turns
+    /// it: Mitsuba's texture coordinates and `dp/du` follow the sphere's axes.
+    pub to_local: Option<prism_math::glam::Mat3>,
 }
 
 /// A light source.

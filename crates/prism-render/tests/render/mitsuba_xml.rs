@@ -158,6 +158,18 @@ fn textured_emitters_render_as_mitsuba_renders_them() {
     );
 }
 
+/// Oracle: Mitsuba 3 rendering `spheres.xml` (beside the references): a textured sphere
+/// and an anisotropic GGX sphere, each turned by its `to_world`, whose texture coordinates
+/// and `dp/du` follow the sphere's own axes; compared as the box is.
+#[test]
+fn turned_spheres_render_as_mitsuba_renders_them() {
+    agrees_with_mitsuba(
+        "spheres",
+        "crates/prism-render/tests/golden/mitsuba/xml/spheres.xml",
+        &[],
+    );
+}
+
 /// Oracle: Mitsuba 3 rendering `parameters.xml` (beside the references): textures as a
 /// rough conductor's alpha, a glass's specular_transmittance, a plastic's
 /// specular_reflectance and a rough dielectric's alpha_u alone (anisotropic, a checkerboard

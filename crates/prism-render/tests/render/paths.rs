@@ -15,6 +15,7 @@ fn furnace(material: Material) -> Scene {
             radius: 1.0,
             material: 0,
             inward: false,
+            to_local: None,
         }],
         materials: vec![material],
         material_names: vec![],

@@ -157,6 +157,7 @@ impl Scene {
                                     radius: r as f32,
                                     material,
                                     inward: false,
+                                    to_local: None,
                                 });
                             }
                             Shape::Empty => {}

@@ -13,9 +13,7 @@ use super::props::{error, not_supported, unsupported};
 use crate::error::SceneError;
 use std::sync::Arc;
 
-use crate::scene::{
-    Camera, Light, Material, ScalarTexture, Scene, SceneSphere, Shading, TriangleMesh,
-};
+use crate::scene::{Camera, Light, Material, Scene, SceneSphere, Shading, TriangleMesh};
 
 /// How the film turns samples into pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -323,19 +321,16 @@ impl Builder<'_> {
                 if !similar || r <= 0.0 {
                     return Err(error(o, format!("{}: to_world must keep the sphere round (rotation, uniform scale, translation)", o.label())));
                 }
-                // prism's spheres keep the world's axes: the texture coordinates of a turned
-                // sphere would be turned with it.
+                // A turned sphere keeps its own axes, which its texture coordinates follow.
                 let turned = (0..3).any(|i| (cols[i] - DVec3::AXES[i] * r).length() > 1e-6 * r);
-                let textured = self.textured(material);
-                if turned && textured {
-                    return Err(not_supported(
-                        o,
-                        format!(
-                            "{}: a textured sphere turned by to_world: not supported by prism yet",
-                            o.label()
-                        ),
-                    ));
-                }
+                let to_local = turned.then(|| {
+                    prism_math::glam::Mat3::from_cols(
+                        (cols[0] / r).as_vec3(),
+                        (cols[1] / r).as_vec3(),
+                        (cols[2] / r).as_vec3(),
+                    )
+                    .transpose()
+                });
                 let c = m.w_axis.truncate();
                 if !(c.as_vec3().is_finite() && (r as f32).is_finite()) {
                     return Err(error(
@@ -352,6 +347,7 @@ impl Builder<'_> {
                     radius: r as f32,
                     material,
                     inward: flip,
+                    to_local,
                 });
                 return Ok(());
             }
@@ -543,51 +539,6 @@ impl Builder<'_> {
             ));
         }
         Ok(())
-    }
-
-    /// True if material `index`, or any it chooses among or tilts, reads a texture.
-    fn textured(&self, index: usize) -> bool {
-        let mut pending = vec![index];
-        // Nested materials come before the materials that hold them.
-        while let Some(i) = pending.pop() {
-            match &self.scene.materials[i] {
-                Material::Diffuse {
-                    texture: Some(_), ..
-                }
-                | Material::Plastic {
-                    texture: Some(_), ..
-                }
-                | Material::RoughPlastic {
-                    texture: Some(_), ..
-                }
-                | Material::Principled {
-                    texture: Some(_), ..
-                }
-                | Material::AreaEmitter {
-                    texture: Some(_), ..
-                }
-                | Material::NormalMap { .. }
-                | Material::BumpMap { .. }
-                | Material::Textured { .. } => return true,
-                Material::Blend {
-                    weight: ScalarTexture::Image(_),
-                    ..
-                }
-                | Material::Mask {
-                    opacity: ScalarTexture::Image(_),
-                    ..
-                } => return true,
-                Material::Blend { materials, .. } => {
-                    pending.extend(materials.iter().filter(|&&m| m < i));
-                }
-                Material::Mask { material, .. } if *material < i => pending.push(*material),
-                Material::AreaEmitter {
-                    surface: Some(m), ..
-                } if *m < i => pending.push(*m),
-                _ => {}
-            }
-        }
-        false
     }
 
     /// Adds material `m`, named `name`, black from behind if `one_sided`; its index.
