@@ -1,6 +1,7 @@
 //! Microfacet distributions (Beckmann and GGX, anisotropic): the density of normals, Smith's
 //! masking, and sampling of the normals visible from a direction, as Mitsuba's rough BSDFs
-//! use them. Directions are in the shading frame, the macro-surface normal being +z.
+//! use them; and reflection and refraction about one microfacet. Directions are in the
+//! shading frame, the macro-surface normal being +z.
 
 use prism_math::{exp, Vec2, Vec3};
 use prism_scene::{MicrofacetKind, Roughness};
@@ -126,4 +127,24 @@ impl Microfacet {
             }
         }
     }
+}
+
+/// `w` reflected about the microfacet normal `m`, where `c = w.m`.
+#[inline]
+pub(super) fn reflect(w: Vec3, m: Vec3, c: f32) -> Vec3 {
+    2.0 * c * m - w
+}
+
+/// `w` refracted through a microfacet of normal `m` (`c = w.m`) on a boundary of relative
+/// index `eta` (the side `m` points away from over the side it points to), with the ratio
+/// of the index `w` leaves over the one it enters; none under total internal reflection.
+#[inline]
+pub(super) fn refract(w: Vec3, m: Vec3, c: f32, eta: f32) -> Option<(Vec3, f32)> {
+    let eta_ti = if c > 0.0 { 1.0 / eta } else { eta };
+    let sin2_t = eta_ti * eta_ti * (1.0 - c * c).max(0.0);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((-eta_ti * w + (eta_ti * c - cos_t.copysign(c)) * m, eta_ti))
 }

@@ -9,7 +9,7 @@ use prism_math::warp::cosine_hemisphere;
 use prism_math::{Rgb, Vec2, Vec3};
 use prism_scene::MicrofacetKind;
 
-use super::microfacet::Microfacet;
+use super::microfacet::{reflect, Microfacet};
 use super::BsdfSample;
 
 /// A principled material's parameters besides its base colour (which a texture may vary).
@@ -360,7 +360,7 @@ pub(super) fn sample(
     let m = distr.sample_visible(side(v, cos_v), u2);
     let (f, cos_t, eta_ti) = fresnel(v.dot(m), p.eta);
     let [diffuse, clearcoat, trans, _] = p.lobe_probabilities(f, front);
-    let reflect_about = |m: Vec3| 2.0 * v.dot(m) * m - v;
+    let reflect_about = |m: Vec3| reflect(v, m, v.dot(m));
     let l = if u1 < diffuse {
         let l = cosine_hemisphere(u2);
         (cos_v * l.z > 0.0).then_some(l)?

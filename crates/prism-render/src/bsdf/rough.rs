@@ -4,7 +4,7 @@
 
 use prism_math::{Rgb, Vec2, Vec3};
 
-use super::microfacet::Microfacet;
+use super::microfacet::{reflect, refract, Microfacet};
 use super::{fresnel_conductor, fresnel_dielectric, upper, BsdfSample};
 
 /// A rough conductor's value (times `|cos wi|`) and sampling density.
@@ -39,7 +39,7 @@ pub(super) fn conductor_sample(
     let side = if wo.z < 0.0 { -1.0 } else { 1.0 };
     let wo_up = Vec3::new(wo.x, wo.y, wo.z * side);
     let h = distr.sample_visible(wo_up, u);
-    let wi = 2.0 * wo_up.dot(h) * h - wo_up;
+    let wi = reflect(wo_up, h, wo_up.dot(h));
     if wi.z <= 0.0 || wo_up.dot(h) <= 0.0 {
         return None;
     }
@@ -115,20 +115,13 @@ pub(super) fn dielectric_sample(
     let c = wo.dot(m);
     let f = fresnel_dielectric(c, ior);
     let (wi, weight) = if u1 <= f {
-        let wi = 2.0 * c * m - wo;
+        let wi = reflect(wo, m, c);
         if wi.z * cos_o <= 0.0 {
             return None;
         }
         (wi, reflectance * distr.g1(wi, m))
     } else {
-        // n_near / n_far, and the refracted direction through the microfacet.
-        let eta_ti = if c > 0.0 { 1.0 / ior } else { ior };
-        let sin2_t = eta_ti * eta_ti * (1.0 - c * c).max(0.0);
-        if sin2_t >= 1.0 {
-            return None;
-        }
-        let cos_t = (1.0 - sin2_t).sqrt();
-        let wi = -eta_ti * wo + (eta_ti * c - cos_t.copysign(c)) * m;
+        let (wi, eta_ti) = refract(wo, m, c, ior)?;
         if wi.z * cos_o >= 0.0 {
             return None;
         }

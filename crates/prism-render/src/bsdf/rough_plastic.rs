@@ -11,7 +11,7 @@ use prism_math::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use prism_math::{Rgb, Vec2, Vec3};
 use prism_scene::MicrofacetKind;
 
-use super::microfacet::Microfacet;
+use super::microfacet::{self, Microfacet};
 use super::{fresnel_dielectric, upper, BsdfSample};
 
 /// Entries of the transmittance table, at cosines `0, 1/63, ..., 1` (Mitsuba's 64).
@@ -79,25 +79,16 @@ fn coat_integral(distr: &Microfacet, wi: Vec3, eta: f32, reflect: bool) -> f64 {
             let c = wi.dot(m);
             let f = fresnel_dielectric(c, eta);
             let value = if reflect {
-                let wo = 2.0 * c * m - wi;
+                let wo = microfacet::reflect(wi, m, c);
                 if wo.z <= 0.0 {
                     0.0
                 } else {
                     f * distr.g1(wo, m)
                 }
             } else {
-                let eta_ti = if c > 0.0 { 1.0 / eta } else { eta };
-                let sin2_t = eta_ti * eta_ti * (1.0 - c * c).max(0.0);
-                if sin2_t >= 1.0 {
-                    0.0
-                } else {
-                    let cos_t = (1.0 - sin2_t).sqrt();
-                    let wo = -eta_ti * wi + (eta_ti * c - cos_t.copysign(c)) * m;
-                    if wo.z * wi.z >= 0.0 {
-                        0.0
-                    } else {
-                        (1.0 - f) * distr.g1(wo, m)
-                    }
+                match microfacet::refract(wi, m, c, eta) {
+                    Some((wo, _)) if wo.z * wi.z < 0.0 => (1.0 - f) * distr.g1(wo, m),
+                    _ => 0.0,
                 }
             };
             total += f64::from(value) * wa * wb * 0.25;
