@@ -179,7 +179,7 @@ impl RenderScene {
             if radiance.max_channel() <= 0.0 {
                 continue;
             }
-            let tris = m
+            let tris: Vec<[Vec3; 3]> = m
                 .triangles
                 .iter()
                 .map(|t| t.map(|i| m.positions[i as usize]))
@@ -188,6 +188,14 @@ impl RenderScene {
                 scene.materials.get(m.material),
                 Some(prism_scene::Material::AreaEmitter { .. })
             );
+            // A one-sided, untextured parallelogram (Mitsuba's rectangle) is sampled as one,
+            // uniformly over its two edges (on the lanes, as Mitsuba samples a rectangle).
+            let flat = one_sided && materials.emission_texture(m.material).is_none();
+            if let Some(area) = flat.then(|| parallelogram(&tris, radiance)).flatten() {
+                mesh_light[mi] = Some(lights.len());
+                lights.push(area);
+                continue;
+            }
             let light = MeshLight::new(tris, radiance).map(|l| {
                 let l = l.one_sided(one_sided);
                 match materials.emission_texture(m.material) {
@@ -491,6 +499,41 @@ impl RenderScene {
     }
 }
 
+/// The one-sided area light of two triangles that make a parallelogram (sharing a
+/// diagonal, the other two corners opposite), emitting `radiance` from the side the first
+/// triangle's winding faces; none for any other shape.
+fn parallelogram(tris: &[[Vec3; 3]], radiance: Rgb) -> Option<RenderLight> {
+    let [t0, t1] = tris else {
+        return None;
+    };
+    // The corner of each triangle the other lacks; the two they share are the diagonal.
+    let lone = |t: &[Vec3; 3], other: &[Vec3; 3]| {
+        let alone: Vec<Vec3> = t.iter().copied().filter(|p| !other.contains(p)).collect();
+        (alone.len() == 1).then(|| alone[0])
+    };
+    let (p, q) = (lone(t0, t1)?, lone(t1, t0)?);
+    let shared: Vec<Vec3> = t0.iter().copied().filter(|v| t1.contains(v)).collect();
+    let [s, t] = shared[..] else {
+        return None;
+    };
+    let (e1, e2) = (s - p, t - p);
+    let scale = e1.length().max(e2.length());
+    if (p + e1 + e2 - q).length() > 1e-6 * scale {
+        return None;
+    }
+    let [a, b, c] = *t0;
+    let normal = (b - a).cross(c - a).try_normalize()?;
+    let area = e1.cross(e2).length();
+    (area > 0.0 && area.is_finite()).then_some(RenderLight::Area {
+        corner: p,
+        e1,
+        e2,
+        normal,
+        area,
+        radiance,
+    })
+}
+
 /// A triangle's `dp/du` and `dp/dv` as Mitsuba's meshes have them: from texture coordinates
 /// `uv` (Mitsuba's, `v` running down the image) where they are not degenerate, the frame
 /// [`prism_math::Frame::from_normal`] puts around the geometric normal where they are, and
@@ -598,5 +641,46 @@ mod tests {
         assert!(!one_normal([Vec3::Y * 1.001; 3]));
         assert!(!one_normal([Vec3::new(f32::NAN, 1.0, 0.0); 3]));
         assert!(one_normal([Vec3::Y; 3]));
+    }
+
+    /// Oracle: the mesh light it stands for. Two triangles making a parallelogram (either
+    /// diagonal, either winding) become an area light with the same area, emitting side and
+    /// density toward any point; other pairs (a kite, a fold) stay meshes.
+    #[test]
+    fn parallelograms_become_area_lights_of_the_same_density() {
+        let (a, b, c, d) = (
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.2),
+            Vec3::new(1.5, 1.3, 1.2),
+            Vec3::new(0.5, 1.3, 1.0),
+        );
+        let radiance = Rgb::splat(3.0);
+        for tris in [
+            [[a, b, c], [c, d, a]],
+            [[b, c, d], [d, a, b]],
+            [[a, d, c], [c, b, a]],
+        ] {
+            let area = parallelogram(&tris, radiance).expect("a parallelogram");
+            let mesh = RenderLight::Mesh(std::sync::Arc::new(
+                MeshLight::new(tris.to_vec(), radiance)
+                    .unwrap()
+                    .one_sided(true),
+            ));
+            let ng = (tris[0][1] - tris[0][0])
+                .cross(tris[0][2] - tris[0][0])
+                .normalize();
+            for p in [Vec3::new(0.7, -1.0, 0.5), Vec3::new(0.2, 3.0, 0.4)] {
+                let q = (a + c) * 0.5;
+                let wi = (q - p).normalize();
+                let dist = (q - p).length();
+                let (x, y) = (area.pdf(wi, dist, ng), mesh.pdf(wi, dist, ng));
+                assert!((x - y).abs() <= 1e-5 * y.max(1.0), "{x} vs {y}");
+            }
+        }
+        let kite = [[a, b, c], [c, d + Vec3::X * 0.1, a]];
+        assert!(parallelogram(&kite, radiance).is_none());
+        let folded = [[a, b, c], [c, d + Vec3::Y * 0.3, a]];
+        assert!(parallelogram(&folded, radiance).is_none());
+        assert!(parallelogram(&[[a, b, c]], radiance).is_none());
     }
 }

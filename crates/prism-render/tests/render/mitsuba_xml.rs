@@ -389,7 +389,7 @@ fn light_sampling_equals_hemisphere_sampling_under_a_grazing_light() {
         let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
         sums.pixels().iter().map(|p| f64::from(p.mean().g)).sum()
     };
-    let (lights, brute) = (total(false, 64), total(true, 2048));
+    let (lights, brute) = (total(false, 512), total(true, 2048));
     assert!(
         (lights / brute - 1.0).abs() < 0.02,
         "light sampling {lights} vs hemisphere {brute}"
