@@ -9,7 +9,7 @@ use prism_scene::{Light, Scene, Shading};
 use crate::bsdf::Bsdf;
 use crate::interaction::Interaction;
 use crate::lights::envmap::EnvMap;
-use crate::lights::{MeshLight, RenderLight};
+use crate::lights::{MeshLight, RenderLight, SphereLight};
 use crate::materials::Materials;
 
 /// What a BVH primitive is.
@@ -51,8 +51,15 @@ pub struct RenderScene {
     bvh: Bvh,
     prims: Vec<Prim>,
     meshes: Vec<MeshRec>,
-    /// Spheres with their material and whether their normals point inwards.
-    spheres: Vec<(Sphere, usize, bool, Option<prism_math::glam::Mat3>)>,
+    /// Spheres with their material, whether their normals point inwards, the rotation to
+    /// their own axes where turned, and the light each is, if it emits.
+    spheres: Vec<(
+        Sphere,
+        usize,
+        bool,
+        Option<prism_math::glam::Mat3>,
+        Option<usize>,
+    )>,
     materials: Materials,
     /// Lights.
     pub lights: Vec<RenderLight>,
@@ -238,6 +245,28 @@ impl RenderScene {
         for i in 0..spheres.len() {
             prims.push(Prim::Sphere { index: i as u32 });
         }
+        // A sphere under an untextured Mitsuba area emitter is a light too, sampled by the
+        // cone it subtends (as Mitsuba samples it).
+        let sphere_light: Vec<Option<usize>> = scene
+            .spheres
+            .iter()
+            .map(|s| match scene.materials.get(s.material) {
+                Some(prism_scene::Material::AreaEmitter {
+                    radiance,
+                    texture: None,
+                    ..
+                }) if radiance.max_channel() > 0.0 && s.radius > 0.0 => {
+                    lights.push(RenderLight::Sphere(SphereLight {
+                        center: s.center,
+                        radius: s.radius,
+                        radiance: *radiance,
+                        inward: s.inward,
+                    }));
+                    Some(lights.len() - 1)
+                }
+                _ => None,
+            })
+            .collect();
         let bvh = Bvh::build(&tris, &spheres, &BuildOptions::default());
         RenderScene {
             bvh,
@@ -256,10 +285,9 @@ impl RenderScene {
                 .collect(),
             spheres: spheres
                 .into_iter()
-                .zip(scene.spheres.iter())
-                .map(|(s, scene_sphere)| {
-                    let sphere = scene_sphere;
-                    (s, sphere.material, sphere.inward, sphere.to_local)
+                .zip(scene.spheres.iter().zip(sphere_light))
+                .map(|(s, (sphere, light))| {
+                    (s, sphere.material, sphere.inward, sphere.to_local, light)
                 })
                 .collect(),
             materials,
@@ -443,7 +471,7 @@ impl RenderScene {
                 }
             }
             Prim::Sphere { index } => {
-                let (s, material, inward, to_local) = self.spheres[index as usize];
+                let (s, material, inward, to_local, light) = self.spheres[index as usize];
                 let p = ray.at(hit.t);
                 let outward = ((p - s.center) / s.radius).normalize();
                 let n = if inward { -outward } else { outward };
@@ -486,7 +514,7 @@ impl RenderScene {
                     } else {
                         mats.emission_at(material, uv).unwrap_or(Rgb::BLACK)
                     },
-                    light: None,
+                    light,
                     t: hit.t,
                     // Along the parallels, as Mitsuba's sphere.
                     tangent: chosen

@@ -50,6 +50,8 @@ pub enum RenderLight {
     },
     /// An emissive mesh, sampled by area.
     Mesh(std::sync::Arc<MeshLight>),
+    /// An emitting sphere, sampled by the cone it subtends.
+    Sphere(SphereLight),
     /// Radiance from the upper hemisphere (world +Y), hidden from camera rays.
     Hemisphere {
         /// Radiance.
@@ -168,6 +170,92 @@ impl MeshLight {
         let point = a * (1.0 - r) + b * (r * (1.0 - u.y)) + c * (r * u.y);
         let radiance = self.radiance_at(i, r * (1.0 - u.y), r * u.y);
         (point, (b - a).cross(c - a).normalize_or_zero(), radiance)
+    }
+}
+
+/// A sphere emitting `radiance` from its outside (or, turned inwards, from its inside), as
+/// Mitsuba's `area` emitter on a `sphere`: from a point outside it, directions are drawn
+/// uniformly in the cone it subtends; from a point inside, points uniformly over its area.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereLight {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius (positive).
+    pub radius: f32,
+    /// Radiance from the emitting side.
+    pub radiance: Rgb,
+    /// True if the inside emits (Mitsuba's `flip_normals`).
+    pub inward: bool,
+}
+
+impl SphereLight {
+    /// The cosine of the half-angle of the cone the sphere subtends from a point at squared
+    /// distance `dist2` from its centre (outside it).
+    fn cos_max(&self, dist2: f32) -> f32 {
+        (1.0 - self.radius * self.radius / dist2).max(0.0).sqrt()
+    }
+
+    /// Samples the sphere from `p` with `u`.
+    fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let d = self.center - p;
+        let dist2 = d.length_squared();
+        if dist2 <= self.radius * self.radius {
+            // Inside: a point uniform over the area, whose inside emits only when inward.
+            if !self.inward {
+                return None;
+            }
+            let n = uniform_sphere(u);
+            let q = self.center + n * self.radius;
+            let area = 4.0 * std::f32::consts::PI * self.radius * self.radius;
+            return toward_surface(p, q, |wi| wi.dot(n), area, self.radiance);
+        }
+        if self.inward {
+            return None;
+        }
+        let cos_max = self.cos_max(dist2);
+        let cos = 1.0 - u.x * (1.0 - cos_max);
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * u.y;
+        let axis = d / dist2.sqrt();
+        let wi =
+            Frame::from_normal(axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos));
+        // The nearer crossing of the sphere along `wi`.
+        let b = wi.dot(d);
+        let t = b
+            - (self.radius * self.radius - (dist2 - b * b))
+                .max(0.0)
+                .sqrt();
+        (t > 0.0 && cos_max < 1.0).then(|| LightSample {
+            wi,
+            dist: t,
+            li: self.radiance,
+            pdf: 1.0 / (2.0 * std::f32::consts::PI * (1.0 - cos_max)),
+            delta: false,
+        })
+    }
+
+    /// The density with which [`SphereLight::sample`] picks direction `wi`, which meets the
+    /// sphere at distance `dist` where its normal (toward the emitting side) is `n`.
+    fn pdf(&self, wi: Vec3, dist: f32, n: Vec3) -> f32 {
+        let outward = if self.inward { -n } else { n };
+        // From the shading point to the centre.
+        let d = wi * dist - outward * self.radius;
+        let dist2 = d.length_squared();
+        if dist2 <= self.radius * self.radius {
+            let cos = wi.dot(outward).abs();
+            let area = 4.0 * std::f32::consts::PI * self.radius * self.radius;
+            return if cos > 0.0 {
+                dist * dist / (area * cos)
+            } else {
+                0.0
+            };
+        }
+        let cos_max = self.cos_max(dist2);
+        if cos_max < 1.0 {
+            1.0 / (2.0 * std::f32::consts::PI * (1.0 - cos_max))
+        } else {
+            0.0
+        }
     }
 }
 
@@ -290,6 +378,7 @@ impl RenderLight {
                 let (q, n, radiance) = mesh.sample_point(u);
                 toward_surface(p, q, |wi| mesh.cos_toward(wi, n), mesh.area, radiance)
             }
+            RenderLight::Sphere(ref sphere) => sphere.sample(p, u),
             RenderLight::Environment { radiance } => Some(LightSample {
                 wi: uniform_sphere(u),
                 dist: f32::INFINITY,
@@ -333,6 +422,7 @@ impl RenderLight {
                     0.0
                 }
             }
+            RenderLight::Sphere(ref sphere) => sphere.pdf(wi, dist, ng),
             RenderLight::Hemisphere { .. } => cosine_hemisphere_pdf(wi.y),
             RenderLight::Environment { .. } => uniform_sphere_pdf(),
             RenderLight::EnvironmentMap(ref map) => map.pdf(wi),
@@ -473,6 +563,67 @@ mod tests {
             assert_eq!(ls.li, colours[k] * 2.0, "at {q}");
         }
         assert!(seen.iter().all(|&n| n > 800), "{seen:?}");
+    }
+
+    /// Oracles for a sphere light: from outside, every sampled direction meets the sphere at
+    /// the distance given, `pdf` recomputes each density, and the irradiance on a plate
+    /// facing the centre is the closed form `pi L (r / D)^2`; from inside a sphere that
+    /// emits inwards, the irradiance at the centre on a plate is `pi L`.
+    #[test]
+    fn sphere_light_samples_its_cone() {
+        let mut rng = Pcg32::new(4, 4);
+        let (center, radius, l) = (Vec3::new(0.2, 3.0, -0.5), 0.7, 2.0);
+        let light = SphereLight {
+            center,
+            radius,
+            radiance: Rgb::splat(l),
+            inward: false,
+        };
+        let p = Vec3::new(0.2, 0.0, -0.5);
+        let n = Vec3::Y;
+        let (mut e, count) = (0.0f64, 200_000);
+        for _ in 0..count {
+            let u = Vec2::new(rng.next_f32(), rng.next_f32());
+            let ls = light
+                .sample(p, u)
+                .expect("outside, every sample meets the sphere");
+            let q = p + ls.wi * ls.dist;
+            assert!(((q - center).length() - radius).abs() < 1e-4, "{q}");
+            let normal = (q - center).normalize();
+            let pdf = light.pdf(ls.wi, ls.dist, normal);
+            assert!((pdf - ls.pdf).abs() <= 1e-4 * ls.pdf, "{pdf} vs {}", ls.pdf);
+            e += f64::from(ls.li.g * ls.wi.dot(n).max(0.0) / ls.pdf);
+        }
+        let d = f64::from((center - p).length());
+        let want = std::f64::consts::PI * f64::from(l) * (f64::from(radius) / d).powi(2);
+        assert!(
+            (e / f64::from(count) / want - 1.0).abs() < 2e-3,
+            "{} vs {want}",
+            e / f64::from(count)
+        );
+        // Inside a sphere that emits inwards, at its centre.
+        let inside = SphereLight {
+            inward: true,
+            ..light
+        };
+        assert!(light.sample(center, Vec2::splat(0.3)).is_none());
+        let mut e = 0.0f64;
+        for _ in 0..count {
+            let u = Vec2::new(rng.next_f32(), rng.next_f32());
+            if let Some(ls) = inside.sample(center, u) {
+                let q = center + ls.wi * ls.dist;
+                let inward_normal = (center - q).normalize();
+                let pdf = inside.pdf(ls.wi, ls.dist, inward_normal);
+                assert!((pdf - ls.pdf).abs() <= 1e-3 * ls.pdf, "{pdf} vs {}", ls.pdf);
+                e += f64::from(ls.li.g * ls.wi.dot(n).max(0.0) / ls.pdf);
+            }
+        }
+        let want = std::f64::consts::PI * f64::from(l);
+        assert!(
+            (e / f64::from(count) / want - 1.0).abs() < 1e-2,
+            "{} vs {want}",
+            e / f64::from(count)
+        );
     }
 
     /// Oracles for area sampling of an emissive mesh, from a point that sees both sides of

@@ -784,25 +784,35 @@ fn wavefront_equals_path_scalar_bit_for_bit() {
     };
     same(&RenderScene::new(&glowing), opts, "emissive mesh");
     // One light picked per light sample (Mitsuba's estimator) among the area light, the
-    // emissive mesh, a point and a directional light: the lanes of a group pick different
-    // lights.
+    // emissive mesh, a point and a directional light and an emitting sphere: the lanes of a
+    // group pick different lights.
     let mut four = glowing.clone();
     four.lights.extend([point.clone(), sun.clone()]);
+    // And a sphere under an area emitter (sampled by its cone, lane by lane).
+    four.materials.push(Material::AreaEmitter {
+        radiance: Rgb::new(2.0, 2.5, 3.0),
+        texture: None,
+        surface: None,
+    });
+    four.spheres.push(SceneSphere {
+        center: Vec3::new(0.5, 1.2, 0.3),
+        radius: 0.15,
+        material: four.materials.len() - 1,
+        inward: false,
+        to_local: None,
+    });
     let four = RenderScene::new(&four);
-    for samples in [1, 3] {
+    for (samples, one_light) in [(1, true), (3, true), (2, false)] {
         let opts = RenderOptions {
             path: PathSettings {
                 light_samples: samples,
-                one_light: true,
+                one_light,
                 ..small.path
             },
             ..small
         };
-        same(
-            &four,
-            opts,
-            &format!("one light of four, {samples} samples"),
-        );
+        let what = format!("five lights, one picked: {one_light}, {samples} samples");
+        same(&four, opts, &what);
     }
     let mut mapped = furnace(Material::Diffuse {
         reflectance: Rgb::splat(0.6),

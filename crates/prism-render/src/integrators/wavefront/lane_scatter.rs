@@ -369,6 +369,7 @@ fn sample_lanes(
             (wi, dist, lanes & zero.lt(local.z), rgb(radiance), Some(pdf))
         }
         RenderLight::Mesh(_)
+        | RenderLight::Sphere(_)
         | RenderLight::Spot(_)
         | RenderLight::Environment { .. }
         | RenderLight::EnvironmentMap(_) => {
