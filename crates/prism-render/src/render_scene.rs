@@ -46,20 +46,25 @@ struct MeshRec {
     uvs: Option<Vec<prism_math::Vec2>>,
 }
 
+/// A sphere as the renderer keeps it.
+#[derive(Clone, Copy)]
+struct SphereRec {
+    sphere: Sphere,
+    material: usize,
+    /// True if its normals point inwards.
+    inward: bool,
+    /// The rotation from the world's axes to its own, where turned.
+    to_local: Option<prism_math::glam::Mat3>,
+    /// The light it is, if it emits.
+    light: Option<usize>,
+}
+
 /// The prepared scene.
 pub struct RenderScene {
     bvh: Bvh,
     prims: Vec<Prim>,
     meshes: Vec<MeshRec>,
-    /// Spheres with their material, whether their normals point inwards, the rotation to
-    /// their own axes where turned, and the light each is, if it emits.
-    spheres: Vec<(
-        Sphere,
-        usize,
-        bool,
-        Option<prism_math::glam::Mat3>,
-        Option<usize>,
-    )>,
+    spheres: Vec<SphereRec>,
     materials: Materials,
     /// Lights.
     pub lights: Vec<RenderLight>,
@@ -286,8 +291,12 @@ impl RenderScene {
             spheres: spheres
                 .into_iter()
                 .zip(scene.spheres.iter().zip(sphere_light))
-                .map(|(s, (sphere, light))| {
-                    (s, sphere.material, sphere.inward, sphere.to_local, light)
+                .map(|(s, (sphere, light))| SphereRec {
+                    sphere: s,
+                    material: sphere.material,
+                    inward: sphere.inward,
+                    to_local: sphere.to_local,
+                    light,
                 })
                 .collect(),
             materials,
@@ -471,7 +480,13 @@ impl RenderScene {
                 }
             }
             Prim::Sphere { index } => {
-                let (s, material, inward, to_local, light) = self.spheres[index as usize];
+                let SphereRec {
+                    sphere: s,
+                    material,
+                    inward,
+                    to_local,
+                    light,
+                } = self.spheres[index as usize];
                 let p = ray.at(hit.t);
                 let outward = ((p - s.center) / s.radius).normalize();
                 let n = if inward { -outward } else { outward };
