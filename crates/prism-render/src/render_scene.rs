@@ -393,6 +393,33 @@ impl RenderScene {
         Some(self.interaction(ray, hit))
     }
 
+    /// The first surface along a camera ray that is not an emitter's: Mitsuba's
+    /// `hide_emitters` lets camera rays pass through area emitters (at most 64 of them).
+    #[must_use]
+    pub fn past_emitters(&self, ray: &Ray) -> Option<Interaction> {
+        let mut r = *ray;
+        for _ in 0..64 {
+            let hit = self.bvh.intersect(&r, 0.0, f32::INFINITY)?;
+            let here = self.interaction(&r, hit);
+            if !self.is_emitter(hit.prim) {
+                return Some(here);
+            }
+            r = here.spawn(ray.dir);
+        }
+        None
+    }
+
+    /// True if primitive `prim` belongs to an emitter (an area light, or a surface whose
+    /// material emits).
+    pub(crate) fn is_emitter(&self, prim: u32) -> bool {
+        let material = match self.prims[prim as usize] {
+            Prim::Mesh { mesh, .. } => self.meshes[mesh as usize].material,
+            Prim::Sphere { index } => self.spheres[index as usize].material,
+            Prim::LightQuad { .. } => return true,
+        };
+        self.materials.emission[material].is_some()
+    }
+
     /// The shading data of `hit` along `ray`.
     #[inline(always)]
     fn interaction(&self, ray: &Ray, hit: prism_accel::Hit) -> Interaction {

@@ -19,7 +19,12 @@ use crate::sampler::Sampler;
 
 /// Radiance arriving along a camera ray.
 pub fn radiance(scene: &RenderScene, ray: &Ray, sampler: &mut Sampler, opts: &PathSettings) -> Rgb {
-    let Some(hit) = scene.intersect(ray) else {
+    let first = if opts.hide_emitters {
+        scene.past_emitters(ray)
+    } else {
+        scene.intersect(ray)
+    };
+    let Some(hit) = first else {
         return if opts.only_bounce.is_none_or(|m| m == 0) && !opts.hide_emitters {
             scene.escaped(ray.dir, true)
         } else {

@@ -714,3 +714,55 @@ fn one_light_per_sample_keeps_the_expectation() {
         );
     }
 }
+
+/// Closed form, as Mitsuba 3.9.1's path integrator defines `hide_emitters`: camera rays pass
+/// through area emitters (not only their light is hidden). A plate of albedo 0.5 under a
+/// constant emitter of radiance 1 shows 0.5 through an emitting square in front of it, and
+/// the square, facing the camera, sheds no light on the plate (and, small and near the
+/// camera, hides 0.08% of its sky).
+#[test]
+fn hidden_emitters_let_camera_rays_through() {
+    let dir = tempfile_dir("hidden-through");
+    let file = dir.join("s.xml");
+    std::fs::write(
+        &file,
+        r#"<scene version="3.0.0">
+    <integrator type="direct"><boolean name="hide_emitters" value="true"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform><bsdf type="diffuse"/></shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="0.1"/><translate z="4"/></transform>
+        <emitter type="area"><rgb name="radiance" value="50"/></emitter>
+    </shape>
+</scene>"#,
+    )
+    .unwrap();
+    let m = prism_scene::read_mitsuba(&file, &[]).expect("the scene reads");
+    let scene = RenderScene::new(&m.scene);
+    for integrator in [
+        prism_render::integrators::Integrator::Path,
+        prism_render::integrators::Integrator::PathScalar,
+    ] {
+        let base = RenderOptions::mitsuba(&m.settings, RenderOptions::default());
+        let opts = RenderOptions {
+            film: FilmSettings {
+                spp: 256,
+                ..base.film
+            },
+            path: PathSettings {
+                integrator,
+                ..base.path
+            },
+        };
+        let share = prism_render::film::Share::whole(opts.film.spp);
+        let job = prism_render::render::Job::share(&share);
+        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let centre = sums.pixels()[4 * 8 + 4].mean().g;
+        assert!((centre - 0.5).abs() < 0.02, "{integrator:?}: {centre}");
+    }
+}

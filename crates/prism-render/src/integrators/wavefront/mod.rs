@@ -134,6 +134,14 @@ fn sample_pass(
         scene.closest_hits(&b.rays, &mut b.bvh_hits);
         laps.lap(Stage::ClosestHits);
         scene.hit_records(&b.rays, &b.bvh_hits, &mut b.hits);
+        // Hidden emitters let camera rays through (`radiance` does the same).
+        if opts.hide_emitters && b.paths.first().is_some_and(|p| p.bounce == 0) {
+            for ((ray, hit), surf) in b.rays.iter().zip(&b.bvh_hits).zip(b.hits.iter_mut()) {
+                if hit.is_some_and(|h| scene.is_emitter(h.prim)) {
+                    *surf = scene.past_emitters(ray);
+                }
+            }
+        }
         laps.lap(Stage::HitRecords);
         b.shadows.clear();
         b.lights.clear();
