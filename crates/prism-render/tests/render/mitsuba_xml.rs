@@ -202,9 +202,7 @@ fn agrees_with_mitsuba(name: &str, scene: &str, defines: &[(&str, &str)]) {
     assert_eq!(m.settings.max_bounces, Some(5));
     let scene = RenderScene::new(&m.scene);
     let opts = RenderOptions::mitsuba(&m.settings, RenderOptions::default());
-    let share = prism_render::film::Share::whole(opts.film.spp);
-    let job = prism_render::render::Job::share(&share);
-    let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+    let sums = whole_render(&scene, &opts);
     // Near a directly seen emitter a wide filter's tail reaches radiance far above the
     // pixel's own: drawing positions from the filter finds it rarely (unbiased, but with a
     // variance 64 samples do not estimate), while splatting weighs it in every sample. Those
@@ -316,9 +314,7 @@ fn opaque_bsdfs_are_black_from_behind_unless_twosided() {
             },
             path: PathSettings::default(),
         };
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let sums = whole_render(&scene, &opts);
         sums.pixels()[4 * 8 + 4].mean().g
     };
     let diffuse = r#"<shape type="rectangle"><bsdf type="diffuse"/></shape>"#;
@@ -331,6 +327,16 @@ fn opaque_bsdfs_are_black_from_behind_unless_twosided() {
     let back = center_pixel(twosided, -5.0);
     assert!((back - 0.5).abs() < 0.02, "{back}");
     assert_eq!(center_pixel(inward, 5.0), 0.0);
+}
+
+/// The pixel sums of a whole render of `scene` with `opts` (every tile, every sample).
+fn whole_render(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+) -> prism_image::Image<prism_render::film::PixelSum> {
+    let share = prism_render::film::Share::whole(opts.film.spp);
+    let job = prism_render::render::Job::share(&share);
+    prism_render::render::render_share(scene, opts, &job, &|_| {})
 }
 
 /// A fresh folder for a test's files.
@@ -384,9 +390,7 @@ fn light_sampling_equals_hemisphere_sampling_under_a_grazing_light() {
                 ..PathSettings::default()
             },
         };
-        let share = prism_render::film::Share::whole(spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let sums = whole_render(&scene, &opts);
         sums.pixels().iter().map(|p| f64::from(p.mean().g)).sum()
     };
     let (lights, brute) = (total(false, 512), total(true, 2048));
@@ -434,9 +438,7 @@ fn hidden_emitters_are_black_to_the_camera_only() {
             ..PathSettings::default()
         },
     };
-    let share = prism_render::film::Share::whole(opts.film.spp);
-    let job = prism_render::render::Job::share(&share);
-    let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+    let sums = whole_render(&scene, &opts);
     let plate = sums.pixels()[4 * 8 + 4].mean().g;
     assert!((plate - 0.5).abs() < 0.02, "{plate}");
     assert_eq!(sums.pixels()[0].mean(), prism_math::Rgb::BLACK);
@@ -658,9 +660,7 @@ fn mean_green(file: &std::path::Path, size: u32, spp: u32, max_bounces: u32) -> 
             ..PathSettings::default()
         },
     };
-    let share = prism_render::film::Share::whole(spp);
-    let job = prism_render::render::Job::share(&share);
-    let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+    let sums = whole_render(&scene, &opts);
     sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / (size * size) as f32
 }
 
@@ -704,9 +704,7 @@ fn one_light_per_sample_keeps_the_expectation() {
         ..picked
     };
     for (what, opts) in [("one light", picked), ("every light", every)] {
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let sums = whole_render(&scene, &opts);
         let mean = sums.pixels().iter().map(|p| p.mean().g).sum::<f32>() / 64.0;
         assert!(
             (mean / expected - 1.0).abs() < 0.01,
@@ -759,9 +757,7 @@ fn hidden_emitters_let_camera_rays_through() {
                 ..base.path
             },
         };
-        let share = prism_render::film::Share::whole(opts.film.spp);
-        let job = prism_render::render::Job::share(&share);
-        let sums = prism_render::render::render_share(&scene, &opts, &job, &|_| {});
+        let sums = whole_render(&scene, &opts);
         let centre = sums.pixels()[4 * 8 + 4].mean().g;
         assert!((centre - 0.5).abs() < 0.02, "{integrator:?}: {centre}");
     }
