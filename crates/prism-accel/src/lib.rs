@@ -51,7 +51,7 @@ mod shapes;
 mod simd;
 mod traverse;
 
-pub use build::BuildOptions;
+pub use build::{BuildOptions, Split};
 pub use hit::Hit;
 pub use inspect::LeafView;
 pub use layout::{Bvh, BvhStats};

@@ -1,5 +1,5 @@
-//! [`Bvh::build`]: the binned-SAH binary tree (`sah`, over the nodes of `node`), collapsed
-//! into 8-wide nodes (`collapse`), its leaves' triangles packed in fours (`leaves`), and the
+//! [`Bvh::build`]: the binned-SAH or median-split binary tree (`sah`, over the nodes of
+//! `node`), collapsed into 8-wide nodes (`collapse`), its leaves' triangles packed in fours (`leaves`), and the
 //! root's leaves listed apart for the batched queries (`root_list`).
 
 mod collapse;
@@ -17,7 +17,7 @@ use crate::layout::tri4::Tri4;
 use crate::layout::{Bvh, LeafRec};
 use crate::shapes::Sphere;
 use node::{free, root_bounds, BuildNode, Summary};
-pub use options::BuildOptions;
+pub use options::{BuildOptions, Split};
 use options::{MAX_LEAF_REF, SMALL_SCENE};
 use sah::{bounds_of, build_node, take_big, Box3A, PrimRef};
 
@@ -73,7 +73,11 @@ impl Bvh {
                 ..*opts
             };
             let (b3, cb) = bounds_of(&prims, opts.parallel_threshold);
-            let big = take_big(&mut prims, b3, opts.parallel_threshold);
+            // (Setting the large ones apart is a cost heuristic; a median tree has none.)
+            let big = match opts.split {
+                Split::Sah => take_big(&mut prims, b3, opts.parallel_threshold),
+                Split::Median => 0,
+            };
             if big == 0 {
                 Some(build_node(&mut prims, 0, 0, &opts, b3, cb))
             } else {

@@ -1,4 +1,16 @@
-//! [`BuildOptions`], the build's parameters, and the leaf sizes it keeps to.
+//! [`BuildOptions`], the build's parameters (among them the [`Split`] rule), and the leaf
+//! sizes it keeps to.
+
+/// How a node's primitives are divided between its two children.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Split {
+    /// The binned surface area heuristic: 16 bins on each axis, the cheapest plane.
+    #[default]
+    Sah,
+    /// The longest axis of the centroids' box, at their median (half the primitives each
+    /// side): the Delft template's scheme.
+    Median,
+}
 
 /// Build parameters.
 #[derive(Clone, Copy, Debug)]
@@ -11,6 +23,8 @@ pub struct BuildOptions {
     pub traversal_cost: f32,
     /// Subtrees with more primitives than this are built in parallel.
     pub parallel_threshold: usize,
+    /// How nodes are split.
+    pub split: Split,
 }
 
 impl Default for BuildOptions {
@@ -26,6 +40,7 @@ impl Default for BuildOptions {
             // triangle pack test.
             traversal_cost: 0.5,
             parallel_threshold: 4096,
+            split: Split::Sah,
         }
     }
 }

@@ -1,13 +1,13 @@
-//! The binned surface-area-heuristic build of the binary tree: primitive references,
-//! 16 bins on each axis, the sweep, the partition, the large primitives set apart, and
-//! parallel halves above a size threshold.
+//! The binned surface-area-heuristic build of the binary tree: primitive references, 16
+//! bins on each axis, the sweep, the partition, the large primitives set apart, parallel
+//! halves above a size threshold; and the median split the Delft template asks for.
 
 use prism_math::glam::Vec3A;
 use prism_math::Aabb;
 use rayon::prelude::*;
 
 use super::node::{BuildNode, Summary};
-use super::options::{BuildOptions, MAX_LEAF_REF};
+use super::options::{BuildOptions, Split, MAX_LEAF_REF};
 use crate::layout::root_list::FLAT_MAX;
 use crate::layout::MEDIAN_DEPTH;
 use crate::simd::bin_indices;
@@ -211,9 +211,12 @@ pub(crate) fn build_node(
     if n <= opts.max_leaf {
         return leaf();
     }
+    let extent = cb.max - cb.min;
+    if opts.split == Split::Median {
+        return median_split(prims, offset, depth, opts, b3, extent);
+    }
     // Binned SAH on every axis with a non-degenerate centroid extent, all three axes binned
     // in one pass.
-    let extent = cb.max - cb.min;
     let scale = Vec3A::select(
         extent.cmpgt(Vec3A::ZERO),
         Vec3A::splat(BINS as f32) / extent,
@@ -311,6 +314,21 @@ pub(crate) fn build_node(
             side.1 = side.1.grow(p.centroid2());
         }
     }
+    children(prims, mid, sides, offset, depth, opts, bounds)
+}
+
+/// The node over `prims` (bounded by `bounds`) whose children are its first `mid` and its
+/// other primitives, with those sides' boxes and doubled-centroid boxes.
+fn children(
+    prims: &mut [PrimRef],
+    mid: usize,
+    sides: [(Box3A, Box3A); 2],
+    offset: usize,
+    depth: usize,
+    opts: &BuildOptions,
+    bounds: Aabb,
+) -> (BuildNode, Summary) {
+    let n = prims.len();
     let (l, r) = prims.split_at_mut(mid);
     let [(lb, lc), (rb, rc)] = sides;
     let ((a, sa), (b, sb)) = if n > opts.parallel_threshold {
@@ -328,6 +346,51 @@ pub(crate) fn build_node(
         BuildNode::interior(bounds, [a, b]),
         Summary::interior(&bounds, opts.traversal_cost, sa, sb),
     )
+}
+
+/// [`Split::Median`]'s node over `prims` (more than a leaf holds): split on the longest axis
+/// of the centroids' box (`extent`, the first of equal ones) at the median centroid, ties
+/// in primitive order, so that each child holds half.
+fn median_split(
+    prims: &mut [PrimRef],
+    offset: usize,
+    depth: usize,
+    opts: &BuildOptions,
+    b3: Box3A,
+    extent: Vec3A,
+) -> (BuildNode, Summary) {
+    let n = prims.len();
+    if extent.max_element() <= 0.0 && n <= MAX_LEAF_REF {
+        // Every centroid coincides: nothing separates them.
+        return (
+            BuildNode::Leaf {
+                bounds: b3.to_aabb(),
+                start: offset,
+                count: n,
+            },
+            Summary::leaf(&b3.to_aabb(), n, depth),
+        );
+    }
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = n / 2;
+    prims.select_nth_unstable_by(mid, |a, b| {
+        a.centroid2()[axis]
+            .total_cmp(&b.centroid2()[axis])
+            .then(a.id.cmp(&b.id))
+    });
+    let mut sides = [(Box3A::EMPTY, Box3A::EMPTY); 2];
+    for (j, p) in prims.iter().enumerate() {
+        let side = &mut sides[usize::from(j >= mid)];
+        side.0 = side.0.union(p.bounds);
+        side.1 = side.1.grow(p.centroid2());
+    }
+    children(prims, mid, sides, offset, depth, opts, b3.to_aabb())
 }
 
 /// The bins (`0..BINS`) of scaled centroid offsets on the three axes: the integer parts,
