@@ -4,13 +4,15 @@
 //! staged `delft-raytracer/data` folder ([`staged_data`]), else the copies built into prism.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
+use prism_image::RgbImage;
 use prism_math::{Rgb, Vec3};
 
 use crate::error::SceneError;
 use crate::obj::read_obj_scene;
 use crate::presets::Preset;
-use crate::render_config::{read_render_config, Features, SceneSource};
+use crate::render_config::{read_render_config, Extras, Features, MeshRef, SceneSource};
 use crate::scene::{Light, OrbitCamera, Scene};
 
 /// A Delft scene ready to trace: the scene, its cameras, the features that start on and the
@@ -25,6 +27,77 @@ pub struct DelftScene {
     pub features: Features,
     /// The config's window size.
     pub window: Option<[u32; 2]>,
+    /// The extras' settings (the defaults without a config).
+    pub extras: Extras,
+    /// The moving meshes: index into the scene's meshes and translation over the shutter.
+    pub motion: Vec<(usize, Vec3)>,
+    /// The config's environment map, read.
+    pub environment: Option<Arc<RgbImage>>,
+}
+
+impl MeshRef {
+    /// The indices of the meshes of `scene` it names (none if it names none).
+    #[must_use]
+    pub fn resolve(&self, scene: &Scene) -> Vec<usize> {
+        match self {
+            MeshRef::Index(i) => (*i < scene.meshes.len())
+                .then_some(*i)
+                .into_iter()
+                .collect(),
+            MeshRef::Name(n) => (0..scene.meshes.len())
+                .filter(|&i| scene.meshes[i].name == *n)
+                .collect(),
+        }
+    }
+}
+
+/// The names of `scene`'s meshes, in order, for messages: `0 "floor", 1 "tallBox"`.
+#[must_use]
+pub fn mesh_names(scene: &Scene) -> String {
+    let names: Vec<String> = (scene.meshes.iter().enumerate())
+        .map(|(i, m)| format!("{i} {:?}", m.name))
+        .collect();
+    if names.is_empty() {
+        "none: the scene has no mesh".to_string()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// Reads an environment map: a latitude-longitude PNG or JPEG (bytes / 255), OpenEXR or
+/// Radiance HDR image, told apart by their first bytes.
+///
+/// # Errors
+/// The file's error: unreadable, not an image, over the decoders' limits, or holding a
+/// texel that is negative or not finite.
+pub fn read_environment_map(path: &Path) -> Result<RgbImage, SceneError> {
+    let bytes = crate::obj::read_bytes(path)?;
+    let file = path.display().to_string();
+    let bad = |message: String| SceneError::Image {
+        path: file.clone(),
+        message,
+    };
+    let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        prism_image::decode_exr(&bytes, &file).map_err(|e| bad(e.to_string()))?
+    } else if prism_image::is_hdr(&bytes) {
+        prism_image::decode_hdr(&bytes, &file).map_err(|e| bad(e.to_string()))?
+    } else {
+        crate::texture_file::decode_texture(&bytes, &file).map_err(|e| {
+            bad(format!(
+                "{e} (an environment map is a PNG, JPEG, OpenEXR or Radiance HDR image)"
+            ))
+        })?
+    };
+    if let Some(i) = (image.pixels().iter())
+        .position(|p| !(p.r >= 0.0 && p.g >= 0.0 && p.b >= 0.0 && (p.r + p.g + p.b).is_finite()))
+    {
+        let (x, y) = (i as u32 % image.width(), i as u32 / image.width());
+        return Err(bad(format!(
+            "texel ({x}, {y}) is {:?}; expected finite, non-negative radiance",
+            image.get(x, y)
+        )));
+    }
+    Ok(image)
 }
 
 /// What cannot be loaded.
@@ -161,11 +234,42 @@ pub fn load_delft(
         } else {
             cfg.cameras.clone()
         };
+        let mut motion = Vec::new();
+        for m in &cfg.extras.motion {
+            let found = m.mesh.resolve(&scene);
+            if found.is_empty() {
+                return Err(SceneError::Line {
+                    at: m.at.clone(),
+                    message: format!(
+                        "[[motion]] mesh {}: no such mesh (the scene's meshes: {})",
+                        match &m.mesh {
+                            MeshRef::Index(i) => i.to_string(),
+                            MeshRef::Name(n) => format!("{n:?}"),
+                        },
+                        mesh_names(&scene)
+                    ),
+                }
+                .into());
+            }
+            motion.extend(found.into_iter().map(|i| (i, m.velocity)));
+        }
+        let environment = match &cfg.extras.environment_map {
+            Some(e) => Some(Arc::new(read_environment_map(&e.path).map_err(|err| {
+                SceneError::Line {
+                    at: e.at.clone(),
+                    message: format!("environment_map: {err}"),
+                }
+            })?)),
+            None => None,
+        };
         return Ok(DelftScene {
             scene,
             cameras,
             features: cfg.features,
             window: cfg.window_size,
+            extras: cfg.extras.extras,
+            motion,
+            environment,
         });
     }
     let scene = if lower.ends_with(".obj") {
@@ -183,6 +287,9 @@ pub fn load_delft(
         cameras: vec![OrbitCamera::default()],
         features: Features::prism_defaults(),
         window: None,
+        extras: Extras::default(),
+        motion: Vec::new(),
+        environment: None,
     })
 }
 

@@ -38,6 +38,14 @@ pub enum SceneError {
         /// The limit.
         limit: u64,
     },
+    /// An image file (an environment map) that cannot be used.
+    #[error("{path}: {message}")]
+    Image {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The file is not well-formed XML.
     #[error("{file}: {source}")]
     Xml {

@@ -42,7 +42,8 @@ pub use collada::{
     MAX_NODE_DEPTH, MAX_PLACED_FACES,
 };
 pub use delft::{
-    default_obj_lights, load_delft, staged_data, DelftError, DelftScene, DelftWarning,
+    default_obj_lights, load_delft, mesh_names, read_environment_map, staged_data, DelftError,
+    DelftScene, DelftWarning,
 };
 pub use environment::EnvironmentMapError;
 pub use error::SceneError;
@@ -55,8 +56,9 @@ pub use mitsuba::{
 pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX_OBJ_BYTES};
 pub use presets::Preset;
 pub use render_config::{
-    parse_render_config, read_render_config, Features, RenderConfig, SceneSource,
-    MAX_WINDOW_PIXELS, MAX_WINDOW_SIDE,
+    parse_render_config, read_render_config, EnvironmentMapFile, Extras, ExtrasTable, Features,
+    MeshRef, Motion, RenderConfig, SceneSource, MAX_EXTENT, MAX_EXTRA_SAMPLES, MAX_WINDOW_PIXELS,
+    MAX_WINDOW_SIDE,
 };
 pub use scene::{
     Camera, CameraMode, Crop, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind,

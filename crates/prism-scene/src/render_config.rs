@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use prism_math::Loc;
-use prism_math::{LineIndex, Rgb, Vec3, Warning};
+use prism_math::{LineIndex, Rgb, Vec3};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
@@ -14,6 +14,9 @@ use crate::error::SceneError;
 use crate::obj::{read_obj_scene, read_text};
 use crate::presets::Preset;
 use crate::scene::{Light, OrbitCamera, Scene};
+pub use extras::{
+    EnvironmentMapFile, Extras, ExtrasTable, MeshRef, Motion, MAX_EXTENT, MAX_EXTRA_SAMPLES,
+};
 
 /// Largest image side a config may ask for.
 pub const MAX_WINDOW_SIDE: u32 = 16384;
@@ -48,11 +51,23 @@ pub struct Features {
     pub transparency: bool,
     /// Bilinear texture filtering (off: nearest).
     pub bilinear: bool,
+    /// A thin lens: depth of field.
+    pub depth_of_field: bool,
+    /// Meshes that move over the shutter interval.
+    pub motion_blur: bool,
+    /// Reflections sampled from the Phong lobe instead of the one mirror ray.
+    pub glossy_reflection: bool,
+    /// Rays that miss see the environment map.
+    pub environment_mapping: bool,
+    /// Textures filtered by ray cones over a mip chain.
+    pub mipmap: bool,
+    /// The BVH built by binned SAH (off: split at the centroid median).
+    pub sah_binning: bool,
 }
 
 impl Features {
     /// The switches' names, as `--enable` and the viewer's status line spell them.
-    pub const NAMES: [&'static str; 11] = [
+    pub const NAMES: [&'static str; 17] = [
         "shading",
         "recursive",
         "hard-shadow",
@@ -64,6 +79,12 @@ impl Features {
         "bloom",
         "transparency",
         "multi-rays",
+        "dof",
+        "motion-blur",
+        "glossy",
+        "env-map",
+        "mipmap",
+        "sah",
     ];
 
     /// The switch called `name` (one of [`Features::NAMES`]).
@@ -80,12 +101,18 @@ impl Features {
             "bloom" => &mut self.bloom,
             "transparency" => &mut self.transparency,
             "multi-rays" => &mut self.multiple_rays_per_pixel,
+            "dof" => &mut self.depth_of_field,
+            "motion-blur" => &mut self.motion_blur,
+            "glossy" => &mut self.glossy_reflection,
+            "env-map" => &mut self.environment_mapping,
+            "mipmap" => &mut self.mipmap,
+            "sah" => &mut self.sah_binning,
             _ => return None,
         })
     }
 
-    /// prism's switches when no config sets them: everything on but bloom, transparency
-    /// and multiple rays per pixel.
+    /// prism's switches when no config sets them: the template's features and SAH binning
+    /// on; bloom, transparency, multiple rays per pixel and the other extras off.
     #[must_use]
     pub fn prism_defaults() -> Features {
         Features {
@@ -97,6 +124,7 @@ impl Features {
             texture_mapping: true,
             accel_structure: true,
             bilinear: true,
+            sah_binning: true,
             ..Features::default()
         }
     }
@@ -132,6 +160,8 @@ pub struct RenderConfig {
     pub cameras: Vec<OrbitCamera>,
     /// `[[lights]]`, used by OBJ scenes (presets bring their own).
     pub lights: Vec<Light>,
+    /// `[extras]` and `[[motion]]`.
+    pub extras: ExtrasTable,
     /// Keys read but without effect in prism, one message each.
     pub warnings: Vec<prism_math::Warning>,
 }
@@ -178,6 +208,8 @@ pub fn parse_render_config(
             "features",
             "cameras",
             "lights",
+            "extras",
+            "motion",
         ],
         "the top level",
     )?;
@@ -191,6 +223,7 @@ pub fn parse_render_config(
         features: Features::default(),
         cameras: Vec::new(),
         lights: Vec::new(),
+        extras: ExtrasTable::default(),
         warnings: Vec::new(),
     };
     if let Some(v) = root.get("command_line_rendering") {
@@ -265,7 +298,7 @@ pub fn parse_render_config(
         };
     }
     if let Some(v) = root.get("features") {
-        cfg.features = cx.features(v, &mut cfg.warnings)?;
+        cfg.features = cx.features(v)?;
     }
     if let Some(v) = root.get("cameras") {
         for c in cx.tables(v, "cameras")? {
@@ -276,6 +309,12 @@ pub fn parse_render_config(
         for l in cx.tables(v, "lights")? {
             cfg.lights.push(cx.light(l)?);
         }
+    }
+    if let Some(v) = root.get("motion") {
+        cx.motions(v, &mut cfg.extras)?;
+    }
+    if let Some(v) = root.get("extras") {
+        cx.extras(v, base, &mut cfg.extras)?;
     }
     Ok(cfg)
 }
@@ -328,9 +367,13 @@ type Val<'i> = Spanned<DeValue<'i>>;
 impl Cx<'_> {
     fn err<T>(&self, at: &Spanned<T>, message: String) -> SceneError {
         SceneError::Line {
-            at: Loc::line(self.file, self.lines.line(at.span().start)),
+            at: self.loc(at),
             message,
         }
+    }
+
+    fn loc<T>(&self, at: &Spanned<T>) -> Loc {
+        Loc::line(self.file, self.lines.line(at.span().start))
     }
 
     fn known_keys(&self, t: &DeTable<'_>, known: &[&str], place: &str) -> Result<(), SceneError> {
@@ -482,11 +525,7 @@ impl Cx<'_> {
             .ok_or_else(|| self.err(at, format!("{place}: missing required key {key:?}")))
     }
 
-    fn features(
-        &self,
-        v: &Val<'_>,
-        warnings: &mut Vec<prism_math::Warning>,
-    ) -> Result<Features, SceneError> {
+    fn features(&self, v: &Val<'_>) -> Result<Features, SceneError> {
         let t = v.get_ref().as_table().ok_or_else(|| {
             self.err(
                 v,
@@ -545,20 +584,12 @@ impl Cx<'_> {
             f.multiple_rays_per_pixel = flag("enable_multiple_rays_per_pixel", e)?;
             f.transparency = flag("enable_transparency", e)?;
             f.bilinear = flag("enable_bilinear_texture_filtering", e)?;
-            // The BVH always bins on the surface area heuristic.
-            flag("enable_bvh_sah_binning", e)?;
-            for key in [
-                "enable_motion_blur",
-                "enable_depth_of_field",
-                "enable_glossy_reflection",
-                "enable_environment_mapping",
-                "enable_mipmap_texture_filtering",
-            ] {
-                if flag(key, e)? {
-                    let at = e.get(key).expect("the flag was read");
-                    warnings.push(Warning::at(Loc::line(self.file, self.lines.line(at.span().start)), format!("features.extra.{key} is not a feature of prism's ray tracer and has no effect")));
-                }
-            }
+            f.sah_binning = flag("enable_bvh_sah_binning", e)?;
+            f.motion_blur = flag("enable_motion_blur", e)?;
+            f.depth_of_field = flag("enable_depth_of_field", e)?;
+            f.glossy_reflection = flag("enable_glossy_reflection", e)?;
+            f.environment_mapping = flag("enable_environment_mapping", e)?;
+            f.mipmap = flag("enable_mipmap_texture_filtering", e)?;
         }
         Ok(f)
     }
@@ -687,5 +718,6 @@ impl Cx<'_> {
     }
 }
 
+mod extras;
 #[cfg(test)]
 mod tests;

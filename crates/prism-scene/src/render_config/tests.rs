@@ -153,17 +153,125 @@ fn bad_configs_are_located() {
     }
 }
 
-/// Extras prism does not have are warnings naming the key, not silent.
+/// Closed form: every extra's switch and setting reads back as written, the rest keep the
+/// documented defaults; `[[motion]]` at the top level and `motion` in `[extras]` both count.
 #[test]
-fn unsupported_extras_warn() {
-    let c = parse("[features.extra]\nenable_motion_blur = true\nenable_bvh_sah_binning = true\n")
-        .unwrap();
-    assert_eq!(c.warnings.len(), 1);
-    assert!(
-        c.warnings[0].to_string().contains("enable_motion_blur"),
-        "{:?}",
-        c.warnings
+fn extras_read_back() {
+    let c = parse(
+        r#"
+[features.extra]
+enable_motion_blur = true
+enable_depth_of_field = true
+enable_glossy_reflection = true
+enable_environment_mapping = true
+enable_mipmap_texture_filtering = true
+enable_bvh_sah_binning = true
+[[motion]]
+mesh = "tallBox"
+velocity = [0.1, 0, 0]
+[extras]
+dof_aperture = 0.2
+dof_focal_distance = 4
+glossy_samples = 9
+environment_map = "sky.exr"
+environment_strength = 2.5
+motion = [{ mesh = 3, velocity = [0, 1, 0] }]
+"#,
+    )
+    .unwrap();
+    let f = c.features;
+    assert!(f.motion_blur && f.depth_of_field && f.glossy_reflection);
+    assert!(f.environment_mapping && f.mipmap && f.sah_binning);
+    assert!(c.warnings.is_empty(), "{:?}", c.warnings);
+    let e = &c.extras;
+    assert_eq!(e.extras.dof_aperture, 0.2);
+    assert_eq!(e.extras.dof_focal_distance, Some(4.0));
+    assert_eq!(e.extras.glossy_samples, 9);
+    assert_eq!(e.extras.dof_samples, 16);
+    assert_eq!(e.extras.motion_samples, 16);
+    assert_eq!(e.extras.environment_strength, 2.5);
+    assert_eq!(
+        e.environment_map.as_ref().map(|m| m.path.clone()),
+        Some(PathBuf::from("/cfg/sky.exr"))
     );
+    let motion: Vec<_> = e
+        .motion
+        .iter()
+        .map(|m| (m.mesh.clone(), m.velocity, m.at.line))
+        .collect();
+    assert_eq!(
+        motion,
+        vec![
+            (MeshRef::Name("tallBox".into()), Vec3::new(0.1, 0.0, 0.0), 9),
+            (MeshRef::Index(3), Vec3::new(0.0, 1.0, 0.0), 18),
+        ]
+    );
+    let d = parse("").unwrap();
+    assert_eq!(d.extras, ExtrasTable::default());
+    assert_eq!(d.extras.extras.dof_aperture, 0.05);
+}
+
+/// Bad extras settings are errors naming the line, the key and what was expected.
+#[test]
+fn bad_extras_are_located() {
+    let cases = [
+        (
+            "[extras]\ndof_aperture = -0.1\n",
+            "c.toml:2: dof_aperture: expected a number from 0",
+        ),
+        (
+            "[extras]\ndof_focal_distance = 0\n",
+            "c.toml:2: dof_focal_distance: expected a number above 0",
+        ),
+        (
+            "[extras]\ndof_samples = 0\n",
+            "c.toml:2: dof_samples: expected 1 to 4096",
+        ),
+        (
+            "[extras]\nglossy_samples = 100000000\n",
+            "c.toml:2: glossy_samples: expected 1 to 4096",
+        ),
+        (
+            "[extras]\nmotion_samples = 1.5\n",
+            "c.toml:2: motion_samples: expected an integer",
+        ),
+        (
+            "[extras]\nenvironment_strength = inf\n",
+            "c.toml:2: environment_strength: expected a finite number",
+        ),
+        (
+            "[extras]\nenvironment_map = 3\n",
+            "c.toml:2: environment_map: expected a string",
+        ),
+        (
+            "[extras]\nlens = 1\n",
+            "c.toml:2: unknown key \"lens\" in [extras]",
+        ),
+        (
+            "\n[[motion]]\nmesh = 0\nvelocity = [nan, 0, 0]\n",
+            "c.toml:4: velocity: expected a finite number",
+        ),
+        (
+            "[[motion]]\nvelocity = [1, 0, 0]\n",
+            "c.toml:1: [[motion]]: missing required key \"mesh\"",
+        ),
+        (
+            "[[motion]]\nmesh = -1\nvelocity = [1, 0, 0]\n",
+            "c.toml:2: mesh: expected an index of 0 or more",
+        ),
+        (
+            "[[motion]]\nmesh = 0\nvelocity = [1e9, 0, 0]\n",
+            "c.toml:3: velocity: expected components up to",
+        ),
+        (
+            "[[motion]]\nmesh = [0]\nvelocity = [1, 0, 0]\n",
+            "c.toml:2: mesh: expected a mesh's name or index",
+        ),
+    ];
+    for (text, want) in cases {
+        let e = parse(text).unwrap_err().to_string();
+        assert!(e.starts_with(want), "{text:?}\n got: {e}\nwant: {want}");
+    }
 }
 
 /// Deep nesting is refused by the parser's recursion limit, never a stack overflow.
