@@ -34,6 +34,7 @@ fn render(scene: &Scene, camera: &OrbitCamera) {
             features,
             light_samples: 4,
             max_depth: 3,
+            extras: prism_scene::Extras::default(),
         },
         spp: 2,
         bloom: prism_image::Bloom::default(),

@@ -14,7 +14,7 @@ use prism_render::whitted::film::{
     rays_per_pixel, raytrace, raytrace_share, trace_pixel, RaytraceOptions,
 };
 use prism_render::whitted::overlay::Overlay;
-use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::scene::{Environment, SceneSetup, Split, WhittedScene};
 use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera};
 
@@ -47,9 +47,9 @@ pub struct RaytraceArgs {
     #[arg(long, value_name = "DIR")]
     data: Option<PathBuf>,
     /// Turn features on, comma-separated: shading, recursive, hard-shadow, soft-shadow,
-    /// normal-interp, texture, bilinear, bvh, bloom, transparency, multi-rays. Without a
-    /// config all but bloom, transparency and multi-rays start on; a config's [features]
-    /// start as it says (off when absent).
+    /// normal-interp, texture, bilinear, bvh, bloom, transparency, multi-rays, and the
+    /// extras dof, motion-blur, glossy, env-map, mipmap, sah. Without a config the first
+    /// eight and sah start on; a config's [features] start as it says (off when absent).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     enable: Vec<String>,
     /// Turn features off (names as --enable).
@@ -68,6 +68,33 @@ pub struct RaytraceArgs {
     /// Most reflection bounces after the camera ray.
     #[arg(long = "max-depth", default_value_t = 3)]
     max_depth: u32,
+    /// Depth of field: the lens radius (turns dof on; default: the config's, else 0.05).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    dof_aperture: Option<f32>,
+    /// Depth of field: distance along the view axis of the plane in focus (turns dof on;
+    /// default: the config's, else the camera's distance from its look-at point).
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    dof_focal_distance: Option<f32>,
+    /// Depth of field: lens samples per pixel (default: the config's, else 16).
+    #[arg(long, value_name = "N")]
+    dof_samples: Option<u32>,
+    /// Motion blur: mesh MESH (its index, or its material's name) moves by VX,VY,VZ over the
+    /// shutter; repeatable, replaces the config's [[motion]] (turns motion-blur on).
+    #[arg(long, value_name = "MESH=VX,VY,VZ", allow_hyphen_values = true)]
+    motion: Vec<String>,
+    /// Motion blur: shutter times per pixel (default: the config's, else 16).
+    #[arg(long, value_name = "N")]
+    motion_samples: Option<u32>,
+    /// Glossy reflection: rays per reflection (default: the config's, else 16).
+    #[arg(long, value_name = "N")]
+    glossy_samples: Option<u32>,
+    /// Environment mapping: a latitude-longitude PNG, JPEG, EXR or HDR image seen by rays
+    /// that miss (turns env-map on; replaces the config's).
+    #[arg(long, value_name = "FILE")]
+    environment_map: Option<PathBuf>,
+    /// Environment mapping: the map's radiance scale (default: the config's, else 1).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    environment_strength: Option<f32>,
     /// Bloom: only pixels whose luminance is above this count as bright.
     #[arg(long, default_value_t = 0.0)]
     bloom_threshold: f32,
@@ -191,6 +218,152 @@ fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
         Vec::new()
     };
     crate::output::check_distinct(&inputs, &outputs)
+}
+
+/// The extras' settings and scene additions a run uses.
+struct RunExtras {
+    settings: prism_scene::Extras,
+    motion: Vec<(usize, prism_math::Vec3)>,
+    environment: Option<Environment>,
+}
+
+/// Checks one extras flag's number: finite, at least `lo` (above it if `open`), at most
+/// [`prism_scene::MAX_EXTENT`].
+fn extent_flag(flag: &str, v: Option<f32>, lo: f32, open: bool) -> Result<Option<f32>> {
+    let Some(x) = v else { return Ok(None) };
+    let ok = x.is_finite() && (if open { x > lo } else { x >= lo }) && x <= prism_scene::MAX_EXTENT;
+    if !ok {
+        let from = if open { "above" } else { "from" };
+        return Err(UserError::Refused(format!(
+            "{flag}: expected a number {from} {lo} up to {}, found {x}",
+            prism_scene::MAX_EXTENT
+        ))
+        .into());
+    }
+    Ok(Some(x))
+}
+
+/// Checks one extras sample-count flag.
+fn samples_flag(flag: &str, v: Option<u32>) -> Result<Option<u32>> {
+    match v {
+        Some(n) if n == 0 || n > prism_scene::MAX_EXTRA_SAMPLES => {
+            Err(UserError::Refused(format!(
+                "{flag}: expected 1 to {} samples, found {n}",
+                prism_scene::MAX_EXTRA_SAMPLES
+            ))
+            .into())
+        }
+        _ => Ok(v),
+    }
+}
+
+/// The extras of a run: the config's settings with the flags' in their place, the moving
+/// meshes and the environment map; flags that set an extra turn it on. Refuses an
+/// environment map switched on without a map.
+fn extras(
+    a: &RaytraceArgs,
+    loaded: &prism_scene::DelftScene,
+    features: &mut Features,
+) -> Result<RunExtras> {
+    let mut e = loaded.extras;
+    if let Some(r) = extent_flag("--dof-aperture", a.dof_aperture, 0.0, false)? {
+        e.dof_aperture = r;
+        features.depth_of_field = true;
+    }
+    if let Some(d) = extent_flag("--dof-focal-distance", a.dof_focal_distance, 0.0, true)? {
+        e.dof_focal_distance = Some(d);
+        features.depth_of_field = true;
+    }
+    e.dof_samples = samples_flag("--dof-samples", a.dof_samples)?.unwrap_or(e.dof_samples);
+    e.motion_samples =
+        samples_flag("--motion-samples", a.motion_samples)?.unwrap_or(e.motion_samples);
+    e.glossy_samples =
+        samples_flag("--glossy-samples", a.glossy_samples)?.unwrap_or(e.glossy_samples);
+    if let Some(s) = extent_flag("--environment-strength", a.environment_strength, 0.0, false)? {
+        e.environment_strength = s;
+    }
+    let mut motion = loaded.motion.clone();
+    if !a.motion.is_empty() {
+        motion.clear();
+        features.motion_blur = true;
+        for m in &a.motion {
+            motion.extend(motion_flag(m, &loaded.scene)?);
+        }
+    }
+    let image = match &a.environment_map {
+        Some(path) => {
+            features.environment_mapping = true;
+            Some(std::sync::Arc::new(
+                prism_scene::read_environment_map(path).map_err(UserError::input)?,
+            ))
+        }
+        None => loaded.environment.clone(),
+    };
+    if features.environment_mapping && image.is_none() {
+        return Err(UserError::Refused(
+            "env-map is on, but no environment map is given: set [extras] environment_map in \
+             the config or --environment-map FILE"
+                .into(),
+        )
+        .into());
+    }
+    if !a.quiet && features.motion_blur && motion.is_empty() {
+        eprintln!(
+            "prism: warning: motion-blur is on, but nothing moves: give [[motion]] entries or \
+             --motion MESH=VX,VY,VZ"
+        );
+    }
+    let environment = image.map(|im| Environment::new((*im).clone(), e.environment_strength));
+    Ok(RunExtras {
+        settings: e,
+        motion: if features.motion_blur {
+            motion
+        } else {
+            Vec::new()
+        },
+        environment: if features.environment_mapping {
+            environment
+        } else {
+            None
+        },
+    })
+}
+
+/// One `--motion MESH=VX,VY,VZ`: the meshes it names and their velocity.
+fn motion_flag(m: &str, scene: &prism_scene::Scene) -> Result<Vec<(usize, prism_math::Vec3)>> {
+    let bad = || {
+        UserError::Refused(format!(
+            "--motion {m}: expected MESH=VX,VY,VZ (a mesh index or name, three finite numbers \
+             up to {} in size)",
+            prism_scene::MAX_EXTENT
+        ))
+    };
+    let (name, v) = m.rsplit_once('=').ok_or_else(bad)?;
+    let v: Vec<f32> = v
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    if v.len() != 3
+        || v.iter()
+            .any(|x| !x.is_finite() || x.abs() > prism_scene::MAX_EXTENT)
+    {
+        return Err(bad().into());
+    }
+    let mesh = match name.trim().parse::<usize>() {
+        Ok(i) => prism_scene::MeshRef::Index(i),
+        Err(_) => prism_scene::MeshRef::Name(name.trim().to_string()),
+    };
+    let found = mesh.resolve(scene);
+    if found.is_empty() {
+        return Err(UserError::Refused(format!(
+            "--motion {m}: no such mesh (the scene's meshes: {})",
+            prism_scene::mesh_names(scene)
+        ))
+        .into());
+    }
+    let v = prism_math::Vec3::new(v[0], v[1], v[2]);
+    Ok(found.into_iter().map(|i| (i, v)).collect())
 }
 
 /// Runs `prism raytrace`.
@@ -366,9 +539,22 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             .into());
         }
     }
+    let extras = extras(a, &loaded, &mut features)?;
     let read = t0.elapsed();
     let t1 = Instant::now();
-    let scene = WhittedScene::new(&loaded.scene, features.accel_structure);
+    let split = if features.sah_binning {
+        Split::Sah
+    } else {
+        Split::Median
+    };
+    let scene = WhittedScene::prepare(
+        &loaded.scene,
+        SceneSetup {
+            bvh: features.accel_structure.then_some(split),
+            motion: extras.motion.clone(),
+            environment: extras.environment,
+        },
+    );
     let build = t1.elapsed();
     if (a.bvh_level.is_some() || a.bvh_leaf.is_some()) && scene.bvh().is_none() {
         return Err(UserError::Refused(
@@ -402,6 +588,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             features,
             light_samples: a.light_samples,
             max_depth: a.max_depth,
+            extras: extras.settings,
         },
         spp: a.spp.unwrap_or(DEFAULT_SPP),
         bloom: Bloom {
@@ -521,14 +708,29 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
             Some(bvh) => {
                 let s = bvh.stats();
                 eprintln!(
-                    "bvh: {} levels (8-wide), binary depth {}, {} leaves, largest leaf {}",
+                    "bvh: {} levels (8-wide), binary depth {}, {} leaves, largest leaf {}, SAH cost {:.2} ({})",
                     bvh.levels(),
                     s.depth,
                     s.leaves,
-                    s.max_leaf_size
+                    s.max_leaf_size,
+                    s.sah_cost,
+                    if features.sah_binning { "binned SAH" } else { "median split" }
                 );
             }
             None => eprintln!("bvh: off (brute force)"),
+        }
+        for (name, rule) in [("binned SAH", Split::Sah), ("median split", Split::Median)] {
+            let t = Instant::now();
+            let s = scene.bvh_stats(rule);
+            eprintln!(
+                "tree by {name}: SAH cost {:.2}, binary depth {}, {} leaves, largest leaf {}, {} nodes, built in {:.1} ms",
+                s.sah_cost,
+                s.depth,
+                s.leaves,
+                s.max_leaf_size,
+                s.nodes,
+                ms(t.elapsed())
+            );
         }
         eprintln!(
             "rays: camera {}, reflection {}, transmission {}, shadow {}, area-sample {}, total {}",

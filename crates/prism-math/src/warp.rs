@@ -121,6 +121,26 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * FRAC_1_PI
 }
 
+/// A direction about +z from the normalised Phong lobe `cos^n`: `cos theta = u.x^(1/(n+1))`,
+/// `phi = 2 pi u.y`. Its density is [`cosine_power_pdf`].
+#[must_use]
+pub fn cosine_power(u: Vec2, n: f32) -> Vec3 {
+    let z = u.x.powf(1.0 / (n + 1.0));
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Density of [`cosine_power`] over solid angle: `(n + 1) / (2 pi) cos^n theta` on the
+/// upper hemisphere, 0 below.
+#[must_use]
+pub fn cosine_power_pdf(cos_theta: f32, n: f32) -> f32 {
+    if cos_theta <= 0.0 {
+        return 0.0;
+    }
+    (n + 1.0) * 0.5 * FRAC_1_PI * cos_theta.powf(n)
+}
+
 /// Uniform barycentric coordinates `(b1, b2)` on a triangle (the first vertex gets
 /// `1 - b1 - b2`), by the square-root parametrisation.
 #[must_use]

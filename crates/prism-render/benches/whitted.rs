@@ -47,6 +47,7 @@ fn main() {
                 features: Features::prism_defaults(),
                 light_samples: 16,
                 max_depth: 3,
+                extras: prism_scene::Extras::default(),
             },
             spp: 1,
             bloom: prism_image::Bloom::default(),

@@ -75,6 +75,7 @@ impl WhittedMode {
                 features: self.features,
                 light_samples: 16,
                 max_depth: 3,
+                extras: prism_scene::Extras::default(),
             },
             spp: 16,
             bloom: Bloom::default(),

@@ -31,6 +31,7 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
             features,
             light_samples: 16,
             max_depth: 3,
+            extras: prism_scene::Extras::default(),
         },
         spp: 4,
         bloom: prism_image::Bloom::default(),

@@ -1,6 +1,6 @@
 //! [`OrbitView`], the Delft ray tracer's camera: rays through pixel corners counted from the
-//! bottom-left, a row of corner directions at a time, and world points projected back to
-//! pixels for overlays.
+//! bottom-left, a row of corner directions at a time, thin-lens rays, ray cones' spread,
+//! and world points projected back to pixels for overlays.
 
 use prism_math::{Ray, Vec2, Vec3};
 
@@ -47,6 +47,28 @@ impl OrbitView {
         let ndc = Vec2::new(2.0 * x / self.width - 1.0, 2.0 * y / self.height - 1.0);
         let local = Vec3::new(-ndc.x * self.hw, ndc.y * self.hh, 1.0).normalize();
         Ray::new(self.eye, self.world_from_camera.vector(local).normalize())
+    }
+
+    /// The thin-lens ray for image position `(x, y)` (as [`OrbitView::ray`]): from the lens
+    /// point `aperture * lens` (`lens` on the unit disk, in the camera's x/y plane about the
+    /// eye) through the pinhole ray's point on the plane in focus, `focus` along the view
+    /// axis.
+    #[must_use]
+    pub fn lens_ray(&self, x: f32, y: f32, lens: Vec2, aperture: f32, focus: f32) -> Ray {
+        let ndc = Vec2::new(2.0 * x / self.width - 1.0, 2.0 * y / self.height - 1.0);
+        let on_plane = Vec3::new(-ndc.x * self.hw, ndc.y * self.hh, 1.0) * focus;
+        let focal = self.eye + self.world_from_camera.vector(on_plane);
+        let at = aperture * lens;
+        let origin = self.eye + self.world_from_camera.vector(Vec3::new(at.x, at.y, 0.0));
+        Ray::new(origin, (focal - origin).normalize())
+    }
+
+    /// How fast a camera ray's cone widens: `2 tan(alpha / 2)` per unit distance, for the
+    /// spread angle `alpha = atan(2 hh / H)` of one pixel at the image centre.
+    #[must_use]
+    pub fn cone_spread(&self) -> f32 {
+        let alpha = (2.0 * self.hh / self.height).atan();
+        2.0 * (0.5 * alpha).tan()
     }
 
     /// The directions of the rays through the lower-left corners of the pixels `x = 0, 1,

@@ -72,6 +72,10 @@ fn ray_json(out: &mut String, r: &DebugRay) {
         out.push_str(",\"blocked_at\":");
         vec(out, v3(p));
     }
+    if let Some(t) = r.time {
+        out.push_str(",\"time\":");
+        num(out, t);
+    }
     out.push_str(",\"hit\":");
     match &r.hit {
         None => out.push_str("null"),

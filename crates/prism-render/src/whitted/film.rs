@@ -10,7 +10,9 @@ use rayon::prelude::*;
 
 use super::camera::OrbitView;
 use super::scene::WhittedScene;
-use super::tracer::{DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer};
+use super::tracer::{
+    stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
+};
 use crate::film::{tile_of, PixelSum, Share};
 
 /// Whitted render settings.
@@ -42,22 +44,35 @@ pub struct Raytraced {
 
 /// The sampler of ray `s` of the pixel at written position `(x, row)`.
 fn pixel_sampler(opts: &RaytraceOptions, x: u32, row: u32, s: u32) -> PixelSampler {
+    pixel_sampler_at(opts, x, row, u64::from(s))
+}
+
+/// The sampler of stream `index` of the pixel at written position `(x, row)`.
+fn pixel_sampler_at(opts: &RaytraceOptions, x: u32, row: u32, index: u64) -> PixelSampler {
     PixelSampler::new(
         opts.seed,
         u64::from(row) * u64::from(opts.width) + u64::from(x),
-        u64::from(s),
+        index,
     )
 }
 
-/// Rays per pixel actually cast: `opts.spp` (at least 1) with multiple rays per pixel on,
-/// else 1.
+/// Camera rays per pixel actually cast: the most of `opts.spp` (with multiple rays per pixel
+/// on), the lens samples (with depth of field on) and the shutter times (with motion blur
+/// on); at least 1.
 #[must_use]
 pub fn rays_per_pixel(opts: &RaytraceOptions) -> u32 {
-    if opts.settings.features.multiple_rays_per_pixel {
-        opts.spp.max(1)
-    } else {
-        1
+    let (f, e) = (opts.settings.features, opts.settings.extras);
+    let mut n = 1;
+    if f.multiple_rays_per_pixel {
+        n = n.max(opts.spp);
     }
+    if f.depth_of_field {
+        n = n.max(e.dof_samples);
+    }
+    if f.motion_blur {
+        n = n.max(e.motion_samples);
+    }
+    n
 }
 
 /// What every pixel of one render shares.
@@ -65,6 +80,35 @@ struct Frame<'a> {
     scene: &'a WhittedScene,
     view: OrbitView,
     opts: &'a RaytraceOptions,
+    /// The distance of the plane in focus along the view axis.
+    focus: f32,
+}
+
+impl Frame<'_> {
+    fn new<'a>(
+        scene: &'a WhittedScene,
+        camera: &prism_scene::OrbitCamera,
+        opts: &'a RaytraceOptions,
+    ) -> Frame<'a> {
+        Frame {
+            scene,
+            view: OrbitView::new(camera, opts.width, opts.height),
+            opts,
+            focus: (opts.settings.extras.dof_focal_distance).unwrap_or(camera.distance),
+        }
+    }
+}
+
+/// The order of a pixel's `n` shutter strata: a permutation of `0..n` drawn from the
+/// pixel's own numbers (so that times and lens points are not paired stratum by stratum).
+fn shutter_strata(opts: &RaytraceOptions, x: u32, row: u32, n: u32) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..n).collect();
+    let mut sampler = pixel_sampler_at(opts, x, row, u64::MAX);
+    for i in (1..n as usize).rev() {
+        let j = ((sampler.next_1d() * (i + 1) as f32) as usize).min(i);
+        order.swap(i, j);
+    }
+    order
 }
 
 /// The sums of the pixel at written position `(x, row)` (row 0 at the top), its single
@@ -78,20 +122,38 @@ fn pixel(
     record: Option<&mut Vec<DebugRay>>,
 ) -> PixelSum {
     let (scene, view, opts) = (f.scene, &f.view, f.opts);
+    let (features, extras) = (opts.settings.features, opts.settings.extras);
     let y = opts.height - 1 - row;
     let n = rays_per_pixel(opts);
     let mut px = PixelSum::default();
     let mut rec: Option<Vec<DebugRay>> = record.as_ref().map(|_| Vec::new());
+    let order = features
+        .motion_blur
+        .then(|| shutter_strata(opts, x, row, n));
     for s in 0..n {
         let mut sampler = pixel_sampler(opts, x, row, s);
-        let (jx, jy) = if n > 1 {
+        let (jx, jy) = if n > 1 && features.multiple_rays_per_pixel {
             (sampler.next_1d(), sampler.next_1d())
         } else {
             (0.0, 0.0)
         };
-        let ray = match corner_dir {
-            Some(d) if n == 1 => Ray::new(view.eye(), d),
-            _ => view.ray(x as f32 + jx, y as f32 + jy),
+        // Stratified times over the shutter [0, 1).
+        let time = order.as_ref().map_or(0.0, |o| {
+            ((o[s as usize] as f32 + sampler.next_1d()) / n as f32).min(1.0 - f32::EPSILON / 2.0)
+        });
+        let (ray, kind) = if features.depth_of_field {
+            let lens = prism_math::warp::concentric_disk(stratified(s, n, &mut sampler));
+            let (sx, sy) = (x as f32 + jx, y as f32 + jy);
+            (
+                view.lens_ray(sx, sy, lens, extras.dof_aperture, f.focus),
+                RayKind::Lens,
+            )
+        } else {
+            let ray = match corner_dir {
+                Some(d) if n == 1 => Ray::new(view.eye(), d),
+                _ => view.ray(x as f32 + jx, y as f32 + jy),
+            };
+            (ray, RayKind::Camera)
         };
         let mut tracer = WhittedTracer {
             scene,
@@ -99,8 +161,10 @@ fn pixel(
             sampler,
             counts: RayCounts::default(),
             record: rec.take(),
+            time,
+            spread: view.cone_spread(),
         };
-        px.accumulate(tracer.trace(&ray, 0, RayKind::Camera));
+        px.accumulate(tracer.trace(&ray, 0, kind, 0.0));
         counts.add(&tracer.counts);
         rec = tracer.record;
     }
@@ -167,8 +231,8 @@ pub fn raytrace_share(
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Image<PixelSum>, RayCounts) {
-    let view = OrbitView::new(camera, opts.width, opts.height);
-    let frame = Frame { scene, view, opts };
+    let frame = Frame::new(scene, camera, opts);
+    let view = frame.view;
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
     let mut sums = Image::new(opts.width, opts.height, PixelSum::default());
@@ -181,7 +245,7 @@ pub fn raytrace_share(
             let mut dirs = Vec::new();
             let mine = |x: u32| share.has_tile(tile_of(x, row, opts.width));
             if (0..opts.width).any(mine) {
-                if rays_per_pixel(opts) == 1 {
+                if rays_per_pixel(opts) == 1 && !opts.settings.features.depth_of_field {
                     view.corner_directions(opts.height - 1 - row, &mut dirs);
                 }
                 for (x, p) in line.iter_mut().enumerate() {
@@ -231,10 +295,9 @@ pub fn trace_pixel(
         x < opts.width && row < opts.height,
         "pixel outside the image"
     );
-    let view = OrbitView::new(camera, opts.width, opts.height);
     let mut rays = Vec::new();
     let mut counts = RayCounts::default();
-    let frame = Frame { scene, view, opts };
+    let frame = Frame::new(scene, camera, opts);
     let color = pixel(&frame, x, row, None, &mut counts, Some(&mut rays)).mean();
     PixelTrace {
         pixel: (x, row),

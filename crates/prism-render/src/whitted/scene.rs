@@ -1,9 +1,13 @@
 //! [`WhittedScene`], the scene as the Whitted ray tracer sees it: every triangle with its
-//! vertex normals and uvs, spheres, Phong materials with their textures, lights, and the
-//! one BVH (or none, for brute force); it answers closest-hit and shadow queries.
+//! vertex normals and uvs, spheres, Phong materials with their textures, lights, the meshes
+//! that move over the shutter, the environment map, and the one BVH (or none, for brute
+//! force); it answers closest-hit and shadow queries at a time of the shutter.
 
-use prism_accel::{intersect_sphere, intersect_triangle, BuildOptions, Bvh, RayPre, Sphere};
-use prism_image::{Texture, Wrap};
+pub use prism_accel::Split;
+use prism_accel::{
+    intersect_sphere, intersect_triangle, BuildOptions, Bvh, BvhStats, RayPre, Sphere,
+};
+use prism_image::{PixelSampling, RgbImage, Texture, Wrap};
 use prism_math::{Ray, Rgb, Vec2, Vec3};
 use prism_scene::{Light, Material, Scene, Shading};
 
@@ -128,6 +132,57 @@ pub struct WhittedHit {
     pub surface: Surface,
 }
 
+/// A latitude-longitude environment map: what a ray that hits nothing sees.
+#[derive(Clone, Debug)]
+pub struct Environment {
+    texture: Texture,
+    strength: f32,
+}
+
+impl Environment {
+    /// The map `image` (row 0 the top, looking up) scaled by `strength`.
+    #[must_use]
+    pub fn new(image: RgbImage, strength: f32) -> Environment {
+        Environment {
+            texture: Texture::new(image).with_wrap(Wrap::Repeat, Wrap::Clamp),
+            strength,
+        }
+    }
+
+    /// The radiance seen along unit direction `d`: the map at
+    /// `u = 0.5 + atan2(d.x, -d.z) / 2 pi`, `v = acos(d.y) / pi` (v = 0 at the top row),
+    /// bilinear, wrapping in u, times the strength.
+    #[must_use]
+    pub fn radiance(&self, d: Vec3) -> Rgb {
+        let u = 0.5 + d.x.atan2(-d.z) / std::f32::consts::TAU;
+        let v = d.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
+        self.texture
+            .sample_level(Vec2::new(u, v), 0, PixelSampling::Bilinear)
+            * self.strength
+    }
+}
+
+/// How a scene is prepared: its BVH, its moving meshes, its environment.
+#[derive(Clone, Debug, Default)]
+pub struct SceneSetup {
+    /// The BVH's split rule; `None` tests every ray against every primitive.
+    pub bvh: Option<Split>,
+    /// Meshes that move: index into the scene's meshes and the translation over the
+    /// shutter interval [0, 1].
+    pub motion: Vec<(usize, Vec3)>,
+    /// What rays that miss see (with environment mapping on).
+    pub environment: Option<Environment>,
+}
+
+/// A mesh that moves: its triangles (a run of the scene's), its translation over the
+/// shutter, and a BVH of its own, traced with the ray moved back by the translation.
+struct Mover {
+    first: u32,
+    count: u32,
+    velocity: Vec3,
+    bvh: Option<Bvh>,
+}
+
 /// The prepared scene.
 pub struct WhittedScene {
     triangles: Vec<[Vec3; 3]>,
@@ -138,16 +193,38 @@ pub struct WhittedScene {
     /// Lights.
     pub lights: Vec<Light>,
     bvh: Option<Bvh>,
+    brute_force: bool,
+    /// The still triangles' numbers when some move (the BVH's triangle `i` is triangle
+    /// `still[i]`); empty when none moves.
+    still: Vec<u32>,
+    movers: Vec<Mover>,
+    environment: Option<Environment>,
     bounds_diagonal: f32,
 }
 
 impl WhittedScene {
-    /// Prepares `scene`; `use_bvh` builds the BVH, else every ray tests every primitive.
+    /// Prepares `scene` with nothing moving and no environment; `use_bvh` builds the BVH
+    /// (binned SAH), else every ray tests every primitive.
     #[must_use]
     pub fn new(scene: &Scene, use_bvh: bool) -> WhittedScene {
+        WhittedScene::prepare(
+            scene,
+            SceneSetup {
+                bvh: use_bvh.then_some(Split::Sah),
+                ..SceneSetup::default()
+            },
+        )
+    }
+
+    /// Prepares `scene` as `setup` says. Motion entries naming no mesh of the scene are
+    /// left out.
+    #[must_use]
+    pub fn prepare(scene: &Scene, setup: SceneSetup) -> WhittedScene {
         let mut triangles = Vec::new();
         let mut tri_data = Vec::new();
+        let mut mesh_start = Vec::with_capacity(scene.meshes.len());
         for m in &scene.meshes {
+            mesh_start.push(triangles.len() as u32);
             for (ti, t) in m.triangles.iter().enumerate() {
                 let pos = t.map(|i| m.positions[i as usize]);
                 let geometric = (pos[1] - pos[0]).cross(pos[2] - pos[0]).normalize_or_zero();
@@ -182,9 +259,48 @@ impl WhittedScene {
             })
             .collect();
         let lights = scene.lights.clone();
-        let bvh = use_bvh.then(|| {
+        let opts = |split: Split| BuildOptions {
+            split,
+            ..BuildOptions::default()
+        };
+        let mut velocity: Vec<Option<Vec3>> = vec![None; scene.meshes.len()];
+        for &(i, v) in &setup.motion {
+            if let Some(slot) = velocity.get_mut(i) {
+                *slot = Some(v);
+            }
+        }
+        let mut movers = Vec::new();
+        let mut moving = vec![false; triangles.len()];
+        for (i, v) in velocity.iter().enumerate() {
+            let Some(v) = *v else { continue };
+            let first = mesh_start[i];
+            let count = scene.meshes[i].triangles.len() as u32;
+            moving[first as usize..(first + count) as usize].fill(true);
+            movers.push(Mover {
+                first,
+                count,
+                velocity: v,
+                bvh: setup.bvh.map(|split| {
+                    let own = &triangles[first as usize..(first + count) as usize];
+                    Bvh::build(own, &[], &opts(split))
+                }),
+            });
+        }
+        let still: Vec<u32> = if movers.is_empty() {
+            Vec::new()
+        } else {
+            (0..triangles.len() as u32)
+                .filter(|&i| !moving[i as usize])
+                .collect()
+        };
+        let bvh = setup.bvh.map(|split| {
             let s: Vec<Sphere> = spheres.iter().map(|s| s.0).collect();
-            Bvh::build(&triangles, &s, &BuildOptions::default())
+            if movers.is_empty() {
+                Bvh::build(&triangles, &s, &opts(split))
+            } else {
+                let t: Vec<[Vec3; 3]> = still.iter().map(|&i| triangles[i as usize]).collect();
+                Bvh::build(&t, &s, &opts(split))
+            }
         });
         let bounds_diagonal = scene.bounds().map_or(1.0, |(lo, hi)| (hi - lo).length());
         WhittedScene {
@@ -199,7 +315,51 @@ impl WhittedScene {
                 .collect(),
             lights,
             bvh,
+            brute_force: setup.bvh.is_none(),
+            still,
+            movers,
+            environment: setup.environment,
             bounds_diagonal,
+        }
+    }
+
+    /// The statistics of the BVH a split rule would build over this scene's primitives
+    /// (all of them, standing still), for comparing rules.
+    #[must_use]
+    pub fn bvh_stats(&self, split: Split) -> BvhStats {
+        let s: Vec<Sphere> = self.spheres.iter().map(|s| s.0).collect();
+        let opts = BuildOptions {
+            split,
+            ..BuildOptions::default()
+        };
+        Bvh::build(&self.triangles, &s, &opts).stats()
+    }
+
+    /// The environment map, when the scene has one.
+    #[must_use]
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_ref()
+    }
+
+    /// True if some mesh moves over the shutter.
+    #[must_use]
+    pub fn has_motion(&self) -> bool {
+        !self.movers.is_empty()
+    }
+
+    /// `sqrt(uv area / world area)` of triangle `i`: the texture's texel density along one
+    /// side is this times the texture's `sqrt(width x height)`; 0 for a triangle without
+    /// area.
+    #[must_use]
+    pub fn uv_density(&self, i: u32) -> f32 {
+        let [v0, v1, v2] = self.triangles[i as usize];
+        let [t0, t1, t2] = self.tri_data[i as usize].uvs;
+        let world = (v1 - v0).cross(v2 - v0).length();
+        let uv = (t1 - t0).perp_dot(t2 - t0).abs();
+        if world > 0.0 {
+            (uv / world).sqrt()
+        } else {
+            0.0
         }
     }
 
@@ -227,48 +387,129 @@ impl WhittedScene {
         self.bounds_diagonal
     }
 
-    /// The closest primitive hit with `0 < t < tmax`: `(t, primitive, b1, b2)`, primitives
-    /// numbered triangles first, then spheres.
-    fn closest(&self, ray: &Ray, tmax: f32) -> Option<(f32, u32, f32, f32)> {
-        if let Some(bvh) = &self.bvh {
-            return bvh
-                .intersect(ray, 0.0, tmax)
-                .map(|h| (h.t, h.prim, h.b1, h.b2));
-        }
-        let pre = RayPre::new(ray);
-        let mut best = None;
-        let mut tmax = tmax;
-        for (i, tri) in self.triangles.iter().enumerate() {
-            if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, tmax) {
-                tmax = t;
-                best = Some((t, i as u32, b1, b2));
-            }
-        }
+    /// The closest primitive hit with `0 < t < tmax` at shutter time `time`:
+    /// `(t, primitive, b1, b2)`, primitives numbered triangles first, then spheres. The
+    /// still primitives are searched first, then each moving mesh in turn (its ray moved
+    /// back by its translation at `time`), a later one winning only when strictly closer;
+    /// within each, the lowest number wins a tie.
+    fn closest(&self, ray: &Ray, tmax: f32, time: f32) -> Option<(f32, u32, f32, f32)> {
         let nt = self.triangles.len() as u32;
-        for (i, (s, _)) in self.spheres.iter().enumerate() {
-            if let Some(t) = intersect_sphere(ray, s, 0.0, tmax) {
-                tmax = t;
-                best = Some((t, nt + i as u32, 0.0, 0.0));
+        let mut best = if let Some(bvh) = &self.bvh {
+            bvh.intersect(ray, 0.0, tmax).map(|h| {
+                let prim = match self.still.get(h.prim as usize) {
+                    Some(&i) => i,
+                    // A sphere, numbered after the BVH's triangles.
+                    None if h.prim >= self.still_count() => nt + h.prim - self.still_count(),
+                    None => h.prim,
+                };
+                (h.t, prim, h.b1, h.b2)
+            })
+        } else {
+            let pre = RayPre::new(ray);
+            let mut best = None;
+            let mut tmax = tmax;
+            let mut test = |i: u32| {
+                let tri = &self.triangles[i as usize];
+                if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, tmax) {
+                    tmax = t;
+                    best = Some((t, i, b1, b2));
+                }
+            };
+            if self.movers.is_empty() {
+                (0..nt).for_each(&mut test);
+            } else {
+                self.still.iter().copied().for_each(&mut test);
+            }
+            for (i, (s, _)) in self.spheres.iter().enumerate() {
+                if let Some(t) = intersect_sphere(ray, s, 0.0, tmax) {
+                    tmax = t;
+                    best = Some((t, nt + i as u32, 0.0, 0.0));
+                }
+            }
+            best
+        };
+        for m in &self.movers {
+            let limit = best.map_or(tmax, |b| b.0);
+            let moved = Ray::new(ray.origin - m.velocity * time, ray.dir);
+            let hit = match &m.bvh {
+                Some(bvh) => bvh
+                    .intersect(&moved, 0.0, limit)
+                    .map(|h| (h.t, m.first + h.prim, h.b1, h.b2)),
+                None => {
+                    let pre = RayPre::new(&moved);
+                    let mut found = None;
+                    let mut lim = limit;
+                    for i in m.first..m.first + m.count {
+                        let tri = &self.triangles[i as usize];
+                        if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, lim) {
+                            lim = t;
+                            found = Some((t, i, b1, b2));
+                        }
+                    }
+                    found
+                }
+            };
+            if hit.is_some() {
+                best = hit;
             }
         }
         best
     }
 
-    /// True if something is hit with `0 < t < tmax`.
-    #[must_use]
-    pub fn occluded(&self, ray: &Ray, tmax: f32) -> bool {
-        if let Some(bvh) = &self.bvh {
-            return bvh.occluded(ray, 0.0, tmax);
+    /// Triangles in the still BVH.
+    fn still_count(&self) -> u32 {
+        if self.movers.is_empty() {
+            self.triangles.len() as u32
+        } else {
+            self.still.len() as u32
         }
-        self.closest(ray, tmax).is_some()
     }
 
-    /// The closest hit along `ray` (whose direction is a unit vector) with `0 < t < tmax`;
-    /// `interpolate` picks interpolated over geometric shading normals. Both normals are
-    /// turned to face against the ray when the geometric one faces along it.
+    /// True if something is hit with `0 < t < tmax` (nothing moving, or at time 0).
+    #[must_use]
+    pub fn occluded(&self, ray: &Ray, tmax: f32) -> bool {
+        self.occluded_at(ray, tmax, 0.0)
+    }
+
+    /// True if something is hit with `0 < t < tmax` at shutter time `time`.
+    #[must_use]
+    pub fn occluded_at(&self, ray: &Ray, tmax: f32, time: f32) -> bool {
+        if self.brute_force {
+            return self.closest(ray, tmax, time).is_some();
+        }
+        let still = self
+            .bvh
+            .as_ref()
+            .is_some_and(|b| b.occluded(ray, 0.0, tmax));
+        still
+            || self.movers.iter().any(|m| {
+                let moved = Ray::new(ray.origin - m.velocity * time, ray.dir);
+                m.bvh
+                    .as_ref()
+                    .is_some_and(|b| b.occluded(&moved, 0.0, tmax))
+            })
+    }
+
+    /// The closest hit along `ray` (whose direction is a unit vector) with `0 < t < tmax`,
+    /// nothing moving (or at time 0); `interpolate` picks interpolated over geometric
+    /// shading normals. Both normals are turned to face against the ray when the geometric
+    /// one faces along it.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, tmax: f32, interpolate: bool) -> Option<WhittedHit> {
-        let (t, prim, b1, b2) = self.closest(ray, tmax)?;
+        self.intersect_at(ray, tmax, interpolate, 0.0)
+    }
+
+    /// [`WhittedScene::intersect`] at shutter time `time`: moving meshes are where their
+    /// translation puts them then.
+    #[must_use]
+    pub fn intersect_at(
+        &self,
+        ray: &Ray,
+        tmax: f32,
+        interpolate: bool,
+        time: f32,
+    ) -> Option<WhittedHit> {
+        let (t, prim, b1, b2) = self.closest(ray, tmax, time)?;
         let p = ray.origin + t * ray.dir;
         let nt = self.triangles.len() as u32;
         let (mut n_g, mut n_s, uv, material, surface) = if prim < nt {

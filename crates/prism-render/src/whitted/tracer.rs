@@ -1,10 +1,12 @@
 //! The Whitted tracer of the Delft ray tracer: Phong per light sample, hard shadows
 //! from point lights, stratified samples of segment and parallelogram lights, recursive
-//! mirror reflection, textures, transparency; every ray it casts can be recorded.
+//! mirror or glossy reflection, textures (mip-mapped by ray cones), transparency, the
+//! environment map; every ray it casts can be recorded.
 
 use prism_image::PixelSampling;
-use prism_math::{Ray, Rgb, Vec2, Vec3};
-use prism_scene::{Features, Light};
+use prism_math::warp::cosine_power;
+use prism_math::{Frame, Ray, Rgb, Vec2, Vec3};
+use prism_scene::{Extras, Features, Light};
 
 use super::scene::{PhongMaterial, Surface, WhittedHit, WhittedScene};
 use super::shading::{parallelogram_color, parallelogram_grid, phong};
@@ -25,6 +27,8 @@ pub struct WhittedSettings {
     pub light_samples: u32,
     /// Most reflection (and transparency) bounces after the camera ray.
     pub max_depth: u32,
+    /// The extras' settings (used where `features` turns them on).
+    pub extras: Extras,
 }
 
 /// What kind of ray a debug record is.
@@ -32,8 +36,12 @@ pub struct WhittedSettings {
 pub enum RayKind {
     /// From the camera.
     Camera,
+    /// From a point of the lens (depth of field).
+    Lens,
     /// A mirror reflection.
     Reflection,
+    /// A reflection drawn from the Phong lobe (glossy reflection).
+    Glossy,
     /// Through a transparent surface.
     Transmission,
     /// Towards a point light.
@@ -44,6 +52,9 @@ pub enum RayKind {
     Normal,
     /// The interpolated normal at a hit.
     InterpolatedNormal,
+    /// What a ray that hit nothing sees of the environment map: from the end of its
+    /// record on, its colour the map's radiance.
+    Environment,
 }
 
 impl RayKind {
@@ -52,12 +63,15 @@ impl RayKind {
     pub fn name(self) -> &'static str {
         match self {
             RayKind::Camera => "camera",
+            RayKind::Lens => "lens",
             RayKind::Reflection => "reflection",
+            RayKind::Glossy => "glossy",
             RayKind::Transmission => "transmission",
             RayKind::Shadow => "shadow",
             RayKind::AreaSample => "area-sample",
             RayKind::Normal => "normal",
             RayKind::InterpolatedNormal => "interpolated-normal",
+            RayKind::Environment => "environment",
         }
     }
 }
@@ -82,6 +96,8 @@ pub struct DebugRay {
     pub blocked_at: Option<Vec3>,
     /// The surface it hit: material name and primitive.
     pub hit: Option<(String, Surface)>,
+    /// The shutter time of its camera sample (with motion blur on).
+    pub time: Option<f32>,
 }
 
 /// Rays cast, by kind.
@@ -89,7 +105,7 @@ pub struct DebugRay {
 pub struct RayCounts {
     /// Camera rays.
     pub camera: u64,
-    /// Reflection rays.
+    /// Reflection rays (mirror and glossy).
     pub reflection: u64,
     /// Transmission rays.
     pub transmission: u64,
@@ -156,6 +172,11 @@ pub struct WhittedTracer<'a> {
     pub counts: RayCounts,
     /// When set, every ray is recorded here.
     pub record: Option<Vec<DebugRay>>,
+    /// The shutter time of this camera sample (0 without motion blur).
+    pub time: f32,
+    /// Growth of a ray cone's width per unit distance, `2 tan(alpha / 2)` for the camera's
+    /// pixel spread angle alpha (used by mip-mapping).
+    pub spread: f32,
 }
 
 const RED: Rgb = Rgb::new(1.0, 0.0, 0.0);
@@ -181,15 +202,19 @@ impl WhittedTracer<'_> {
         Some(rec.len() - 1)
     }
 
-    /// The colour seen along `ray` (unit direction), `depth` bounces after the camera.
-    pub fn trace(&mut self, ray: &Ray, depth: u32, kind: RayKind) -> Rgb {
+    /// The colour seen along `ray` (unit direction), `depth` bounces after the camera;
+    /// `width` is its cone's width at its origin (0 from the camera).
+    pub fn trace(&mut self, ray: &Ray, depth: u32, kind: RayKind, width: f32) -> Rgb {
         match kind {
-            RayKind::Camera => self.counts.camera += 1,
-            RayKind::Reflection => self.counts.reflection += 1,
+            RayKind::Camera | RayKind::Lens => self.counts.camera += 1,
+            RayKind::Reflection | RayKind::Glossy => self.counts.reflection += 1,
             _ => self.counts.transmission += 1,
         }
         let f = self.settings.features;
-        let hit = self.scene.intersect(ray, f32::INFINITY, f.normal_interp);
+        let hit = self
+            .scene
+            .intersect_at(ray, f32::INFINITY, f.normal_interp, self.time);
+        let time = self.time_tag();
         let slot = self.push(|_| DebugRay {
             kind,
             depth,
@@ -204,21 +229,82 @@ impl WhittedTracer<'_> {
                     h.surface,
                 )
             }),
+            time,
         });
-        let Some(hit) = hit else { return Rgb::BLACK };
-        let color = self.shade(ray, &hit, depth);
+        let Some(hit) = hit else {
+            return self.environment(ray, depth);
+        };
+        let color = self.shade(ray, &hit, depth, width + self.spread * hit.t);
         if let (Some(i), Some(rec)) = (slot, self.record.as_mut()) {
             rec[i].color = color;
         }
         color
     }
 
-    fn shade(&mut self, ray: &Ray, hit: &WhittedHit, depth: u32) -> Rgb {
+    /// The shutter time to record on rays, with motion blur on.
+    fn time_tag(&self) -> Option<f32> {
+        self.settings.features.motion_blur.then_some(self.time)
+    }
+
+    /// What a ray that hit nothing sees: the environment map with environment mapping on
+    /// (recorded as an environment ray past the miss), else black.
+    fn environment(&mut self, ray: &Ray, depth: u32) -> Rgb {
+        let env = match self.scene.environment() {
+            Some(e) if self.settings.features.environment_mapping => e,
+            _ => return Rgb::BLACK,
+        };
+        let c = env.radiance(ray.dir);
+        let time = self.time_tag();
+        self.push(|_| DebugRay {
+            kind: RayKind::Environment,
+            depth,
+            origin: ray.origin + MISS_LENGTH * ray.dir,
+            end: ray.origin + 2.0 * MISS_LENGTH * ray.dir,
+            color: c,
+            blocked: None,
+            blocked_at: None,
+            hit: None,
+            time,
+        });
+        if let Some(rec) = self.record.as_mut() {
+            // The missed ray's own record (just before) returns the map's colour too.
+            let n = rec.len();
+            if n >= 2 {
+                rec[n - 2].color = c;
+            }
+        }
+        c
+    }
+
+    /// The texel of `m`'s texture at `hit`: nearest or bilinear at level 0, or, with
+    /// mip-mapping on, trilinear at the level of the ray cone's footprint (`width` at the
+    /// hit, in world units).
+    fn texel(&self, tex: &prism_image::Texture, hit: &WhittedHit, dir: Vec3, width: f32) -> Rgb {
+        let f = self.settings.features;
+        let uv = Vec2::new(hit.uv.x, 1.0 - hit.uv.y);
+        if f.mipmap {
+            if let super::scene::Surface::Triangle(i) = hit.surface {
+                let (w, h) = tex.size();
+                let texels = self.scene.uv_density(i) * ((w as f32) * (h as f32)).sqrt();
+                let footprint = width / hit.n_s.dot(dir).abs() * texels;
+                let level = footprint.log2().max(0.0);
+                return tex.sample_at_level(uv, level, PixelSampling::Bilinear);
+            }
+        }
+        let mode = if f.bilinear {
+            PixelSampling::Bilinear
+        } else {
+            PixelSampling::Nearest
+        };
+        tex.sample_level(uv, 0, mode)
+    }
+
+    fn shade(&mut self, ray: &Ray, hit: &WhittedHit, depth: u32, width: f32) -> Rgb {
         let f = self.settings.features;
         let m: &PhongMaterial = &self.scene.materials[hit.material as usize];
         if self.record.is_some() {
             let len = 0.05 * self.scene.size();
-            self.push(|_| DebugRay {
+            self.push(|t| DebugRay {
                 kind: RayKind::Normal,
                 depth,
                 origin: hit.p,
@@ -227,9 +313,10 @@ impl WhittedTracer<'_> {
                 blocked: None,
                 blocked_at: None,
                 hit: None,
+                time: t.time_tag(),
             });
             if f.normal_interp {
-                self.push(|_| DebugRay {
+                self.push(|t| DebugRay {
                     kind: RayKind::InterpolatedNormal,
                     depth,
                     origin: hit.p,
@@ -238,18 +325,12 @@ impl WhittedTracer<'_> {
                     blocked: None,
                     blocked_at: None,
                     hit: None,
+                    time: t.time_tag(),
                 });
             }
         }
         let kd = match (&m.texture, f.texture_mapping) {
-            (Some(tex), true) => {
-                let mode = if f.bilinear {
-                    PixelSampling::Bilinear
-                } else {
-                    PixelSampling::Nearest
-                };
-                tex.sample_level(Vec2::new(hit.uv.x, 1.0 - hit.uv.y), 0, mode)
-            }
+            (Some(tex), true) => self.texel(tex, hit, ray.dir, width),
             _ => m.kd,
         };
         if !f.shading {
@@ -274,11 +355,16 @@ impl WhittedTracer<'_> {
             // The mirror direction of a unit ray about a unit normal is a unit vector; it
             // is used as computed, as the template does.
             let r = ray.dir - 2.0 * ray.dir.dot(n) * n;
-            let reflected = self.trace(
-                &Ray::new(hit.p + RAY_EPSILON * r, r),
-                depth + 1,
-                RayKind::Reflection,
-            );
+            let reflected = if f.glossy_reflection {
+                self.glossy(hit, r, shininess, depth, width)
+            } else {
+                self.trace(
+                    &Ray::new(hit.p + RAY_EPSILON * r, r),
+                    depth + 1,
+                    RayKind::Reflection,
+                    width,
+                )
+            };
             color += ks * reflected;
         }
         if f.transparency && transparency < 1.0 && depth < self.settings.max_depth {
@@ -286,10 +372,36 @@ impl WhittedTracer<'_> {
                 &Ray::new(hit.p + RAY_EPSILON * ray.dir, ray.dir),
                 depth + 1,
                 RayKind::Transmission,
+                width,
             );
             color = color * transparency + behind * (1.0 - transparency);
         }
         color
+    }
+
+    /// Glossy reflection at `hit`: the mean colour of `glossy_samples` rays about the
+    /// mirror direction `r` drawn from the normalised Phong lobe `cos^shininess` (stratified
+    /// on a square grid, the rest independent), those below the surface counting black.
+    fn glossy(&mut self, hit: &WhittedHit, r: Vec3, shininess: f32, depth: u32, width: f32) -> Rgb {
+        let n = self.settings.extras.glossy_samples.max(1);
+        let frame = Frame::from_normal(r);
+        let mut sum = Rgb::BLACK;
+        for i in 0..n {
+            let u = stratified(i, n, &mut self.sampler);
+            let d = frame
+                .to_world(cosine_power(u, shininess))
+                .normalize_or_zero();
+            if d.dot(hit.n_s) <= 0.0 {
+                continue;
+            }
+            sum += self.trace(
+                &Ray::new(hit.p + RAY_EPSILON * d, d),
+                depth + 1,
+                RayKind::Glossy,
+                width,
+            );
+        }
+        sum * (1.0 / n as f32)
     }
 
     /// One light's contribution at a shading point.
@@ -373,12 +485,15 @@ impl WhittedTracer<'_> {
             let tmax = dist - RAY_EPSILON;
             if self.record.is_some() {
                 // The blocking point is drawn: find the closest blocker.
-                blocked_at = self.scene.intersect(&ray, tmax, false).map(|b| b.p);
-            } else if self.scene.occluded(&ray, tmax) {
+                blocked_at = (self.scene)
+                    .intersect_at(&ray, tmax, false, self.time)
+                    .map(|b| b.p);
+            } else if self.scene.occluded_at(&ray, tmax, self.time) {
                 return Rgb::BLACK;
             }
         }
         let blocked = blocked_at.is_some();
+        let time = self.time_tag();
         self.push(|_| DebugRay {
             kind,
             depth: at.depth,
@@ -388,6 +503,7 @@ impl WhittedTracer<'_> {
             blocked: Some(blocked),
             blocked_at,
             hit: None,
+            time,
         });
         if blocked {
             return Rgb::BLACK;
@@ -395,3 +511,24 @@ impl WhittedTracer<'_> {
         phong(hit.n_s, l, at.v, at.kd, at.ks, at.shininess, c)
     }
 }
+
+/// Sample `i` of `n` on the unit square: with `k = floor(sqrt(n))`, the first `k^2` samples
+/// are jittered in the cells of a `k x k` grid (row by row), the rest independent; every
+/// sample is uniform over its cell, so the mean over all `n` is unbiased.
+#[must_use]
+pub fn stratified(i: u32, n: u32, sampler: &mut PixelSampler) -> Vec2 {
+    let k = (n as f64).sqrt() as u32;
+    let (a, b) = (sampler.next_1d(), sampler.next_1d());
+    if i < k * k {
+        let k_f = k as f32;
+        Vec2::new(
+            (((i % k) as f32 + a) / k_f).min(ONE_BELOW),
+            (((i / k) as f32 + b) / k_f).min(ONE_BELOW),
+        )
+    } else {
+        Vec2::new(a, b)
+    }
+}
+
+/// The largest float below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;

@@ -24,6 +24,7 @@ fn options(w: u32, h: u32, features: Features) -> RaytraceOptions {
             features,
             light_samples: 16,
             max_depth: 3,
+            extras: prism_scene::Extras::default(),
         },
         spp: 4,
         bloom: Bloom::default(),

@@ -33,6 +33,7 @@ fn options() -> RaytraceOptions {
             features: Features::prism_defaults(),
             light_samples: 16,
             max_depth: 3,
+            extras: prism_scene::Extras::default(),
         },
         spp: 16,
         bloom: prism_image::Bloom::default(),
