@@ -283,11 +283,7 @@ impl WhittedTracer<'_> {
         let f = self.settings.features;
         let uv = Vec2::new(hit.uv.x, 1.0 - hit.uv.y);
         if f.mipmap {
-            if let super::scene::Surface::Triangle(i) = hit.surface {
-                let (w, h) = tex.size();
-                let texels = self.scene.uv_density(i) * ((w as f32) * (h as f32)).sqrt();
-                let footprint = width / hit.n_s.dot(dir).abs() * texels;
-                let level = footprint.log2().max(0.0);
+            if let Some(level) = self.texture_level(tex, hit, dir, width) {
                 return tex.sample_at_level(uv, level, PixelSampling::Bilinear);
             }
         }
@@ -297,6 +293,26 @@ impl WhittedTracer<'_> {
             PixelSampling::Nearest
         };
         tex.sample_level(uv, 0, mode)
+    }
+
+    /// The mip level of `tex` for a ray cone `width` wide arriving along `dir` at `hit`:
+    /// `max(0, log2(width / |n_s.dir| x texels per unit length))`, the texels per unit length
+    /// being `sqrt(uv area x W x H / world area)` of the triangle hit; `None` on spheres.
+    #[must_use]
+    pub fn texture_level(
+        &self,
+        tex: &prism_image::Texture,
+        hit: &WhittedHit,
+        dir: Vec3,
+        width: f32,
+    ) -> Option<f32> {
+        let super::scene::Surface::Triangle(i) = hit.surface else {
+            return None;
+        };
+        let (w, h) = tex.size();
+        let texels = self.scene.uv_density(i) * ((w as f32) * (h as f32)).sqrt();
+        let footprint = width / hit.n_s.dot(dir).abs() * texels;
+        Some(footprint.log2().max(0.0))
     }
 
     fn shade(&mut self, ray: &Ray, hit: &WhittedHit, depth: u32, width: f32) -> Rgb {

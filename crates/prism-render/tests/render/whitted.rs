@@ -12,11 +12,11 @@ use prism_render::whitted::shading::{parallelogram_color, phong};
 use prism_render::whitted::tracer::{RayKind, WhittedSettings};
 use prism_scene::{Features, Light, Material, OrbitCamera, Preset, Scene, Shading, TriangleMesh};
 
-fn all_on() -> Features {
+pub(super) fn all_on() -> Features {
     Features::prism_defaults()
 }
 
-fn options(w: u32, h: u32, features: Features) -> RaytraceOptions {
+pub(super) fn options(w: u32, h: u32, features: Features) -> RaytraceOptions {
     RaytraceOptions {
         width: w,
         height: h,
@@ -32,7 +32,7 @@ fn options(w: u32, h: u32, features: Features) -> RaytraceOptions {
     }
 }
 
-fn phong_material(kd: Rgb, ks: Rgb) -> Material {
+pub(super) fn phong_material(kd: Rgb, ks: Rgb) -> Material {
     Material::Phong {
         kd,
         ks,
@@ -43,7 +43,7 @@ fn phong_material(kd: Rgb, ks: Rgb) -> Material {
 }
 
 /// A scene of the given triangles (flat normals unless given) with one material.
-fn triangles(tris: &[[Vec3; 3]], material: Material, lights: Vec<Light>) -> Scene {
+pub(super) fn triangles(tris: &[[Vec3; 3]], material: Material, lights: Vec<Light>) -> Scene {
     let mut positions = Vec::new();
     let mut idx = Vec::new();
     for t in tris {
@@ -71,7 +71,7 @@ fn triangles(tris: &[[Vec3; 3]], material: Material, lights: Vec<Light>) -> Scen
 }
 
 /// The camera on the -z axis at distance 3, looking along +z at the origin.
-fn head_on() -> OrbitCamera {
+pub(super) fn head_on() -> OrbitCamera {
     OrbitCamera {
         rotation: Vec3::ZERO,
         ..OrbitCamera::default()
@@ -79,7 +79,7 @@ fn head_on() -> OrbitCamera {
 }
 
 /// A floor at y = 0 spanning [-5, 5]^2, facing up.
-fn floor() -> [[Vec3; 3]; 2] {
+pub(super) fn floor() -> [[Vec3; 3]; 2] {
     let p = |x: f32, z: f32| Vec3::new(x, 0.0, z);
     [
         [p(-5.0, -5.0), p(-5.0, 5.0), p(5.0, 5.0)],
