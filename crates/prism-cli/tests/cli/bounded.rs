@@ -594,3 +594,102 @@ fn cube_maps_are_counted_whole() {
         &[dir.join("out.png")],
     );
 }
+
+/// The extras' settings, from flags and from a config: out-of-range numbers, NaN
+/// velocities, absurd sample counts, a switched-on environment without a map, missing and
+/// huge maps, unknown meshes: each refused before rendering, exit 2, located, nothing
+/// written.
+#[test]
+fn extras_settings_are_bounded() {
+    let dir = scratch("bounded-extras");
+    std::fs::write(dir.join("huge.png"), huge_png()).unwrap();
+    let config = |name: &str, body: &str| {
+        std::fs::write(
+            dir.join(name),
+            format!("scene = \"cornell_box\"\nwindow_size = [16, 16]\n{body}"),
+        )
+        .unwrap();
+    };
+    config("aperture.toml", "[extras]\ndof_aperture = -0.5\n");
+    config("nan.toml", "[[motion]]\nmesh = 6\nvelocity = [nan, 0, 0]\n");
+    config("samples.toml", "[extras]\nglossy_samples = 1000000\n");
+    config("sky.toml", "[extras]\nenvironment_map = \"huge.png\"\n");
+    config(
+        "nomesh.toml",
+        "[[motion]]\nmesh = \"nothing\"\nvelocity = [1, 0, 0]\n",
+    );
+    let out = dir.join("out.png");
+    let cases: [(&[&str], &str); 12] = [
+        (
+            &["--dof-aperture", "-1"],
+            "--dof-aperture: expected a number from 0",
+        ),
+        (
+            &["--dof-focal-distance", "0"],
+            "--dof-focal-distance: expected a number above 0",
+        ),
+        (
+            &["--dof-samples", "0"],
+            "--dof-samples: expected 1 to 4096 samples, found 0",
+        ),
+        (
+            &["--glossy-samples", "99999999"],
+            "--glossy-samples: expected 1 to 4096 samples",
+        ),
+        (
+            &["--motion", "6=nan,0,0"],
+            "--motion 6=nan,0,0: expected MESH=VX,VY,VZ",
+        ),
+        (
+            &["--motion", "chair=1,0,0"],
+            "--motion chair=1,0,0: no such mesh (the scene's meshes: 0 \"floor\"",
+        ),
+        (
+            &["--enable", "env-map"],
+            "env-map is on, but no environment map is given",
+        ),
+        (&["--environment-map", "missing.exr"], "missing.exr"),
+        (
+            &["--environment-map", "huge.png"],
+            "huge.png: a 16384x16384 image needs",
+        ),
+        (
+            &["aperture.toml"],
+            "aperture.toml:4: dof_aperture: expected a number from 0",
+        ),
+        (
+            &["nan.toml"],
+            "nan.toml:5: velocity: expected a finite number",
+        ),
+        (
+            &["samples.toml"],
+            "samples.toml:4: glossy_samples: expected 1 to 4096 samples",
+        ),
+    ];
+    for (args, expect) in cases {
+        let scene: &[&str] = if args[0].ends_with(".toml") {
+            &[]
+        } else {
+            &["cornell-box", "-r", "16", "16"]
+        };
+        let line = [&["raytrace"], scene, args, &["-o", "out.png"]].concat();
+        let o = bounded(&dir, &line);
+        refused(&line.join(" "), &o, expect, std::slice::from_ref(&out));
+    }
+    for (file, expect) in [
+        ("sky.toml", "sky.toml:4: environment_map: "),
+        (
+            "nomesh.toml",
+            "nomesh.toml:3: [[motion]] mesh \"nothing\": no such mesh",
+        ),
+    ] {
+        let o = bounded(&dir, &["raytrace", file, "-o", "out.png"]);
+        refused(file, &o, expect, std::slice::from_ref(&out));
+    }
+    let o = bounded(&dir, &["raytrace", "sky.toml", "-o", "out.png"]);
+    assert!(
+        stderr(&o).contains("a 16384x16384 image needs"),
+        "{}",
+        stderr(&o)
+    );
+}

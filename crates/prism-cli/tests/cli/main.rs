@@ -1354,6 +1354,61 @@ fn envmap_lights_the_unlit_bunny() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The template's extras from a config: every one on, the settings read, both trees in
+/// `--stats`, the extras' rays in the ray tree with their shutter times; the environment map
+/// path is the config's folder's.
+#[test]
+fn raytrace_extras_from_a_config() {
+    let dir = scratch("raytrace-extras");
+    let sky = prism_image::Image::from_fn(8, 4, |x, y| [(x * 30) as u8, (y * 60) as u8, 200]);
+    prism_image::write_png(&dir.join("sky.png"), &sky).unwrap();
+    std::fs::write(
+        dir.join("extras.toml"),
+        "scene = \"cornell_box\"\nwindow_size = [24, 24]\n\
+         [features]\nenable_shading = true\nenable_recursive = true\nenable_accel_structure = true\n\
+         [features.extra]\nenable_depth_of_field = true\nenable_motion_blur = true\n\
+         enable_glossy_reflection = true\nenable_environment_mapping = true\n\
+         enable_mipmap_texture_filtering = true\n\
+         [[motion]]\nmesh = \"tallBox\"\nvelocity = [0.2, 0, 0]\n\
+         [extras]\ndof_aperture = 0.1\ndof_samples = 4\nmotion_samples = 4\nglossy_samples = 4\n\
+         environment_map = \"sky.png\"\nenvironment_strength = 0.5\n",
+    )
+    .unwrap();
+    let out = dir.join("x.png");
+    let o = prism()
+        .arg("raytrace")
+        .arg(dir.join("extras.toml"))
+        .args(["-q", "--stats", "--debug-pixel", "12,12", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(!err.contains("warning"), "{err}");
+    for line in [
+        "bvh: ",
+        "tree by binned SAH: SAH cost ",
+        "tree by median split: SAH cost ",
+    ] {
+        assert!(
+            err.lines().any(|l| l.starts_with(line)),
+            "{line} missing: {err}"
+        );
+    }
+    assert!(err.contains("(median split)"), "{err}");
+    let json = std::fs::read_to_string(dir.join("x.rays.json")).unwrap();
+    for kind in ["lens", "glossy", "environment"] {
+        assert!(
+            json.contains(&format!("\"kind\":\"{kind}\"")),
+            "{kind}: {json}"
+        );
+    }
+    assert!(json.contains("\"time\":"), "{json}");
+    let img = prism_image::read_png(&out).unwrap();
+    // The corners look past the box at the sky (blue 200 x 0.5 / 255).
+    assert!(img.pixels()[0][2] > 80, "{:?}", img.pixels()[0]);
+}
+
 /// `prism raytrace`: presets, configs with several cameras, the debug outputs, and every
 /// kind of bad OBJ, MTL or config input as a located error with exit 2 and no output.
 #[test]
