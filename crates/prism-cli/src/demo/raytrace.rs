@@ -1,5 +1,5 @@
 //! The gallery's Whitted ray-tracer pictures: the presets, feature switches side by side,
-//! bloom and its layer, a BVH level, and a pixel's ray tree.
+//! the template's extras, bloom and its layer, a BVH level, and a pixel's ray tree.
 
 use std::path::Path;
 
@@ -105,6 +105,8 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
             switches.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
         ),
     });
+    // The template's extras, each beside the plain picture.
+    extras(&dirs, &cam, &opts, &write_grid, entries)?;
     // Bloom on the teapot, and the layer it adds.
     // The teapot's highlight blooms; without the course's files, the built-in spheres.
     let (bloomed, scene) = match Preset::Teapot.load(&dirs) {
@@ -191,5 +193,95 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
             ),
         });
     }
+    Ok(())
+}
+
+/// The extras' panel: the Cornell box plain, with depth of field, with the tall box moving,
+/// with glossy reflection and under the demo's sky; and the textured cube's mip-mapping.
+fn extras(
+    dirs: &[std::path::PathBuf],
+    cam: &prism_scene::OrbitCamera,
+    opts: &dyn Fn(u32, prism_scene::Features) -> prism_render::whitted::film::RaytraceOptions,
+    write_grid: &dyn Fn(&str, &[prism_image::RgbImage], usize, u32, &[&str]) -> Result<()>,
+    entries: &mut Vec<Entry>,
+) -> Result<()> {
+    use prism_render::whitted::film::raytrace;
+    use prism_render::whitted::scene::{Environment, SceneSetup, Split, WhittedScene};
+    use prism_scene::{Features, Preset};
+    let user = |e: prism_scene::SceneError| crate::error::UserError::input(e);
+    let on = Features::prism_defaults();
+    let scene = Preset::CornellBox.load(dirs).map_err(user)?;
+    let tall = (scene.meshes.iter())
+        .position(|m| m.name == "tallBox")
+        .unwrap_or(0);
+    let ws = WhittedScene::prepare(
+        &scene,
+        SceneSetup {
+            bvh: Some(Split::Sah),
+            motion: vec![(tall, prism_math::Vec3::new(0.3, 0.0, 0.0))],
+            environment: Some(Environment::new(super::render::sky_map(), 1.0)),
+        },
+    );
+    let size = 200;
+    let mut panels = Vec::new();
+    let with = |f: Features| {
+        let mut o = opts(size, f);
+        o.settings.extras.dof_aperture = 0.1;
+        o.settings.extras.dof_focal_distance = Some(2.2);
+        raytrace(&ws, cam, &o, &|_| {}).image
+    };
+    panels.push(with(on));
+    for f in [
+        Features {
+            depth_of_field: true,
+            ..on
+        },
+        Features {
+            motion_blur: true,
+            ..on
+        },
+        Features {
+            glossy_reflection: true,
+            ..on
+        },
+        Features {
+            environment_mapping: true,
+            ..on
+        },
+    ] {
+        panels.push(with(f));
+    }
+    let cube = Preset::CubeTextured.load(dirs).map_err(user)?;
+    let cube = WhittedScene::new(&cube, true);
+    let far = prism_scene::OrbitCamera {
+        distance: 6.0,
+        ..*cam
+    };
+    let mip = Features { mipmap: true, ..on };
+    panels.push(raytrace(&cube, &far, &opts(size, mip), &|_| {}).image);
+    let labels = [
+        "plain",
+        "depth of field",
+        "motion blur",
+        "glossy",
+        "environment map",
+        "mip-mapped",
+    ];
+    let flags = [
+        "everything on",
+        "--dof-aperture 0.1 --dof-focal-distance 2.2",
+        "--motion tallBox=0.3,0,0",
+        "--enable glossy",
+        "--environment-map sky.exr",
+        "cube-textured at distance 6, --enable mipmap",
+    ];
+    write_grid("raytrace_extras.png", &panels, 3, size, &labels)?;
+    entries.push(Entry {
+        file: "raytrace_extras.png".into(),
+        caption: format!(
+            "the template's extras on cornell-box, left to right and down: {}",
+            flags.join("; ")
+        ),
+    });
     Ok(())
 }

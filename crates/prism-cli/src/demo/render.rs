@@ -33,7 +33,7 @@ fn trace(
 
 /// A small sky for the environment-map demo, in linear radiance: blue overhead fading to a
 /// pale horizon, a warm sun above the camera's right shoulder, and a dim brown ground.
-fn sky_map() -> prism_image::RgbImage {
+pub(super) fn sky_map() -> prism_image::RgbImage {
     let sun = prism_math::Vec3::new(0.5, 0.7, 0.6).normalize();
     Image::from_fn(128, 64, |x, y| {
         let uv = prism_math::Vec2::new((x as f32 + 0.5) / 128.0, (y as f32 + 0.5) / 64.0);
