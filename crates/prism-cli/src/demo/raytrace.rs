@@ -196,13 +196,17 @@ pub fn pictures(output: &Path, assets: Option<&Path>, entries: &mut Vec<Entry>) 
     Ok(())
 }
 
+/// Writes a labelled grid: file name, panels, columns, panel size, labels.
+type GridWriter<'a> =
+    dyn Fn(&str, &[prism_image::RgbImage], usize, u32, &[&str]) -> Result<()> + 'a;
+
 /// The extras' panel: the Cornell box plain, with depth of field, with the tall box moving,
 /// with glossy reflection and under the demo's sky; and the textured cube's mip-mapping.
 fn extras(
     dirs: &[std::path::PathBuf],
     cam: &prism_scene::OrbitCamera,
     opts: &dyn Fn(u32, prism_scene::Features) -> prism_render::whitted::film::RaytraceOptions,
-    write_grid: &dyn Fn(&str, &[prism_image::RgbImage], usize, u32, &[&str]) -> Result<()>,
+    write_grid: &GridWriter<'_>,
     entries: &mut Vec<Entry>,
 ) -> Result<()> {
     use prism_render::whitted::film::raytrace;
