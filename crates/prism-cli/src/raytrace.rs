@@ -224,7 +224,28 @@ fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
 struct RunExtras {
     settings: prism_scene::Extras,
     motion: Vec<(usize, prism_math::Vec3)>,
-    environment: Option<Environment>,
+    environment: Option<std::sync::Arc<prism_image::RgbImage>>,
+}
+
+impl RunExtras {
+    /// `scene`'s fingerprint with what the extras add to the scene (moving meshes, the
+    /// environment map's texels) folded in, so that parts of different runs do not merge.
+    fn fingerprint(&self, scene: u64) -> u64 {
+        let mut h = scene;
+        let mut add = |bits: u32| h = (h ^ u64::from(bits)).wrapping_mul(0x0100_0000_01b3);
+        for &(i, v) in &self.motion {
+            add(i as u32);
+            v.to_array().iter().for_each(|x| add(x.to_bits()));
+        }
+        if let Some(im) = &self.environment {
+            add(im.width());
+            add(im.height());
+            for p in im.pixels() {
+                [p.r, p.g, p.b].iter().for_each(|x| add(x.to_bits()));
+            }
+        }
+        h
+    }
 }
 
 /// Checks one extras flag's number: finite, at least `lo` (above it if `open`), at most
@@ -313,7 +334,6 @@ fn extras(
              --motion MESH=VX,VY,VZ"
         );
     }
-    let environment = image.map(|im| Environment::new((*im).clone(), e.environment_strength));
     Ok(RunExtras {
         settings: e,
         motion: if features.motion_blur {
@@ -322,7 +342,7 @@ fn extras(
             Vec::new()
         },
         environment: if features.environment_mapping {
-            environment
+            image
         } else {
             None
         },
@@ -552,7 +572,8 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
         SceneSetup {
             bvh: features.accel_structure.then_some(split),
             motion: extras.motion.clone(),
-            environment: extras.environment,
+            environment: (extras.environment.as_ref())
+                .map(|im| Environment::new((**im).clone(), extras.settings.environment_strength)),
         },
     );
     let build = t1.elapsed();
@@ -605,7 +626,7 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     let mut render_time = std::time::Duration::ZERO;
     let mut write_time = std::time::Duration::ZERO;
     if let Some((part, parts)) = a.tile {
-        let fingerprint = loaded.scene.fingerprint();
+        let fingerprint = extras.fingerprint(loaded.scene.fingerprint());
         for (ci, camera) in loaded.cameras.iter().enumerate() {
             let share = Share {
                 part,
