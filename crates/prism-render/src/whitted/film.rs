@@ -9,7 +9,7 @@ use prism_math::{Ray, Rgb};
 use rayon::prelude::*;
 
 use super::camera::OrbitView;
-use super::scene::WhittedScene;
+use super::scene::{WhittedHit, WhittedScene};
 use super::tracer::{
     stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
 };
@@ -82,6 +82,8 @@ struct Frame<'a> {
     opts: &'a RaytraceOptions,
     /// The distance of the plane in focus along the view axis.
     focus: f32,
+    /// The camera rays' cone spread ([`OrbitView::cone_spread`]).
+    spread: f32,
 }
 
 impl Frame<'_> {
@@ -90,11 +92,13 @@ impl Frame<'_> {
         camera: &prism_scene::OrbitCamera,
         opts: &'a RaytraceOptions,
     ) -> Frame<'a> {
+        let view = OrbitView::new(camera, opts.width, opts.height);
         Frame {
             scene,
-            view: OrbitView::new(camera, opts.width, opts.height),
+            view,
             opts,
             focus: (opts.settings.extras.dof_focal_distance).unwrap_or(camera.distance),
+            spread: view.cone_spread(),
         }
     }
 }
@@ -111,13 +115,14 @@ fn shutter_strata(opts: &RaytraceOptions, x: u32, row: u32, n: u32) -> Vec<u32> 
     order
 }
 
-/// The sums of the pixel at written position `(x, row)` (row 0 at the top), its single
-/// ray along `corner_dir` if given, with every ray recorded into `record` if given.
+/// The sums of the pixel at written position `(x, row)` (row 0 at the top), with every ray
+/// recorded into `record` if given. `first` is its one camera ray and that ray's closest
+/// hit, when the row's rays were traced together (one ray per pixel, no lens, no shutter).
 fn pixel(
     f: &Frame<'_>,
     x: u32,
     row: u32,
-    corner_dir: Option<prism_math::Vec3>,
+    first: Option<(Ray, Option<WhittedHit>)>,
     counts: &mut RayCounts,
     record: Option<&mut Vec<DebugRay>>,
 ) -> PixelSum {
@@ -149,11 +154,7 @@ fn pixel(
                 RayKind::Lens,
             )
         } else {
-            let ray = match corner_dir {
-                Some(d) if n == 1 => Ray::new(view.eye(), d),
-                _ => view.ray(x as f32 + jx, y as f32 + jy),
-            };
-            (ray, RayKind::Camera)
+            (view.ray(x as f32 + jx, y as f32 + jy), RayKind::Camera)
         };
         let mut tracer = WhittedTracer {
             scene,
@@ -162,9 +163,13 @@ fn pixel(
             counts: RayCounts::default(),
             record: rec.take(),
             time,
-            spread: view.cone_spread(),
+            spread: f.spread,
         };
-        px.accumulate(tracer.trace(&ray, 0, kind, 0.0));
+        let color = match first {
+            Some((ray, hit)) if n == 1 => tracer.trace_hit(&ray, 0, kind, 0.0, hit),
+            _ => tracer.trace(&ray, 0, kind, 0.0),
+        };
+        px.accumulate(color);
         counts.add(&tracer.counts);
         rec = tracer.record;
     }
@@ -184,8 +189,10 @@ pub fn raytrace(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Raytraced {
     let whole = Share::whole(rays_per_pixel(opts));
-    let (sums, counts) = raytrace_share(scene, camera, opts, &whole, progress);
-    with_bloom(sums.map(PixelSum::mean), counts, opts)
+    let (image, counts) = rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p| {
+        p.mean()
+    });
+    with_bloom(image, counts, opts)
 }
 
 /// Adds bloom to a Whitted image when `opts` turns it on.
@@ -231,29 +238,50 @@ pub fn raytrace_share(
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Image<PixelSum>, RayCounts) {
+    rows(scene, camera, opts, share, progress, PixelSum::default(), |p| p)
+}
+
+/// The pixel loop, row by row on rayon: each pixel of `share`'s tiles stored as `store`
+/// makes it of its sums, the others `empty`; and the rays cast. With one camera ray per
+/// pixel and neither lens nor shutter, a row's camera rays (through the pixels' corners)
+/// are traced together.
+fn rows<T: Copy + Send + Sync>(
+    scene: &WhittedScene,
+    camera: &prism_scene::OrbitCamera,
+    opts: &RaytraceOptions,
+    share: &Share,
+    progress: &(dyn Fn(u64) + Sync),
+    empty: T,
+    store: impl Fn(PixelSum) -> T + Sync,
+) -> (Image<T>, RayCounts) {
     let frame = Frame::new(scene, camera, opts);
     let view = frame.view;
+    let f = opts.settings.features;
+    let batched = rays_per_pixel(opts) == 1 && !f.depth_of_field && !f.motion_blur;
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
-    let mut sums = Image::new(opts.width, opts.height, PixelSum::default());
-    sums.pixels_mut()
+    let mut out = Image::new(opts.width, opts.height, empty);
+    out.pixels_mut()
         .par_chunks_mut(opts.width as usize)
         .enumerate()
         .for_each(|(row, line)| {
             let row = row as u32;
             let mut counts = RayCounts::default();
-            let mut dirs = Vec::new();
             let mine = |x: u32| share.has_tile(tile_of(x, row, opts.width));
-            if (0..opts.width).any(mine) {
-                if rays_per_pixel(opts) == 1 && !opts.settings.features.depth_of_field {
-                    view.corner_directions(opts.height - 1 - row, &mut dirs);
-                }
-                for (x, p) in line.iter_mut().enumerate() {
-                    let x = x as u32;
-                    if mine(x) {
-                        let d = dirs.get(x as usize).copied();
-                        *p = pixel(&frame, x, row, d, &mut counts, None);
-                    }
+            let mut firsts: Vec<Option<(Ray, Option<WhittedHit>)>> = Vec::new();
+            if batched && (0..opts.width).any(mine) {
+                let mut dirs = Vec::new();
+                view.corner_directions(opts.height - 1 - row, &mut dirs);
+                let rays: Vec<Ray> = dirs.iter().map(|&d| Ray::new(view.eye(), d)).collect();
+                let mut hits = Vec::new();
+                scene.intersect_batch(&rays, f.normal_interp, &mut hits);
+                firsts = rays.into_iter().zip(hits).map(Some).collect();
+            }
+            for (x, p) in line.iter_mut().enumerate() {
+                let x32 = x as u32;
+                if mine(x32) {
+                    let first = firsts.get(x).copied().flatten();
+                    *p = store(pixel(&frame, x32, row, first, &mut counts, None));
                 }
             }
             totals
@@ -264,7 +292,7 @@ pub fn raytrace_share(
             progress(d);
         });
     let counts = totals.into_inner().expect("no panics under the lock");
-    (sums, counts)
+    (out, counts)
 }
 
 /// One pixel's ray tree, for visual debugging.

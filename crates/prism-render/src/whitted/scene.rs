@@ -509,7 +509,37 @@ impl WhittedScene {
         interpolate: bool,
         time: f32,
     ) -> Option<WhittedHit> {
-        let (t, prim, b1, b2) = self.closest(ray, tmax, time)?;
+        let found = self.closest(ray, tmax, time)?;
+        Some(self.hit(ray, found, interpolate))
+    }
+
+    /// [`WhittedScene::intersect`] for each ray of `rays` (unit directions, from the
+    /// camera, nothing moving): `hits[i]` for `rays[i]`, the same hits, the BVH walking the
+    /// rays together.
+    pub fn intersect_batch(
+        &self,
+        rays: &[Ray],
+        interpolate: bool,
+        hits: &mut Vec<Option<WhittedHit>>,
+    ) {
+        hits.clear();
+        match &self.bvh {
+            Some(bvh) if self.movers.is_empty() => {
+                let mut found = vec![None; rays.len()];
+                bvh.intersect_batch(rays, 0.0, f32::INFINITY, &mut found);
+                hits.extend(rays.iter().zip(found).map(|(ray, h)| {
+                    h.map(|h| self.hit(ray, (h.t, h.prim, h.b1, h.b2), interpolate))
+                }));
+            }
+            _ => hits.extend(
+                (rays.iter()).map(|ray| self.intersect(ray, f32::INFINITY, interpolate)),
+            ),
+        }
+    }
+
+    /// What shading needs of the closest hit `(t, primitive, b1, b2)` along `ray`.
+    fn hit(&self, ray: &Ray, found: (f32, u32, f32, f32), interpolate: bool) -> WhittedHit {
+        let (t, prim, b1, b2) = found;
         let p = ray.origin + t * ray.dir;
         let nt = self.triangles.len() as u32;
         let (mut n_g, mut n_s, uv, material, surface) = if prim < nt {
@@ -536,7 +566,7 @@ impl WhittedScene {
             n_g = -n_g;
             n_s = -n_s;
         }
-        Some(WhittedHit {
+        WhittedHit {
             t,
             p,
             n_g,
@@ -544,6 +574,6 @@ impl WhittedScene {
             uv,
             material,
             surface,
-        })
+        }
     }
 }

@@ -205,15 +205,28 @@ impl WhittedTracer<'_> {
     /// The colour seen along `ray` (unit direction), `depth` bounces after the camera;
     /// `width` is its cone's width at its origin (0 from the camera).
     pub fn trace(&mut self, ray: &Ray, depth: u32, kind: RayKind, width: f32) -> Rgb {
+        let f = self.settings.features;
+        let hit = self
+            .scene
+            .intersect_at(ray, f32::INFINITY, f.normal_interp, self.time);
+        self.trace_hit(ray, depth, kind, width, hit)
+    }
+
+    /// [`WhittedTracer::trace`] for a ray whose closest hit (at this tracer's time, with
+    /// its normals as the features say) is known: `hit`.
+    pub fn trace_hit(
+        &mut self,
+        ray: &Ray,
+        depth: u32,
+        kind: RayKind,
+        width: f32,
+        hit: Option<WhittedHit>,
+    ) -> Rgb {
         match kind {
             RayKind::Camera | RayKind::Lens => self.counts.camera += 1,
             RayKind::Reflection | RayKind::Glossy => self.counts.reflection += 1,
             _ => self.counts.transmission += 1,
         }
-        let f = self.settings.features;
-        let hit = self
-            .scene
-            .intersect_at(ray, f32::INFINITY, f.normal_interp, self.time);
         let time = self.time_tag();
         let slot = self.push(|_| DebugRay {
             kind,
