@@ -67,10 +67,18 @@ impl ExactSum {
     /// The sum as a float, rounded to nearest.
     #[must_use]
     pub fn value(self) -> f64 {
-        // Both conversions round to nearest; the 64-bit one is one instruction.
-        match i64::try_from(self.0) {
-            Ok(v) => v as f64 / SCALE,
-            Err(_) => self.0 as f64 / SCALE,
+        // Both conversions round to nearest; the 64-bit one is one instruction, and the
+        // 128-bit one (a library call) is kept off the common path.
+        #[cold]
+        #[inline(never)]
+        fn wide(v: i128) -> f64 {
+            v as f64 / SCALE
+        }
+        let small = self.0 as i64;
+        if i128::from(small) == self.0 {
+            small as f64 / SCALE
+        } else {
+            wide(self.0)
         }
     }
 

@@ -154,7 +154,10 @@ fn pixel(
                 RayKind::Lens,
             )
         } else {
-            (view.ray(x as f32 + jx, y as f32 + jy), RayKind::Camera)
+            match first {
+                Some((ray, _)) if n == 1 => (ray, RayKind::Camera),
+                _ => (view.ray(x as f32 + jx, y as f32 + jy), RayKind::Camera),
+            }
         };
         let mut tracer = WhittedTracer {
             scene,
@@ -267,7 +270,8 @@ fn rows<T: Copy + Send + Sync>(
         .for_each(|(row, line)| {
             let row = row as u32;
             let mut counts = RayCounts::default();
-            let mine = |x: u32| share.has_tile(tile_of(x, row, opts.width));
+            let whole = share.parts <= 1;
+            let mine = |x: u32| whole || share.has_tile(tile_of(x, row, opts.width));
             let mut firsts: Vec<Option<(Ray, Option<WhittedHit>)>> = Vec::new();
             if batched && (0..opts.width).any(mine) {
                 let mut dirs = Vec::new();
