@@ -75,27 +75,28 @@ impl OrbitView {
     /// ...` of row `y` (counted from the bottom), the same bits as [`OrbitView::ray`] gives,
     /// computed a row at a time so that the square roots and divisions run on SIMD lanes.
     pub fn corner_directions(&self, y: u32, out: &mut Vec<Vec3>) {
+        const LANES: usize = 16;
         let n = self.width as usize;
         let ly = (2.0 * y as f32 / self.height - 1.0) * self.hh;
-        let lx: Vec<f32> = (0..n)
-            .map(|x| -(2.0 * x as f32 / self.width - 1.0) * self.hw)
-            .collect();
-        // As `Vec3::normalize`: times the reciprocal of the length, x, y, z summed in order.
-        let r1: Vec<f32> = lx
-            .iter()
-            .map(|&x| 1.0 / (x * x + ly * ly + 1.0).sqrt())
-            .collect();
-        let w: Vec<Vec3> = lx
-            .iter()
-            .zip(&r1)
-            .map(|(&x, &r)| self.world_from_camera.vector(Vec3::new(x * r, ly * r, r)))
-            .collect();
-        let r2: Vec<f32> = w
-            .iter()
-            .map(|v| 1.0 / (v.x * v.x + v.y * v.y + v.z * v.z).sqrt())
-            .collect();
         out.clear();
-        out.extend(w.iter().zip(&r2).map(|(&v, &r)| v * r));
+        for start in (0..n).step_by(LANES) {
+            let m = LANES.min(n - start);
+            let mut lx = [0f32; LANES];
+            for (k, v) in lx.iter_mut().enumerate() {
+                *v = -(2.0 * (start + k) as f32 / self.width - 1.0) * self.hw;
+            }
+            // As `Vec3::normalize`: times the reciprocal of the length, x, y, z summed in order.
+            let r1 = lx.map(|x| 1.0 / (x * x + ly * ly + 1.0).sqrt());
+            let mut w = [Vec3::ZERO; LANES];
+            for k in 0..LANES {
+                let r = r1[k];
+                w[k] = self
+                    .world_from_camera
+                    .vector(Vec3::new(lx[k] * r, ly * r, r));
+            }
+            let r2 = w.map(|v| 1.0 / (v.x * v.x + v.y * v.y + v.z * v.z).sqrt());
+            out.extend((0..m).map(|k| w[k] * r2[k]));
+        }
     }
 
     /// Where a world point lands: `(x, y from the top, depth along the view axis)` in

@@ -244,6 +244,15 @@ pub fn raytrace_share(
     rows(scene, camera, opts, share, progress, PixelSum::default(), |p| p)
 }
 
+/// A worker's buffers for one row at a time: corner directions, camera rays, their hits.
+#[derive(Default)]
+struct RowScratch {
+    dirs: Vec<prism_math::Vec3>,
+    rays: Vec<Ray>,
+    hits: Vec<Option<WhittedHit>>,
+    found: Vec<Option<prism_accel::Hit>>,
+}
+
 /// The pixel loop, row by row on rayon: each pixel of `share`'s tiles stored as `store`
 /// makes it of its sums, the others `empty`; and the rays cast. With one camera ray per
 /// pixel and neither lens nor shutter, a row's camera rays (through the pixels' corners)
@@ -267,24 +276,27 @@ fn rows<T: Copy + Send + Sync>(
     out.pixels_mut()
         .par_chunks_mut(opts.width as usize)
         .enumerate()
-        .for_each(|(row, line)| {
+        .for_each_init(RowScratch::default, |scratch, (row, line)| {
             let row = row as u32;
             let mut counts = RayCounts::default();
             let whole = share.parts <= 1;
             let mine = |x: u32| whole || share.has_tile(tile_of(x, row, opts.width));
-            let mut firsts: Vec<Option<(Ray, Option<WhittedHit>)>> = Vec::new();
+            let RowScratch {
+                dirs,
+                rays,
+                hits,
+                found,
+            } = scratch;
+            rays.clear();
             if batched && (0..opts.width).any(mine) {
-                let mut dirs = Vec::new();
-                view.corner_directions(opts.height - 1 - row, &mut dirs);
-                let rays: Vec<Ray> = dirs.iter().map(|&d| Ray::new(view.eye(), d)).collect();
-                let mut hits = Vec::new();
-                scene.intersect_batch(&rays, f.normal_interp, &mut hits);
-                firsts = rays.into_iter().zip(hits).map(Some).collect();
+                view.corner_directions(opts.height - 1 - row, dirs);
+                rays.extend(dirs.iter().map(|&d| Ray::new(view.eye(), d)));
+                scene.intersect_batch(rays, f.normal_interp, hits, found);
             }
             for (x, p) in line.iter_mut().enumerate() {
                 let x32 = x as u32;
                 if mine(x32) {
-                    let first = firsts.get(x).copied().flatten();
+                    let first = rays.get(x).map(|&r| (r, hits[x]));
                     *p = store(pixel(&frame, x32, row, first, &mut counts, None));
                 }
             }

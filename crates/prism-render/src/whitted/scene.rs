@@ -515,19 +515,21 @@ impl WhittedScene {
 
     /// [`WhittedScene::intersect`] for each ray of `rays` (unit directions, from the
     /// camera, nothing moving): `hits[i]` for `rays[i]`, the same hits, the BVH walking the
-    /// rays together.
+    /// rays together (`found` holds its answers on the way).
     pub fn intersect_batch(
         &self,
         rays: &[Ray],
         interpolate: bool,
         hits: &mut Vec<Option<WhittedHit>>,
+        found: &mut Vec<Option<prism_accel::Hit>>,
     ) {
         hits.clear();
         match &self.bvh {
             Some(bvh) if self.movers.is_empty() => {
-                let mut found = vec![None; rays.len()];
-                bvh.intersect_batch(rays, 0.0, f32::INFINITY, &mut found);
-                hits.extend(rays.iter().zip(found).map(|(ray, h)| {
+                found.clear();
+                found.resize(rays.len(), None);
+                bvh.intersect_batch(rays, 0.0, f32::INFINITY, found);
+                hits.extend(rays.iter().zip(found.iter()).map(|(ray, h)| {
                     h.map(|h| self.hit(ray, (h.t, h.prim, h.b1, h.b2), interpolate))
                 }));
             }
