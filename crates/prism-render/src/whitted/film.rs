@@ -118,6 +118,7 @@ fn shutter_strata(opts: &RaytraceOptions, x: u32, row: u32, n: u32) -> Vec<u32> 
 /// The sums of the pixel at written position `(x, row)` (row 0 at the top), with every ray
 /// recorded into `record` if given. `first` is its one camera ray and that ray's closest
 /// hit, when the row's rays were traced together (one ray per pixel, no lens, no shutter).
+#[inline(always)]
 fn pixel(
     f: &Frame<'_>,
     x: u32,
