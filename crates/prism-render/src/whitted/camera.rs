@@ -1,5 +1,5 @@
 //! [`OrbitView`], the Delft ray tracer's camera: rays through pixel corners counted from the
-//! bottom-left, a row of corner directions at a time, thin-lens rays, ray cones' spread,
+//! bottom-left, a row of corner rays at a time, thin-lens rays, ray cones' spread,
 //! and world points projected back to pixels for overlays.
 
 use prism_math::{Ray, Vec2, Vec3};
@@ -71,10 +71,10 @@ impl OrbitView {
         2.0 * (0.5 * alpha).tan()
     }
 
-    /// The directions of the rays through the lower-left corners of the pixels `x = 0, 1,
-    /// ...` of row `y` (counted from the bottom), the same bits as [`OrbitView::ray`] gives,
-    /// computed a row at a time so that the square roots and divisions run on SIMD lanes.
-    pub fn corner_directions(&self, y: u32, out: &mut Vec<Vec3>) {
+    /// The rays through the lower-left corners of the pixels `x = 0, 1, ...` of row `y`
+    /// (counted from the bottom), the same bits as [`OrbitView::ray`] gives, computed
+    /// sixteen at a time so that the square roots and divisions run on SIMD lanes.
+    pub fn corner_rays(&self, y: u32, out: &mut Vec<Ray>) {
         const LANES: usize = 16;
         let n = self.width as usize;
         let ly = (2.0 * y as f32 / self.height - 1.0) * self.hh;
@@ -95,7 +95,7 @@ impl OrbitView {
                     .vector(Vec3::new(lx[k] * r, ly * r, r));
             }
             let r2 = w.map(|v| 1.0 / (v.x * v.x + v.y * v.y + v.z * v.z).sqrt());
-            out.extend((0..m).map(|k| w[k] * r2[k]));
+            out.extend((0..m).map(|k| Ray::new(self.eye, w[k] * r2[k])));
         }
     }
 

@@ -245,10 +245,9 @@ pub fn raytrace_share(
     rows(scene, camera, opts, share, progress, PixelSum::default(), |p| p)
 }
 
-/// A worker's buffers for one row at a time: corner directions, camera rays, their hits.
+/// A worker's buffers for one row at a time: camera rays and their hits.
 #[derive(Default)]
 struct RowScratch {
-    dirs: Vec<prism_math::Vec3>,
     rays: Vec<Ray>,
     hits: Vec<Option<WhittedHit>>,
     found: Vec<Option<prism_accel::Hit>>,
@@ -282,16 +281,10 @@ fn rows<T: Copy + Send + Sync>(
             let mut counts = RayCounts::default();
             let whole = share.parts <= 1;
             let mine = |x: u32| whole || share.has_tile(tile_of(x, row, opts.width));
-            let RowScratch {
-                dirs,
-                rays,
-                hits,
-                found,
-            } = scratch;
+            let RowScratch { rays, hits, found } = scratch;
             rays.clear();
             if batched && (0..opts.width).any(mine) {
-                view.corner_directions(opts.height - 1 - row, dirs);
-                rays.extend(dirs.iter().map(|&d| Ray::new(view.eye(), d)));
+                view.corner_rays(opts.height - 1 - row, rays);
                 scene.intersect_batch(rays, f.normal_interp, hits, found);
             }
             for (x, p) in line.iter_mut().enumerate() {

@@ -513,13 +513,15 @@ fn row_directions_equal_single_rays_bit_for_bit() {
             ..OrbitCamera::default()
         };
         let view = prism_render::whitted::camera::OrbitView::new(&cam, w, h);
-        let mut dirs = Vec::new();
+        let mut rays = Vec::new();
         for y in 0..h {
-            view.corner_directions(y, &mut dirs);
-            for (x, d) in dirs.iter().enumerate() {
+            view.corner_rays(y, &mut rays);
+            assert_eq!(rays.len(), w as usize);
+            for (x, d) in rays.iter().enumerate() {
                 let r = view.ray(x as f32, y as f32);
+                assert_eq!(d.origin, r.origin);
                 assert_eq!(
-                    d.to_array().map(f32::to_bits),
+                    d.dir.to_array().map(f32::to_bits),
                     r.dir.to_array().map(f32::to_bits)
                 );
             }
