@@ -2,12 +2,13 @@
 //! a course SVG at 1024x1024 and 16 samples per pixel, one progressive pass of the Cornell
 //! box at 512x384, a 50x50 cloth simulated and shaded at 1024x800, and a mesh of over 100k
 //! triangles (the course's beetle, Loop-subdivided twice) orbited at 960x720, with and
-//! without its wireframe. Median and spread of 15 frames each, after 3 to warm up.
+//! without its wireframe, and the Whitted ray tracer orbiting the Cornell box at 800x800
+//! (its previews, and the full frame it refines to). Median and spread of 15 frames each, after 3 to warm up.
 
 use std::time::Instant;
 
 use prism_raster::{read_svg, Dialect};
-use prism_view::{ClothMode, Input, Key, MeshMode, PathMode, SvgMode, Viewer};
+use prism_view::{ClothMode, Input, Key, MeshMode, PathMode, SvgMode, Viewer, WhittedMode};
 
 fn measure(name: &str, viewer: &mut Viewer, next: &mut dyn FnMut(&mut Viewer)) {
     let mut times = Vec::new();
@@ -103,4 +104,45 @@ fn main() {
             ctrl: false,
         });
     }
+
+    // The Whitted ray tracer orbiting the mirror Cornell box: previews while the camera
+    // moves, and the full-resolution frame it refines to once it rests.
+    let scene = prism_scene::Preset::CornellBox
+        .load(&[assets.join("delft-raytracer/data")])
+        .expect("the Cornell box");
+    let whitted = |rest| {
+        let mode = WhittedMode::new(
+            scene.clone(),
+            "cornell-box",
+            prism_scene::OrbitCamera::default(),
+            prism_scene::Features::prism_defaults(),
+        )
+        .with_rest(rest);
+        Viewer::new(Box::new(mode), 800, 800)
+    };
+    let mut v = whitted(std::time::Duration::from_secs(86_400));
+    let mut x = 100.0;
+    v.input(Input::Cursor { x, y: 100.0 });
+    v.input(Input::Button(true));
+    measure(
+        "whitted cornell-box, 800x800, orbiting (half-resolution previews)",
+        &mut v,
+        &mut |v| {
+            x += 2.0;
+            v.input(Input::Cursor { x, y: 100.0 });
+        },
+    );
+    let mut v = whitted(std::time::Duration::ZERO);
+    v.input(Input::Cursor { x, y: 100.0 });
+    v.input(Input::Button(true));
+    measure(
+        "whitted cornell-box, 800x800, the full-resolution frame after a move",
+        &mut v,
+        &mut |v| {
+            x += 2.0;
+            v.input(Input::Cursor { x, y: 100.0 });
+            // The preview, then (no rest to wait for) the refined frame is measured.
+            v.frame();
+        },
+    );
 }

@@ -1,7 +1,10 @@
 //! [`WhittedMode`]: the Delft ray tracer with its visual debugging in the window: feature
 //! switches as keys, a click on a pixel traces its ray tree (coloured as `prism raytrace
 //! --debug-pixel` colours it) and keeps it in the scene while the camera orbits, and the BVH
-//! shown level by level and leaf by leaf.
+//! shown level by level and leaf by leaf. While the camera moves, frames are traced at half
+//! the width and height; once it rests, at full resolution.
+
+use std::time::{Duration, Instant};
 
 use prism_image::{Bloom, Rgb8Image, RgbImage};
 use prism_render::whitted::camera::OrbitView;
@@ -32,7 +35,18 @@ pub struct WhittedMode {
     cursor: (f64, f64),
     press: Option<(f64, f64)>,
     last: (f64, f64),
+    /// The camera moved since the last full-resolution picture: the next one is a preview.
+    moving: bool,
+    /// The picture is a preview (half width and height, scaled up) still to be refined.
+    preview: bool,
+    /// When the camera last moved.
+    moved_at: Instant,
+    /// How long the camera must rest before the picture is refined.
+    rest: Duration,
 }
+
+/// How long the camera rests before a preview is traced again at full resolution.
+pub const REST: Duration = Duration::from_millis(150);
 
 impl WhittedMode {
     /// A viewer of `scene` (named `name`) through `camera`, with `features` on.
@@ -52,7 +66,24 @@ impl WhittedMode {
             cursor: (0.0, 0.0),
             press: None,
             last: (0.0, 0.0),
+            moving: false,
+            preview: false,
+            moved_at: Instant::now(),
+            rest: REST,
         }
+    }
+
+    /// The mode with another rest before refining (zero refines at the next frame).
+    #[must_use]
+    pub fn with_rest(mut self, rest: Duration) -> WhittedMode {
+        self.rest = rest;
+        self
+    }
+
+    /// True while the picture is a half-resolution preview.
+    #[must_use]
+    pub fn previewing(&self) -> bool {
+        self.preview
     }
 
     /// The ray tree of the pixel clicked last.
@@ -85,6 +116,15 @@ impl WhittedMode {
 
     fn changed(&mut self) -> Response {
         self.base = None;
+        self.moving = false;
+        Response::Redraw
+    }
+
+    /// The camera moved: the next picture is a preview.
+    fn moved(&mut self) -> Response {
+        self.base = None;
+        self.moving = true;
+        self.moved_at = Instant::now();
         Response::Redraw
     }
 }
@@ -102,7 +142,7 @@ impl Mode for WhittedMode {
         vec![
             ("click", "trace the pixel's rays and keep them in the scene"),
             ("X", "clear the rays"),
-            ("drag", "orbit the camera"),
+            ("drag", "orbit the camera (half resolution until it rests)"),
             ("wheel", "move the camera closer or farther"),
             (
                 "1-9 0 M",
@@ -173,7 +213,7 @@ impl Mode for WhittedMode {
                 self.camera.rotation.y -= dx * per_pixel;
                 self.camera.rotation.x =
                     (self.camera.rotation.x + dy * per_pixel).clamp(-89.0, 89.0);
-                self.changed()
+                self.moved()
             }
             Input::Button(true) => {
                 self.press = Some(self.cursor);
@@ -202,7 +242,7 @@ impl Mode for WhittedMode {
             Input::Wheel(lines) => {
                 self.camera.distance =
                     (self.camera.distance * 0.9f32.powf(lines as f32)).clamp(1e-3, 1e6);
-                self.changed()
+                self.moved()
             }
             Input::Resize { .. } => self.changed(),
             Input::Key { .. } => Response::Ignored,
@@ -214,9 +254,21 @@ impl Mode for WhittedMode {
             .base
             .as_ref()
             .is_none_or(|b| (b.width(), b.height()) != (width, height));
-        if stale {
+        let rested = self.preview && self.moved_at.elapsed() >= self.rest;
+        if stale && self.moving {
+            // A preview: half the width and height, each pixel drawn as a 2 x 2 block.
+            let (w, h) = (width.div_ceil(2), height.div_ceil(2));
+            let opts = self.options(w, h);
+            let small = raytrace(&self.scene, &self.camera, &opts, &|_| {}).image;
+            self.base = Some(RgbImage::from_fn(width, height, |x, y| {
+                small.get(x / 2, y / 2)
+            }));
+            self.moving = false;
+            self.preview = true;
+        } else if stale || rested {
             let opts = self.options(width, height);
             self.base = Some(raytrace(&self.scene, &self.camera, &opts, &|_| {}).image);
+            self.preview = false;
         }
         let base = self.base.as_ref().expect("drawn above");
         if self.trace.is_none() && self.level.is_none() && self.leaf.is_none() {
@@ -238,6 +290,10 @@ impl Mode for WhittedMode {
         }
         ov.bvh(&self.scene, self.level, self.leaf);
         ov.image.to_rgb8_truncated()
+    }
+
+    fn busy(&self) -> bool {
+        self.preview
     }
 
     fn status(&self) -> String {

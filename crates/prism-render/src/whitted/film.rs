@@ -242,7 +242,15 @@ pub fn raytrace_share(
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Image<PixelSum>, RayCounts) {
-    rows(scene, camera, opts, share, progress, PixelSum::default(), |p| p)
+    rows(
+        scene,
+        camera,
+        opts,
+        share,
+        progress,
+        PixelSum::default(),
+        |p| p,
+    )
 }
 
 /// A worker's buffers for one row at a time: camera rays and their hits.

@@ -533,9 +533,8 @@ impl WhittedScene {
                     h.map(|h| self.hit(ray, (h.t, h.prim, h.b1, h.b2), interpolate))
                 }));
             }
-            _ => hits.extend(
-                (rays.iter()).map(|ray| self.intersect(ray, f32::INFINITY, interpolate)),
-            ),
+            _ => hits
+                .extend((rays.iter()).map(|ray| self.intersect(ray, f32::INFINITY, interpolate))),
         }
     }
 

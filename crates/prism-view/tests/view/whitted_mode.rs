@@ -97,3 +97,75 @@ fn drags_features_and_bvh_keys() {
     v.input(key(']'));
     assert_eq!(v.message(), Some("the BVH is off (8 turns it on)"));
 }
+
+/// Oracle: the batch ray tracer at half and at full resolution. While the camera moves the
+/// picture is the half-width, half-height render with each pixel drawn as a 2 x 2 block,
+/// and the mode stays busy; once the camera has rested, the next frame is the full render
+/// from the new camera and the mode is idle. Keys draw at full resolution at once.
+#[test]
+fn orbiting_previews_at_half_resolution_then_refines() {
+    let scene = Preset::from_name("cornell-box").unwrap().load(&[]).unwrap();
+    let camera = OrbitCamera::default();
+    let mode = WhittedMode::new(
+        scene.clone(),
+        "cornell-box",
+        camera,
+        Features::prism_defaults(),
+    );
+    // A rest of a whole day: the preview stays until asked.
+    let mode = mode.with_rest(std::time::Duration::from_secs(86_400));
+    let mut v = Viewer::new(Box::new(mode), 80, 60);
+    let ws = WhittedScene::new(&scene, true);
+    v.picture();
+    v.input(Input::Cursor { x: 10.0, y: 10.0 });
+    v.input(Input::Button(true));
+    v.input(Input::Cursor { x: 30.0, y: 14.0 });
+    // The drag's camera: 180 degrees across the window's width.
+    let per_pixel = 180.0 / 80.0;
+    let moved = OrbitCamera {
+        rotation: prism_math::Vec3::new(
+            camera.rotation.x + 4.0 * per_pixel,
+            camera.rotation.y - 20.0 * per_pixel,
+            0.0,
+        ),
+        ..camera
+    };
+    let half = RaytraceOptions {
+        width: 40,
+        height: 30,
+        ..options()
+    };
+    let small = raytrace(&ws, &moved, &half, &|_| {})
+        .image
+        .to_rgb8_truncated();
+    let preview = v.picture().clone();
+    assert_eq!((preview.width(), preview.height()), (80, 60));
+    for y in 0..60 {
+        for x in 0..80 {
+            assert_eq!(preview.get(x, y), small.get(x / 2, y / 2), "pixel {x},{y}");
+        }
+    }
+    assert!(v.busy());
+    // Still moving: the preview holds.
+    assert_eq!(v.picture(), &preview);
+    v.input(Input::Button(false));
+    // A key draws at full resolution at once.
+    v.input(key('1'));
+    v.input(key('1'));
+    let full = raytrace(&ws, &moved, &options(), &|_| {})
+        .image
+        .to_rgb8_truncated();
+    assert_eq!(v.picture(), &full);
+    assert!(!v.busy());
+    // With no rest to wait for, the first frame after the motion is refined.
+    let mode = WhittedMode::new(scene, "cornell-box", camera, Features::prism_defaults())
+        .with_rest(std::time::Duration::ZERO);
+    let mut v = Viewer::new(Box::new(mode), 80, 60);
+    v.input(Input::Cursor { x: 10.0, y: 10.0 });
+    v.input(Input::Button(true));
+    v.input(Input::Cursor { x: 30.0, y: 14.0 });
+    assert_eq!(v.picture(), &preview);
+    assert!(v.busy());
+    assert_eq!(v.picture(), &full);
+    assert!(!v.busy());
+}
