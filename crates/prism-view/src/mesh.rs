@@ -4,11 +4,13 @@
 //! normals, `W` wireframe, `Ctrl+Z` undo, `Ctrl+S` save as `NAME-edited.obj` (or `-2`, `-3`, ... if taken). An operation
 //! the mesh cannot take says why on the status line and changes nothing.
 
+use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
 
+use prism_accel::{BuildOptions, Bvh};
 use prism_image::Rgb8Image;
 use prism_math::glam::DVec3;
-use prism_math::{Rgb, Vec3};
+use prism_math::{Ray, Rgb, Vec3};
 use prism_mesh::{loop_subdivide, EdgeId, FaceId, HalfedgeMesh, LoopWeights, VertexId};
 use prism_shade::{shade_rgb8, ShadeMesh, ShadeOptions, Shader, Uniforms, View};
 
@@ -43,6 +45,36 @@ pub struct MeshMode {
     home: (Vec3, f32),
     hover: Option<Hover>,
     cursor: (f64, f64),
+    /// The faces' BVH for picking, built at the first hover after a change.
+    picker: OnceCell<Picker>,
+}
+
+/// The mesh's faces as triangles (fans from their first corner) in prism's one BVH, and
+/// the face each triangle belongs to.
+struct Picker {
+    bvh: Bvh,
+    face_of: Vec<FaceId>,
+}
+
+impl Picker {
+    fn new(m: &HalfedgeMesh) -> Picker {
+        let mut triangles = Vec::new();
+        let mut face_of = Vec::new();
+        for fi in 0..m.face_count() as u32 {
+            let f = FaceId(fi);
+            let corners: Vec<Vec3> = (m.face_halfedges(f))
+                .map(|h| m.position(m.origin(h)).as_vec3())
+                .collect();
+            for i in 1..corners.len().saturating_sub(1) {
+                triangles.push([corners[0], corners[i], corners[i + 1]]);
+                face_of.push(f);
+            }
+        }
+        Picker {
+            bvh: Bvh::build(&triangles, &[], &BuildOptions::default()),
+            face_of,
+        }
+    }
 }
 
 /// The mesh drawn: fans of its faces, one vertex per corner for flat normals.
@@ -86,6 +118,7 @@ impl MeshMode {
             home: (centre, radius),
             hover: None,
             cursor: (0.0, 0.0),
+            picker: OnceCell::new(),
         }
     }
 
@@ -122,26 +155,14 @@ impl MeshMode {
         let inverse = view.clip_from_world().ok()?.inverse();
         let ndc_x = (2.0 * x / f64::from(size.0) - 1.0) as f32;
         let ndc_y = (1.0 - 2.0 * y / f64::from(size.1)) as f32;
-        let o = inverse.point(Vec3::new(ndc_x, ndc_y, -1.0)).as_dvec3();
-        let far = inverse.point(Vec3::new(ndc_x, ndc_y, 1.0)).as_dvec3();
+        let o = inverse.point(Vec3::new(ndc_x, ndc_y, -1.0));
+        let far = inverse.point(Vec3::new(ndc_x, ndc_y, 1.0));
         let d = (far - o).normalize_or_zero();
         let m = &self.mesh;
-        let mut best: Option<(f64, FaceId, DVec3)> = None;
-        for fi in 0..m.face_count() as u32 {
-            let f = FaceId(fi);
-            let corners: Vec<DVec3> = m
-                .face_halfedges(f)
-                .map(|h| m.position(m.origin(h)))
-                .collect();
-            for i in 1..corners.len().saturating_sub(1) {
-                if let Some(t) = hit(o, d, corners[0], corners[i], corners[i + 1]) {
-                    if best.is_none_or(|b| t < b.0) {
-                        best = Some((t, f, o + d * t));
-                    }
-                }
-            }
-        }
-        let (_, f, p) = best?;
+        let picker = self.picker.get_or_init(|| Picker::new(m));
+        let found = picker.bvh.intersect(&Ray::new(o, d), 0.0, f32::INFINITY)?;
+        let f = picker.face_of[found.prim as usize];
+        let p = o.as_dvec3() + d.as_dvec3() * f64::from(found.t);
         // The nearest corner or side of the face, if near enough; else the face.
         let hs: Vec<_> = m.face_halfedges(f).collect();
         let size_of = hs
@@ -201,6 +222,7 @@ impl MeshMode {
         }
         self.shade = shade_mesh(&self.mesh, self.flat);
         self.hover = None;
+        self.picker = OnceCell::new();
     }
 
     fn save(&self) -> Response {
@@ -229,22 +251,6 @@ impl MeshMode {
             Err(e) => Response::Message(format!("not saved: {e}")),
         }
     }
-}
-
-/// Distance along `d` from `o` to triangle `abc` (Moller-Trumbore), if hit in front.
-fn hit(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
-    let (e1, e2) = (b - a, c - a);
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-14 {
-        return None;
-    }
-    let s = o - a;
-    let u = s.dot(p) / det;
-    let q = s.cross(e1);
-    let v = d.dot(q) / det;
-    let t = e2.dot(q) / det;
-    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
 }
 
 /// Distance from `p` to the segment `ab`.
@@ -290,6 +296,7 @@ impl Mode for MeshMode {
                         self.mesh = m;
                         self.shade = shade_mesh(&self.mesh, self.flat);
                         self.hover = None;
+                        self.picker = OnceCell::new();
                         Response::Message("undone".into())
                     }
                     None => Response::Message("nothing to undo".into()),
