@@ -1534,8 +1534,8 @@ fn raytrace_scenes_debugging_and_errors() {
             "kitchen: no such file or preset; presets: single-triangle".to_string(),
         ),
         (
-            vec!["cube".into(), "--enable".into(), "glossy".into()],
-            "--enable glossy: expected one of".to_string(),
+            vec!["cube".into(), "--enable".into(), "shiny".into()],
+            "--enable shiny: expected one of".to_string(),
         ),
         (
             vec!["cube".into(), "--debug-pixel".into(), "900,1".into()],
