@@ -280,8 +280,11 @@ fn rows<T: Copy + Send + Sync>(
     let batched = rays_per_pixel(opts) == 1 && !f.depth_of_field && !f.motion_blur;
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
-    let mut out = Image::new(opts.width, opts.height, empty);
-    out.pixels_mut()
+    // Each worker writes its rows into memory the image has not touched yet: no pass
+    // filling it first, and its pages are first touched (and faulted in) by both threads.
+    let n = opts.width as usize * opts.height as usize;
+    let mut pixels: Vec<T> = Vec::with_capacity(n);
+    pixels.spare_capacity_mut()[..n]
         .par_chunks_mut(opts.width as usize)
         .enumerate()
         .for_each_init(RowScratch::default, |scratch, (row, line)| {
@@ -297,10 +300,12 @@ fn rows<T: Copy + Send + Sync>(
             }
             for (x, p) in line.iter_mut().enumerate() {
                 let x32 = x as u32;
-                if mine(x32) {
+                p.write(if mine(x32) {
                     let first = rays.get(x).map(|&r| (r, hits[x]));
-                    *p = store(pixel(&frame, x32, row, first, &mut counts, None));
-                }
+                    store(pixel(&frame, x32, row, first, &mut counts, None))
+                } else {
+                    empty
+                });
             }
             totals
                 .lock()
@@ -309,8 +314,11 @@ fn rows<T: Copy + Send + Sync>(
             let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(d);
         });
+    // SAFETY: the loop above wrote every one of the first `n` elements (each row's every
+    // pixel, of `n / width` rows), and `n` is within the capacity reserved.
+    unsafe { pixels.set_len(n) };
     let counts = totals.into_inner().expect("no panics under the lock");
-    (out, counts)
+    (Image::from_vec(opts.width, opts.height, pixels), counts)
 }
 
 /// One pixel's ray tree, for visual debugging.
