@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use super::camera::OrbitView;
 use super::scene::{WhittedHit, WhittedScene};
 use super::tracer::{
-    stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
+    shadow_ray, stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
 };
 use crate::film::{tile_of, PixelSum, Share};
 
@@ -123,7 +123,7 @@ fn pixel(
     f: &Frame<'_>,
     x: u32,
     row: u32,
-    first: Option<(Ray, Option<WhittedHit>)>,
+    first: Option<First<'_>>,
     counts: &mut RayCounts,
     record: Option<&mut Vec<DebugRay>>,
 ) -> PixelSum {
@@ -155,8 +155,8 @@ fn pixel(
                 RayKind::Lens,
             )
         } else {
-            match first {
-                Some((ray, _)) if n == 1 => (ray, RayKind::Camera),
+            match &first {
+                Some(fr) if n == 1 => (fr.ray, RayKind::Camera),
                 _ => (view.ray(x as f32 + jx, y as f32 + jy), RayKind::Camera),
             }
         };
@@ -168,9 +168,10 @@ fn pixel(
             record: rec.take(),
             time,
             spread: f.spread,
+            blocked: first.as_ref().map_or(&[], |fr| fr.blocked),
         };
-        let color = match first {
-            Some((ray, hit)) if n == 1 => tracer.trace_hit(&ray, 0, kind, 0.0, hit),
+        let color = match &first {
+            Some(fr) if n == 1 => tracer.trace_hit(&fr.ray, 0, kind, 0.0, fr.hit),
             _ => tracer.trace(&ray, 0, kind, 0.0),
         };
         px.accumulate(color);
@@ -253,12 +254,26 @@ pub fn raytrace_share(
     )
 }
 
-/// A worker's buffers for one row at a time: camera rays and their hits.
+/// A worker's buffers for one row at a time: camera rays, their hits, and the shadow rays
+/// from those hits towards point lights (whether each is blocked, by pixel and light).
 #[derive(Default)]
 struct RowScratch {
     rays: Vec<Ray>,
     hits: Vec<Option<WhittedHit>>,
     found: Vec<Option<prism_accel::Hit>>,
+    shadow_rays: Vec<Ray>,
+    shadow_ends: Vec<f32>,
+    shadow_slots: Vec<usize>,
+    shadow_blocked: Vec<bool>,
+    known: Vec<Option<bool>>,
+}
+
+/// A pixel's one camera ray as its row traced it: the ray, its closest hit, and per light
+/// whether the hit's shadow ray is blocked (where known).
+struct First<'a> {
+    ray: Ray,
+    hit: Option<WhittedHit>,
+    blocked: &'a [Option<bool>],
 }
 
 /// The pixel loop, row by row on rayon: each pixel of `share`'s tiles stored as `store`
@@ -278,6 +293,9 @@ fn rows<T: Copy + Send + Sync>(
     let view = frame.view;
     let f = opts.settings.features;
     let batched = rays_per_pixel(opts) == 1 && !f.depth_of_field && !f.motion_blur;
+    // Shadow rays from the camera hits are traced with their row's when the BVH is there
+    // (brute force gains nothing from batches).
+    let shadows = f.shading && f.hard_shadow && scene.bvh().is_some();
     let done = std::sync::atomic::AtomicU64::new(0);
     let totals = Mutex::new(RayCounts::default());
     // Each worker writes its rows into memory the image has not touched yet: no pass
@@ -292,16 +310,57 @@ fn rows<T: Copy + Send + Sync>(
             let mut counts = RayCounts::default();
             let whole = share.parts <= 1;
             let mine = |x: u32| whole || share.has_tile(tile_of(x, row, opts.width));
-            let RowScratch { rays, hits, found } = scratch;
+            let RowScratch {
+                rays,
+                hits,
+                found,
+                shadow_rays,
+                shadow_ends,
+                shadow_slots,
+                shadow_blocked,
+                known,
+            } = scratch;
             rays.clear();
+            known.clear();
+            let lights = scene.lights.len();
             if batched && (0..opts.width).any(mine) {
                 view.corner_rays(opts.height - 1 - row, rays);
                 scene.intersect_batch(rays, f.normal_interp, hits, found);
+                if shadows {
+                    // The camera hits' shadow rays towards point lights, traced together.
+                    shadow_rays.clear();
+                    shadow_ends.clear();
+                    shadow_slots.clear();
+                    known.resize(rays.len() * lights, None);
+                    for (x, hit) in hits.iter().enumerate() {
+                        let Some(hit) = hit else { continue };
+                        if !mine(x as u32) {
+                            continue;
+                        }
+                        for (li, light) in scene.lights.iter().enumerate() {
+                            if let prism_scene::Light::Point { position, .. } = light {
+                                if let Some((ray, end)) = shadow_ray(hit, *position) {
+                                    shadow_rays.push(ray);
+                                    shadow_ends.push(end);
+                                    shadow_slots.push(x * lights + li);
+                                }
+                            }
+                        }
+                    }
+                    scene.occluded_batch(shadow_rays, shadow_ends, shadow_blocked);
+                    for (&slot, &b) in shadow_slots.iter().zip(shadow_blocked.iter()) {
+                        known[slot] = Some(b);
+                    }
+                }
             }
             for (x, p) in line.iter_mut().enumerate() {
                 let x32 = x as u32;
                 p.write(if mine(x32) {
-                    let first = rays.get(x).map(|&r| (r, hits[x]));
+                    let first = rays.get(x).map(|&ray| First {
+                        ray,
+                        hit: hits[x],
+                        blocked: known.get(x * lights..(x + 1) * lights).unwrap_or(&[]),
+                    });
                     store(pixel(&frame, x32, row, first, &mut counts, None))
                 } else {
                     empty

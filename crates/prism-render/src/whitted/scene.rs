@@ -538,6 +538,21 @@ impl WhittedScene {
         }
     }
 
+    /// [`WhittedScene::occluded`] for each ray of `rays` with its own end (`blocked[i]` for
+    /// `rays[i]` and `tmax[i]`, nothing moving), the BVH walking the rays together.
+    pub fn occluded_batch(&self, rays: &[Ray], tmax: &[f32], blocked: &mut Vec<bool>) {
+        blocked.clear();
+        blocked.resize(rays.len(), false);
+        match &self.bvh {
+            Some(bvh) if self.movers.is_empty() => bvh.occluded_batch(rays, 0.0, tmax, blocked),
+            _ => {
+                for ((ray, &t), b) in rays.iter().zip(tmax).zip(blocked.iter_mut()) {
+                    *b = self.occluded(ray, t);
+                }
+            }
+        }
+    }
+
     /// What shading needs of the closest hit `(t, primitive, b1, b2)` along `ray`.
     fn hit(&self, ray: &Ray, found: (f32, u32, f32, f32), interpolate: bool) -> WhittedHit {
         let (t, prim, b1, b2) = found;

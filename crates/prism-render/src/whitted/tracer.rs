@@ -177,6 +177,9 @@ pub struct WhittedTracer<'a> {
     /// Growth of a ray cone's width per unit distance, `2 tan(alpha / 2)` for the camera's
     /// pixel spread angle alpha (used by mip-mapping).
     pub spread: f32,
+    /// Per light, whether the camera hit's shadow ray towards it is blocked, where that was
+    /// found beforehand (empty: nothing known).
+    pub blocked: &'a [Option<bool>],
 }
 
 const RED: Rgb = Rgb::new(1.0, 0.0, 0.0);
@@ -440,7 +443,15 @@ impl WhittedTracer<'_> {
             Light::Point {
                 position,
                 intensity,
-            } => self.sample(at, position, intensity, f.hard_shadow, RayKind::Shadow),
+            } => {
+                // The camera hit's shadow rays may have been traced with its row's.
+                let known = if at.depth == 0 {
+                    self.blocked.get(li).copied().flatten()
+                } else {
+                    None
+                };
+                self.sample(at, position, intensity, f.hard_shadow, RayKind::Shadow, known)
+            }
             Light::Segment { endpoints, colors } => {
                 if !f.soft_shadow {
                     return Rgb::BLACK;
@@ -451,7 +462,7 @@ impl WhittedTracer<'_> {
                     let t = (i as f32 + self.sampler.next_1d()) / n as f32;
                     let q = endpoints[0] + t * (endpoints[1] - endpoints[0]);
                     let c = colors[0] * (1.0 - t) + colors[1] * t;
-                    sum += self.sample(at, q, c, true, RayKind::AreaSample);
+                    sum += self.sample(at, q, c, true, RayKind::AreaSample, None);
                 }
                 sum * (1.0 / n as f32)
             }
@@ -476,7 +487,7 @@ impl WhittedTracer<'_> {
                             continue;
                         }
                         let c = parallelogram_color(&colors, a, b);
-                        sum += self.sample(at, q, c, true, RayKind::AreaSample);
+                        sum += self.sample(at, q, c, true, RayKind::AreaSample, None);
                     }
                 }
                 sum * (1.0 / (k * k) as f32)
@@ -487,6 +498,7 @@ impl WhittedTracer<'_> {
     }
 
     /// Phong for one light sample at `q` of colour `c`, shadow-tested if `shadowed`.
+    /// `known`: whether the shadow ray is blocked, when that was found beforehand.
     fn sample(
         &mut self,
         at: &ShadePoint<'_>,
@@ -494,25 +506,24 @@ impl WhittedTracer<'_> {
         c: Rgb,
         shadowed: bool,
         kind: RayKind,
+        known: Option<bool>,
     ) -> Rgb {
         let hit = at.hit;
-        let to = q - hit.p;
-        let dist = to.length();
-        // normalize(q - p), as `Vec3::normalize` computes it.
-        let l = to * dist.recip();
-        // Also refuses a light at the hit point itself (NaN direction).
-        if hit.n_s.dot(l).is_nan() || hit.n_s.dot(l) <= 0.0 {
+        let Some((ray, tmax)) = shadow_ray(hit, q) else {
             return Rgb::BLACK;
-        }
+        };
+        let l = ray.dir;
         let mut blocked_at = None;
         if shadowed {
             match kind {
                 RayKind::Shadow => self.counts.shadow += 1,
                 _ => self.counts.area_sample += 1,
             }
-            let ray = Ray::new(hit.p + RAY_EPSILON * l, l);
-            let tmax = dist - RAY_EPSILON;
-            if self.record.is_some() {
+            if let Some(b) = known {
+                if b {
+                    return Rgb::BLACK;
+                }
+            } else if self.record.is_some() {
                 // The blocking point is drawn: find the closest blocker.
                 blocked_at = (self.scene)
                     .intersect_at(&ray, tmax, false, self.time)
@@ -539,6 +550,23 @@ impl WhittedTracer<'_> {
         }
         phong(hit.n_s, l, at.v, at.kd, at.ks, at.shininess, c)
     }
+}
+
+/// The shadow ray from `hit` towards the light point `q` and its end: from
+/// `p + 1e-4 l` along `l = normalize(q - p)`, ending `1e-4` short of `q`; none when `q` is
+/// behind the shading normal or at the hit point itself.
+#[must_use]
+pub fn shadow_ray(hit: &WhittedHit, q: Vec3) -> Option<(Ray, f32)> {
+    let to = q - hit.p;
+    let dist = to.length();
+    // normalize(q - p), as `Vec3::normalize` computes it.
+    let l = to * dist.recip();
+    // Also refuses a light at the hit point itself (NaN direction).
+    let nl = hit.n_s.dot(l);
+    if nl.is_nan() || nl <= 0.0 {
+        return None;
+    }
+    Some((Ray::new(hit.p + RAY_EPSILON * l, l), dist - RAY_EPSILON))
 }
 
 /// Sample `i` of `n` on the unit square: with `k = floor(sqrt(n))`, the first `k^2` samples

@@ -412,6 +412,7 @@ fn ray_cone_levels_follow_texels_per_pixel() {
             record: None,
             time: 0.0,
             spread: view.cone_spread(),
+            blocked: &[],
         };
         let tex = ws.materials[0].texture.as_ref().unwrap();
         let level = tracer
