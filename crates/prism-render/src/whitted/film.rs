@@ -164,7 +164,7 @@ fn pixel(
             scene,
             settings: &opts.settings,
             sampler,
-            counts: RayCounts::default(),
+            counts: &mut *counts,
             record: rec.take(),
             time,
             spread: f.spread,
@@ -175,7 +175,6 @@ fn pixel(
             _ => tracer.trace(&ray, 0, kind, 0.0),
         };
         px.accumulate(color);
-        counts.add(&tracer.counts);
         rec = tracer.record;
     }
     if let (Some(out), Some(r)) = (record, rec) {

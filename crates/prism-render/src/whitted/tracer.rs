@@ -168,8 +168,8 @@ pub struct WhittedTracer<'a> {
     pub settings: &'a WhittedSettings,
     /// Random numbers for light-sample jitter.
     pub sampler: PixelSampler,
-    /// Rays cast so far.
-    pub counts: RayCounts,
+    /// Rays cast so far, added to as rays are cast.
+    pub counts: &'a mut RayCounts,
     /// When set, every ray is recorded here.
     pub record: Option<Vec<DebugRay>>,
     /// The shutter time of this camera sample (0 without motion blur).

@@ -408,7 +408,7 @@ fn ray_cone_levels_follow_texels_per_pixel() {
             scene: &ws,
             settings: &o.settings,
             sampler: PixelSampler::new(0, 0, 0),
-            counts: RayCounts::default(),
+            counts: &mut RayCounts::default(),
             record: None,
             time: 0.0,
             spread: view.cone_spread(),
