@@ -202,7 +202,11 @@ fn open_mode(a: &ViewArgs, chosen: &mut Option<&'static str>) -> Result<Viewer> 
             };
             let camera = loaded.cameras.first().copied().unwrap_or_default();
             let name = a.file.display().to_string();
-            let mode = WhittedMode::new(loaded.scene, &name, camera, loaded.features);
+            let mode = WhittedMode::new(loaded.scene, &name, camera, loaded.features).with_extras(
+                loaded.extras,
+                loaded.motion,
+                loaded.environment,
+            );
             Ok(Viewer::new(Box::new(mode), w, h))
         }
         ModeArg::Mesh => {

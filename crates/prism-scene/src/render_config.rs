@@ -747,12 +747,7 @@ impl Cx<'_> {
     }
 
     /// The `[extras]` table into `out` (its `motion` entries appended).
-    fn extras(
-        &self,
-        v: &Val<'_>,
-        base: &Path,
-        out: &mut ExtrasTable,
-    ) -> Result<(), SceneError> {
+    fn extras(&self, v: &Val<'_>, base: &Path, out: &mut ExtrasTable) -> Result<(), SceneError> {
         let t = v.get_ref().as_table().ok_or_else(|| {
             self.err(
                 v,

@@ -10,9 +10,9 @@ use prism_image::{Bloom, Rgb8Image, RgbImage};
 use prism_render::whitted::camera::OrbitView;
 use prism_render::whitted::film::{raytrace, trace_pixel, PixelTrace, RaytraceOptions};
 use prism_render::whitted::overlay::Overlay;
-use prism_render::whitted::scene::WhittedScene;
+use prism_render::whitted::scene::{Environment, SceneSetup, Split, WhittedScene};
 use prism_render::whitted::tracer::WhittedSettings;
-use prism_scene::{Features, OrbitCamera, Scene};
+use prism_scene::{Extras, Features, OrbitCamera, Scene};
 
 use crate::input::{Input, Key};
 use crate::viewer::{Mode, Response};
@@ -43,6 +43,12 @@ pub struct WhittedMode {
     moved_at: Instant,
     /// How long the camera must rest before the picture is refined.
     rest: Duration,
+    /// The extras' settings.
+    extras: Extras,
+    /// The moving meshes (index, translation over the shutter).
+    motion: Vec<(usize, prism_math::Vec3)>,
+    /// The environment map.
+    environment: Option<std::sync::Arc<RgbImage>>,
 }
 
 /// How long the camera rests before a preview is traced again at full resolution.
@@ -52,9 +58,10 @@ impl WhittedMode {
     /// A viewer of `scene` (named `name`) through `camera`, with `features` on.
     #[must_use]
     pub fn new(scene: Scene, name: &str, camera: OrbitCamera, features: Features) -> WhittedMode {
-        WhittedMode {
+        let mut mode = WhittedMode {
             name: name.to_string(),
-            scene: WhittedScene::new(&scene, features.accel_structure),
+            // Replaced below, once the mode can say how to prepare it.
+            scene: WhittedScene::new(&Scene::new(scene.camera.clone()), false),
             source: scene,
             start: camera,
             camera,
@@ -70,7 +77,53 @@ impl WhittedMode {
             preview: false,
             moved_at: Instant::now(),
             rest: REST,
-        }
+            extras: Extras::default(),
+            motion: Vec::new(),
+            environment: None,
+        };
+        mode.scene = mode.prepare();
+        mode
+    }
+
+    /// The mode with a config's extras: their settings, the meshes that move and the
+    /// environment map (each used when its feature is on).
+    #[must_use]
+    pub fn with_extras(
+        mut self,
+        extras: Extras,
+        motion: Vec<(usize, prism_math::Vec3)>,
+        environment: Option<std::sync::Arc<RgbImage>>,
+    ) -> WhittedMode {
+        self.extras = extras;
+        self.motion = motion;
+        self.environment = environment;
+        self.scene = self.prepare();
+        self
+    }
+
+    /// The scene as the features say: BVH on or off (split by SAH or at the median), the
+    /// moving meshes with motion blur on, the environment map with environment mapping on.
+    fn prepare(&self) -> WhittedScene {
+        let f = self.features;
+        let split = if f.sah_binning {
+            Split::Sah
+        } else {
+            Split::Median
+        };
+        WhittedScene::prepare(
+            &self.source,
+            SceneSetup {
+                bvh: f.accel_structure.then_some(split),
+                motion: if f.motion_blur {
+                    self.motion.clone()
+                } else {
+                    Vec::new()
+                },
+                environment: (self.environment.as_ref())
+                    .filter(|_| f.environment_mapping)
+                    .map(|im| Environment::new((**im).clone(), self.extras.environment_strength)),
+            },
+        )
     }
 
     /// The mode with another rest before refining (zero refines at the next frame).
@@ -106,7 +159,7 @@ impl WhittedMode {
                 features: self.features,
                 light_samples: 16,
                 max_depth: 3,
-                extras: prism_scene::Extras::default(),
+                extras: self.extras,
             },
             spp: 16,
             bloom: Bloom::default(),
@@ -168,7 +221,7 @@ impl Mode for WhittedMode {
                     *on = !*on;
                     let state = if *on { "on" } else { "off" };
                     if name == "bvh" {
-                        self.scene = WhittedScene::new(&self.source, self.features.accel_structure);
+                        self.scene = self.prepare();
                         self.level = None;
                         self.leaf = None;
                     }

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 use super::camera::OrbitView;
 use super::scene::{WhittedHit, WhittedScene};
 use super::tracer::{
-    shadow_ray, stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings, WhittedTracer,
+    shadow_ray, stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings,
+    WhittedTracer,
 };
 use crate::film::{tile_of, PixelSum, Share};
 

@@ -450,7 +450,14 @@ impl WhittedTracer<'_> {
                 } else {
                     None
                 };
-                self.sample(at, position, intensity, f.hard_shadow, RayKind::Shadow, known)
+                self.sample(
+                    at,
+                    position,
+                    intensity,
+                    f.hard_shadow,
+                    RayKind::Shadow,
+                    known,
+                )
             }
             Light::Segment { endpoints, colors } => {
                 if !f.soft_shadow {

@@ -169,3 +169,53 @@ fn orbiting_previews_at_half_resolution_then_refines() {
     assert_eq!(v.picture(), &full);
     assert!(!v.busy());
 }
+
+/// Oracle: the batch ray tracer on the same scene setup. A config's extras reach the window:
+/// with environment mapping on, misses show the map; with the tall box moving and motion
+/// blur on, the picture is the motion-blurred render.
+#[test]
+fn a_configs_extras_reach_the_window() {
+    use prism_render::whitted::scene::{Environment, SceneSetup, Split};
+    let scene = Preset::from_name("cornell-box").unwrap().load(&[]).unwrap();
+    let sky = prism_image::Image::from_fn(8, 4, |x, y| {
+        prism_math::Rgb::new(x as f32 / 8.0, y as f32 / 4.0, 0.7)
+    });
+    let features = Features {
+        environment_mapping: true,
+        motion_blur: true,
+        ..Features::prism_defaults()
+    };
+    let extras = prism_scene::Extras {
+        motion_samples: 3,
+        environment_strength: 0.5,
+        ..prism_scene::Extras::default()
+    };
+    let motion = vec![(6, prism_math::Vec3::new(0.3, 0.0, 0.0))];
+    let mode = WhittedMode::new(
+        scene.clone(),
+        "cornell-box",
+        OrbitCamera::default(),
+        features,
+    )
+    .with_extras(
+        extras,
+        motion.clone(),
+        Some(std::sync::Arc::new(sky.clone())),
+    );
+    let mut v = Viewer::new(Box::new(mode), 80, 60);
+    let ws = WhittedScene::prepare(
+        &scene,
+        SceneSetup {
+            bvh: Some(Split::Sah),
+            motion,
+            environment: Some(Environment::new(sky, 0.5)),
+        },
+    );
+    let mut o = options();
+    o.settings.features = features;
+    o.settings.extras = extras;
+    let want = raytrace(&ws, &OrbitCamera::default(), &o, &|_| {});
+    assert_eq!(v.picture(), &want.image.to_rgb8_truncated());
+    // The corners look past the box at the map.
+    assert_ne!(v.picture().get(0, 0), [0, 0, 0]);
+}
