@@ -61,7 +61,7 @@ impl WhittedMode {
         let mut mode = WhittedMode {
             name: name.to_string(),
             // Replaced below, once the mode can say how to prepare it.
-            scene: WhittedScene::new(&Scene::new(scene.camera.clone()), false),
+            scene: WhittedScene::new(&Scene::new(scene.camera), false),
             source: scene,
             start: camera,
             camera,
