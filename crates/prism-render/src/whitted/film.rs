@@ -5,7 +5,7 @@
 use std::sync::Mutex;
 
 use prism_image::{Bloom, Image, RgbImage};
-use prism_math::{Ray, Rgb};
+use prism_math::{ExactSum, Ray, Rgb};
 use rayon::prelude::*;
 
 use super::camera::OrbitView;
@@ -120,19 +120,19 @@ fn shutter_strata(opts: &RaytraceOptions, x: u32, row: u32, n: u32) -> Vec<u32> 
 /// recorded into `record` if given. `first` is its one camera ray and that ray's closest
 /// hit, when the row's rays were traced together (one ray per pixel, no lens, no shutter).
 #[inline(always)]
-fn pixel(
+fn pixel<S: Samples>(
     f: &Frame<'_>,
     x: u32,
     row: u32,
     first: Option<First<'_>>,
     counts: &mut RayCounts,
     record: Option<&mut Vec<DebugRay>>,
-) -> PixelSum {
+) -> S {
     let (scene, view, opts) = (f.scene, &f.view, f.opts);
     let (features, extras) = (opts.settings.features, opts.settings.extras);
     let y = opts.height - 1 - row;
     let n = rays_per_pixel(opts);
-    let mut px = PixelSum::default();
+    let mut px = S::default();
     let mut rec: Option<Vec<DebugRay>> = record.as_ref().map(|_| Vec::new());
     let order = features
         .motion_blur
@@ -175,7 +175,7 @@ fn pixel(
             Some(fr) if n == 1 => tracer.trace_hit(&fr.ray, 0, kind, 0.0, fr.hit),
             _ => tracer.trace(&ray, 0, kind, 0.0),
         };
-        px.accumulate(color);
+        px.add(color);
         rec = tracer.record;
     }
     if let (Some(out), Some(r)) = (record, rec) {
@@ -194,9 +194,13 @@ pub fn raytrace(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Raytraced {
     let whole = Share::whole(rays_per_pixel(opts));
-    let (image, counts) = rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p| {
-        p.mean()
-    });
+    let (image, counts) = if rays_per_pixel(opts) == 1 {
+        rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p: One| p.mean())
+    } else {
+        rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p: PixelSum| {
+            p.mean()
+        })
+    };
     with_bloom(image, counts, opts)
 }
 
@@ -223,9 +227,9 @@ pub fn with_bloom(image: RgbImage, counts: RayCounts, opts: &RaytraceOptions) ->
 }
 
 /// The most bytes a `width x height` Whitted render's film holds at once: the pixel sums
-/// (filled row by row in place) and three colour images made from them (the picture,
-/// bloom's layer, the output). A caller checks it against the memory budget before
-/// rendering. (Measured: a 2048 x 2048 ray trace peaks at 375 MB of the 487 MB this gives.)
+/// (a split part's, filled row by row in place; a whole picture keeps colours) and three
+/// colour images made from them (the picture, bloom's layer, the output). A caller checks
+/// it against the memory budget before rendering.
 #[must_use]
 pub fn raytrace_bytes(width: u32, height: u32) -> u64 {
     let per_pixel = std::mem::size_of::<PixelSum>() + 3 * std::mem::size_of::<Rgb>();
@@ -250,8 +254,52 @@ pub fn raytrace_share(
         share,
         progress,
         PixelSum::default(),
-        |p| p,
+        |p: PixelSum| p,
     )
+}
+
+/// What a pixel keeps of its samples.
+trait Samples: Default {
+    /// Takes one sample.
+    fn add(&mut self, c: Rgb);
+}
+
+impl Samples for PixelSum {
+    fn add(&mut self, c: Rgb) {
+        self.accumulate(c);
+    }
+}
+
+/// A pixel's only sample, for pictures of one ray per pixel: its [`One::mean`] is the
+/// mean [`PixelSum`] gives of that one sample, bit for bit, without the sums' other work.
+#[derive(Clone, Copy, Debug, Default)]
+struct One(Rgb);
+
+impl Samples for One {
+    fn add(&mut self, c: Rgb) {
+        self.0 = c;
+    }
+}
+
+impl One {
+    /// As [`PixelSum::mean`] after one [`PixelSum::accumulate`]: each channel in the exact
+    /// sum's fixed point and back (a mean over one sample divides by 1, which is exact), or
+    /// black if a channel is not representable there.
+    fn mean(self) -> Rgb {
+        let c = self.0;
+        match (
+            ExactSum::fixed(c.r),
+            ExactSum::fixed(c.g),
+            ExactSum::fixed(c.b),
+        ) {
+            (Some(r), Some(g), Some(b)) => Rgb::new(
+                ExactSum(r).value() as f32,
+                ExactSum(g).value() as f32,
+                ExactSum(b).value() as f32,
+            ),
+            _ => Rgb::BLACK,
+        }
+    }
 }
 
 /// A worker's buffers for one row at a time: camera rays, their hits, and the shadow rays
@@ -280,14 +328,14 @@ struct First<'a> {
 /// makes it of its sums, the others `empty`; and the rays cast. With one camera ray per
 /// pixel and neither lens nor shutter, a row's camera rays (through the pixels' corners)
 /// are traced together.
-fn rows<T: Copy + Send + Sync>(
+fn rows<T: Copy + Send + Sync, S: Samples>(
     scene: &WhittedScene,
     camera: &prism_scene::OrbitCamera,
     opts: &RaytraceOptions,
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
     empty: T,
-    store: impl Fn(PixelSum) -> T + Sync,
+    store: impl Fn(S) -> T + Sync,
 ) -> (Image<T>, RayCounts) {
     let frame = Frame::new(scene, camera, opts);
     let view = frame.view;
@@ -411,10 +459,52 @@ pub fn trace_pixel(
     let mut rays = Vec::new();
     let mut counts = RayCounts::default();
     let frame = Frame::new(scene, camera, opts);
-    let color = pixel(&frame, x, row, None, &mut counts, Some(&mut rays)).mean();
+    let color = pixel::<PixelSum>(&frame, x, row, None, &mut counts, Some(&mut rays)).mean();
     PixelTrace {
         pixel: (x, row),
         color,
         rays,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Oracle: the pixel sums. One sample's mean by [`One`] is [`PixelSum`]'s, bit for bit,
+    /// for ordinary, tiny, subnormal, huge, negative, infinite and NaN values.
+    #[test]
+    fn one_sample_mean_is_the_sums_mean() {
+        let mut rng = prism_math::Pcg32::new(1, 2);
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            1e-30,
+            1e-8,
+            f32::MIN_POSITIVE,
+            1e-45,
+            3.0e16,
+            3.7e16,
+            f32::MAX,
+            -2.5,
+            f32::INFINITY,
+            f32::NAN,
+        ];
+        values.extend((0..10_000).map(|_| {
+            let e = (rng.next_f32() * 80.0 - 60.0) as i32;
+            rng.next_f32() * 2f32.powi(e)
+        }));
+        for w in values.windows(3) {
+            let c = Rgb::new(w[0], w[1], w[2]);
+            let mut sums = PixelSum::default();
+            sums.accumulate(c);
+            let (a, b) = (One(c).mean(), sums.mean());
+            assert_eq!(
+                [a.r, a.g, a.b].map(f32::to_bits),
+                [b.r, b.g, b.b].map(f32::to_bits),
+                "{c:?}"
+            );
+        }
     }
 }
