@@ -2,6 +2,7 @@
 //! bottom-left, a row of corner rays at a time, thin-lens rays, ray cones' spread,
 //! and world points projected back to pixels for overlays.
 
+use prism_math::lanes::{F16, LANES};
 use prism_math::{Ray, Vec2, Vec3};
 
 /// The Delft ray tracer's camera over an image of `width` x `height` pixels: pixel
@@ -75,27 +76,32 @@ impl OrbitView {
     /// (counted from the bottom), the same bits as [`OrbitView::ray`] gives, computed
     /// sixteen at a time so that the square roots and divisions run on SIMD lanes.
     pub fn corner_rays(&self, y: u32, out: &mut Vec<Ray>) {
-        const LANES: usize = 16;
         let n = self.width as usize;
-        let ly = (2.0 * y as f32 / self.height - 1.0) * self.hh;
+        let ly = F16::splat((2.0 * y as f32 / self.height - 1.0) * self.hh);
+        let one = F16::splat(1.0);
+        // The rotation's columns, for `Mat4::transform_vector3` on lanes: the same products
+        // and sums (x column first) as `Transform::vector` takes.
+        let m = self.world_from_camera.matrix();
+        let col = |c: prism_math::glam::Vec4| [F16::splat(c.x), F16::splat(c.y), F16::splat(c.z)];
+        let (cx, cy, cz) = (col(m.x_axis), col(m.y_axis), col(m.z_axis));
         out.clear();
         for start in (0..n).step_by(LANES) {
-            let m = LANES.min(n - start);
             let mut lx = [0f32; LANES];
             for (k, v) in lx.iter_mut().enumerate() {
                 *v = -(2.0 * (start + k) as f32 / self.width - 1.0) * self.hw;
             }
+            let lx = F16(lx);
             // As `Vec3::normalize`: times the reciprocal of the length, x, y, z summed in order.
-            let r1 = lx.map(|x| 1.0 / (x * x + ly * ly + 1.0).sqrt());
-            let mut w = [Vec3::ZERO; LANES];
-            for k in 0..LANES {
-                let r = r1[k];
-                w[k] = self
-                    .world_from_camera
-                    .vector(Vec3::new(lx[k] * r, ly * r, r));
-            }
-            let r2 = w.map(|v| 1.0 / (v.x * v.x + v.y * v.y + v.z * v.z).sqrt());
-            out.extend((0..m).map(|k| Ray::new(self.eye, w[k] * r2[k])));
+            let r1 = one / (lx * lx + ly * ly + one).sqrt();
+            let local = [lx * r1, ly * r1, r1];
+            let w: [F16; 3] =
+                std::array::from_fn(|i| cx[i] * local[0] + cy[i] * local[1] + cz[i] * local[2]);
+            let r2 = one / (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            let (dx, dy, dz) = (w[0] * r2, w[1] * r2, w[2] * r2);
+            out.extend(
+                (0..LANES.min(n - start))
+                    .map(|k| Ray::new(self.eye, Vec3::new(dx.0[k], dy.0[k], dz.0[k]))),
+            );
         }
     }
 

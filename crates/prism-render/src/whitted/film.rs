@@ -195,11 +195,25 @@ pub fn raytrace(
 ) -> Raytraced {
     let whole = Share::whole(rays_per_pixel(opts));
     let (image, counts) = if rays_per_pixel(opts) == 1 {
-        rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p: One| p.mean())
+        rows(
+            scene,
+            camera,
+            opts,
+            &whole,
+            progress,
+            Rgb::BLACK,
+            |p: One| p.mean(),
+        )
     } else {
-        rows(scene, camera, opts, &whole, progress, Rgb::BLACK, |p: PixelSum| {
-            p.mean()
-        })
+        rows(
+            scene,
+            camera,
+            opts,
+            &whole,
+            progress,
+            Rgb::BLACK,
+            |p: PixelSum| p.mean(),
+        )
     };
     with_bloom(image, counts, opts)
 }
