@@ -49,9 +49,11 @@ pub enum ModeArg {
   cloth      P play/pause, N one frame, R back to the start, C next shader (phong,
              diffuse, normal, wireframe), drag to orbit, wheel to move closer
   whitted    click a pixel to trace its rays (kept while the camera orbits), X clear them,
-             drag to orbit, wheel to move closer, 1-9 0 M toggle shading, recursive,
-             hard shadow, soft shadow, normal interpolation, texture, bilinear, bvh, bloom,
-             transparency, multi-rays; [ ] BVH level, , . BVH leaf, R reset the camera
+             drag to orbit (half resolution until the camera rests), wheel to move
+             closer, 1-9 0 M toggle shading, recursive, hard shadow, soft shadow, normal
+             interpolation, texture, bilinear, bvh, bloom, transparency, multi-rays; D B G E
+             P A toggle depth of field, motion blur, glossy, environment map, mip-mapping,
+             SAH binning; [ ] BVH level, , . BVH leaf, R reset the camera
   mesh       hover highlights the vertex, edge or face under the cursor; F flip, S split,
              C collapse the highlighted edge, U Loop subdivision, N smooth/flat normals,
              W wireframe, Ctrl+Z undo, Ctrl+S save as NAME-edited.obj; drag orbits, wheel

@@ -18,7 +18,9 @@ use crate::input::{Input, Key};
 use crate::viewer::{Mode, Response};
 
 /// The keys of the feature switches, in the order of [`Features::NAMES`].
-const KEYS: [char; 11] = ['1', '2', '3', '4', '5', '6', '7', '8', '9', '0', 'm'];
+const KEYS: [char; 17] = [
+    '1', '2', '3', '4', '5', '6', '7', '8', '9', '0', 'm', 'd', 'b', 'g', 'e', 'p', 'a',
+];
 
 /// A Whitted scene in the viewer.
 pub struct WhittedMode {
@@ -205,6 +207,11 @@ impl Mode for WhittedMode {
                 "",
                 "texture, bilinear, bvh, bloom, transparency, multi-rays",
             ),
+            (
+                "D B G E P A",
+                "depth of field, motion blur, glossy, environment map,",
+            ),
+            ("", "mip-mapping, SAH binning (off: median split)"),
             ("[ ]", "BVH level down / up (below 0: none)"),
             (", .", "BVH leaf back / forward (below 0: none)"),
             ("R", "reset the camera"),
@@ -220,8 +227,11 @@ impl Mode for WhittedMode {
                     let on = self.features.switch(name).expect("a switch's name");
                     *on = !*on;
                     let state = if *on { "on" } else { "off" };
-                    if name == "bvh" {
+                    // These change the scene: its BVH, what moves, what misses see.
+                    if matches!(name, "bvh" | "sah" | "motion-blur" | "env-map") {
                         self.scene = self.prepare();
+                    }
+                    if matches!(name, "bvh" | "sah") {
                         self.level = None;
                         self.leaf = None;
                     }

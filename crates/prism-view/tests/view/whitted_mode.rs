@@ -218,4 +218,36 @@ fn a_configs_extras_reach_the_window() {
     assert_eq!(v.picture(), &want.image.to_rgb8_truncated());
     // The corners look past the box at the map.
     assert_ne!(v.picture().get(0, 0), [0, 0, 0]);
+    // E turns the map off: misses are black; E again brings it back.
+    v.input(key('e'));
+    assert_eq!(v.message(), Some("env-map off"));
+    assert_eq!(v.picture().get(0, 0), [0, 0, 0]);
+    v.input(key('e'));
+    assert_eq!(v.picture(), &want.image.to_rgb8_truncated());
+    // B stops the motion: the picture is the still render's.
+    v.input(key('b'));
+    assert_eq!(v.message(), Some("motion-blur off"));
+    let still = WhittedScene::prepare(
+        &scene,
+        SceneSetup {
+            bvh: Some(Split::Sah),
+            motion: Vec::new(),
+            environment: Some(Environment::new(
+                prism_image::Image::from_fn(8, 4, |x, y| {
+                    prism_math::Rgb::new(x as f32 / 8.0, y as f32 / 4.0, 0.7)
+                }),
+                0.5,
+            )),
+        },
+    );
+    o.settings.features.motion_blur = false;
+    let want = raytrace(&still, &OrbitCamera::default(), &o, &|_| {});
+    assert_eq!(v.picture(), &want.image.to_rgb8_truncated());
+    // G, D, P and A switch the other extras, each saying so.
+    for (k, name) in [('g', "glossy"), ('d', "dof"), ('p', "mipmap"), ('a', "sah")] {
+        v.input(key(k));
+        let on = if name == "sah" { "off" } else { "on" };
+        assert_eq!(v.message(), Some(format!("{name} {on}").as_str()));
+    }
+    assert!(v.mode().status().contains("glossy"));
 }
