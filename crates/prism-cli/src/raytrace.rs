@@ -191,8 +191,14 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
 }
 
 /// Checks, before any rendering, every file the run will write (each camera's picture,
-/// linear copy, ray tree, PLY and debug picture): none may name the scene or another.
-fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
+/// linear copy, ray tree, PLY and debug picture): none may name the scene, the environment
+/// map or another.
+fn check_every_output(
+    a: &RaytraceArgs,
+    n: usize,
+    debug: bool,
+    environment: Option<&Path>,
+) -> Result<()> {
     let mut outputs: Vec<(&str, PathBuf)> = Vec::new();
     for ci in 0..n {
         let path = numbered(&a.output, ci, n);
@@ -212,11 +218,12 @@ fn check_every_output(a: &RaytraceArgs, n: usize, debug: bool) -> Result<()> {
     }
     let outputs: Vec<(&str, &Path)> = outputs.iter().map(|(f, p)| (*f, p.as_path())).collect();
     let scene = Path::new(&a.scene);
-    let inputs: Vec<(&str, &Path)> = if scene.is_file() {
+    let mut inputs: Vec<(&str, &Path)> = if scene.is_file() {
         vec![("the scene", scene)]
     } else {
         Vec::new()
     };
+    inputs.extend(environment.map(|e| ("the environment map", e)));
     crate::output::check_distinct(&inputs, &outputs)
 }
 
@@ -225,6 +232,8 @@ struct RunExtras {
     settings: prism_scene::Extras,
     motion: Vec<(usize, prism_math::Vec3)>,
     environment: Option<std::sync::Arc<prism_image::RgbImage>>,
+    /// The environment map's file (read even when environment mapping is off).
+    environment_file: Option<PathBuf>,
 }
 
 impl RunExtras {
@@ -311,6 +320,10 @@ fn extras(
             motion.extend(motion_flag(m, &loaded.scene)?);
         }
     }
+    let environment_file = a
+        .environment_map
+        .clone()
+        .or_else(|| loaded.environment_file.clone());
     let image = match &a.environment_map {
         Some(path) => {
             features.environment_mapping = true;
@@ -346,6 +359,7 @@ fn extras(
         } else {
             None
         },
+        environment_file,
     })
 }
 
@@ -620,7 +634,12 @@ pub fn run(a: &RaytraceArgs) -> Result<()> {
     };
     let pool = crate::resources::pool(a.threads)?;
     let n = loaded.cameras.len();
-    check_every_output(a, n, debug_pixel.is_some())?;
+    check_every_output(
+        a,
+        n,
+        debug_pixel.is_some(),
+        extras.environment_file.as_deref(),
+    )?;
     let mut written = Vec::new();
     let mut counts = prism_render::whitted::tracer::RayCounts::default();
     let mut render_time = std::time::Duration::ZERO;

@@ -33,6 +33,8 @@ pub struct DelftScene {
     pub motion: Vec<(usize, Vec3)>,
     /// The config's environment map, read.
     pub environment: Option<Arc<RgbImage>>,
+    /// The file it was read from.
+    pub environment_file: Option<PathBuf>,
 }
 
 impl MeshRef {
@@ -78,14 +80,16 @@ pub fn read_environment_map(path: &Path) -> Result<RgbImage, SceneError> {
         message,
     };
     let image = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        prism_image::decode_exr(&bytes, &file).map_err(|e| bad(e.to_string()))?
+        prism_image::decode_exr(&bytes, &file).map_err(|e| SceneError::Decode(Arc::new(e)))?
     } else if prism_image::is_hdr(&bytes) {
-        prism_image::decode_hdr(&bytes, &file).map_err(|e| bad(e.to_string()))?
+        prism_image::decode_hdr(&bytes, &file).map_err(|e| SceneError::Decode(Arc::new(e)))?
     } else {
-        crate::texture_file::decode_texture(&bytes, &file).map_err(|e| {
-            bad(format!(
+        use crate::texture_file::TextureFileError;
+        crate::texture_file::decode_texture(&bytes, &file).map_err(|e| match e {
+            TextureFileError::Decode(d) => SceneError::Decode(Arc::new(d)),
+            TextureFileError::NotAnImage => bad(format!(
                 "{e} (an environment map is a PNG, JPEG, OpenEXR or Radiance HDR image)"
-            ))
+            )),
         })?
     };
     if let Some(i) = (image.pixels().iter())
@@ -270,6 +274,7 @@ pub fn load_delft(
             extras: cfg.extras.extras,
             motion,
             environment,
+            environment_file: cfg.extras.environment_map.map(|e| e.path),
         });
     }
     let scene = if lower.ends_with(".obj") {
@@ -290,6 +295,7 @@ pub fn load_delft(
         extras: Extras::default(),
         motion: Vec::new(),
         environment: None,
+        environment_file: None,
     })
 }
 

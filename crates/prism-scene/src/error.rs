@@ -38,6 +38,9 @@ pub enum SceneError {
         /// The limit.
         limit: u64,
     },
+    /// An image the decoder refused (its message names the file).
+    #[error(transparent)]
+    Decode(Arc<prism_image::ImageError>),
     /// An image file (an environment map) that cannot be used.
     #[error("{path}: {message}")]
     Image {

@@ -37,11 +37,16 @@ fn refused(what: &str, o: &Output, expect: &str, outputs: &[PathBuf]) {
 
 /// A real 16 x 16 JPEG (about 600 bytes) whose frame header claims 4096 x 65535 pixels.
 fn huge_jpeg() -> Vec<u8> {
+    jpeg_claiming(4096, 65535)
+}
+
+/// A real 16 x 16 JPEG (about 600 bytes) whose frame header claims `width x height` pixels.
+fn jpeg_claiming(width: u16, height: u16) -> Vec<u8> {
     let im = prism_image::Image::from_fn(16, 16, |x, y| [(x * 9) as u8, (y * 9) as u8, 77]);
     let mut bytes = prism_image::encode_jpeg(&im).unwrap();
     let sof = bytes.windows(2).position(|w| w == [0xff, 0xc0]).unwrap();
-    bytes[sof + 5..sof + 7].copy_from_slice(&65535u16.to_be_bytes());
-    bytes[sof + 7..sof + 9].copy_from_slice(&4096u16.to_be_bytes());
+    bytes[sof + 5..sof + 7].copy_from_slice(&height.to_be_bytes());
+    bytes[sof + 7..sof + 9].copy_from_slice(&width.to_be_bytes());
     bytes
 }
 
@@ -692,4 +697,52 @@ fn extras_settings_are_bounded() {
         "{}",
         stderr(&o)
     );
+    // A 600-byte JPEG claiming 60000 x 60000 pixels, /dev/zero and a FIFO as the map:
+    // refused before reading or allocating.
+    std::fs::write(dir.join("claims.jpg"), jpeg_claiming(60000, 60000)).unwrap();
+    let fifo = dir.join("fifo.png");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    let mut maps = vec![
+        ("claims.jpg", "claims.jpg: a 60000x60000 image needs"),
+        ("/dev/zero", "/dev/zero: not a regular file"),
+    ];
+    if made.is_ok_and(|s| s.success()) {
+        maps.push(("fifo.png", "fifo.png: not a regular file"));
+    }
+    for (map, expect) in maps {
+        let line = [
+            "raytrace",
+            "cornell-box",
+            "-r",
+            "16",
+            "16",
+            "--environment-map",
+            map,
+        ];
+        let o = bounded(&dir, &[&line[..], &["-o", "out.png"]].concat());
+        refused(map, &o, expect, std::slice::from_ref(&out));
+    }
+    // The picture never replaces the environment map, named by a flag or by the config.
+    let sky = prism_image::Image::from_fn(4, 2, |x, _| [(x * 60) as u8, 90, 200]);
+    prism_image::write_png(&dir.join("sky.png"), &sky).unwrap();
+    let before = std::fs::read(dir.join("sky.png")).unwrap();
+    config("mapped.toml", "[extras]\nenvironment_map = \"sky.png\"\n");
+    for line in [
+        "raytrace cornell-box -r 16 16 --environment-map sky.png -o sky.png",
+        "raytrace mapped.toml -o sky.png",
+    ] {
+        let args: Vec<&str> = line.split_whitespace().collect();
+        let o = bounded(&dir, &args);
+        refused(
+            line,
+            &o,
+            "--output sky.png: it names the environment map",
+            &[],
+        );
+        assert_eq!(
+            std::fs::read(dir.join("sky.png")).unwrap(),
+            before,
+            "{line}"
+        );
+    }
 }
