@@ -57,8 +57,8 @@ pub use obj::{parse_obj_scene, read_obj_scene, Companions, MAX_FACE_CORNERS, MAX
 pub use presets::Preset;
 pub use render_config::{
     parse_render_config, read_render_config, EnvironmentMapFile, Extras, ExtrasTable, Features,
-    MeshRef, Motion, RenderConfig, SceneSource, MAX_EXTENT, MAX_EXTRA_SAMPLES, MAX_WINDOW_PIXELS,
-    MAX_WINDOW_SIDE,
+    MeshRef, Motion, RenderConfig, SceneSource, MAX_CONFIG_BYTES, MAX_EXTENT, MAX_EXTRA_SAMPLES,
+    MAX_WINDOW_PIXELS, MAX_WINDOW_SIDE,
 };
 pub use scene::{
     Camera, CameraMode, Crop, EnvMapping, Light, Material, MaterialTexture, MicrofacetKind,

@@ -11,7 +11,7 @@ use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
 use crate::error::SceneError;
-use crate::obj::{read_obj_scene, read_text};
+use crate::obj::{read_obj_scene, read_text_within};
 use crate::presets::Preset;
 use crate::scene::{Light, OrbitCamera, Scene};
 pub use extras::{
@@ -22,6 +22,10 @@ pub use extras::{
 pub const MAX_WINDOW_SIDE: u32 = 16384;
 /// Most pixels a config may ask for (64 M).
 pub const MAX_WINDOW_PIXELS: u64 = 1 << 26;
+
+/// Largest render config read: its TOML document takes about fifty times its size in
+/// memory, so this bounds a config's reading at about 200 MB.
+pub const MAX_CONFIG_BYTES: u64 = 4 << 20;
 
 /// Largest colour value a light may have.
 pub const MAX_COLOR: f32 = 1e6;
@@ -171,7 +175,7 @@ pub struct RenderConfig {
 /// # Errors
 /// A located [`SceneError`] for unreadable or malformed files.
 pub fn read_render_config(path: &Path) -> Result<RenderConfig, SceneError> {
-    let text = read_text(path)?;
+    let text = read_text_within(path, MAX_CONFIG_BYTES)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     parse_render_config(&text, &path.display().to_string(), &base)
 }
@@ -181,12 +185,20 @@ pub fn read_render_config(path: &Path) -> Result<RenderConfig, SceneError> {
 ///
 /// # Errors
 /// A located [`SceneError`] for malformed text, unknown keys, wrong types and impossible
-/// values (zero field of view, zero-area light, absurd window size).
+/// values (zero field of view, zero-area light, absurd window size); text over
+/// [`MAX_CONFIG_BYTES`].
 pub fn parse_render_config(
     text: &str,
     file: &str,
     base: &Path,
 ) -> Result<RenderConfig, SceneError> {
+    if text.len() as u64 > MAX_CONFIG_BYTES {
+        return Err(SceneError::TooLarge {
+            path: file.to_string(),
+            bytes: text.len() as u64,
+            limit: MAX_CONFIG_BYTES,
+        });
+    }
     let lines = LineIndex::new(text);
     let cx = Cx {
         file,

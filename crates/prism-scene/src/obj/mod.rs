@@ -41,7 +41,12 @@ pub fn read_obj_scene(path: &Path, normalize: bool) -> Result<Scene, SceneError>
 
 /// Reads a regular file of at most [`MAX_OBJ_BYTES`].
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
-    prism_math::limits::read_input(path, MAX_OBJ_BYTES).map_err(|e| SceneError::Io {
+    read_bytes_within(path, MAX_OBJ_BYTES)
+}
+
+/// Reads a regular file of at most `limit` bytes.
+fn read_bytes_within(path: &Path, limit: u64) -> Result<Vec<u8>, SceneError> {
+    prism_math::limits::read_input(path, limit).map_err(|e| SceneError::Io {
         path: path.display().to_string(),
         source: Arc::new(e),
     })
@@ -49,7 +54,12 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, SceneError> {
 
 /// Reads a text file of at most [`MAX_OBJ_BYTES`].
 pub(crate) fn read_text(path: &Path) -> Result<String, SceneError> {
-    let bytes = read_bytes(path)?;
+    read_text_within(path, MAX_OBJ_BYTES)
+}
+
+/// Reads a text file of at most `limit` bytes.
+pub(crate) fn read_text_within(path: &Path, limit: u64) -> Result<String, SceneError> {
+    let bytes = read_bytes_within(path, limit)?;
     String::from_utf8(bytes).map_err(|e| SceneError::Line {
         at: Loc::line(
             &path.display().to_string(),

@@ -280,3 +280,23 @@ fn deep_nesting_is_an_error() {
     let text = format!("x = {}{}", "[".repeat(100_000), "]".repeat(100_000));
     assert!(parse(&text).is_err());
 }
+
+/// Bounded: a config over [`MAX_CONFIG_BYTES`] is refused before its TOML is parsed (a
+/// document takes about fifty times its text in memory), whether read or given as text.
+#[test]
+fn oversized_configs_are_refused_before_parsing() {
+    let mut text = "[[motion]]\nmesh = 0\nvelocity = [1, 0, 0]\n".repeat(110_000);
+    assert!(text.len() as u64 > MAX_CONFIG_BYTES);
+    let e = parse(&text).unwrap_err();
+    assert!(matches!(e, SceneError::TooLarge { .. }), "{e}");
+    let dir = std::env::temp_dir().join(format!("prism-config-size-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("big.toml");
+    std::fs::write(&file, &text).unwrap();
+    let e = read_render_config(&file).unwrap_err();
+    assert!(e.to_string().contains("over the limit of 4 MiB"), "{e}");
+    // Just under the limit, it reads.
+    text.truncate(MAX_CONFIG_BYTES as usize - MAX_CONFIG_BYTES as usize % 41);
+    assert!(parse(&text).is_ok());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
