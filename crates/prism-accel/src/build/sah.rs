@@ -213,7 +213,13 @@ pub(crate) fn build_node(
     }
     let extent = cb.max - cb.min;
     if opts.split == Split::Median {
-        return median_split(prims, offset, depth, opts, b3, extent);
+        if extent.max_element() <= 0.0 && n <= MAX_LEAF_REF {
+            // Every centroid coincides: nothing separates them.
+            return leaf();
+        }
+        let mid = median_partition(prims, extent);
+        let sides = sides_at(prims, mid);
+        return children(prims, mid, sides, offset, depth, opts, bounds);
     }
     // Binned SAH on every axis with a non-degenerate centroid extent, all three axes binned
     // in one pass.
@@ -307,12 +313,7 @@ pub(crate) fn build_node(
     }
     if mid == 0 || mid == n {
         mid = n / 2;
-        sides = [(Box3A::EMPTY, Box3A::EMPTY); 2];
-        for (j, p) in prims.iter().enumerate() {
-            let side = &mut sides[usize::from(j >= mid)];
-            side.0 = side.0.union(p.bounds);
-            side.1 = side.1.grow(p.centroid2());
-        }
+        sides = sides_at(prims, mid);
     }
     children(prims, mid, sides, offset, depth, opts, bounds)
 }
@@ -348,29 +349,10 @@ fn children(
     )
 }
 
-/// [`Split::Median`]'s node over `prims` (more than a leaf holds): split on the longest axis
-/// of the centroids' box (`extent`, the first of equal ones) at the median centroid, ties
-/// in primitive order, so that each child holds half.
-fn median_split(
-    prims: &mut [PrimRef],
-    offset: usize,
-    depth: usize,
-    opts: &BuildOptions,
-    b3: Box3A,
-    extent: Vec3A,
-) -> (BuildNode, Summary) {
-    let n = prims.len();
-    if extent.max_element() <= 0.0 && n <= MAX_LEAF_REF {
-        // Every centroid coincides: nothing separates them.
-        return (
-            BuildNode::Leaf {
-                bounds: b3.to_aabb(),
-                start: offset,
-                count: n,
-            },
-            Summary::leaf(&b3.to_aabb(), n, depth),
-        );
-    }
+/// [`Split::Median`]'s partition of `prims` (more than a leaf holds): on the longest axis of
+/// the centroids' box (`extent`, the first of equal ones), the half with the lower centroids
+/// first (ties in primitive order); returns where the second half starts.
+fn median_partition(prims: &mut [PrimRef], extent: Vec3A) -> usize {
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
     } else if extent.y >= extent.z {
@@ -378,19 +360,24 @@ fn median_split(
     } else {
         2
     };
-    let mid = n / 2;
+    let mid = prims.len() / 2;
     prims.select_nth_unstable_by(mid, |a, b| {
         a.centroid2()[axis]
             .total_cmp(&b.centroid2()[axis])
             .then(a.id.cmp(&b.id))
     });
+    mid
+}
+
+/// The boxes and doubled-centroid boxes of `prims[..mid]` and `prims[mid..]`.
+fn sides_at(prims: &[PrimRef], mid: usize) -> [(Box3A, Box3A); 2] {
     let mut sides = [(Box3A::EMPTY, Box3A::EMPTY); 2];
     for (j, p) in prims.iter().enumerate() {
         let side = &mut sides[usize::from(j >= mid)];
         side.0 = side.0.union(p.bounds);
         side.1 = side.1.grow(p.centroid2());
     }
-    children(prims, mid, sides, offset, depth, opts, b3.to_aabb())
+    sides
 }
 
 /// The bins (`0..BINS`) of scaled centroid offsets on the three axes: the integer parts,
