@@ -12,7 +12,7 @@ use super::camera::OrbitView;
 use super::scene::{WhittedHit, WhittedScene};
 use super::tracer::{
     shadow_ray, stratified, DebugRay, PixelSampler, RayCounts, RayKind, WhittedSettings,
-    WhittedTracer,
+    WhittedTracer, ONE_BELOW,
 };
 use crate::film::{tile_of, PixelSum, Share};
 
@@ -146,7 +146,7 @@ fn pixel<S: Samples>(
         };
         // Stratified times over the shutter [0, 1).
         let time = order.as_ref().map_or(0.0, |o| {
-            ((o[s as usize] as f32 + sampler.next_1d()) / n as f32).min(1.0 - f32::EPSILON / 2.0)
+            ((o[s as usize] as f32 + sampler.next_1d()) / n as f32).min(ONE_BELOW)
         });
         let (ray, kind) = if features.depth_of_field {
             let lens = prism_math::warp::concentric_disk(stratified(s, n, &mut sampler));

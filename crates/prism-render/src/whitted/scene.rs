@@ -193,7 +193,6 @@ pub struct WhittedScene {
     /// Lights.
     pub lights: Vec<Light>,
     bvh: Option<Bvh>,
-    brute_force: bool,
     /// The still triangles' numbers when some move (the BVH's triangle `i` is triangle
     /// `still[i]`); empty when none moves.
     still: Vec<u32>,
@@ -315,7 +314,6 @@ impl WhittedScene {
                 .collect(),
             lights,
             bvh,
-            brute_force: setup.bvh.is_none(),
             still,
             movers,
             environment: setup.environment,
@@ -405,21 +403,12 @@ impl WhittedScene {
                 (h.t, prim, h.b1, h.b2)
             })
         } else {
-            let pre = RayPre::new(ray);
-            let mut best = None;
-            let mut tmax = tmax;
-            let mut test = |i: u32| {
-                let tri = &self.triangles[i as usize];
-                if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, tmax) {
-                    tmax = t;
-                    best = Some((t, i, b1, b2));
-                }
-            };
-            if self.movers.is_empty() {
-                (0..nt).for_each(&mut test);
+            let mut best = if self.movers.is_empty() {
+                self.brute_force(ray, 0..nt, tmax)
             } else {
-                self.still.iter().copied().for_each(&mut test);
-            }
+                self.brute_force(ray, self.still.iter().copied(), tmax)
+            };
+            let mut tmax = best.map_or(tmax, |b| b.0);
             for (i, (s, _)) in self.spheres.iter().enumerate() {
                 if let Some(t) = intersect_sphere(ray, s, 0.0, tmax) {
                     tmax = t;
@@ -435,22 +424,31 @@ impl WhittedScene {
                 Some(bvh) => bvh
                     .intersect(&moved, 0.0, limit)
                     .map(|h| (h.t, m.first + h.prim, h.b1, h.b2)),
-                None => {
-                    let pre = RayPre::new(&moved);
-                    let mut found = None;
-                    let mut lim = limit;
-                    for i in m.first..m.first + m.count {
-                        let tri = &self.triangles[i as usize];
-                        if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, lim) {
-                            lim = t;
-                            found = Some((t, i, b1, b2));
-                        }
-                    }
-                    found
-                }
+                None => self.brute_force(&moved, m.first..m.first + m.count, limit),
             };
             if hit.is_some() {
                 best = hit;
+            }
+        }
+        best
+    }
+
+    /// The closest of triangles `ids` (in that order, a later one winning only when strictly
+    /// closer) hit with `0 < t < tmax`, tested one by one.
+    fn brute_force(
+        &self,
+        ray: &Ray,
+        ids: impl Iterator<Item = u32>,
+        tmax: f32,
+    ) -> Option<(f32, u32, f32, f32)> {
+        let pre = RayPre::new(ray);
+        let mut best = None;
+        let mut tmax = tmax;
+        for i in ids {
+            let tri = &self.triangles[i as usize];
+            if let Some((t, b1, b2)) = intersect_triangle(&pre, tri, 0.0, tmax) {
+                tmax = t;
+                best = Some((t, i, b1, b2));
             }
         }
         best
@@ -474,7 +472,7 @@ impl WhittedScene {
     /// True if something is hit with `0 < t < tmax` at shutter time `time`.
     #[must_use]
     pub fn occluded_at(&self, ray: &Ray, tmax: f32, time: f32) -> bool {
-        if self.brute_force {
+        if self.bvh.is_none() {
             return self.closest(ray, tmax, time).is_some();
         }
         let still = self

@@ -247,10 +247,10 @@ impl WhittedTracer<'_> {
             }),
             time,
         });
-        let Some(hit) = hit else {
-            return self.environment(ray, depth);
+        let color = match hit {
+            Some(hit) => self.shade(ray, &hit, depth, width + self.spread * hit.t),
+            None => self.environment(ray, depth),
         };
-        let color = self.shade(ray, &hit, depth, width + self.spread * hit.t);
         if let (Some(i), Some(rec)) = (slot, self.record.as_mut()) {
             rec[i].color = color;
         }
@@ -282,13 +282,6 @@ impl WhittedTracer<'_> {
             hit: None,
             time,
         });
-        if let Some(rec) = self.record.as_mut() {
-            // The missed ray's own record (just before) returns the map's colour too.
-            let n = rec.len();
-            if n >= 2 {
-                rec[n - 2].color = c;
-            }
-        }
         c
     }
 
@@ -595,4 +588,4 @@ pub fn stratified(i: u32, n: u32, sampler: &mut PixelSampler) -> Vec2 {
 }
 
 /// The largest float below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+pub(crate) const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
