@@ -546,6 +546,16 @@ fn extras_rays_are_recorded_and_renders_do_not_depend_on_threads() {
         .rays
         .iter()
         .all(|r| r.time.is_some_and(|t| (0.0..1.0).contains(&t))));
+    // A ray that misses returns what its environment segment (recorded next) sees.
+    let mut misses = 0;
+    for w in tr.rays.windows(2) {
+        if w[1].kind == RayKind::Environment {
+            assert!(w[0].hit.is_none());
+            assert_eq!(w[0].color, w[1].color);
+            misses += 1;
+        }
+    }
+    assert!(misses > 0);
     let json = tr.to_json();
     assert!(json.contains("\"kind\":\"lens\"") && json.contains("\"time\":"));
     let one = prism_testkit::on_threads(1, || raytrace(&ws, &cam, &o, &|_| {}).image);
