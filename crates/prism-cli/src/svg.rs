@@ -6,7 +6,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use prism_image::{LevelSampling, PixelSampling};
-use prism_raster::{read_svg, render, Dialect, Document, RasterOptions, View};
+use prism_raster::{read_svg_with, render, Dialect, Document, Fonts, RasterOptions, View};
 
 use crate::error::UserError;
 use crate::output::{image_output, write_rgb8, ImageFormat};
@@ -48,14 +48,43 @@ pub struct SvgArgs {
     /// directory, for PNGs, when the input is a directory.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Output width in pixels. Standard SVG: the document is fitted into --width x --height
-    /// keeping its aspect ratio (default 1024x1024 box); with only one given, the other
-    /// follows the aspect ratio. With --compat cs184 the image is exactly this size.
+    /// Output width in pixels. Standard SVG (as resvg's command line): the document's own
+    /// size by default; with only --width or --height the other follows the aspect ratio;
+    /// with both, the document is fitted into that box keeping its aspect ratio. With
+    /// --compat cs184 or --view the image is exactly this size (default 1024).
     #[arg(long)]
     pub width: Option<u32>,
     /// Output height in pixels (see --width).
     #[arg(long)]
     pub height: Option<u32>,
+    /// Scale the document's own size by this factor (standard SVG; not with --width or
+    /// --height).
+    #[arg(short = 'z', long, conflicts_with_all = ["width", "height"])]
+    pub zoom: Option<f64>,
+    /// A folder of font files to load for text, besides the system's (repeatable).
+    #[arg(long = "font-dir", value_name = "DIR")]
+    pub font_dirs: Vec<PathBuf>,
+    /// Load no system fonts: only those of --font-dir.
+    #[arg(long)]
+    pub skip_system_fonts: bool,
+    /// The font family for text that names none (default Times New Roman).
+    #[arg(long, value_name = "FAMILY")]
+    pub font_family: Option<String>,
+    /// The family that `serif` stands for (default Times New Roman).
+    #[arg(long, value_name = "FAMILY")]
+    pub serif_family: Option<String>,
+    /// The family that `sans-serif` stands for (default Arial).
+    #[arg(long, value_name = "FAMILY")]
+    pub sans_serif_family: Option<String>,
+    /// The family that `monospace` stands for (default Courier New).
+    #[arg(long, value_name = "FAMILY")]
+    pub monospace_family: Option<String>,
+    /// The family that `cursive` stands for (default Comic Sans MS).
+    #[arg(long, value_name = "FAMILY")]
+    pub cursive_family: Option<String>,
+    /// The family that `fantasy` stands for (default Impact).
+    #[arg(long, value_name = "FAMILY")]
+    pub fantasy_family: Option<String>,
     /// Samples per pixel: a perfect square (1, 4, 9, 16, ...; at most 256).
     #[arg(
         short = 's',
@@ -107,6 +136,20 @@ fn parse_view(s: &str) -> Result<View> {
     }
 }
 
+/// The fonts the arguments ask for.
+fn fonts(a: &SvgArgs) -> Fonts {
+    Fonts {
+        dirs: a.font_dirs.clone(),
+        skip_system: a.skip_system_fonts,
+        family: a.font_family.clone(),
+        serif: a.serif_family.clone(),
+        sans_serif: a.sans_serif_family.clone(),
+        monospace: a.monospace_family.clone(),
+        cursive: a.cursive_family.clone(),
+        fantasy: a.fantasy_family.clone(),
+    }
+}
+
 /// Output size for a document under these arguments.
 fn output_size(doc: &Document, a: &SvgArgs) -> (u32, u32) {
     if a.compat.is_some() || a.view.is_some() {
@@ -114,6 +157,7 @@ fn output_size(doc: &Document, a: &SvgArgs) -> (u32, u32) {
     }
     let aspect = doc.width / doc.height;
     let round = |v: f64| (v.round().max(1.0)).min(f64::from(u32::MAX)) as u32;
+    let ceil = |v: f64| (v.ceil().max(1.0)).min(f64::from(u32::MAX)) as u32;
     match (a.width, a.height) {
         (Some(w), Some(h)) => {
             if f64::from(w) / f64::from(h) > aspect {
@@ -122,14 +166,18 @@ fn output_size(doc: &Document, a: &SvgArgs) -> (u32, u32) {
                 (w, round(f64::from(w) / aspect))
             }
         }
-        (Some(w), None) => (w, round(f64::from(w) / aspect)),
-        (None, Some(h)) => (round(f64::from(h) * aspect), h),
+        // As resvg: the document's size in whole pixels, scaled, rounded up.
+        (Some(w), None) => {
+            let (iw, ih) = (doc.width.ceil().max(1.0), doc.height.ceil().max(1.0));
+            (w, ceil(f64::from(w) * ih / iw))
+        }
+        (None, Some(h)) => {
+            let (iw, ih) = (doc.width.ceil().max(1.0), doc.height.ceil().max(1.0));
+            (ceil(f64::from(h) * iw / ih), h)
+        }
         (None, None) => {
-            if aspect >= 1.0 {
-                (1024, round(1024.0 / aspect))
-            } else {
-                (round(1024.0 * aspect), 1024)
-            }
+            let z = a.zoom.unwrap_or(1.0);
+            (ceil(doc.width * z), ceil(doc.height * z))
         }
     }
 }
@@ -152,7 +200,7 @@ fn render_one(
         Dialect::Svg
     };
     let t0 = Instant::now();
-    let doc = read_svg(input, dialect).map_err(UserError::input)?;
+    let doc = read_svg_with(input, dialect, &fonts(a)).map_err(UserError::input)?;
     let parse = t0.elapsed();
     let (width, height) = output_size(&doc, a);
     let opts = RasterOptions {
@@ -227,6 +275,14 @@ pub fn run(a: &SvgArgs) -> Result<()> {
 /// Runs `prism svg` on the current worker pool.
 fn run_in_pool(a: &SvgArgs) -> Result<()> {
     let view = a.view.as_deref().map(parse_view).transpose()?;
+    if let Some(z) = a.zoom {
+        if !(z.is_finite() && z > 0.0) {
+            return Err(UserError::Refused(format!(
+                "--zoom: expected a positive number, found {z}"
+            ))
+            .into());
+        }
+    }
     if prism_raster::sample_rate(a.samples).is_none() {
         return Err(UserError::Refused(format!(
             "--spp: expected a perfect square from 1 to {} (1, 4, 9, 16, ...), found {}",

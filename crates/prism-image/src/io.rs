@@ -162,6 +162,39 @@ pub fn decode_jpeg(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
     ))
 }
 
+/// Decodes the first frame of a GIF to RGBA8, placed on its logical screen as resvg and
+/// browsers show a still GIF.
+///
+/// # Errors
+/// [`ImageError::Decode`] for malformed data; [`ImageError::BadSize`] for an empty image;
+/// [`ImageError::OverBudget`] for a screen over the image budget.
+pub fn decode_gif(bytes: &[u8], what: &str) -> Result<Rgba8Image, ImageError> {
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = opts.read_info(bytes).map_err(|e| decode_err(what, e))?;
+    let (w, h) = (u64::from(decoder.width()), u64::from(decoder.height()));
+    check_size(what, (w, h), 8, 0, bytes.len())?;
+    let frame = decoder
+        .read_next_frame()
+        .map_err(|e| decode_err(what, e))?
+        .ok_or_else(|| decode_err(what, "no image frame"))?;
+    let mut out = vec![[0u8; 4]; (w * h) as usize];
+    let (fw, fh) = (usize::from(frame.width), usize::from(frame.height));
+    let (fl, ft) = (usize::from(frame.left), usize::from(frame.top));
+    for y in 0..fh {
+        for x in 0..fw {
+            let (sx, sy) = (fl + x, ft + y);
+            if sx < w as usize && sy < h as usize {
+                let i = (y * fw + x) * 4;
+                if let Some(p) = frame.buffer.get(i..i + 4) {
+                    out[sy * w as usize + sx] = [p[0], p[1], p[2], p[3]];
+                }
+            }
+        }
+    }
+    Ok(Rgba8Image::from_vec(w as u32, h as u32, out))
+}
+
 /// The largest image file the readers open, in bytes (1 GiB).
 pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
 

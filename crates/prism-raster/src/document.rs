@@ -181,8 +181,10 @@ pub enum GradientKind {
         center: DVec2,
         /// Radius of the end circle.
         radius: f64,
-        /// The focal point (offset 0).
+        /// The focal point: centre of the start circle (offset 0).
         focus: DVec2,
+        /// Radius of the start circle.
+        focal_radius: f64,
     },
 }
 
@@ -206,6 +208,25 @@ pub enum Paint {
     Solid(Rgb),
     /// A gradient.
     Gradient(Arc<Gradient>),
+    /// A tile of drawings repeated over the plane.
+    Pattern(Arc<Pattern>),
+}
+
+/// A pattern paint: `items` drawn in a tile of `rect`, repeated.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    /// The tile's content, in tile coordinates (origin at the tile's corner).
+    pub items: Vec<Item>,
+    /// The tile `(x, y, width, height)` in pattern space.
+    pub rect: [f64; 4],
+    /// Maps pattern space to the user space of the painted element.
+    pub transform: Mat3,
+}
+
+impl PartialEq for Pattern {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
 }
 
 /// One drawable thing, in painter's order.
@@ -301,14 +322,76 @@ pub enum Item {
         /// Opacity in [0, 1].
         opacity: f32,
     },
-    /// Starts an offscreen layer; everything up to the matching [`Item::EndLayer`] is
-    /// composited onto what lies below with `opacity`.
+    /// Starts an offscreen layer, ended by the matching [`Item::EndLayer`],
+    /// [`Item::ClipEnd`] or [`Item::MaskEnd`].
     BeginLayer,
-    /// Ends the innermost layer.
+    /// Ends the innermost layer and composites it onto what lies below.
     EndLayer {
         /// Group opacity in [0, 1].
         opacity: f32,
+        /// How the layer's colours combine with those below.
+        blend: BlendMode,
     },
+    /// Ends the innermost layer, whose shapes are a clip path, and multiplies the layer
+    /// below by its coverage (alpha): what lies outside the clip becomes transparent.
+    ClipEnd,
+    /// Ends the innermost layer, whose content is a mask, and multiplies the layer below by
+    /// its luminance times alpha, or by its alpha alone.
+    MaskEnd(MaskKind),
+    /// A layer's content rendered whole, then passed through filters; drawn where it lies.
+    Filtered(Arc<crate::filter::Filtered>),
+}
+
+/// Which value of a mask's content scales what it masks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MaskKind {
+    /// `0.2125 R + 0.7154 G + 0.0721 B` of the stored sRGB values, times alpha (SVG's
+    /// `mask-type: luminance`, with the coefficients resvg uses).
+    #[default]
+    Luminance,
+    /// Alpha alone.
+    Alpha,
+}
+
+/// How a layer's colours combine with the colours below it (CSS Compositing's
+/// `mix-blend-mode`), on stored sRGB values with source-over alpha.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BlendMode {
+    /// The source colour.
+    #[default]
+    Normal,
+    /// `s * d`.
+    Multiply,
+    /// `s + d - s * d`.
+    Screen,
+    /// Hard light with source and backdrop swapped.
+    Overlay,
+    /// `min(s, d)`.
+    Darken,
+    /// `max(s, d)`.
+    Lighten,
+    /// Brightens the backdrop towards the source.
+    ColorDodge,
+    /// Darkens the backdrop towards the source.
+    ColorBurn,
+    /// Multiply or screen, by the source.
+    HardLight,
+    /// A softer hard light (the W3C formula).
+    SoftLight,
+    /// `|s - d|`.
+    Difference,
+    /// `s + d - 2 s d`.
+    Exclusion,
+    /// The source's hue with the backdrop's saturation and luminosity.
+    Hue,
+    /// The source's saturation with the backdrop's hue and luminosity.
+    Saturation,
+    /// The source's hue and saturation with the backdrop's luminosity.
+    Color,
+    /// The source's luminosity with the backdrop's hue and saturation.
+    Luminosity,
+    /// `min(1, s + d)` on premultiplied values.
+    PlusLighter,
 }
 
 /// A parsed SVG, ready to rasterize.
@@ -332,4 +415,31 @@ pub struct Document {
     pub texture_alpha: Vec<Option<Arc<Texture>>>,
     /// One line per kind of thing that was skipped or approximated.
     pub warnings: Vec<prism_math::Warning>,
+}
+
+impl BlendMode {
+    /// usvg's blend mode as prism's.
+    #[must_use]
+    pub fn from_usvg(b: usvg::BlendMode) -> BlendMode {
+        use usvg::BlendMode as U;
+        match b {
+            U::Normal => BlendMode::Normal,
+            U::Multiply => BlendMode::Multiply,
+            U::Screen => BlendMode::Screen,
+            U::Overlay => BlendMode::Overlay,
+            U::Darken => BlendMode::Darken,
+            U::Lighten => BlendMode::Lighten,
+            U::ColorDodge => BlendMode::ColorDodge,
+            U::ColorBurn => BlendMode::ColorBurn,
+            U::HardLight => BlendMode::HardLight,
+            U::SoftLight => BlendMode::SoftLight,
+            U::Difference => BlendMode::Difference,
+            U::Exclusion => BlendMode::Exclusion,
+            U::Hue => BlendMode::Hue,
+            U::Saturation => BlendMode::Saturation,
+            U::Color => BlendMode::Color,
+            U::Luminosity => BlendMode::Luminosity,
+            U::PlusLighter => BlendMode::PlusLighter,
+        }
+    }
 }

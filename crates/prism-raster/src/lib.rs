@@ -14,18 +14,23 @@
 //! ```
 #![warn(missing_docs)]
 
+mod blend;
 mod document;
 mod figures;
+pub mod filter;
 mod parse;
 pub mod path;
 mod raster;
 mod triangulate;
 
-pub use document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread, Stop};
+pub use document::{
+    BlendMode, Document, FillRule, Gradient, GradientKind, Item, Mat3, MaskKind, Paint, Pattern,
+    Spread, Stop,
+};
 pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
-    parse_path_data, parse_path_data_prefix, parse_svg, read_svg, Dialect, PathDataError, Source,
-    SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
+    parse_path_data, parse_path_data_prefix, parse_svg, read_svg, read_svg_with, Dialect, Fonts, PathDataError, Source,
+    SvgError, MAX_DEPTH, MAX_IMAGE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RasterError, RasterOptions, RasterStats, View,

@@ -143,6 +143,7 @@ fn draw(svg: &str, dialect: Dialect, opts: &RasterOptions, out: &Path) -> Result
         &Source {
             name: "<demo>".into(),
             base_dir: PathBuf::new(),
+            ..Source::default()
         },
     )?;
     let (img, _) = render(&doc, opts)?;

@@ -121,6 +121,24 @@ pub enum SvgError {
         /// The limit.
         limit: usize,
     },
+    /// A font directory given for text cannot be read.
+    #[error("{dir}: font directory: {source}")]
+    FontDir {
+        /// The directory.
+        dir: String,
+        /// What the operating system said.
+        #[source]
+        source: Arc<std::io::Error>,
+    },
+    /// usvg refused the document as a whole (no valid size, too many elements).
+    #[error("{file}: {source}")]
+    Usvg {
+        /// The file.
+        file: String,
+        /// usvg's error.
+        #[source]
+        source: Arc<usvg::Error>,
+    },
 }
 
 impl SvgError {
@@ -130,7 +148,9 @@ impl SvgError {
         match self {
             SvgError::Io { file, .. }
             | SvgError::Encoding { file, .. }
-            | SvgError::FileTooLarge { file, .. } => Loc::line(file, 0),
+            | SvgError::FileTooLarge { file, .. }
+            | SvgError::Usvg { file, .. } => Loc::line(file, 0),
+            SvgError::FontDir { dir, .. } => Loc::line(dir, 0),
             SvgError::Xml { at, .. }
             | SvgError::Element { at, .. }
             | SvgError::PathData { at, .. }

@@ -18,6 +18,29 @@ pub struct Source {
     pub name: String,
     /// The directory relative file references are resolved against.
     pub base_dir: PathBuf,
+    /// The fonts text is set in (standard dialect).
+    pub fonts: Fonts,
+}
+
+/// Where text finds its fonts, as resvg's command line sets them.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Fonts {
+    /// Directories of font files loaded in addition to the system's.
+    pub dirs: Vec<PathBuf>,
+    /// Leave out the system's fonts.
+    pub skip_system: bool,
+    /// The family used when an element names none (default Times New Roman).
+    pub family: Option<String>,
+    /// The family `serif` stands for.
+    pub serif: Option<String>,
+    /// The family `sans-serif` stands for.
+    pub sans_serif: Option<String>,
+    /// The family `monospace` stands for.
+    pub monospace: Option<String>,
+    /// The family `cursive` stands for.
+    pub cursive: Option<String>,
+    /// The family `fantasy` stands for.
+    pub fantasy: Option<String>,
 }
 
 /// The state of one reading of a document, shared by both dialects.

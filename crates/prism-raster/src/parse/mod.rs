@@ -9,11 +9,14 @@ pub(crate) mod common;
 mod context;
 mod course;
 pub(crate) mod cs184;
+mod fonts;
+mod guard;
 mod images;
 mod number;
 mod pathdata;
+mod resources;
+mod standard;
 mod style;
-mod svg;
 mod viewport;
 
 use prism_math::Loc;
@@ -21,7 +24,8 @@ use std::path::Path as FsPath;
 use std::sync::Arc;
 
 pub use common::{SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
-pub use context::Source;
+pub use context::{Fonts, Source};
+pub use resources::MAX_IMAGE_BYTES;
 use context::{element_loc, Ctx};
 pub use pathdata::{parse_path_data, parse_path_data_prefix, PathDataError};
 
@@ -51,6 +55,9 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
             limit: MAX_SVG_BYTES,
         });
     }
+    if dialect == Dialect::Svg {
+        return standard::parse(text, source);
+    }
     let opts = roxmltree::ParsingOptions {
         allow_dtd: true,
         nodes_limit: 50_000_000,
@@ -72,17 +79,23 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
         let loc = element_loc(&ctx, &root);
         return Err(loc.err("expected the root element to be <svg>"));
     }
-    match dialect {
-        Dialect::Cs184 => cs184::parse(root, &mut ctx),
-        Dialect::Svg => svg::parse(root, &mut ctx),
-    }
+    cs184::parse(root, &mut ctx)
 }
 
-/// Reads and parses an SVG file; relative references resolve against its directory.
+/// Reads and parses an SVG file; relative references resolve against its directory, and
+/// text uses the system's fonts.
 ///
 /// # Errors
 /// As [`parse_svg`], plus an unreadable or non-UTF-8 file.
 pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
+    read_svg_with(path, dialect, &Fonts::default())
+}
+
+/// [`read_svg`] with text set in the given fonts.
+///
+/// # Errors
+/// As [`read_svg`], plus a font directory that cannot be read.
+pub fn read_svg_with(path: &FsPath, dialect: Dialect, fonts: &Fonts) -> Result<Document, SvgError> {
     let name = path.display().to_string();
     let io = |e: std::io::Error| SvgError::Io {
         file: name.clone(),
@@ -94,7 +107,11 @@ pub fn read_svg(path: &FsPath, dialect: Dialect) -> Result<Document, SvgError> {
         source: e.utf8_error(),
     })?;
     let base_dir = path.parent().map(FsPath::to_path_buf).unwrap_or_default();
-    let source = Source { name, base_dir };
+    let source = Source {
+        name,
+        base_dir,
+        fonts: fonts.clone(),
+    };
     parse_svg(&text, dialect, &source)
 }
 

@@ -3,20 +3,9 @@
 
 use prism_math::DVec2;
 
+use crate::blend::{composite, over as blend};
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
-use crate::document::FillRule;
-
-#[inline]
-pub(super) fn blend(dst: &mut [f32; 4], src: [f32; 4]) {
-    if src[3] >= 1.0 {
-        *dst = src;
-    } else if src[3] > 0.0 {
-        let k = 1.0 - src[3];
-        for c in 0..4 {
-            dst[c] = src[c] + dst[c] * k;
-        }
-    }
-}
+use crate::document::{BlendMode, FillRule, MaskKind};
 
 /// The course renderer's translucent blend: both colours truncated to 8 bits, mixed as
 /// `a * src + (1 - a) * dst` in `f32` on the 0..255 scale, truncated again. Opaque targets
@@ -105,21 +94,54 @@ impl Band {
                 }
                 self.layers.push(buf);
             }
-            Prim::EndLayer(op) => {
-                if self.layers.len() < 2 {
-                    return;
+            Prim::EndLayer(op, mode) => {
+                let op = *op;
+                self.end_layer(pl, |d, s| {
+                    let s = [s[0] * op, s[1] * op, s[2] * op, s[3] * op];
+                    if *mode == BlendMode::Normal {
+                        blend(d, s);
+                    } else {
+                        composite(d, s, *mode);
+                    }
+                });
+            }
+            Prim::ClipEnd => self.end_layer(pl, |d, s| {
+                let k = s[3].min(1.0);
+                *d = [d[0] * k, d[1] * k, d[2] * k, d[3] * k];
+            }),
+            Prim::MaskEnd(kind) => self.end_layer(pl, |d, s| {
+                let k = match kind {
+                    MaskKind::Alpha => s[3],
+                    MaskKind::Luminance => 0.2125 * s[0] + 0.7154 * s[1] + 0.0721 * s[2],
                 }
-                let (rows, cols) = self.region(pl);
-                let stride = self.cols;
-                let src = self.layers.pop().expect("checked");
-                let dst = self.top();
-                for j in rows {
-                    let range = j * stride + cols.start..j * stride + cols.end;
-                    for (d, s) in dst[range.clone()].iter_mut().zip(&src[range]) {
-                        blend(d, [s[0] * op, s[1] * op, s[2] * op, s[3] * op]);
+                .clamp(0.0, 1.0);
+                *d = [d[0] * k, d[1] * k, d[2] * k, d[3] * k];
+            }),
+            Prim::Raster { x0, y0, w, px } => {
+                let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
+                let (by0, rows_px, cols, width) = (self.y0, self.rows_px, self.cols, self.width);
+                let h = (px.len() / w.max(&1)) as i32;
+                let ya = (*y0).max(by0);
+                let yb = (y0 + h).min(by0 + rows_px);
+                let xa = (*x0).max(0);
+                let xb = (x0 + *w as i32).min(width);
+                let buf = self.top();
+                for y in ya..yb {
+                    let src_row = (y - y0) as usize * w;
+                    for j in 0..sr {
+                        let row = ((y - by0) as usize * sr + j) * cols;
+                        for x in xa..xb {
+                            let c = px[src_row + (x - x0) as usize];
+                            if c[3] <= 0.0 {
+                                continue;
+                            }
+                            let at = row + x as usize * sc;
+                            for s in &mut buf[at..at + sc] {
+                                blend(s, c);
+                            }
+                        }
                     }
                 }
-                self.spare.push(src);
             }
             Prim::Pixels { px, color } => {
                 let (y0, y1, cols) = (self.y0, self.y0 + self.rows_px, self.cols);
@@ -151,6 +173,25 @@ impl Band {
         }
     }
 
+    /// Pops the top layer and combines each of its samples in the placed box into the
+    /// layer below with `f(below, top)`.
+    fn end_layer(&mut self, pl: &Placed, f: impl Fn(&mut [f32; 4], [f32; 4])) {
+        if self.layers.len() < 2 {
+            return;
+        }
+        let (rows, cols) = self.region(pl);
+        let stride = self.cols;
+        let src = self.layers.pop().expect("checked");
+        let dst = self.top();
+        for j in rows {
+            let range = j * stride + cols.start..j * stride + cols.end;
+            for (d, s) in dst[range.clone()].iter_mut().zip(&src[range]) {
+                f(d, *s);
+            }
+        }
+        self.spare.push(src);
+    }
+
     fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols as f64);
         let band_lo = f64::from(self.y0);
@@ -167,7 +208,7 @@ impl Band {
         let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
         // Gradients are evaluated once per pixel, at its centre, and the colour given to
         // every covered sample (as multisampling shades); alpha < 0 marks "not yet".
-        let gradient = matches!(paint, DevPaint::Gradient { .. });
+        let gradient = !matches!(paint, DevPaint::Solid(_));
         let mut row_cache: Vec<[f32; 4]> = Vec::new();
         let mut cache_row = usize::MAX;
         for j in 0..self.rows_px as usize * sr {
@@ -438,6 +479,27 @@ impl Band {
                 };
                 blend(&mut buf[j * cols + i], color);
                 i += 1;
+            }
+        }
+    }
+
+    /// Box-filters the canvas layer into premultiplied pixels.
+    pub(super) fn resolve_premultiplied(&self, out: &mut [[f32; 4]]) {
+        let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
+        let k = 1.0 / (sr * sc) as f32;
+        let w = self.width as usize;
+        let stride = self.cols;
+        for py in 0..self.rows_px as usize {
+            let base = py * sr * stride;
+            for (x, o) in out[py * w..(py + 1) * w].iter_mut().enumerate() {
+                let mut sum = [0f32; 4];
+                for j in 0..sr {
+                    let start = base + j * stride + x * sc;
+                    for s in &self.layers[0][start..start + sc] {
+                        sum = add4(sum, *s);
+                    }
+                }
+                *o = sum.map(|v| v * k);
             }
         }
     }

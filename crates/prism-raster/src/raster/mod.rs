@@ -15,6 +15,7 @@
 //! than a pixel are drawn one pixel wide with their opacity scaled by their width.
 
 mod band;
+mod offscreen;
 mod options;
 mod primitives;
 
@@ -23,8 +24,9 @@ use std::time::{Duration, Instant};
 use prism_image::Rgba8Image;
 use rayon::prelude::*;
 
-use crate::document::Document;
+use crate::document::{Document, Item, Mat3};
 use band::{Band, Pattern};
+use primitives::Placed;
 pub use options::{
     sample_rate, view_transform, RasterError, RasterOptions, View, MAX_DIMENSION, MAX_SAMPLES,
 };
@@ -61,23 +63,70 @@ pub fn render(
     }
     let t0 = Instant::now();
     let view = view_transform(doc, opts);
-    let prims = prepare(doc, opts, &view);
+    let prims = prepare(doc, &doc.items, opts, &view);
     let prepare_time = t0.elapsed();
     let t1 = Instant::now();
+    let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
+    let compat = opts.compat;
+    let times = draw_bands(&prims, opts, r, &mut pixels, |band, out| {
+        band.resolve(out, compat);
+    });
+    let wall = t1.elapsed();
+    let (rt, st): (Duration, Duration) = times
+        .iter()
+        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| {
+            (a + *x, b + *y)
+        });
+    let total = (rt + st).as_secs_f64().max(1e-12);
+    let stats = RasterStats {
+        prepare: prepare_time,
+        raster: wall.mul_f64(rt.as_secs_f64() / total),
+        resolve: wall.mul_f64(st.as_secs_f64() / total),
+    };
+    Ok((Rgba8Image::from_vec(w, h, pixels), stats))
+}
+
+/// Renders `items` of `doc` through `view` into premultiplied pixels of an
+/// `opts.width` x `opts.height` image on a transparent background (offscreen layers:
+/// pattern tiles and filtered groups).
+pub(super) fn render_premultiplied(
+    doc: &Document,
+    items: &[Item],
+    opts: &RasterOptions,
+    view: &Mat3,
+) -> Vec<[f32; 4]> {
+    let r = sample_rate(opts.samples).unwrap_or(1) as usize;
+    let prims = prepare(doc, items, opts, view);
+    let mut pixels = vec![[0f32; 4]; opts.width as usize * opts.height as usize];
+    draw_bands(&prims, opts, r, &mut pixels, |band, out| {
+        band.resolve_premultiplied(out);
+    });
+    pixels
+}
+
+/// Draws `prims` band by band in parallel and resolves each band into its rows of `pixels`
+/// with `resolve`; returns each band's (raster, resolve) thread time.
+fn draw_bands<T: Send>(
+    prims: &[Placed],
+    opts: &RasterOptions,
+    r: usize,
+    pixels: &mut [T],
+    resolve: impl Fn(&Band, &mut [T]) + Sync,
+) -> Vec<(Duration, Duration)> {
+    let w = opts.width;
     // Regular r x r grid: it agreed better with analytic coverage (resvg) on the test suites
     // than n-rooks patterns did.
     let pat = Pattern::grid(r);
     let cols = w as usize * pat.sub_cols;
     // About 256 KiB of samples per band (and per layer of a band), to stay in L2.
     let band_rows = ((256usize << 10) / (cols * pat.sub_rows * 16)).clamp(1, 64);
-    let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
     let background = if opts.compat {
         [1.0, 1.0, 1.0, 1.0]
     } else {
         [0.0; 4]
     };
     let full = band_rows * pat.sub_rows * cols;
-    let times: Vec<(Duration, Duration)> = pixels
+    pixels
         .par_chunks_mut(band_rows * w as usize)
         .enumerate()
         .map_init(
@@ -100,30 +149,17 @@ pub fn render(
                 canvas.fill(background);
                 band.layers.push(canvas);
                 let (y0, rows_px) = (band.y0, band.rows_px);
-                for p in &prims {
+                for p in prims {
                     if p.y1 > y0 && p.y0 < y0 + rows_px {
                         band.draw(p, opts.compat);
                     }
                 }
                 let tb = Instant::now();
-                band.resolve(out, opts.compat);
+                resolve(band, out);
                 (tb - ta, tb.elapsed())
             },
         )
-        .collect();
-    let wall = t1.elapsed();
-    let (rt, st): (Duration, Duration) = times
-        .iter()
-        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| {
-            (a + *x, b + *y)
-        });
-    let total = (rt + st).as_secs_f64().max(1e-12);
-    let stats = RasterStats {
-        prepare: prepare_time,
-        raster: wall.mul_f64(rt.as_secs_f64() / total),
-        resolve: wall.mul_f64(st.as_secs_f64() / total),
-    };
-    Ok((Rgba8Image::from_vec(w, h, pixels), stats))
+        .collect()
 }
 
 #[cfg(test)]
@@ -288,7 +324,10 @@ mod tests {
                             transform: Mat3::IDENTITY,
                         }
                     });
-                    doc.items.push(Item::EndLayer { opacity: 0.5 });
+                    doc.items.push(Item::EndLayer {
+                        opacity: 0.5,
+                        blend: crate::BlendMode::Normal,
+                    });
                 }
                 for samples in [1, 16] {
                     let opts = RasterOptions {

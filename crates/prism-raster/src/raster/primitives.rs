@@ -8,7 +8,10 @@ use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
 use super::options::{RasterOptions, TOLERANCE};
-use crate::document::{Document, FillRule, Gradient, GradientKind, Item, Mat3, Paint, Spread};
+use super::offscreen::{filtered, pattern_paint, Tile};
+use crate::document::{
+    BlendMode, Document, FillRule, Gradient, GradientKind, Item, Mat3, MaskKind, Paint, Spread,
+};
 use crate::path::{stroke, Path, StrokeStyle};
 
 /// A non-horizontal polygon edge in device space with `y0 < y1`.
@@ -60,6 +63,13 @@ pub(super) enum DevPaint {
         /// Premultiplied colours for `t = i / (LUT_SIZE - 1)`.
         lut: Vec<[f32; 4]>,
     },
+    /// A repeated tile, sampled bilinearly.
+    Pattern {
+        tile: Arc<Tile>,
+        /// Device pixel to tile pixel.
+        inv: prism_math::DAffine2,
+        opacity: f32,
+    },
 }
 
 /// Entries in a gradient's colour table: `t` in [0, 1] is quantised to 1/1023.
@@ -110,6 +120,10 @@ impl DevPaint {
     pub(super) fn at(&self, x: f64, y: f64) -> [f32; 4] {
         match self {
             DevPaint::Solid(c) => *c,
+            DevPaint::Pattern { tile, inv, opacity } => {
+                let p = inv.transform_point2(DVec2::new(x, y));
+                tile.sample(p).map(|v| v * opacity)
+            }
             DevPaint::Gradient { g, inv, lut } => {
                 let p = inv.transform_point2(DVec2::new(x, y));
                 let t = match g.kind {
@@ -126,7 +140,14 @@ impl DevPaint {
                         center,
                         radius,
                         focus,
-                    } => radial_t(p, center, radius, focus),
+                        focal_radius,
+                    } => {
+                        if focal_radius > 0.0 {
+                            conical_t(p, center, radius, focus, focal_radius)
+                        } else {
+                            radial_t(p, center, radius, focus)
+                        }
+                    }
                 };
                 let t = match g.spread {
                     Spread::Pad => t.clamp(0.0, 1.0),
@@ -178,6 +199,36 @@ pub(super) fn radial_t(p: DVec2, center: DVec2, radius: f64, focus: DVec2) -> f6
     }
 }
 
+/// The gradient parameter of `p` for the two-point conical gradient from the circle
+/// (`focus`, `fr`) at 0 to (`center`, `radius`) at 1: the largest `t` whose circle, of
+/// non-negative radius, passes through `p`.
+pub(super) fn conical_t(p: DVec2, center: DVec2, radius: f64, focus: DVec2, fr: f64) -> f64 {
+    let (cd, pd, dr) = (center - focus, p - focus, radius - fr);
+    // |pd - t cd| = fr + t dr, squared: a t^2 - 2 b t + c = 0.
+    let a = cd.length_squared() - dr * dr;
+    let b = pd.dot(cd) + fr * dr;
+    let c = pd.length_squared() - fr * fr;
+    let ok = |t: f64| fr + t * dr >= 0.0;
+    if a.abs() < 1e-12 {
+        let t = if b.abs() < 1e-12 { 0.0 } else { c / (2.0 * b) };
+        return if ok(t) { t } else { 0.0 };
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return 0.0;
+    }
+    let s = disc.sqrt();
+    let (t1, t2) = ((b + s) / a, (b - s) / a);
+    let (hi, lo) = (t1.max(t2), t1.min(t2));
+    if ok(hi) {
+        hi
+    } else if ok(lo) {
+        lo
+    } else {
+        0.0
+    }
+}
+
 #[derive(Clone, Debug)]
 pub(super) enum TriShade {
     Solid([f32; 4]),
@@ -210,8 +261,18 @@ pub(super) enum Prim {
         px: Vec<(i32, i32)>,
         color: [f32; 4],
     },
+    /// A premultiplied image aligned to the pixel grid: `w` pixels wide, its top-left pixel
+    /// at `(x0, y0)`; every sample of a pixel takes the pixel's colour.
+    Raster {
+        x0: i32,
+        y0: i32,
+        w: usize,
+        px: Arc<Vec<[f32; 4]>>,
+    },
     BeginLayer,
-    EndLayer(f32),
+    EndLayer(f32, BlendMode),
+    ClipEnd,
+    MaskEnd(MaskKind),
 }
 
 /// A primitive with the pixel rows `[y0, y1)` and columns `[x0, x1)` it can touch.
@@ -313,7 +374,12 @@ pub(super) fn to_f32(p: DVec2) -> (f32, f32) {
 }
 
 /// Turns document items into device primitives.
-pub(super) fn prepare(doc: &Document, opts: &RasterOptions, view: &Mat3) -> Vec<Placed> {
+pub(super) fn prepare(
+    doc: &Document,
+    items: &[Item],
+    opts: &RasterOptions,
+    view: &Mat3,
+) -> Vec<Placed> {
     let h = opts.height as i32;
     let w = opts.width as f64;
     let hf = opts.height as f64;
@@ -381,6 +447,7 @@ pub(super) fn prepare(doc: &Document, opts: &RasterOptions, view: &Mat3) -> Vec<
     };
     let dev_paint = |paint: &Paint, m: &Mat3, opacity: f32| -> Option<DevPaint> {
         match paint {
+            Paint::Pattern(p) => pattern_paint(doc, p, m, opacity, opts),
             Paint::Solid(c) => Some(DevPaint::Solid(solid(*c, opacity))),
             Paint::Gradient(g) => {
                 let full = m.mul(&g.transform).to_affine();
@@ -623,17 +690,32 @@ pub(super) fn prepare(doc: &Document, opts: &RasterOptions, view: &Mat3) -> Vec<
                 x1: 0,
                 prim: Prim::BeginLayer,
             }),
-            Item::EndLayer { opacity } => out.push(Placed {
+            Item::EndLayer { opacity, blend } => out.push(Placed {
                 y0: 0,
                 y1: 0,
                 x0: 0,
                 x1: 0,
-                prim: Prim::EndLayer(*opacity),
+                prim: Prim::EndLayer(*opacity, *blend),
             }),
+            Item::ClipEnd => out.push(Placed {
+                y0: 0,
+                y1: 0,
+                x0: 0,
+                x1: 0,
+                prim: Prim::ClipEnd,
+            }),
+            Item::MaskEnd(kind) => out.push(Placed {
+                y0: 0,
+                y1: 0,
+                x0: 0,
+                x1: 0,
+                prim: Prim::MaskEnd(*kind),
+            }),
+            Item::Filtered(f) => out.extend(filtered(doc, f, view, opts)),
         }
         out
     };
-    let mut prims: Vec<Placed> = doc.items.par_iter().map(per_item).flatten_iter().collect();
+    let mut prims: Vec<Placed> = items.par_iter().map(per_item).flatten_iter().collect();
     if opts.compat {
         // The course's canvas outline, corners pushed out by one pixel.
         let corner = |x: f64, y: f64, dx: f64, dy: f64| {
@@ -677,7 +759,26 @@ pub(super) fn bound_layers(prims: &mut [Placed]) {
                 stack.push((i, cur));
                 cur = empty;
             }
-            Prim::EndLayer(_) => {
+            Prim::ClipEnd | Prim::MaskEnd(_) => {
+                // A clip or mask layer covers the whole box of what it clips (outside its
+                // own shapes it removes everything), and the box does not grow.
+                let Some((b, outer)) = stack.pop() else {
+                    continue;
+                };
+                let boxed = if outer.0 < outer.1 && outer.2 < outer.3 {
+                    outer
+                } else {
+                    (0, 0, 0, 0)
+                };
+                for k in [b, i] {
+                    prims[k].y0 = boxed.0;
+                    prims[k].y1 = boxed.1;
+                    prims[k].x0 = boxed.2;
+                    prims[k].x1 = boxed.3;
+                }
+                cur = outer;
+            }
+            Prim::EndLayer(..) => {
                 let Some((b, outer)) = stack.pop() else {
                     continue;
                 };
