@@ -321,6 +321,8 @@ pub enum Item {
         transform: Mat3,
         /// Opacity in [0, 1].
         opacity: f32,
+        /// Texel lookup (SVG's `image-rendering`).
+        sampling: prism_image::PixelSampling,
     },
     /// Starts an offscreen layer, ended by the matching [`Item::EndLayer`],
     /// [`Item::ClipEnd`] or [`Item::MaskEnd`].

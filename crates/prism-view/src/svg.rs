@@ -142,7 +142,7 @@ impl Mode for SvgMode {
                 Key::Char('p') => {
                     self.pixel = match self.pixel {
                         PixelSampling::Nearest => PixelSampling::Bilinear,
-                        PixelSampling::Bilinear => PixelSampling::Nearest,
+                        PixelSampling::Bilinear | PixelSampling::Bicubic => PixelSampling::Nearest,
                     };
                     Response::Redraw
                 }
@@ -223,6 +223,7 @@ impl Mode for SvgMode {
         let pixel = match self.pixel {
             PixelSampling::Nearest => "nearest",
             PixelSampling::Bilinear => "bilinear",
+            PixelSampling::Bicubic => "bicubic",
         };
         let level = match self.level {
             LevelSampling::Zero => "level 0",

@@ -120,5 +120,6 @@ pub(crate) fn image_item(
         rect,
         transform,
         opacity: 1.0,
+        sampling: prism_image::PixelSampling::Bilinear,
     }))
 }

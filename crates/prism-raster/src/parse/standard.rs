@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use prism_image::PixelSampling;
 use prism_math::{DVec2, Loc, Rgb, Warning};
 use usvg::tiny_skia_path::PathSegment;
 
@@ -452,6 +453,14 @@ impl Converter<'_> {
                     rect: [0.0, 0.0, f64::from(w), f64::from(h)],
                     transform: m,
                     opacity: 1.0,
+                    sampling: match img.rendering_mode() {
+                        usvg::ImageRendering::OptimizeSpeed
+                        | usvg::ImageRendering::CrispEdges
+                        | usvg::ImageRendering::Pixelated => PixelSampling::Nearest,
+                        usvg::ImageRendering::Smooth => PixelSampling::Bilinear,
+                        usvg::ImageRendering::OptimizeQuality
+                        | usvg::ImageRendering::HighQuality => PixelSampling::Bicubic,
+                    },
                 };
                 self.push(out, item)
             }

@@ -164,7 +164,7 @@ impl Band {
                     }
                 }
             }
-            Prim::Poly { edges, rule, paint } => self.poly(edges, *rule, paint),
+            Prim::Poly { edges, rule, paint } => self.poly(edges, *rule, paint, compat),
             Prim::Tri {
                 v,
                 inclusive,
@@ -192,7 +192,11 @@ impl Band {
         self.spare.push(src);
     }
 
-    fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint) {
+    /// Fills a polygon. A sample on an edge belongs to one side only: in compat mode the
+    /// left and top edges own it (`y0 <= y < y1`); otherwise the right and bottom edges do
+    /// (`y0 < y <= y1`), which is tiny-skia's rule, so that edges on the sample grid cover
+    /// what resvg covers.
+    fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols as f64);
         let band_lo = f64::from(self.y0);
         let band_hi = f64::from(self.y0 + self.rows_px);
@@ -222,8 +226,12 @@ impl Band {
             let y_centre = f64::from(self.y0) + (j / sr) as f64 + 0.5;
             xs.clear();
             for e in &local {
-                // Half-open in y: an edge owns samples with y0 <= y < y1.
-                if y >= e.y0 && y < e.y1 {
+                let owns = if compat {
+                    y >= e.y0 && y < e.y1
+                } else {
+                    y > e.y0 && y <= e.y1
+                };
+                if owns {
                     xs.push((e.x0 + (y - e.y0) * e.dxdy, e.dir));
                 }
             }
@@ -242,8 +250,12 @@ impl Band {
                 if !inside {
                     continue;
                 }
-                // Samples with x in [xa, xb): left edges inclusive, right exclusive.
-                let first = |x: f64| (((x - xo) * sc).ceil().clamp(0.0, cols as f64)) as usize;
+                // The first sample at or right of x (compat), or right of x.
+                let first = |x: f64| {
+                    let k = (x - xo) * sc;
+                    let k = if compat { k.ceil() } else { k.floor() + 1.0 };
+                    k.clamp(0.0, cols as f64) as usize
+                };
                 let (a, b) = (first(xs[k].0), first(xs[k + 1].0));
                 match paint {
                     DevPaint::Solid(c) if c[3] >= 1.0 => row[a..b].fill(*c),

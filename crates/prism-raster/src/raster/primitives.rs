@@ -654,6 +654,7 @@ pub(super) fn prepare(
                 rect,
                 transform,
                 opacity,
+                sampling,
             } => {
                 let m = view.mul(transform);
                 let [x, y, w, h] = *rect;
@@ -676,7 +677,7 @@ pub(super) fn prepare(
                         *texture,
                         v,
                         [uv[a], uv[b], uv[cc]],
-                        PixelSampling::Bilinear,
+                        *sampling,
                         LevelSampling::Linear,
                         *opacity,
                     );
@@ -747,9 +748,35 @@ pub(super) fn prepare(
     prims
 }
 
-/// Gives every layer the bounding box of what it contains, so bands skip empty layers and
-/// layer clearing and compositing touch only that box.
+/// Gives every layer the bounding box of what it contains (a clip or mask layer: the box
+/// of what it clips), so bands skip empty layers and layer clearing and compositing touch
+/// only that box; then limits every primitive to the box of each layer around it, so that
+/// a band that skips a layer skips all of its content.
 pub(super) fn bound_layers(prims: &mut [Placed]) {
+    box_layers(prims);
+    let mut stack: Vec<(i32, i32, i32, i32)> = Vec::new();
+    for p in prims.iter_mut() {
+        let opens = matches!(p.prim, Prim::BeginLayer);
+        let closes = matches!(p.prim, Prim::EndLayer(..) | Prim::ClipEnd | Prim::MaskEnd(_));
+        if closes {
+            stack.pop();
+        }
+        if let Some(&(y0, y1, x0, x1)) = stack.last() {
+            p.y0 = p.y0.max(y0);
+            p.y1 = p.y1.min(y1);
+            p.x0 = p.x0.max(x0);
+            p.x1 = p.x1.min(x1);
+            if p.y1 <= p.y0 || p.x1 <= p.x0 {
+                (p.y0, p.y1, p.x0, p.x1) = (0, 0, 0, 0);
+            }
+        }
+        if opens {
+            stack.push((p.y0, p.y1, p.x0, p.x1));
+        }
+    }
+}
+
+fn box_layers(prims: &mut [Placed]) {
     let empty = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
     let mut stack: Vec<(usize, (i32, i32, i32, i32))> = Vec::new();
     let mut cur = empty;
