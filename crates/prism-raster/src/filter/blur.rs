@@ -1,5 +1,6 @@
-//! Gaussian blur of a premultiplied image, separable: three box blurs for deviations of
-//! 2 pixels or more (the approximation SVG 1.1 gives), an exact sampled kernel below.
+//! Gaussian blur of a premultiplied image, separable: for deviations of 2 pixels or more,
+//! five centred box blurs whose sizes give the Gaussian's variance (as resvg; SVG 1.1 allows
+//! any box approximation), and an exact sampled kernel below.
 
 use super::Img;
 
@@ -31,24 +32,31 @@ pub(crate) fn gaussian(img: &mut Img, sx: f64, sy: f64) {
 
 fn blur_line(line: &mut [[f32; 4]], tmp: &mut Vec<[f32; 4]>, sigma: f64) {
     if sigma >= 2.0 {
-        // d = floor(s * 3 sqrt(2 pi) / 4 + 0.5); odd d: three centred boxes of size d;
-        // even d: two boxes of size d (centred between pixels, one each way) and one of d + 1.
-        let d = (sigma * 3.0 * (2.0 * std::f64::consts::PI).sqrt() / 4.0 + 0.5).floor();
-        let d = d.min(2.0 * line.len() as f64 + 1.0) as usize;
-        if d % 2 == 1 {
-            let r = d / 2;
-            for _ in 0..3 {
-                box_pass(line, tmp, r, r);
-            }
-        } else {
-            let r = d / 2;
-            box_pass(line, tmp, r, r - 1);
-            box_pass(line, tmp, r - 1, r);
+        for size in box_sizes(sigma.min(2.0 * line.len() as f64 + 1.0)) {
+            let r = (size - 1) / 2;
             box_pass(line, tmp, r, r);
         }
     } else {
         kernel_pass(line, tmp, sigma);
     }
+}
+
+/// Five odd box sizes whose successive blurs have variance close to `sigma^2`: `m` boxes
+/// of the odd width `wl` just below the ideal `sqrt(12 sigma^2 / 5 + 1)`, the rest of
+/// `wl + 2`, with `m` chosen to match the variance (each box of width `w` adds
+/// `(w^2 - 1) / 12`).
+fn box_sizes(sigma: f64) -> [usize; 5] {
+    let n = 5.0;
+    let ideal = (12.0 * sigma * sigma / n + 1.0).sqrt();
+    let mut wl = ideal.floor() as i64;
+    if wl % 2 == 0 {
+        wl -= 1;
+    }
+    let wlf = wl as f64;
+    let m = ((12.0 * sigma * sigma - n * wlf * wlf - 4.0 * n * wlf - 3.0 * n) / (-4.0 * wlf - 4.0))
+        .round()
+        .max(0.0) as usize;
+    std::array::from_fn(|i| if i < m { wl.max(1) as usize } else { (wl + 2) as usize })
 }
 
 /// The mean over `[i - left, i + right]` for each `i`, outside the line transparent.

@@ -22,6 +22,9 @@ pub(super) struct Tile {
     w: usize,
     h: usize,
     px: Vec<[f32; 4]>,
+    /// Whether tile pixels map one to one onto device pixels (only shifted): then the
+    /// nearest pixel is taken, as Skia does, and no blur is added.
+    nearest: bool,
 }
 
 impl Tile {
@@ -31,6 +34,11 @@ impl Tile {
         let (u, v) = (p.x - 0.5, p.y - 0.5);
         if !(u.is_finite() && v.is_finite()) {
             return [0.0; 4];
+        }
+        if self.nearest {
+            let x = (p.x.floor() as i64).rem_euclid(self.w as i64);
+            let y = (p.y.floor() as i64).rem_euclid(self.h as i64);
+            return self.px[y as usize * self.w + x as usize];
         }
         let (fu, fv) = (u.floor(), v.floor());
         let (tx, ty) = ((u - fu) as f32, (v - fv) as f32);
@@ -83,11 +91,14 @@ pub(super) fn pattern_paint(
     if det == 0.0 || !det.is_finite() {
         return None;
     }
+    let m2 = to_device.matrix2;
+    let nearest = (m2.x_axis - DVec2::X).length() < 1e-9 && (m2.y_axis - DVec2::Y).length() < 1e-9;
     Some(DevPaint::Pattern {
         tile: Arc::new(Tile {
             w: tw as usize,
             h: th as usize,
             px,
+            nearest,
         }),
         inv: to_device.inverse(),
         opacity,
