@@ -24,13 +24,13 @@ mod raster;
 mod triangulate;
 
 pub use document::{
-    BlendMode, Document, FillRule, Gradient, GradientKind, Item, Mat3, MaskKind, Paint, Pattern,
+    BlendMode, Document, FillRule, Gradient, GradientKind, Item, MaskKind, Mat3, Paint, Pattern,
     Spread, Stop,
 };
 pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
-    parse_path_data, parse_path_data_prefix, parse_svg, read_svg, read_svg_with, Dialect, Fonts, PathDataError, Source,
-    SvgError, MAX_DEPTH, MAX_IMAGE_BYTES, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS,
+    parse_path_data, parse_path_data_prefix, parse_svg, read_svg, read_svg_with, Dialect, Fonts,
+    PathDataError, Source, SvgError, MAX_DEPTH, MAX_IMAGE_BYTES, MAX_ITEMS, MAX_SVG_BYTES,
 };
 pub use raster::{
     render, sample_rate, view_transform, RasterError, RasterOptions, RasterStats, View,

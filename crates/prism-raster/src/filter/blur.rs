@@ -56,7 +56,13 @@ fn box_sizes(sigma: f64) -> [usize; 5] {
     let m = ((12.0 * sigma * sigma - n * wlf * wlf - 4.0 * n * wlf - 3.0 * n) / (-4.0 * wlf - 4.0))
         .round()
         .max(0.0) as usize;
-    std::array::from_fn(|i| if i < m { wl.max(1) as usize } else { (wl + 2) as usize })
+    std::array::from_fn(|i| {
+        if i < m {
+            wl.max(1) as usize
+        } else {
+            (wl + 2) as usize
+        }
+    })
 }
 
 /// The mean over `[i - left, i + right]` for each `i`, outside the line transparent.

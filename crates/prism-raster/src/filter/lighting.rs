@@ -44,7 +44,9 @@ fn light(
 ) -> Img {
     let (w, h) = (input.w as i64, input.h as i64);
     let ss = f64::from(surface_scale);
-    let alpha = |x: i64, y: i64| f64::from(input.px[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize][3]);
+    let alpha = |x: i64, y: i64| {
+        f64::from(input.px[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize][3])
+    };
     let mut base = [color.red, color.green, color.blue].map(|c| f32::from(c) / 255.0);
     if linear {
         base = base.map(super::to_linear);
@@ -66,8 +68,14 @@ fn light(
             let surface = DVec3::new(x as f64, y as f64, z);
             let (l, c) = match source {
                 LightSource::DistantLight(d) => {
-                    let (az, el) = (f64::from(d.azimuth).to_radians(), f64::from(d.elevation).to_radians());
-                    (DVec3::new(az.cos() * el.cos(), az.sin() * el.cos(), el.sin()), base)
+                    let (az, el) = (
+                        f64::from(d.azimuth).to_radians(),
+                        f64::from(d.elevation).to_radians(),
+                    );
+                    (
+                        DVec3::new(az.cos() * el.cos(), az.sin() * el.cos(), el.sin()),
+                        base,
+                    )
                 }
                 LightSource::PointLight(p) => {
                     let pos = DVec3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z));
@@ -104,15 +112,22 @@ fn light(
 pub(crate) fn diffuse(input: &Img, fe: &DiffuseLighting, ts: &DAffine2) -> Img {
     let kd = f64::from(fe.diffuse_constant());
     let linear = false;
-    light(input, fe.surface_scale(), place(fe.light_source(), ts), fe.lighting_color(), linear, |n, l, c| {
-        let k = kd * n.dot(l).max(0.0);
-        [
-            (k * c[0]).clamp(0.0, 1.0) as f32,
-            (k * c[1]).clamp(0.0, 1.0) as f32,
-            (k * c[2]).clamp(0.0, 1.0) as f32,
-            1.0,
-        ]
-    })
+    light(
+        input,
+        fe.surface_scale(),
+        place(fe.light_source(), ts),
+        fe.lighting_color(),
+        linear,
+        |n, l, c| {
+            let k = kd * n.dot(l).max(0.0);
+            [
+                (k * c[0]).clamp(0.0, 1.0) as f32,
+                (k * c[1]).clamp(0.0, 1.0) as f32,
+                (k * c[2]).clamp(0.0, 1.0) as f32,
+                1.0,
+            ]
+        },
+    )
 }
 
 /// `feSpecularLighting`: `ks (N . H)^exponent` times the light colour, alpha the largest
@@ -120,10 +135,17 @@ pub(crate) fn diffuse(input: &Img, fe: &DiffuseLighting, ts: &DAffine2) -> Img {
 pub(crate) fn specular(input: &Img, fe: &SpecularLighting, ts: &DAffine2) -> Img {
     let ks = f64::from(fe.specular_constant());
     let e = f64::from(fe.specular_exponent());
-    light(input, fe.surface_scale(), place(fe.light_source(), ts), fe.lighting_color(), false, |n, l, c| {
-        let hv = (l + DVec3::Z).normalize_or_zero();
-        let k = ks * n.dot(hv).max(0.0).powf(e);
-        let rgb = c.map(|v| (k * v).clamp(0.0, 1.0) as f32);
-        [rgb[0], rgb[1], rgb[2], rgb[0].max(rgb[1]).max(rgb[2])]
-    })
+    light(
+        input,
+        fe.surface_scale(),
+        place(fe.light_source(), ts),
+        fe.lighting_color(),
+        false,
+        |n, l, c| {
+            let hv = (l + DVec3::Z).normalize_or_zero();
+            let k = ks * n.dot(hv).max(0.0).powf(e);
+            let rgb = c.map(|v| (k * v).clamp(0.0, 1.0) as f32);
+            [rgb[0], rgb[1], rgb[2], rgb[0].max(rgb[1]).max(rgb[2])]
+        },
+    )
 }

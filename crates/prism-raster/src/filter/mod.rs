@@ -330,8 +330,8 @@ fn run(
             Kind::Tile(fe) => ops::tile(&get(fe.input(), &results), region),
             Kind::Image(_) => {
                 let (sx, sy) = scale_of(ts);
-                let view = Mat3::translate(f64::from(sub.x0), f64::from(sub.y0))
-                    .mul(&Mat3::scale(sx, sy));
+                let view =
+                    Mat3::translate(f64::from(sub.x0), f64::from(sub.y0)).mul(&Mat3::scale(sx, sy));
                 let items = f.images.get(*image_index).map_or(&[][..], Vec::as_slice);
                 *image_index += 1;
                 Img {

@@ -46,7 +46,12 @@ pub(crate) fn composite(a: &Img, b: &Img, op: CompositeOperator) -> Img {
                 let v: [f32; 4] =
                     std::array::from_fn(|c| k1 * s[c] * d[c] + k2 * s[c] + k3 * d[c] + k4);
                 let a = v[3].clamp(0.0, 1.0);
-                [v[0].clamp(0.0, a), v[1].clamp(0.0, a), v[2].clamp(0.0, a), a]
+                [
+                    v[0].clamp(0.0, a),
+                    v[1].clamp(0.0, a),
+                    v[2].clamp(0.0, a),
+                    a,
+                ]
             }
         };
     }

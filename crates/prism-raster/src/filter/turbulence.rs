@@ -100,7 +100,12 @@ fn noise2(l: &Lattice, k: usize, x: f64, y: f64, st: Option<Stitch>) -> f64 {
         (by1 & BM) as usize,
     );
     let (i, j) = (l.sel[bx0], l.sel[bx1]);
-    let (b00, b10, b01, b11) = (l.sel[i + by0], l.sel[j + by0], l.sel[i + by1], l.sel[j + by1]);
+    let (b00, b10, b01, b11) = (
+        l.sel[i + by0],
+        l.sel[j + by0],
+        l.sel[i + by1],
+        l.sel[j + by1],
+    );
     let curve = |t: f64| t * t * (3.0 - 2.0 * t);
     let (sx, sy) = (curve(rx0), curve(ry0));
     let g = &l.grad[k];
@@ -134,12 +139,20 @@ fn turbulence(
         if fx != 0.0 {
             let lo = (tw * fx).floor() / tw;
             let hi = (tw * fx).ceil() / tw;
-            fx = if lo > 0.0 && fx / lo < hi / fx { lo } else { hi };
+            fx = if lo > 0.0 && fx / lo < hi / fx {
+                lo
+            } else {
+                hi
+            };
         }
         if fy != 0.0 {
             let lo = (th * fy).floor() / th;
             let hi = (th * fy).ceil() / th;
-            fy = if lo > 0.0 && fy / lo < hi / fy { lo } else { hi };
+            fy = if lo > 0.0 && fy / lo < hi / fy {
+                lo
+            } else {
+                hi
+            };
         }
         let width = (tw * fx + 0.5) as i64;
         let height = (th * fy + 0.5) as i64;

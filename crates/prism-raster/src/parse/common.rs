@@ -1,25 +1,19 @@
-//! Pieces shared by both SVG dialects: errors with locations, limits, number lists and
-//! numbers with units, transforms.
+//! Errors with locations and the readers' limits; number lists, numbers with units and
+//! transforms for the course dialect.
 
 use std::sync::Arc;
 
 use prism_math::Loc;
 
 use super::number::{number_prefix_len, to_num, Precision};
-use super::pathdata::PathDataError;
 use crate::document::Mat3;
 
-/// Deepest element nesting a document may have.
+/// Deepest element nesting a document may have, counting references (`use`, `url(#id)`).
 pub const MAX_DEPTH: usize = 256;
 /// Largest SVG file accepted, in bytes.
 pub const MAX_SVG_BYTES: u64 = 256 << 20;
 /// Most drawables (after expanding points and triangles) a document may produce.
 pub const MAX_ITEMS: usize = 20_000_000;
-/// Most elements that `use` references may create when expanded (each reference copies
-/// its target's whole subtree, references inside it included), as usvg limits them.
-pub const MAX_USE_ELEMENTS: usize = 1_000_000;
-/// Most gradients a gradient's `href` chain may hold (itself included).
-pub const MAX_HREF_CHAIN: usize = 16;
 
 /// A reader error with its location, shown as `file:line: element: message` (or `file: message`
 /// for the whole file).
@@ -70,17 +64,6 @@ pub enum SvgError {
         /// What was expected and what was found.
         message: String,
     },
-    /// An element's `d` attribute is not valid path data.
-    #[error("{at}: {element}: d: {source}")]
-    PathData {
-        /// Where: the file (or `<memory>`) and the line of the element's start tag.
-        at: Loc,
-        /// The element's name.
-        element: String,
-        /// What is wrong, and where in the attribute.
-        #[source]
-        source: PathDataError,
-    },
     /// Elements nest deeper than [`MAX_DEPTH`] (counting `use` references).
     #[error("{at}: {element}: elements nest deeper than the limit of {limit}")]
     NestingLimit {
@@ -95,26 +78,6 @@ pub enum SvgError {
     #[error("{at}: {element}: more than {limit} drawables")]
     ItemsLimit {
         /// Where: the file (or `<memory>`) and the line of the element that passed the limit.
-        at: Loc,
-        /// Its name.
-        element: String,
-        /// The limit.
-        limit: usize,
-    },
-    /// Expanding `use` references would create more than [`MAX_USE_ELEMENTS`] elements.
-    #[error("{at}: {element}: use references would expand to more than {limit} elements")]
-    UseLimit {
-        /// Where: the file (or `<memory>`) and the line of the element whose expansion passes the limit.
-        at: Loc,
-        /// Its name.
-        element: String,
-        /// The limit.
-        limit: usize,
-    },
-    /// A gradient's `href` chain holds more than [`MAX_HREF_CHAIN`] gradients.
-    #[error("{at}: {element}: href chain is longer than the limit of {limit} gradients")]
-    HrefChainLimit {
-        /// Where: the file (or `<memory>`) and the line of the gradient that starts the chain.
         at: Loc,
         /// Its name.
         element: String,
@@ -153,11 +116,8 @@ impl SvgError {
             SvgError::FontDir { dir, .. } => Loc::line(dir, 0),
             SvgError::Xml { at, .. }
             | SvgError::Element { at, .. }
-            | SvgError::PathData { at, .. }
             | SvgError::NestingLimit { at, .. }
-            | SvgError::ItemsLimit { at, .. }
-            | SvgError::UseLimit { at, .. }
-            | SvgError::HrefChainLimit { at, .. } => at.clone(),
+            | SvgError::ItemsLimit { at, .. } => at.clone(),
         }
     }
 }
@@ -199,14 +159,6 @@ impl ElementAt<'_> {
         }
     }
 
-    pub fn path_data(&self, source: PathDataError) -> SvgError {
-        SvgError::PathData {
-            at: self.at(),
-            element: self.element.to_string(),
-            source,
-        }
-    }
-
     pub fn nesting_limit(&self) -> SvgError {
         SvgError::NestingLimit {
             at: self.at(),
@@ -220,22 +172,6 @@ impl ElementAt<'_> {
             at: self.at(),
             element: self.element.to_string(),
             limit: MAX_ITEMS,
-        }
-    }
-
-    pub fn href_chain_limit(&self) -> SvgError {
-        SvgError::HrefChainLimit {
-            at: self.at(),
-            element: self.element.to_string(),
-            limit: MAX_HREF_CHAIN,
-        }
-    }
-
-    pub fn use_limit(&self) -> SvgError {
-        SvgError::UseLimit {
-            at: self.at(),
-            element: self.element.to_string(),
-            limit: MAX_USE_ELEMENTS,
         }
     }
 }

@@ -2,14 +2,12 @@
 //! ([`Source`]), the XML tree, line numbers for locating elements, the warnings already
 //! given and the textures already decoded.
 
-use prism_math::Warning;
 use std::path::PathBuf;
 
 use prism_image::UvConvention;
 use roxmltree::Node;
 
 use super::common::ElementAt;
-use crate::document::Document;
 
 /// Where a document came from, for resolving relative files and naming errors.
 #[derive(Clone, Debug, Default)]
@@ -43,25 +41,14 @@ pub struct Fonts {
     pub fantasy: Option<String>,
 }
 
-/// The state of one reading of a document, shared by both dialects.
+/// The state of one reading of a course-dialect document.
 pub(crate) struct Ctx<'a> {
     pub source: &'a Source,
-    pub xml: &'a roxmltree::Document<'a>,
     /// Line numbers of the text's byte offsets, for locating elements.
     pub lines: prism_math::LineIndex<'a>,
-    pub warned: std::collections::BTreeSet<String>,
     /// Textures already decoded, by reference and uv convention: each file or data URI is
     /// decoded once however often it is used.
     pub textures: std::cell::RefCell<std::collections::HashMap<(String, UvConvention), usize>>,
-}
-
-impl Ctx<'_> {
-    /// Records `warning` in `doc`, once per `key`.
-    pub fn warn_once(&mut self, doc: &mut Document, key: &str, warning: Warning) {
-        if self.warned.insert(key.to_string()) {
-            doc.warnings.push(warning);
-        }
-    }
 }
 
 /// Where `node` sits in the document, for error messages.

@@ -14,7 +14,9 @@ use super::context::Fonts;
 /// [`SvgError::FontDir`] for a font directory that cannot be read.
 pub(crate) fn font_database(fonts: &Fonts) -> Result<Arc<Database>, SvgError> {
     static CACHE: Mutex<Option<(Fonts, Arc<Database>)>> = Mutex::new(None);
-    let mut cache = CACHE.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut cache = CACHE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     if let Some((key, db)) = cache.as_ref() {
         if key == fonts {
             return Ok(db.clone());

@@ -61,7 +61,11 @@ pub(crate) fn check_nesting<'a>(text: &'a str, source: &Source) -> Result<Docume
     depth.insert(root.id(), ON_STACK);
     let succ = |n: Node, refs: &mut Vec<NodeId>| -> Vec<NodeId> {
         references(n, refs);
-        let mut s: Vec<NodeId> = n.children().filter(|c| c.is_element()).map(|c| c.id()).collect();
+        let mut s: Vec<NodeId> = n
+            .children()
+            .filter(|c| c.is_element())
+            .map(|c| c.id())
+            .collect();
         s.extend(refs.iter().copied());
         s
     };

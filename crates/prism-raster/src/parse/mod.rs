@@ -4,7 +4,6 @@
 //! (the number lexer), `pathdata`, `color`, `context` (the reading state), `images` and
 //! `course` (the course's own elements, read in both dialects).
 
-mod color;
 pub(crate) mod common;
 mod context;
 mod course;
@@ -16,18 +15,16 @@ mod number;
 mod pathdata;
 mod resources;
 mod standard;
-mod style;
-mod viewport;
 
 use prism_math::Loc;
 use std::path::Path as FsPath;
 use std::sync::Arc;
 
-pub use common::{SvgError, MAX_DEPTH, MAX_HREF_CHAIN, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
-pub use context::{Fonts, Source};
-pub use resources::MAX_IMAGE_BYTES;
+pub use common::{SvgError, MAX_DEPTH, MAX_ITEMS, MAX_SVG_BYTES};
 use context::{element_loc, Ctx};
+pub use context::{Fonts, Source};
 pub use pathdata::{parse_path_data, parse_path_data_prefix, PathDataError};
+pub use resources::MAX_IMAGE_BYTES;
 
 use crate::document::Document;
 
@@ -70,9 +67,7 @@ pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Docume
     let root = xml.root_element();
     let mut ctx = Ctx {
         source,
-        xml: &xml,
         lines: prism_math::LineIndex::new(text),
-        warned: Default::default(),
         textures: Default::default(),
     };
     if root.tag_name().name() != "svg" {

@@ -54,7 +54,10 @@ pub(crate) fn raster_texture(doc: &mut Document, kind: &usvg::ImageKind) -> Opti
         usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "embedded JPEG image"),
         usvg::ImageKind::GIF(d) => prism_image::decode_gif(d, "embedded GIF image"),
         usvg::ImageKind::WEBP(_) => {
-            warn(doc, "a WebP image was skipped: prism does not decode WebP".into());
+            warn(
+                doc,
+                "a WebP image was skipped: prism does not decode WebP".into(),
+            );
             return None;
         }
         usvg::ImageKind::SVG(_) => return None,
@@ -75,17 +78,15 @@ pub(crate) fn raster_texture(doc: &mut Document, kind: &usvg::ImageKind) -> Opti
     } else {
         rgba.to_rgb8().to_rgb_f32()
     };
-    doc.textures
-        .push(Arc::new(Texture::new(rgb).with_uv_convention(UvConvention::Standard)));
+    doc.textures.push(Arc::new(
+        Texture::new(rgb).with_uv_convention(UvConvention::Standard),
+    ));
     doc.texture_alpha.push(alpha);
     Some(doc.textures.len() - 1)
 }
 
 fn warn(doc: &mut Document, message: String) {
-    let w = Warning {
-        at: None,
-        message,
-    };
+    let w = Warning { at: None, message };
     if !doc.warnings.contains(&w) {
         doc.warnings.push(w);
     }

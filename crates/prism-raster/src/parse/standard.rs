@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use prism_image::PixelSampling;
-use prism_math::{DVec2, Loc, Rgb, Warning};
+use prism_math::{DVec2, Loc, Rgb};
 use usvg::tiny_skia_path::PathSegment;
 
 use super::common::{SvgError, MAX_ITEMS};
@@ -12,7 +12,7 @@ use super::context::Source;
 use super::fonts::font_database;
 use super::guard::check_nesting;
 use crate::document::{
-    BlendMode, Document, FillRule, Gradient, GradientKind, Item, Mat3, MaskKind, Paint, Pattern,
+    BlendMode, Document, FillRule, Gradient, GradientKind, Item, MaskKind, Mat3, Paint, Pattern,
     Spread, Stop,
 };
 use crate::filter::Filtered;
@@ -123,12 +123,6 @@ impl Converter<'_> {
         Ok(())
     }
 
-    fn warn(&mut self, w: Warning) {
-        if !self.doc.warnings.contains(&w) {
-            self.doc.warnings.push(w);
-        }
-    }
-
     /// The children of `g` drawn under `m` (the transform of `g` itself not applied).
     pub(crate) fn group_content(
         &mut self,
@@ -149,7 +143,12 @@ impl Converter<'_> {
 
     /// A group: its transform, and a layer with filters, clip, mask, opacity and blending
     /// when it needs one.
-    fn group(&mut self, g: &usvg::Group, parent: Mat3, out: &mut Vec<Item>) -> Result<(), SvgError> {
+    fn group(
+        &mut self,
+        g: &usvg::Group,
+        parent: Mat3,
+        out: &mut Vec<Item>,
+    ) -> Result<(), SvgError> {
         let m = parent.mul(&mat(g.transform()));
         if !g.should_isolate() {
             return self.group_content(g, m, out);
@@ -165,7 +164,11 @@ impl Converter<'_> {
                 for prim in f.primitives() {
                     if let usvg::filter::Kind::Image(img) = prim.kind() {
                         let mut items = Vec::new();
-                        self.group_content(img.root(), m.mul(&mat(img.root().transform())), &mut items)?;
+                        self.group_content(
+                            img.root(),
+                            m.mul(&mat(img.root().transform())),
+                            &mut items,
+                        )?;
                         images.push(items);
                     }
                 }
@@ -180,7 +183,13 @@ impl Converter<'_> {
             });
             let Some(region) = region else {
                 // An invalid filter region draws nothing, as resvg does.
-                self.push(out, Item::EndLayer { opacity: 0.0, blend: BlendMode::Normal })?;
+                self.push(
+                    out,
+                    Item::EndLayer {
+                        opacity: 0.0,
+                        blend: BlendMode::Normal,
+                    },
+                )?;
                 return Ok(());
             };
             let f = Filtered {
@@ -208,7 +217,12 @@ impl Converter<'_> {
     }
 
     /// A clip path as a clip layer (and its own clip path after it).
-    fn clip(&mut self, clip: &usvg::ClipPath, m: Mat3, out: &mut Vec<Item>) -> Result<(), SvgError> {
+    fn clip(
+        &mut self,
+        clip: &usvg::ClipPath,
+        m: Mat3,
+        out: &mut Vec<Item>,
+    ) -> Result<(), SvgError> {
         self.push(out, Item::BeginLayer)?;
         let cm = m.mul(&mat(clip.transform()));
         self.clip_content(clip.root(), cm, out)?;

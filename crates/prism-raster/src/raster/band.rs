@@ -3,8 +3,8 @@
 
 use prism_math::DVec2;
 
-use crate::blend::{composite, over as blend};
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
+use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
 
 /// The course renderer's translucent blend: both colours truncated to 8 bits, mixed as

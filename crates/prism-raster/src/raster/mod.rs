@@ -26,11 +26,11 @@ use rayon::prelude::*;
 
 use crate::document::{Document, Item, Mat3};
 use band::{Band, Pattern};
-use primitives::Placed;
 pub use options::{
     sample_rate, view_transform, RasterError, RasterOptions, View, MAX_DIMENSION, MAX_SAMPLES,
 };
 use primitives::prepare;
+use primitives::Placed;
 
 /// Wall-clock time spent in each stage of [`render`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

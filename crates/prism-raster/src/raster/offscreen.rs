@@ -107,7 +107,12 @@ pub(super) fn pattern_paint(
 
 /// A filtered group: its content rendered over its filter region (clipped to the image
 /// grown by half its size on each side), filtered, and placed as pixels.
-pub(super) fn filtered(doc: &Document, f: &Filtered, view: &Mat3, opts: &RasterOptions) -> Vec<Placed> {
+pub(super) fn filtered(
+    doc: &Document,
+    f: &Filtered,
+    view: &Mat3,
+    opts: &RasterOptions,
+) -> Vec<Placed> {
     let m = view.mul(&f.transform).to_affine();
     let [x, y, w, h] = f.region;
     let pts = [(x, y), (x + w, y), (x, y + h), (x + w, y + h)]
@@ -134,7 +139,8 @@ pub(super) fn filtered(doc: &Document, f: &Filtered, view: &Mat3, opts: &RasterO
     let shift = Mat3::translate(-x0, -y0);
     let content = render_premultiplied(doc, &f.items, &sub, &shift.mul(view));
     let ts = shift.mul(view).mul(&f.transform).to_affine();
-    let draw = |items: &[crate::document::Item], v: &Mat3| render_premultiplied(doc, items, &sub, v);
+    let draw =
+        |items: &[crate::document::Item], v: &Mat3| render_premultiplied(doc, items, &sub, v);
     let px = crate::filter::apply(f, content, rw as usize, rh as usize, &ts, &draw);
     let (ix, iy) = (x0 as i32, y0 as i32);
     let rows = (iy.max(0), (iy + rh as i32).min(opts.height as i32));

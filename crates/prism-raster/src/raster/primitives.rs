@@ -7,10 +7,10 @@ use prism_image::{LevelSampling, PixelSampling, Texture};
 use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
-use super::options::{RasterOptions, TOLERANCE};
 use super::offscreen::{filtered, pattern_paint, Tile};
+use super::options::{RasterOptions, TOLERANCE};
 use crate::document::{
-    BlendMode, Document, FillRule, Gradient, GradientKind, Item, Mat3, MaskKind, Paint, Spread,
+    BlendMode, Document, FillRule, Gradient, GradientKind, Item, MaskKind, Mat3, Paint, Spread,
 };
 use crate::path::{stroke, Path, StrokeStyle};
 
@@ -757,7 +757,10 @@ pub(super) fn bound_layers(prims: &mut [Placed]) {
     let mut stack: Vec<(i32, i32, i32, i32)> = Vec::new();
     for p in prims.iter_mut() {
         let opens = matches!(p.prim, Prim::BeginLayer);
-        let closes = matches!(p.prim, Prim::EndLayer(..) | Prim::ClipEnd | Prim::MaskEnd(_));
+        let closes = matches!(
+            p.prim,
+            Prim::EndLayer(..) | Prim::ClipEnd | Prim::MaskEnd(_)
+        );
         if closes {
             stack.pop();
         }
