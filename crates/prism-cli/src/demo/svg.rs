@@ -1,6 +1,7 @@
 //! The gallery's rasterizer pictures: a triangle fan at 1, 4 and 16 samples per pixel,
-//! barycentric colour triangles, a minified texture at each level sampling, and nested
-//! transformed groups, all from SVG made here.
+//! barycentric colour triangles and a minified texture at each level sampling (the course
+//! dialect), nested transformed groups, all from SVG made here, and the standard-SVG
+//! feature picture of `docs/examples/svg/features.svg`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -174,7 +175,7 @@ pub fn jobs() -> Result<Vec<Job>> {
         "colortri.png".into(),
         "Barycentric colour triangles".into(),
         colortri_svg(),
-        Dialect::Svg,
+        Dialect::Cs184,
         base(200, 200, 16),
     ));
     for (name, lsm) in [
@@ -189,7 +190,7 @@ pub fn jobs() -> Result<Vec<Job>> {
             format!("texture_level_{name}.png"),
             format!("Minified texture, bilinear pixels, level sampling {name}"),
             tex.clone(),
-            Dialect::Svg,
+            Dialect::Cs184,
             o,
         ));
     }
@@ -199,6 +200,15 @@ pub fn jobs() -> Result<Vec<Job>> {
         group_svg(),
         Dialect::Svg,
         base(240, 240, 16),
+    ));
+    jobs.push((
+        "svg_features.png".into(),
+        "Standard SVG: a drop shadow, turbulence lit as paper, a masked pattern, a clip path, \
+         multiply blending, text on a path with a glow (docs/examples/svg/features.svg)"
+            .into(),
+        include_str!("../../../../docs/examples/svg/features.svg").into(),
+        Dialect::Svg,
+        base(480, 240, 16),
     ));
     Ok(jobs)
 }

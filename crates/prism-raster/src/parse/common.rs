@@ -14,6 +14,9 @@ pub const MAX_DEPTH: usize = 256;
 pub const MAX_SVG_BYTES: u64 = 256 << 20;
 /// Most drawables (after expanding points and triangles) a document may produce.
 pub const MAX_ITEMS: usize = 20_000_000;
+/// Most elements that `use` references may create when expanded (each reference copies
+/// its target's whole subtree, references inside it included), as usvg limits them.
+pub const MAX_USE_ELEMENTS: usize = 1_000_000;
 
 /// A reader error with its location, shown as `file:line: element: message` (or `file: message`
 /// for the whole file).
@@ -84,6 +87,25 @@ pub enum SvgError {
         /// The limit.
         limit: usize,
     },
+    /// Expanding `use` references would create more than [`MAX_USE_ELEMENTS`] elements.
+    #[error("{at}: {element}: use references would expand to more than {limit} elements")]
+    UseLimit {
+        /// Where: the file and the line of the element whose expansion passes the limit.
+        at: Loc,
+        /// Its name.
+        element: String,
+        /// The limit.
+        limit: usize,
+    },
+    /// An image the document holds is larger than the image budget allows.
+    #[error("{file}: image: {source}")]
+    Image {
+        /// The SVG file.
+        file: String,
+        /// The refusal, with the image's size and the budget.
+        #[source]
+        source: Arc<prism_image::ImageError>,
+    },
     /// A font directory given for text cannot be read.
     #[error("{dir}: font directory: {source}")]
     FontDir {
@@ -112,12 +134,14 @@ impl SvgError {
             SvgError::Io { file, .. }
             | SvgError::Encoding { file, .. }
             | SvgError::FileTooLarge { file, .. }
-            | SvgError::Usvg { file, .. } => Loc::line(file, 0),
+            | SvgError::Usvg { file, .. }
+            | SvgError::Image { file, .. } => Loc::line(file, 0),
             SvgError::FontDir { dir, .. } => Loc::line(dir, 0),
             SvgError::Xml { at, .. }
             | SvgError::Element { at, .. }
             | SvgError::NestingLimit { at, .. }
-            | SvgError::ItemsLimit { at, .. } => at.clone(),
+            | SvgError::ItemsLimit { at, .. }
+            | SvgError::UseLimit { at, .. } => at.clone(),
         }
     }
 }

@@ -1,13 +1,14 @@
-//! The checks made on a standard SVG's XML before usvg reads it: nesting depth counted
-//! through references (`url(#id)`, `href="#id"`), so that no reading recurses deeper than
-//! [`MAX_DEPTH`].
+//! The checks made on a standard SVG's XML before usvg reads it: an `<svg>` root; nesting
+//! depth counted through references (`url(#id)`, `href="#id"`), so that no reading
+//! recurses deeper than [`MAX_DEPTH`]; and the elements `use` copies would create, at most
+//! [`MAX_USE_ELEMENTS`], each refused at the element where it passes its limit.
 
 use std::collections::HashMap;
 
 use prism_math::Loc;
 use roxmltree::{Document, Node, NodeId, ParsingOptions};
 
-use super::common::{SvgError, MAX_DEPTH};
+use super::common::{SvgError, MAX_DEPTH, MAX_USE_ELEMENTS};
 use super::context::Source;
 
 /// Parses the XML and checks its nesting.
@@ -29,14 +30,28 @@ pub(crate) fn check_nesting<'a>(text: &'a str, source: &Source) -> Result<Docume
         .descendants()
         .filter_map(|n| Some((n.attribute("id")?, n.id())))
         .collect();
-    let mut refs: Vec<NodeId> = Vec::new();
-    let references = |n: Node, out: &mut Vec<NodeId>| {
-        out.clear();
+    let root = xml.root_element();
+    if root.tag_name().name() != "svg" {
+        return Err(SvgError::Element {
+            at: Loc::line(&source.name, xml.text_pos_at(root.range().start).row),
+            element: root.tag_name().name().to_string(),
+            message: "expected the root element to be <svg>".into(),
+        });
+    }
+    // Each element's successors: its child elements and what it references, each marked
+    // with whether usvg copies it (children, and a `use` element's target).
+    let succ = |n: Node| -> Vec<(NodeId, bool)> {
+        let mut out: Vec<(NodeId, bool)> = n
+            .children()
+            .filter(|c| c.is_element())
+            .map(|c| (c.id(), true))
+            .collect();
+        let is_use = n.tag_name().name() == "use";
         for a in n.attributes() {
             let v = a.value();
             if a.name() == "href" {
                 if let Some(id) = v.trim().strip_prefix('#') {
-                    out.extend(ids.get(id));
+                    out.extend(ids.get(id).map(|&t| (t, is_use)));
                 }
             }
             let mut rest = v;
@@ -45,71 +60,98 @@ pub(crate) fn check_nesting<'a>(text: &'a str, source: &Source) -> Result<Docume
                 let end = rest.find(')').unwrap_or(rest.len());
                 let id = rest[..end].trim().trim_matches(['\'', '"']).trim();
                 if let Some(id) = id.strip_prefix('#') {
-                    out.extend(ids.get(id));
+                    out.extend(ids.get(id).map(|&t| (t, false)));
                 }
                 rest = &rest[end..];
             }
         }
+        out
     };
-    // Depth-first over children and references with an explicit stack; `depth` holds the
-    // longest chain found below each finished element, and an element still on the stack
-    // (a reference cycle, which usvg skips) adds nothing.
-    const ON_STACK: u32 = u32::MAX;
-    let mut depth: HashMap<NodeId, u32> = HashMap::new();
-    let mut stack: Vec<(NodeId, Vec<NodeId>, usize, u32)> = Vec::new();
-    let root = xml.root_element();
-    depth.insert(root.id(), ON_STACK);
-    let succ = |n: Node, refs: &mut Vec<NodeId>| -> Vec<NodeId> {
-        references(n, refs);
-        let mut s: Vec<NodeId> = n
-            .children()
-            .filter(|c| c.is_element())
-            .map(|c| c.id())
-            .collect();
-        s.extend(refs.iter().copied());
-        s
+    let located = |id: NodeId| {
+        let n = xml.get_node(id).unwrap_or(root);
+        (
+            Loc::line(&source.name, xml.text_pos_at(n.range().start).row),
+            n.tag_name().name().to_string(),
+        )
     };
-    stack.push((root.id(), succ(root, &mut refs), 0, 0));
+    // Depth-first over children and references with an explicit stack. For each finished
+    // element, `done` holds the longest chain below it and the number of elements usvg
+    // creates for it (`use` copies counted); an element still on the stack (a reference
+    // cycle, which usvg skips) adds nothing.
+    struct Frame {
+        id: NodeId,
+        next: Vec<(NodeId, bool)>,
+        k: usize,
+        depth: usize,
+        size: u64,
+    }
+    let mut done: HashMap<NodeId, (usize, u64)> = HashMap::new();
+    let mut on_stack: std::collections::HashSet<NodeId> = std::collections::HashSet::new();
+    on_stack.insert(root.id());
+    let mut stack = vec![Frame {
+        id: root.id(),
+        next: succ(root),
+        k: 0,
+        depth: 0,
+        size: 1,
+    }];
     while let Some(top) = stack.last_mut() {
-        let (id, next, k, best) = (top.0, &top.1, top.2, top.3);
-        if k < next.len() {
-            let c = next[k];
-            top.2 += 1;
-            let known = depth.get(&c).copied();
-            if let Some(d) = known.filter(|&d| d != ON_STACK) {
-                top.3 = best.max(d);
+        if top.k < top.next.len() {
+            let (c, copied) = top.next[top.k];
+            top.k += 1;
+            if on_stack.contains(&c) {
+                continue;
             }
-            let reach = match known {
-                None => 1,
-                Some(ON_STACK) => 0,
-                Some(d) => d as usize,
-            };
-            match known {
-                Some(_) if stack.len() + reach <= MAX_DEPTH => {}
-                _ => {
-                    if stack.len() + reach > MAX_DEPTH {
-                        let n = xml.get_node(c).unwrap_or(root);
-                        let row = xml.text_pos_at(n.range().start).row;
-                        return Err(SvgError::NestingLimit {
-                            at: Loc::line(&source.name, row),
-                            element: n.tag_name().name().to_string(),
-                            limit: MAX_DEPTH,
-                        });
-                    }
-                    if known.is_some() {
-                        continue;
-                    }
-                    depth.insert(c, ON_STACK);
-                    let n = xml.get_node(c).unwrap_or(root);
-                    let s = succ(n, &mut refs);
-                    stack.push((c, s, 0, 0));
+            if let Some(&(d, n)) = done.get(&c) {
+                top.depth = top.depth.max(d);
+                if copied {
+                    top.size = top.size.saturating_add(n);
                 }
+                if stack.len() + d > MAX_DEPTH {
+                    let (at, element) = located(c);
+                    return Err(SvgError::NestingLimit {
+                        at,
+                        element,
+                        limit: MAX_DEPTH,
+                    });
+                }
+                continue;
             }
+            if stack.len() >= MAX_DEPTH {
+                let (at, element) = located(c);
+                return Err(SvgError::NestingLimit {
+                    at,
+                    element,
+                    limit: MAX_DEPTH,
+                });
+            }
+            on_stack.insert(c);
+            let n = xml.get_node(c).unwrap_or(root);
+            stack.push(Frame {
+                id: c,
+                next: succ(n),
+                k: 0,
+                depth: 0,
+                size: 1,
+            });
         } else {
-            depth.insert(id, best + 1);
-            stack.pop();
+            let f = stack.pop().expect("non-empty");
+            on_stack.remove(&f.id);
+            if f.size > MAX_USE_ELEMENTS as u64 {
+                let (at, element) = located(f.id);
+                return Err(SvgError::UseLimit {
+                    at,
+                    element,
+                    limit: MAX_USE_ELEMENTS,
+                });
+            }
+            done.insert(f.id, (f.depth + 1, f.size));
             if let Some(parent) = stack.last_mut() {
-                parent.3 = parent.3.max(best + 1);
+                parent.depth = parent.depth.max(f.depth + 1);
+                let copied = parent.next[parent.k - 1].1;
+                if copied {
+                    parent.size = parent.size.saturating_add(f.size);
+                }
             }
         }
     }

@@ -4,6 +4,7 @@
 //! (the number lexer), `pathdata`, `color`, `context` (the reading state), `images` and
 //! `course` (the course's own elements, read in both dialects).
 
+mod caught;
 pub(crate) mod common;
 mod context;
 mod course;
@@ -20,7 +21,7 @@ use prism_math::Loc;
 use std::path::Path as FsPath;
 use std::sync::Arc;
 
-pub use common::{SvgError, MAX_DEPTH, MAX_ITEMS, MAX_SVG_BYTES};
+pub use common::{SvgError, MAX_DEPTH, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
 use context::{element_loc, Ctx};
 pub use context::{Fonts, Source};
 pub use pathdata::{parse_path_data, parse_path_data_prefix, PathDataError};
@@ -42,9 +43,11 @@ pub enum Dialect {
 ///
 /// # Errors
 /// [`SvgError`] naming the file, line and element: malformed XML, a root that is not
-/// `<svg>`, bad numbers, colours or path data, non-finite coordinates, a missing or corrupt
-/// texture, or a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_SVG_BYTES`],
-/// [`MAX_ITEMS`], [`MAX_USE_ELEMENTS`], [`MAX_HREF_CHAIN`]), each its own variant.
+/// `<svg>`, a document beyond the documented limits ([`MAX_DEPTH`], [`MAX_SVG_BYTES`],
+/// [`MAX_ITEMS`], [`MAX_USE_ELEMENTS`]) or one usvg refuses as a whole; in the course
+/// dialect also bad numbers, colours or coordinates and a missing or corrupt texture. The
+/// standard dialect reads past bad attribute values as browsers and resvg do, with a
+/// warning.
 pub fn parse_svg(text: &str, dialect: Dialect, source: &Source) -> Result<Document, SvgError> {
     if text.len() as u64 > MAX_SVG_BYTES {
         return Err(SvgError::FileTooLarge {

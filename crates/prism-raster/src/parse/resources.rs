@@ -6,6 +6,7 @@ use std::sync::Arc;
 use prism_image::{Texture, UvConvention};
 use prism_math::Warning;
 
+use super::common::SvgError;
 use super::context::Source;
 use crate::document::Document;
 
@@ -46,27 +47,42 @@ pub(crate) fn resolver(source: &Source) -> usvg::ImageHrefResolver<'static> {
 }
 
 /// Decodes a raster image into a texture of `doc` (colours premultiplied when it has
-/// transparency); `None`, with a warning, when it cannot be decoded or is over the image
-/// budget: the image is then skipped, as resvg skips it.
-pub(crate) fn raster_texture(doc: &mut Document, kind: &usvg::ImageKind) -> Option<usize> {
+/// transparency); `None`, with a warning, when it cannot be decoded (the image is then
+/// skipped, as resvg skips it).
+///
+/// # Errors
+/// [`SvgError::Image`] for an image over the image budget: its size is refused before
+/// its pixels are allocated.
+pub(crate) fn raster_texture(
+    doc: &mut Document,
+    kind: &usvg::ImageKind,
+    source: &Source,
+) -> Result<Option<usize>, SvgError> {
     let decoded = match kind {
         usvg::ImageKind::PNG(d) => prism_image::decode_png(d, "embedded PNG image"),
         usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "embedded JPEG image"),
         usvg::ImageKind::GIF(d) => prism_image::decode_gif(d, "embedded GIF image"),
         usvg::ImageKind::WEBP(_) => {
-            warn(
-                doc,
-                "a WebP image was skipped: prism does not decode WebP".into(),
+            let w = format!(
+                "{}: a WebP image was skipped: prism does not decode WebP",
+                source.name
             );
-            return None;
+            warn(doc, w);
+            return Ok(None);
         }
-        usvg::ImageKind::SVG(_) => return None,
+        usvg::ImageKind::SVG(_) => return Ok(None),
     };
     let rgba = match decoded {
         Ok(i) => i,
+        Err(e @ prism_image::ImageError::OverBudget { .. }) => {
+            return Err(SvgError::Image {
+                file: source.name.clone(),
+                source: Arc::new(e),
+            })
+        }
         Err(e) => {
-            warn(doc, format!("an image was skipped: {e}"));
-            return None;
+            warn(doc, format!("{}: an image was skipped: {e}", source.name));
+            return Ok(None);
         }
     };
     let alpha = rgba.pixels().iter().any(|p| p[3] < 255).then(|| {
@@ -82,7 +98,7 @@ pub(crate) fn raster_texture(doc: &mut Document, kind: &usvg::ImageKind) -> Opti
         Texture::new(rgb).with_uv_convention(UvConvention::Standard),
     ));
     doc.texture_alpha.push(alpha);
-    Some(doc.textures.len() - 1)
+    Ok(Some(doc.textures.len() - 1))
 }
 
 fn warn(doc: &mut Document, message: String) {

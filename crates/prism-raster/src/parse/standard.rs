@@ -4,9 +4,10 @@
 use std::sync::Arc;
 
 use prism_image::PixelSampling;
-use prism_math::{DVec2, Loc, Rgb};
+use prism_math::{DVec2, Loc, Rgb, Warning};
 use usvg::tiny_skia_path::PathSegment;
 
+use super::caught::catching;
 use super::common::{SvgError, MAX_ITEMS};
 use super::context::Source;
 use super::fonts::font_database;
@@ -35,7 +36,8 @@ pub(crate) fn parse(text: &str, source: &Source) -> Result<Document, SvgError> {
     if has_text {
         opts.fontdb = font_database(&source.fonts)?;
     }
-    let tree = usvg::Tree::from_xmltree(&xml, &opts).map_err(|e| SvgError::Usvg {
+    let (tree, caught) = catching(|| usvg::Tree::from_xmltree(&xml, &opts));
+    let tree = tree.map_err(|e| SvgError::Usvg {
         file: source.name.clone(),
         source: Arc::new(e),
     })?;
@@ -53,6 +55,11 @@ pub(crate) fn parse(text: &str, source: &Source) -> Result<Document, SvgError> {
     let mut items = Vec::new();
     conv.group_content(tree.root(), Mat3::IDENTITY, &mut items)?;
     doc.items = items;
+    let read_past = caught.into_iter().map(|m| Warning {
+        at: None,
+        message: format!("{}: {m}", source.name),
+    });
+    doc.warnings.splice(0..0, read_past);
     Ok(doc)
 }
 
@@ -458,7 +465,8 @@ impl Converter<'_> {
                 )
             }
             kind => {
-                let Some(texture) = super::resources::raster_texture(self.doc, kind) else {
+                let Some(texture) = super::resources::raster_texture(self.doc, kind, self.source)?
+                else {
                     return Ok(());
                 };
                 let (w, h) = self.doc.textures[texture].size();

@@ -123,7 +123,10 @@ fn mask_chains_are_bounded() {
             i - 1
         );
     }
-    body += &format!("</defs>\n<rect width='5' height='5' mask='url(#m{})'/>", n - 1);
+    body += &format!(
+        "</defs>\n<rect width='5' height='5' mask='url(#m{})'/>",
+        n - 1
+    );
     let err = parse(&svg(&body), Dialect::Svg).unwrap_err();
     assert!(matches!(err, SvgError::NestingLimit { .. }), "{err}");
     assert_eq!(err.at().line, 3);
