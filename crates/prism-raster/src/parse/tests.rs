@@ -87,12 +87,19 @@ fn use_fan_out_under_the_limit_draws_every_copy() {
     assert_eq!(doc.items.len(), 1 << 10);
 }
 
-/// The 2^29-rectangle document is refused once expansion passes usvg's million elements,
-/// naming the file, in bounded time.
+/// The 2^29-rectangle document is refused by counting, before usvg expands anything.
+/// Closed form: group `g_i` expands to `5·2^i − 3` elements (itself, two `use`s, two
+/// copies of `g_{i−1}`), first over a million at `g18` (line 20).
 #[test]
 fn use_fan_out_past_the_limit_is_refused() {
     let err = parse(&fan_out(30), Dialect::Svg).unwrap_err();
-    assert!(matches!(err, SvgError::Usvg { .. }), "{err}");
+    match &err {
+        SvgError::UseLimit { at, element, limit } => assert_eq!(
+            (at.line, element.as_str(), *limit),
+            (20, "g", MAX_USE_ELEMENTS)
+        ),
+        other => panic!("expected the use limit, got {other:?}"),
+    }
     assert!(err.to_string().starts_with("hostile.svg:"), "{err}");
 }
 
