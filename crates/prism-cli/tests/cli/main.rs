@@ -1209,7 +1209,7 @@ fn standard_svg_is_lenient_as_browsers_are() {
             "Error during path parsing",
         ),
         (
-            "<g fill='blue'><rect width='9' height='9' fill='#12' stroke-width='-3' stroke='red'/></g>",
+            "<g fill='blue'><rect width='9' height='9' fill='#12' stroke='red'/></g>",
             "<g fill='blue'><rect width='9' height='9' fill='black' stroke='red'/></g>",
             "Failed to parse fill value: '#12'. Fallback to black.",
         ),
