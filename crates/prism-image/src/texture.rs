@@ -224,12 +224,13 @@ impl Texture {
                 let (fx, fy) = (gx.floor(), gy.floor());
                 let (wx, wy) = (mitchell((gx - fx) as f32), mitchell((gy - fy) as f32));
                 let (x0, y0) = (fx as i64 - 1, fy as i64 - 1);
+                let xs: [u32; 4] = std::array::from_fn(|i| self.fold(x0 + i as i64, w, 0));
                 let mut sum = Rgb::BLACK;
                 for (j, wyj) in wy.iter().enumerate() {
                     let y = self.fold(y0 + j as i64, h, 1);
                     let mut row = Rgb::BLACK;
-                    for (i, wxi) in wx.iter().enumerate() {
-                        row = row + im.get(self.fold(x0 + i as i64, w, 0), y) * *wxi;
+                    for (x, wxi) in xs.iter().zip(&wx) {
+                        row = row + im.get(*x, y) * *wxi;
                     }
                     sum = sum + row * *wyj;
                 }

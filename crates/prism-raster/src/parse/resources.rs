@@ -57,7 +57,20 @@ pub(crate) fn raster_texture(
     doc: &mut Document,
     kind: &usvg::ImageKind,
     source: &Source,
+    cache: &mut Vec<(Arc<Vec<u8>>, usize)>,
 ) -> Result<Option<usize>, SvgError> {
+    let bytes = match kind {
+        usvg::ImageKind::PNG(d)
+        | usvg::ImageKind::JPEG(d)
+        | usvg::ImageKind::GIF(d)
+        | usvg::ImageKind::WEBP(d) => Some(d),
+        usvg::ImageKind::SVG(_) => None,
+    };
+    if let Some(d) = bytes {
+        if let Some((_, i)) = cache.iter().find(|(b, _)| Arc::ptr_eq(b, d) || b == d) {
+            return Ok(Some(*i));
+        }
+    }
     let decoded = match kind {
         usvg::ImageKind::PNG(d) => prism_image::decode_png(d, "embedded PNG image"),
         usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "embedded JPEG image"),
@@ -98,7 +111,11 @@ pub(crate) fn raster_texture(
         Texture::new(rgb).with_uv_convention(UvConvention::Standard),
     ));
     doc.texture_alpha.push(alpha);
-    Ok(Some(doc.textures.len() - 1))
+    let index = doc.textures.len() - 1;
+    if let Some(d) = bytes {
+        cache.push((d.clone(), index));
+    }
+    Ok(Some(index))
 }
 
 fn warn(doc: &mut Document, message: String) {

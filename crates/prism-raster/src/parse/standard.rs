@@ -51,6 +51,7 @@ pub(crate) fn parse(text: &str, source: &Source) -> Result<Document, SvgError> {
         doc: &mut doc,
         source,
         items: 0,
+        decoded: Vec::new(),
     };
     let mut items = Vec::new();
     conv.group_content(tree.root(), Mat3::IDENTITY, &mut items)?;
@@ -114,6 +115,9 @@ pub(crate) struct Converter<'a> {
     pub(crate) doc: &'a mut Document,
     pub(crate) source: &'a Source,
     pub(crate) items: usize,
+    /// Images decoded so far, by their encoded bytes: each is decoded once however often
+    /// the document holds it.
+    pub(crate) decoded: Vec<(Arc<Vec<u8>>, usize)>,
 }
 
 impl Converter<'_> {
@@ -465,7 +469,12 @@ impl Converter<'_> {
                 )
             }
             kind => {
-                let Some(texture) = super::resources::raster_texture(self.doc, kind, self.source)?
+                let Some(texture) = super::resources::raster_texture(
+                    self.doc,
+                    kind,
+                    self.source,
+                    &mut self.decoded,
+                )?
                 else {
                     return Ok(());
                 };
@@ -490,10 +499,11 @@ impl Converter<'_> {
     }
 }
 
-/// resvg skips fills of paths whose bounds have no width or no height.
+/// Whether a fill can cover anything: resvg skips paths whose bounds have no width or no
+/// height, and a path of two points (a `<line>`) encloses nothing either.
 fn has_area(p: &usvg::Path) -> bool {
     let b = p.data().bounds();
-    b.width() > 0.0 && b.height() > 0.0
+    b.width() > 0.0 && b.height() > 0.0 && p.data().points().len() > 2
 }
 
 fn fill_rule(r: usvg::FillRule) -> FillRule {

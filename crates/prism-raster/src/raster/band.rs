@@ -251,10 +251,18 @@ impl Band {
                     continue;
                 }
                 // The first sample at or right of x (compat), or right of x.
+                // (`floor` and `ceil` are libm calls on baseline x86-64: a truncating cast
+                // and a correction do the same for the clamped range.)
                 let first = |x: f64| {
-                    let k = (x - xo) * sc;
-                    let k = if compat { k.ceil() } else { k.floor() + 1.0 };
-                    k.clamp(0.0, cols as f64) as usize
+                    let k = ((x - xo) * sc).clamp(-1.0, cols as f64);
+                    let t = k as i64;
+                    let below = (t as f64) < k;
+                    let i = if compat {
+                        t + i64::from(below)
+                    } else {
+                        t + 1 - i64::from(k < t as f64)
+                    };
+                    i.clamp(0, cols as i64) as usize
                 };
                 let (a, b) = (first(xs[k].0), first(xs[k + 1].0));
                 match paint {
