@@ -10,21 +10,27 @@ pub(crate) fn gaussian(img: &mut Img, sx: f64, sy: f64) {
     let (w, h) = (img.w, img.h);
     let mut line = Vec::new();
     let mut tmp = Vec::new();
-    if sx >= 0.05 && sx.is_finite() {
+    let run_x = sx >= 0.05 && sx.is_finite();
+    let run_y = sy >= 0.05 && sy.is_finite();
+    if !(run_x || run_y) {
+        return;
+    }
+    let px = std::sync::Arc::make_mut(&mut img.px);
+    if run_x {
         for y in 0..h {
             line.clear();
-            line.extend_from_slice(&img.px[y * w..(y + 1) * w]);
+            line.extend_from_slice(&px[y * w..(y + 1) * w]);
             blur_line(&mut line, &mut tmp, sx);
-            img.px[y * w..(y + 1) * w].copy_from_slice(&line);
+            px[y * w..(y + 1) * w].copy_from_slice(&line);
         }
     }
-    if sy >= 0.05 && sy.is_finite() {
+    if run_y {
         for x in 0..w {
             line.clear();
-            line.extend((0..h).map(|y| img.px[y * w + x]));
+            line.extend((0..h).map(|y| px[y * w + x]));
             blur_line(&mut line, &mut tmp, sy);
             for (y, p) in line.iter().enumerate() {
-                img.px[y * w + x] = *p;
+                px[y * w + x] = *p;
             }
         }
     }
@@ -131,7 +137,7 @@ mod tests {
         let mut img = Img {
             w: n,
             h: 1,
-            px: vec![[0.0; 4]; n],
+            px: std::sync::Arc::new(vec![[0.0; 4]; n]),
             region: IRect {
                 x0: 0,
                 y0: 0,
@@ -140,7 +146,7 @@ mod tests {
             },
             linear: false,
         };
-        img.px[n / 2] = [1.0; 4];
+        std::sync::Arc::make_mut(&mut img.px)[n / 2] = [1.0; 4];
         img
     }
 

@@ -52,10 +52,7 @@ fn light(
         base = base.map(super::to_linear);
     }
     let base = base.map(f64::from);
-    let mut out = Img {
-        px: vec![[0.0; 4]; input.px.len()],
-        ..input.clone()
-    };
+    let mut px = vec![[0.0f32; 4]; input.px.len()];
     for y in 0..h {
         for x in 0..w {
             let a = |dx: i64, dy: i64| alpha(x + dx, y + dy);
@@ -102,10 +99,13 @@ fn light(
                     (l, base.map(|v| v * k))
                 }
             };
-            out.px[(y * w + x) as usize] = shade(n, l, c);
+            px[(y * w + x) as usize] = shade(n, l, c);
         }
     }
-    out
+    Img {
+        px: std::sync::Arc::new(px),
+        ..input.clone()
+    }
 }
 
 /// `feDiffuseLighting`: `kd (N . L)` times the light colour, opaque.

@@ -78,12 +78,13 @@ impl IRect {
 }
 
 /// A premultiplied RGBA image the size of the canvas, with the rectangle that holds data
-/// and the colour space its values are in.
+/// and the colour space its values are in. Pixels are shared between results and inputs
+/// and copied only when a primitive changes a shared image.
 #[derive(Clone, Debug)]
 pub(crate) struct Img {
     pub w: usize,
     pub h: usize,
-    pub px: Vec<[f32; 4]>,
+    pub px: Arc<Vec<[f32; 4]>>,
     pub region: IRect,
     pub linear: bool,
 }
@@ -93,7 +94,7 @@ impl Img {
         Img {
             w,
             h,
-            px: vec![[0.0; 4]; w * h],
+            px: Arc::new(vec![[0.0; 4]; w * h]),
             region,
             linear: false,
         }
@@ -104,7 +105,7 @@ impl Img {
         let want = cs == ColorInterpolation::LinearRGB;
         if want != self.linear {
             let f = if want { to_linear } else { to_srgb };
-            for p in &mut self.px {
+            for p in Arc::make_mut(&mut self.px).iter_mut() {
                 if p[3] > 0.0 {
                     for c in 0..3 {
                         p[c] = f((p[c] / p[3]).clamp(0.0, 1.0)) * p[3];
@@ -118,8 +119,19 @@ impl Img {
 
     /// Clears every pixel outside `r`.
     fn crop(&mut self, r: IRect) {
+        let inside = IRect {
+            x0: 0,
+            y0: 0,
+            x1: self.w as i32,
+            y1: self.h as i32,
+        };
+        if r.intersect(inside) == inside {
+            return;
+        }
+        let w = self.w;
+        let px = Arc::make_mut(&mut self.px);
         for y in 0..self.h as i32 {
-            let row = &mut self.px[y as usize * self.w..(y as usize + 1) * self.w];
+            let row = &mut px[y as usize * w..(y as usize + 1) * w];
             if y < r.y0 || y >= r.y1 {
                 row.fill([0.0; 4]);
             } else {
@@ -177,7 +189,7 @@ pub(crate) fn apply(
     let mut source = Img {
         w,
         h,
-        px: canvas,
+        px: Arc::new(canvas),
         region: full,
         linear: false,
     };
@@ -188,6 +200,15 @@ pub(crate) fn apply(
         let region = IRect::of(rect, ts).map(|r| r.intersect(full));
         let out = match region {
             Some(region) if !region.is_empty() => {
+                // A filter that never reads its source (turbulence, flood, images) lets the
+                // source's pixels go before it runs.
+                let reads = filter.primitives().iter().any(|p| {
+                    p.kind().has_input(&Input::SourceGraphic)
+                        || p.kind().has_input(&Input::SourceAlpha)
+                });
+                if !reads {
+                    source.px = Arc::new(Vec::new());
+                }
                 run(filter, &source, region, ts, draw, f, &mut image_index)
             }
             _ => None,
@@ -203,7 +224,7 @@ pub(crate) fn apply(
             None => Img::empty(w, h, full),
         };
     }
-    source.px
+    Arc::try_unwrap(source.px).unwrap_or_else(|shared| (*shared).clone())
 }
 
 /// One filter's graph; `None` when it has no primitives.
@@ -219,13 +240,16 @@ fn run(
     let (w, h) = (source.w, source.h);
     let mut results: Vec<(String, Img)> = Vec::new();
     let get = |input: &Input, results: &[(String, Img)]| -> Img {
+        if source.px.is_empty() && !matches!(input, Input::Reference(_)) {
+            return Img::empty(w, h, region);
+        }
         match input {
             Input::SourceGraphic => Img {
                 region,
                 ..source.clone()
             },
             Input::SourceAlpha => Img {
-                px: source.px.iter().map(|p| [0.0, 0.0, 0.0, p[3]]).collect(),
+                px: Arc::new(source.px.iter().map(|p| [0.0, 0.0, 0.0, p[3]]).collect()),
                 region,
                 ..source.clone()
             },
@@ -234,13 +258,19 @@ fn run(
                 .rev()
                 .find(|(n, _)| n == name)
                 .map(|(_, i)| i.clone())
-                .unwrap_or_else(|| Img {
-                    region,
-                    ..source.clone()
+                .unwrap_or_else(|| {
+                    if source.px.is_empty() {
+                        Img::empty(w, h, region)
+                    } else {
+                        Img {
+                            region,
+                            ..source.clone()
+                        }
+                    }
                 }),
         }
     };
-    for prim in filter.primitives() {
+    for (index, prim) in filter.primitives().iter().enumerate() {
         let r = prim.rect();
         let rect = [r.x(), r.y(), r.width(), r.height()].map(f64::from);
         let mut sub = IRect::of(rect, ts).unwrap_or(region);
@@ -268,7 +298,7 @@ fn run(
                 acc.linear = cs == ColorInterpolation::LinearRGB;
                 for input in fe.inputs() {
                     let i = get(input, &results).into_space(cs);
-                    for (d, s) in acc.px.iter_mut().zip(&i.px) {
+                    for (d, s) in Arc::make_mut(&mut acc.px).iter_mut().zip(i.px.iter()) {
                         crate::blend::over(d, *s);
                     }
                 }
@@ -279,7 +309,7 @@ fn run(
                 let c = fe.color();
                 let c = prism_math::Rgb::from_u8([c.red, c.green, c.blue]);
                 let a = fe.opacity().get();
-                img.px.fill([c.r * a, c.g * a, c.b * a, a]);
+                Arc::make_mut(&mut img.px).fill([c.r * a, c.g * a, c.b * a, a]);
                 img
             }
             Kind::GaussianBlur(fe) => {
@@ -308,14 +338,14 @@ fn run(
                 if cs == ColorInterpolation::LinearRGB {
                     col = col.map(to_linear);
                 }
-                for p in &mut shadow.px {
+                for p in Arc::make_mut(&mut shadow.px).iter_mut() {
                     let a = p[3] * op;
                     *p = [col[0] * a, col[1] * a, col[2] * a, a];
                 }
                 let dx = (f64::from(fe.dx()) * sx) as i32;
                 let dy = (f64::from(fe.dy()) * sy) as i32;
                 let mut out = ops::offset(&shadow, dx, dy);
-                for (d, s) in out.px.iter_mut().zip(&input.px) {
+                for (d, s) in Arc::make_mut(&mut out.px).iter_mut().zip(input.px.iter()) {
                     crate::blend::over(d, *s);
                 }
                 out
@@ -337,7 +367,7 @@ fn run(
                 Img {
                     w,
                     h,
-                    px: draw(items, &view),
+                    px: Arc::new(draw(items, &view)),
                     region,
                     linear: false,
                 }
@@ -397,6 +427,18 @@ fn run(
             out.region = region;
         }
         results.push((prim.result().to_string(), out));
+        // Results no later primitive reads are dropped: only the live ones hold memory.
+        let later = &filter.primitives()[index + 1..];
+        let last = results.len() - 1;
+        let mut k = 0;
+        results.retain(|(name, _)| {
+            let keep = k == last
+                || later
+                    .iter()
+                    .any(|p| p.kind().has_input(&Input::Reference(name.clone())));
+            k += 1;
+            keep
+        });
     }
     results.pop().map(|(_, img)| img)
 }

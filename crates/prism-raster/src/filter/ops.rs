@@ -3,6 +3,7 @@
 //! displacement.
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use usvg::filter::{
     ColorChannel, ColorMatrixKind, ComponentTransfer, CompositeOperator, ConvolveMatrix,
@@ -12,9 +13,10 @@ use usvg::filter::{
 use super::{IRect, Img};
 use crate::document::BlendMode;
 
+/// A transparent image of `a`'s size, region and colour space.
 fn like(a: &Img) -> Img {
     Img {
-        px: vec![[0.0; 4]; a.px.len()],
+        px: Arc::new(vec![[0.0; 4]; a.px.len()]),
         ..a.clone()
     }
 }
@@ -22,7 +24,7 @@ fn like(a: &Img) -> Img {
 /// `feBlend`: `a` (in) blended onto `b` (in2).
 pub(crate) fn blend(a: &Img, b: &Img, mode: BlendMode) -> Img {
     let mut out = b.clone();
-    for (d, s) in out.px.iter_mut().zip(&a.px) {
+    for (d, s) in Arc::make_mut(&mut out.px).iter_mut().zip(a.px.iter()) {
         crate::blend::composite(d, *s, mode);
     }
     out
@@ -31,7 +33,8 @@ pub(crate) fn blend(a: &Img, b: &Img, mode: BlendMode) -> Img {
 /// `feComposite`: `a` (in) with `b` (in2) by Porter-Duff or arithmetic.
 pub(crate) fn composite(a: &Img, b: &Img, op: CompositeOperator) -> Img {
     let mut out = like(a);
-    for ((o, s), d) in out.px.iter_mut().zip(&a.px).zip(&b.px) {
+    let px = Arc::make_mut(&mut out.px);
+    for ((o, s), d) in px.iter_mut().zip(a.px.iter()).zip(b.px.iter()) {
         let (sa, da) = (s[3], d[3]);
         *o = match op {
             CompositeOperator::Over => std::array::from_fn(|c| s[c] + d[c] * (1.0 - sa)),
@@ -61,6 +64,7 @@ pub(crate) fn composite(a: &Img, b: &Img, op: CompositeOperator) -> Img {
 /// `feOffset`: the image moved by whole pixels.
 pub(crate) fn offset(a: &Img, dx: i32, dy: i32) -> Img {
     let mut out = like(a);
+    let px = Arc::make_mut(&mut out.px);
     let (w, h) = (a.w as i64, a.h as i64);
     for y in 0..h {
         let sy = y - i64::from(dy);
@@ -70,7 +74,7 @@ pub(crate) fn offset(a: &Img, dx: i32, dy: i32) -> Img {
         for x in 0..w {
             let sx = x - i64::from(dx);
             if sx >= 0 && sx < w {
-                out.px[(y * w + x) as usize] = a.px[(sy * w + sx) as usize];
+                px[(y * w + x) as usize] = a.px[(sy * w + sx) as usize];
             }
         }
     }
@@ -90,11 +94,12 @@ pub(crate) fn tile(a: &Img, region: IRect) -> Img {
         return out;
     }
     let (tw, th) = (t.x1 - t.x0, t.y1 - t.y0);
+    let px = Arc::make_mut(&mut out.px);
     for y in region.y0.max(0)..region.y1.min(a.h as i32) {
         let sy = t.y0 + (y - t.y0).rem_euclid(th);
         for x in region.x0.max(0)..region.x1.min(a.w as i32) {
             let sx = t.x0 + (x - t.x0).rem_euclid(tw);
-            out.px[y as usize * a.w + x as usize] = a.px[sy as usize * a.w + sx as usize];
+            px[y as usize * a.w + x as usize] = a.px[sy as usize * a.w + sx as usize];
         }
     }
     out
@@ -102,7 +107,7 @@ pub(crate) fn tile(a: &Img, region: IRect) -> Img {
 
 /// Applies `f` to each pixel's straight (unpremultiplied) colour and alpha.
 fn straight(img: &mut Img, f: impl Fn([f32; 4]) -> [f32; 4]) {
-    for p in &mut img.px {
+    for p in Arc::make_mut(&mut img.px).iter_mut() {
         let a = p[3];
         let s = if a > 0.0 {
             [p[0] / a, p[1] / a, p[2] / a, a]
@@ -229,6 +234,7 @@ pub(crate) fn convolve(a: &Img, fe: &ConvolveMatrix) -> Img {
     let bias = fe.bias();
     let keep = fe.preserve_alpha();
     let mut out = like(a);
+    let px = Arc::make_mut(&mut out.px);
     for y in 0..h {
         for x in 0..w {
             let mut acc = [0f32; 4];
@@ -274,7 +280,7 @@ pub(crate) fn convolve(a: &Img, fe: &ConvolveMatrix) -> Img {
                     v.clamp(0.0, alpha)
                 }
             };
-            out.px[(y * w + x) as usize] = [f(acc[0]), f(acc[1]), f(acc[2]), alpha];
+            px[(y * w + x) as usize] = [f(acc[0]), f(acc[1]), f(acc[2]), alpha];
         }
     }
     out
@@ -307,8 +313,9 @@ fn slide(v: &[f32], r: usize, max: bool, out: &mut Vec<f32>) {
 /// `feMorphology`: erode (minimum) or dilate (maximum) over a `2 rx + 1` by `2 ry + 1`
 /// window, channel by channel; a zero radius clears the image.
 pub(crate) fn morphology(mut img: Img, op: MorphologyOperator, rx: f64, ry: f64) -> Img {
+    let px = Arc::make_mut(&mut img.px);
     if !(rx > 0.0 && ry > 0.0) {
-        img.px.fill([0.0; 4]);
+        px.fill([0.0; 4]);
         return img;
     }
     let max = op == MorphologyOperator::Dilate;
@@ -318,18 +325,18 @@ pub(crate) fn morphology(mut img: Img, op: MorphologyOperator, rx: f64, ry: f64)
     for c in 0..4 {
         for y in 0..h {
             line.clear();
-            line.extend(img.px[y * w..(y + 1) * w].iter().map(|p| p[c]));
+            line.extend(px[y * w..(y + 1) * w].iter().map(|p| p[c]));
             slide(&line, rx, max, &mut res);
             for (x, v) in res.iter().enumerate() {
-                img.px[y * w + x][c] = *v;
+                px[y * w + x][c] = *v;
             }
         }
         for x in 0..w {
             line.clear();
-            line.extend((0..h).map(|y| img.px[y * w + x][c]));
+            line.extend((0..h).map(|y| px[y * w + x][c]));
             slide(&line, ry, max, &mut res);
             for (y, v) in res.iter().enumerate() {
-                img.px[y * w + x][c] = *v;
+                px[y * w + x][c] = *v;
             }
         }
     }
@@ -340,6 +347,7 @@ pub(crate) fn morphology(mut img: Img, op: MorphologyOperator, rx: f64, ry: f64)
 /// `scale` user units at full value (nearest pixel).
 pub(crate) fn displace(a: &Img, map: &Img, fe: &DisplacementMap, sx: f64, sy: f64) -> Img {
     let mut out = like(a);
+    let px = Arc::make_mut(&mut out.px);
     let (w, h) = (a.w as i64, a.h as i64);
     let channel = |p: [f32; 4], c: ColorChannel| {
         let alpha = p[3];
@@ -360,7 +368,7 @@ pub(crate) fn displace(a: &Img, map: &Img, fe: &DisplacementMap, sx: f64, sy: f6
             let ox = (x as f64 + dx * sx * scale).round() as i64;
             let oy = (y as f64 + dy * sy * scale).round() as i64;
             if ox >= 0 && oy >= 0 && ox < w && oy < h {
-                out.px[(y * w + x) as usize] = a.px[(oy * w + ox) as usize];
+                px[(y * w + x) as usize] = a.px[(oy * w + ox) as usize];
             }
         }
     }

@@ -205,15 +205,17 @@ pub(crate) fn fill(img: &mut Img, fe: &usvg::filter::Turbulence, ts: &DAffine2, 
             f64::from(region.y1 - region.y0) / sy,
         ]
     });
+    let w = img.w;
+    let px = std::sync::Arc::make_mut(&mut img.px);
     for y in region.y0.max(0)..region.y1.min(img.h as i32) {
-        for x in region.x0.max(0)..region.x1.min(img.w as i32) {
+        for x in region.x0.max(0)..region.x1.min(w as i32) {
             let p = ((f64::from(x) - tx) / sx, (f64::from(y) - ty) / sy);
             let c: [f32; 4] = std::array::from_fn(|k| {
                 let n = turbulence(&l, k, p, freq, octaves, fractal, tile);
                 let v = if fractal { (n + 1.0) / 2.0 } else { n };
                 v.clamp(0.0, 1.0) as f32
             });
-            img.px[y as usize * img.w + x as usize] = [c[0] * c[3], c[1] * c[3], c[2] * c[3], c[3]];
+            px[y as usize * w + x as usize] = [c[0] * c[3], c[1] * c[3], c[2] * c[3], c[3]];
         }
     }
 }
