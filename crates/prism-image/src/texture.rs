@@ -230,9 +230,9 @@ impl Texture {
                     let y = self.fold(y0 + j as i64, h, 1);
                     let mut row = Rgb::BLACK;
                     for (x, wxi) in xs.iter().zip(&wx) {
-                        row = row + im.get(*x, y) * *wxi;
+                        row += im.get(*x, y) * *wxi;
                     }
-                    sum = sum + row * *wyj;
+                    sum += row * *wyj;
                 }
                 Rgb::new(sum.r.max(0.0), sum.g.max(0.0), sum.b.max(0.0))
             }
@@ -377,9 +377,60 @@ fn floor(x: f64) -> f64 {
     }
 }
 
+/// The Mitchell-Netravali (B = C = 1/3) weights of the four texels at offsets -1, 0, 1, 2
+/// from a point `t` in [0, 1) past the second.
+fn mitchell(t: f32) -> [f32; 4] {
+    let k = |x: f32| {
+        let x = x.abs();
+        let (b, c) = (1.0 / 3.0, 1.0 / 3.0);
+        if x < 1.0 {
+            ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
+                + (-18.0 + 12.0 * b + 6.0 * c) * x * x
+                + (6.0 - 2.0 * b))
+                / 6.0
+        } else if x < 2.0 {
+            ((-b - 6.0 * c) * x * x * x
+                + (6.0 * b + 30.0 * c) * x * x
+                + (-12.0 * b - 48.0 * c) * x
+                + (8.0 * b + 24.0 * c))
+                / 6.0
+        } else {
+            0.0
+        }
+    };
+    [k(1.0 + t), k(t), k(1.0 - t), k(2.0 - t)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Closed form: the Mitchell-Netravali kernel's weights sum to one and have no first
+    /// moment, so bicubic sampling reproduces a linear ramp exactly away from the edges.
+    #[test]
+    fn bicubic_reproduces_linear_ramps() {
+        let img = RgbImage::from_fn(16, 8, |x, y| {
+            Rgb::new(
+                x as f32 / 15.0,
+                y as f32 / 7.0,
+                0.25 + 0.5 * x as f32 / 15.0,
+            )
+        });
+        let tex = Texture::new(img);
+        for (u, v) in [(0.31f32, 0.43f32), (0.5, 0.5), (0.62, 0.37), (0.25, 0.6)] {
+            let got = tex.sample_level(Vec2::new(u, v), 0, PixelSampling::Bicubic);
+            let (gx, gy) = (u * 16.0 - 0.5, v * 8.0 - 0.5);
+            let want = Rgb::new(gx / 15.0, gy / 7.0, 0.25 + 0.5 * gx / 15.0);
+            for (a, b) in [(got.r, want.r), (got.g, want.g), (got.b, want.b)] {
+                assert!(
+                    (a - b).abs() < 1e-5,
+                    "at ({u}, {v}): {got:?} against {want:?}"
+                );
+            }
+        }
+        let weights = mitchell(0.37);
+        assert!((weights.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+    }
 
     /// Oracle: the standard library's `floor`, bit for bit, on edge cases (signed zeros,
     /// halves, the 2^52 boundary, huge values, infinities) and a million random floats.
@@ -670,28 +721,4 @@ mod tests {
             }
         }
     }
-}
-
-/// The Mitchell-Netravali (B = C = 1/3) weights of the four texels at offsets -1, 0, 1, 2
-/// from a point `t` in [0, 1) past the second.
-fn mitchell(t: f32) -> [f32; 4] {
-    let k = |x: f32| {
-        let x = x.abs();
-        let (b, c) = (1.0 / 3.0, 1.0 / 3.0);
-        if x < 1.0 {
-            ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
-                + (-18.0 + 12.0 * b + 6.0 * c) * x * x
-                + (6.0 - 2.0 * b))
-                / 6.0
-        } else if x < 2.0 {
-            ((-b - 6.0 * c) * x * x * x
-                + (6.0 * b + 30.0 * c) * x * x
-                + (-12.0 * b - 48.0 * c) * x
-                + (8.0 * b + 24.0 * c))
-                / 6.0
-        } else {
-            0.0
-        }
-    };
-    [k(1.0 + t), k(t), k(1.0 - t), k(2.0 - t)]
 }

@@ -179,6 +179,6 @@ mod tests {
         let mut img = impulse(64);
         gaussian(&mut img, 1e6, 1e6);
         let sum: f32 = img.px.iter().map(|p| p[3]).sum();
-        assert!(sum <= 1.0 + 1e-4 && sum >= 0.0);
+        assert!((0.0..=1.0 + 1e-4).contains(&sum));
     }
 }

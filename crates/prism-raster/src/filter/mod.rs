@@ -32,6 +32,10 @@ pub struct Filtered {
     pub images: Vec<Vec<Item>>,
 }
 
+/// Renders items through a view into a canvas-sized premultiplied image (how `feImage`
+/// content is drawn, handed in by the rasterizer).
+pub(crate) type DrawItems<'a> = dyn Fn(&[Item], &Mat3) -> Vec<[f32; 4]> + 'a;
+
 /// An integer pixel rectangle `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct IRect {
@@ -178,7 +182,7 @@ pub(crate) fn apply(
     w: usize,
     h: usize,
     ts: &DAffine2,
-    draw: &dyn Fn(&[Item], &Mat3) -> Vec<[f32; 4]>,
+    draw: &DrawItems<'_>,
 ) -> Vec<[f32; 4]> {
     let full = IRect {
         x0: 0,
@@ -233,7 +237,7 @@ fn run(
     source: &Img,
     region: IRect,
     ts: &DAffine2,
-    draw: &dyn Fn(&[Item], &Mat3) -> Vec<[f32; 4]>,
+    draw: &DrawItems<'_>,
     f: &Filtered,
     image_index: &mut usize,
 ) -> Option<Img> {

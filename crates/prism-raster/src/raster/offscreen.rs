@@ -68,7 +68,7 @@ pub(super) fn pattern_paint(
     let full = m.mul(&p.transform).to_affine();
     let (mut sx, mut sy) = (full.matrix2.x_axis.length(), full.matrix2.y_axis.length());
     let [rx, ry, rw, rh] = p.rect;
-    if !(sx > 0.0 && sy > 0.0 && rw > 0.0 && rh > 0.0) || !(sx * sy * rw * rh).is_finite() {
+    if !(sx > 0.0 && sy > 0.0 && rw > 0.0 && rh > 0.0 && (sx * sy * rw * rh).is_finite()) {
         return None;
     }
     let area = rw * sx * rh * sy;
