@@ -63,7 +63,7 @@ pub fn render(
     }
     let t0 = Instant::now();
     let view = view_transform(doc, opts);
-    let prims = prepare(doc, &doc.items, opts, &view);
+    let prims = prepare(doc, &doc.items, opts, &view, render_premultiplied);
     let prepare_time = t0.elapsed();
     let t1 = Instant::now();
     let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
@@ -89,14 +89,14 @@ pub fn render(
 /// Renders `items` of `doc` through `view` into premultiplied pixels of an
 /// `opts.width` x `opts.height` image on a transparent background (offscreen layers:
 /// pattern tiles and filtered groups).
-pub(super) fn render_premultiplied(
+fn render_premultiplied(
     doc: &Document,
     items: &[Item],
     opts: &RasterOptions,
     view: &Mat3,
 ) -> Vec<[f32; 4]> {
     let r = sample_rate(opts.samples).unwrap_or(1) as usize;
-    let prims = prepare(doc, items, opts, view);
+    let prims = prepare(doc, items, opts, view, render_premultiplied);
     let mut pixels = vec![[0f32; 4]; opts.width as usize * opts.height as usize];
     draw_bands(&prims, opts, r, &mut pixels, |band, out| {
         band.resolve_premultiplied(out);

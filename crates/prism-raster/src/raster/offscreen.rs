@@ -2,15 +2,24 @@
 //! sampled as a repeating paint) and filtered groups (rendered into their region, filtered,
 //! then placed as pixels).
 
-use std::sync::Arc;
-
 use prism_math::{DAffine2, DVec2};
 
 use super::options::RasterOptions;
-use super::primitives::{DevPaint, Placed, Prim};
-use super::render_premultiplied;
-use crate::document::{Document, Mat3, Pattern};
+use crate::document::{Document, Item, Mat3, Pattern};
 use crate::filter::Filtered;
+
+/// Renders items of a document through a view into premultiplied pixels of
+/// `opts.width` x `opts.height` (the rasterizer's own offscreen entry, handed in so that
+/// this file needs nothing above it).
+pub(super) type SubRender = fn(&Document, &[Item], &RasterOptions, &Mat3) -> Vec<[f32; 4]>;
+
+/// A filtered group's pixels: `w` wide, the top-left one at device pixel `(x0, y0)`.
+pub(super) struct Raster {
+    pub(super) x0: i32,
+    pub(super) y0: i32,
+    pub(super) w: usize,
+    pub(super) px: Vec<[f32; 4]>,
+}
 
 /// The most pixels a pattern tile is rendered with; larger tiles are drawn at a lower
 /// resolution and magnified.
@@ -56,15 +65,16 @@ impl Tile {
     }
 }
 
-/// The pattern as a device paint under `m` (the painted element's user space to device),
-/// its tile rendered at the device scale; `None` when the tile has no area.
-pub(super) fn pattern_paint(
+/// The pattern's tile rendered at the device scale of `m` (the painted element's user
+/// space to device), and the map from device pixels to tile pixels; `None` when the tile
+/// has no area.
+pub(super) fn pattern_tile(
     doc: &Document,
     p: &Pattern,
     m: &Mat3,
-    opacity: f32,
     opts: &RasterOptions,
-) -> Option<DevPaint> {
+    render: SubRender,
+) -> Option<(Tile, DAffine2)> {
     let full = m.mul(&p.transform).to_affine();
     let (mut sx, mut sy) = (full.matrix2.x_axis.length(), full.matrix2.y_axis.length());
     let [rx, ry, rw, rh] = p.rect;
@@ -83,7 +93,7 @@ pub(super) fn pattern_paint(
         height: th as u32,
         ..opts.clone()
     };
-    let px = render_premultiplied(doc, &p.items, &tile_opts, &Mat3::scale(sx, sy));
+    let px = render(doc, &p.items, &tile_opts, &Mat3::scale(sx, sy));
     let to_device = full
         * DAffine2::from_translation(DVec2::new(rx, ry))
         * DAffine2::from_scale(DVec2::new(1.0 / sx, 1.0 / sy));
@@ -93,26 +103,24 @@ pub(super) fn pattern_paint(
     }
     let m2 = to_device.matrix2;
     let nearest = (m2.x_axis - DVec2::X).length() < 1e-9 && (m2.y_axis - DVec2::Y).length() < 1e-9;
-    Some(DevPaint::Pattern {
-        tile: Arc::new(Tile {
-            w: tw as usize,
-            h: th as usize,
-            px,
-            nearest,
-        }),
-        inv: to_device.inverse(),
-        opacity,
-    })
+    let tile = Tile {
+        w: tw as usize,
+        h: th as usize,
+        px,
+        nearest,
+    };
+    Some((tile, to_device.inverse()))
 }
 
 /// A filtered group: its content rendered over its filter region (clipped to the image
-/// grown by half its size on each side), filtered, and placed as pixels.
+/// grown by half its size on each side) and filtered; `None` when that region is empty.
 pub(super) fn filtered(
     doc: &Document,
     f: &Filtered,
     view: &Mat3,
     opts: &RasterOptions,
-) -> Vec<Placed> {
+    render: SubRender,
+) -> Option<Raster> {
     let m = view.mul(&f.transform).to_affine();
     let [x, y, w, h] = f.region;
     let pts = [(x, y), (x + w, y), (x, y + h), (x + w, y + h)]
@@ -120,7 +128,7 @@ pub(super) fn filtered(
     let lo = pts.iter().fold(pts[0], |a, b| a.min(*b));
     let hi = pts.iter().fold(pts[0], |a, b| a.max(*b));
     if !(lo.is_finite() && hi.is_finite()) {
-        return Vec::new();
+        return None;
     }
     let (cw, ch) = (f64::from(opts.width), f64::from(opts.height));
     let x0 = lo.x.floor().max(-cw / 2.0);
@@ -128,7 +136,7 @@ pub(super) fn filtered(
     let x1 = hi.x.ceil().min(1.5 * cw);
     let y1 = hi.y.ceil().min(1.5 * ch);
     if x1 <= x0 || y1 <= y0 {
-        return Vec::new();
+        return None;
     }
     let (rw, rh) = ((x1 - x0) as u32, (y1 - y0) as u32);
     let sub = RasterOptions {
@@ -137,27 +145,14 @@ pub(super) fn filtered(
         ..opts.clone()
     };
     let shift = Mat3::translate(-x0, -y0);
-    let content = render_premultiplied(doc, &f.items, &sub, &shift.mul(view));
+    let content = render(doc, &f.items, &sub, &shift.mul(view));
     let ts = shift.mul(view).mul(&f.transform).to_affine();
-    let draw =
-        |items: &[crate::document::Item], v: &Mat3| render_premultiplied(doc, items, &sub, v);
+    let draw = |items: &[Item], v: &Mat3| render(doc, items, &sub, v);
     let px = crate::filter::apply(f, content, rw as usize, rh as usize, &ts, &draw);
-    let (ix, iy) = (x0 as i32, y0 as i32);
-    let rows = (iy.max(0), (iy + rh as i32).min(opts.height as i32));
-    let cols = (ix.max(0), (ix + rw as i32).min(opts.width as i32));
-    if rows.1 <= rows.0 || cols.1 <= cols.0 {
-        return Vec::new();
-    }
-    vec![Placed {
-        y0: rows.0,
-        y1: rows.1,
-        x0: cols.0,
-        x1: cols.1,
-        prim: Prim::Raster {
-            x0: ix,
-            y0: iy,
-            w: rw as usize,
-            px: Arc::new(px),
-        },
-    }]
+    Some(Raster {
+        x0: x0 as i32,
+        y0: y0 as i32,
+        w: rw as usize,
+        px,
+    })
 }

@@ -7,7 +7,7 @@ use prism_image::{LevelSampling, PixelSampling, Texture};
 use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
-use super::offscreen::{filtered, pattern_paint, Tile};
+use super::offscreen::{filtered, pattern_tile, SubRender, Tile};
 use super::options::{RasterOptions, TOLERANCE};
 use crate::document::{
     BlendMode, Document, FillRule, Gradient, GradientKind, Item, MaskKind, Mat3, Paint, Spread,
@@ -379,6 +379,7 @@ pub(super) fn prepare(
     items: &[Item],
     opts: &RasterOptions,
     view: &Mat3,
+    render: SubRender,
 ) -> Vec<Placed> {
     let h = opts.height as i32;
     let w = opts.width as f64;
@@ -447,7 +448,14 @@ pub(super) fn prepare(
     };
     let dev_paint = |paint: &Paint, m: &Mat3, opacity: f32| -> Option<DevPaint> {
         match paint {
-            Paint::Pattern(p) => pattern_paint(doc, p, m, opacity, opts),
+            Paint::Pattern(p) => {
+                let (tile, inv) = pattern_tile(doc, p, m, opts, render)?;
+                Some(DevPaint::Pattern {
+                    tile: Arc::new(tile),
+                    inv,
+                    opacity,
+                })
+            }
             Paint::Solid(c) => Some(DevPaint::Solid(solid(*c, opacity))),
             Paint::Gradient(g) => {
                 let full = m.mul(&g.transform).to_affine();
@@ -712,7 +720,28 @@ pub(super) fn prepare(
                 x1: 0,
                 prim: Prim::MaskEnd(*kind),
             }),
-            Item::Filtered(f) => out.extend(filtered(doc, f, view, opts)),
+            Item::Filtered(f) => {
+                let Some(r) = filtered(doc, f, view, opts, render) else {
+                    return out;
+                };
+                let h = (r.px.len() / r.w.max(1)) as i32;
+                let rows = (r.y0.max(0), (r.y0 + h).min(opts.height as i32));
+                let cols = (r.x0.max(0), (r.x0 + r.w as i32).min(opts.width as i32));
+                if rows.1 > rows.0 && cols.1 > cols.0 {
+                    out.push(Placed {
+                        y0: rows.0,
+                        y1: rows.1,
+                        x0: cols.0,
+                        x1: cols.1,
+                        prim: Prim::Raster {
+                            x0: r.x0,
+                            y0: r.y0,
+                            w: r.w,
+                            px: Arc::new(r.px),
+                        },
+                    });
+                }
+            }
         }
         out
     };
