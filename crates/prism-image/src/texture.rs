@@ -221,7 +221,7 @@ impl Texture {
                 if !gx.is_finite() || !gy.is_finite() {
                     return im.get(0, 0);
                 }
-                let (fx, fy) = (gx.floor(), gy.floor());
+                let (fx, fy) = (floor(gx), floor(gy));
                 let (wx, wy) = (mitchell((gx - fx) as f32), mitchell((gy - fy) as f32));
                 let (x0, y0) = (fx as i64 - 1, fy as i64 - 1);
                 let xs: [u32; 4] = std::array::from_fn(|i| self.fold(x0 + i as i64, w, 0));
@@ -256,6 +256,7 @@ impl Texture {
     }
 
     /// Texel `i` of `n` along `axis` (0 for x), wrapped as the axis wraps.
+    #[inline]
     fn fold(&self, i: i64, n: i64, axis: usize) -> u32 {
         match self.wrap[axis] {
             Wrap::Clamp => i.clamp(0, n - 1) as u32,
@@ -337,7 +338,8 @@ impl Texture {
     }
 
     /// Samples at a continuous level `d`, blending levels `floor(d)` and `floor(d) + 1`
-    /// linearly; `d` is clamped to the chain.
+    /// linearly; `d` is clamped to the chain. Bicubic texels are for magnification: past
+    /// level 0 the levels are already filtered, and their texels are blended bilinearly.
     #[must_use]
     pub fn sample_at_level(&self, uv: Vec2, d: f32, pixel: PixelSampling) -> Rgb {
         let max = (self.levels.len() - 1) as f32;
@@ -345,6 +347,11 @@ impl Texture {
             d.clamp(0.0, max)
         } else {
             0.0
+        };
+        let pixel = if d > 0.0 && pixel == PixelSampling::Bicubic {
+            PixelSampling::Bilinear
+        } else {
+            pixel
         };
         let lo = d.floor();
         let t = d - lo;
@@ -378,27 +385,14 @@ fn floor(x: f64) -> f64 {
 }
 
 /// The Mitchell-Netravali (B = C = 1/3) weights of the four texels at offsets -1, 0, 1, 2
-/// from a point `t` in [0, 1) past the second.
+/// from a point `t` in [0, 1) past the second: the kernel's two cubic pieces, for
+/// `|x| < 1` `(7|x|^3 - 12|x|^2 + 16/3) / 6` and for `1 <= |x| < 2`
+/// `(-7/3|x|^3 + 12|x|^2 - 20|x| + 32/3) / 6`.
+#[inline]
 fn mitchell(t: f32) -> [f32; 4] {
-    let k = |x: f32| {
-        let x = x.abs();
-        let (b, c) = (1.0 / 3.0, 1.0 / 3.0);
-        if x < 1.0 {
-            ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
-                + (-18.0 + 12.0 * b + 6.0 * c) * x * x
-                + (6.0 - 2.0 * b))
-                / 6.0
-        } else if x < 2.0 {
-            ((-b - 6.0 * c) * x * x * x
-                + (6.0 * b + 30.0 * c) * x * x
-                + (-12.0 * b - 48.0 * c) * x
-                + (8.0 * b + 24.0 * c))
-                / 6.0
-        } else {
-            0.0
-        }
-    };
-    [k(1.0 + t), k(t), k(1.0 - t), k(2.0 - t)]
+    let near = |x: f32| ((7.0 * x - 12.0) * x * x + 16.0 / 3.0) / 6.0;
+    let far = |x: f32| (((-7.0 / 3.0 * x + 12.0) * x - 20.0) * x + 32.0 / 3.0) / 6.0;
+    [far(1.0 + t), near(t), near(1.0 - t), far(2.0 - t)]
 }
 
 #[cfg(test)]

@@ -679,13 +679,26 @@ pub(super) fn prepare(
                     Vec2::new(0.0, 1.0),
                     Vec2::new(1.0, 1.0),
                 ];
+                // An image whose texels land one to one on whole pixels is copied, not
+                // filtered (as Skia drops filtering for an integer translation).
+                let (tw, th) = doc.textures[*texture].size();
+                let ex = (d[1] - d[0]) - DVec2::new(f64::from(tw), 0.0);
+                let ey = (d[2] - d[0]) - DVec2::new(0.0, f64::from(th));
+                let whole = |v: f64| (v - v.round()).abs() < 1e-6;
+                let aligned =
+                    ex.length() < 1e-6 && ey.length() < 1e-6 && whole(d[0].x) && whole(d[0].y);
+                let sampling = if aligned {
+                    PixelSampling::Nearest
+                } else {
+                    *sampling
+                };
                 for (a, b, cc) in [(0, 1, 2), (2, 1, 3)] {
                     let v = [d[a], d[b], d[cc]];
                     let shade = tex_shade(
                         *texture,
                         v,
                         [uv[a], uv[b], uv[cc]],
-                        *sampling,
+                        sampling,
                         LevelSampling::Linear,
                         *opacity,
                     );
