@@ -629,3 +629,20 @@ fn hostile_filter_regions_and_radii_are_bounded() {
     let img = draw(dilate, 64, 64);
     assert_eq!(px(&img, 20, 20), [255, 0, 0, 255]);
 }
+
+/// A font directory that does not exist is an error naming it, not a silent fallback.
+#[test]
+fn missing_font_directory_is_an_error() {
+    let text = "<svg xmlns='http://www.w3.org/2000/svg' width='20' height='20'>\
+                <text x='1' y='15'>A</text></svg>";
+    let source = Source {
+        name: "fonts.svg".into(),
+        fonts: Fonts {
+            dirs: vec!["/nonexistent/fonts".into()],
+            ..Fonts::default()
+        },
+        ..Source::default()
+    };
+    let err = parse_svg(text, Dialect::Svg, &source).unwrap_err();
+    assert!(err.to_string().starts_with("/nonexistent/fonts: font directory:"), "{err}");
+}
