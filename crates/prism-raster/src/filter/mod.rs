@@ -11,7 +11,7 @@ mod turbulence;
 
 use std::sync::Arc;
 
-use prism_math::DAffine2;
+use prism_math::{DAffine2, DVec2};
 use usvg::filter::{ColorInterpolation, Input, Kind};
 
 use crate::document::{Item, Mat3};
@@ -167,9 +167,15 @@ pub(crate) fn to_srgb(v: f32) -> f32 {
     }
 }
 
-/// The lengths of the transform's axes: how many pixels one user unit spans along x and y.
-fn scale_of(ts: &DAffine2) -> (f64, f64) {
-    (ts.matrix2.x_axis.length(), ts.matrix2.y_axis.length())
+/// The transform's scale as resvg takes it (tiny-skia's `get_scale`): the lengths of the
+/// rows of its linear part, `(|(a, c)|, |(b, d)|)` for `x' = a x + c y`, `y' = b x + d y`.
+/// Filter lengths (deviations, offsets, radii) are scaled by it.
+pub(crate) fn scale_of(ts: &DAffine2) -> (f64, f64) {
+    let m = ts.matrix2;
+    (
+        DVec2::new(m.x_axis.x, m.y_axis.x).length(),
+        DVec2::new(m.x_axis.y, m.y_axis.y).length(),
+    )
 }
 
 /// Runs `f`'s filters over `canvas` (a `w` x `h` premultiplied sRGB image whose pixel

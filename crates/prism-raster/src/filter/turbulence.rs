@@ -184,7 +184,7 @@ fn turbulence(
 /// Fills `region` of `img` with the primitive's noise; pixel `(x, y)` samples user-space
 /// point `((x - tx) / sx, (y - ty) / sy)` of the canvas transform `ts`.
 pub(crate) fn fill(img: &mut Img, fe: &usvg::filter::Turbulence, ts: &DAffine2, region: IRect) {
-    let (sx, sy) = (ts.matrix2.x_axis.length(), ts.matrix2.y_axis.length());
+    let (sx, sy) = super::scale_of(ts);
     if !(sx > 1e-12 && sy > 1e-12) {
         return;
     }

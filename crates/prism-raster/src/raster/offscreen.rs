@@ -76,7 +76,7 @@ pub(super) fn pattern_tile(
     render: SubRender,
 ) -> Option<(Tile, DAffine2)> {
     let full = m.mul(&p.transform).to_affine();
-    let (mut sx, mut sy) = (full.matrix2.x_axis.length(), full.matrix2.y_axis.length());
+    let (mut sx, mut sy) = crate::filter::scale_of(&full);
     let [rx, ry, rw, rh] = p.rect;
     if !(sx > 0.0 && sy > 0.0 && rw > 0.0 && rh > 0.0 && (sx * sy * rw * rh).is_finite()) {
         return None;
