@@ -517,6 +517,19 @@ fn fe_image_and_turbulence() {
         40,
     );
     assert!(max_diff(&img, &draw(SQUARE, 40, 40)) <= 1);
+    // Under a transform, the element is drawn from the primitive subregion's corner.
+    let moved = draw(
+        &format!(
+            "<defs>{}</defs><filter id='f' filterUnits='userSpaceOnUse' x='0' y='0' \
+             width='40' height='40'><feImage href='#sq'/></filter>\
+             <g transform='translate(5 5)' filter='url(#f)'><rect width='1' height='1'/></g>",
+            SQUARE.replace("<rect", "<rect id='sq'")
+        ),
+        40,
+        40,
+    );
+    let shifted = draw(&format!("<g transform='translate(5 5)'>{SQUARE}</g>"), 40, 40);
+    assert!(max_diff(&moved, &shifted) <= 1);
     let a = filtered(
         "<feTurbulence baseFrequency='0.05' numOctaves='2' seed='3'/>",
         "",

@@ -175,11 +175,7 @@ impl Converter<'_> {
                 for prim in f.primitives() {
                     if let usvg::filter::Kind::Image(img) = prim.kind() {
                         let mut items = Vec::new();
-                        self.group_content(
-                            img.root(),
-                            m.mul(&mat(img.root().transform())),
-                            &mut items,
-                        )?;
+                        self.group_content(img.root(), Mat3::IDENTITY, &mut items)?;
                         images.push(items);
                     }
                 }
