@@ -31,7 +31,7 @@ pub use figures::{de_casteljau_construction, wireframe};
 pub use parse::{
     parse_path_data, parse_path_data_prefix, parse_svg, read_svg, read_svg_with, Dialect, Fonts,
     PathDataError, Source, SvgError, MAX_DEPTH, MAX_IMAGE_BYTES, MAX_ITEMS, MAX_SVG_BYTES,
-    MAX_USE_ELEMENTS,
+    MAX_TEXT_PATH, MAX_USE_ELEMENTS,
 };
 pub use raster::{
     render, sample_rate, view_transform, RasterError, RasterOptions, RasterStats, View,

@@ -528,7 +528,11 @@ fn fe_image_and_turbulence() {
         40,
         40,
     );
-    let shifted = draw(&format!("<g transform='translate(5 5)'>{SQUARE}</g>"), 40, 40);
+    let shifted = draw(
+        &format!("<g transform='translate(5 5)'>{SQUARE}</g>"),
+        40,
+        40,
+    );
     assert!(max_diff(&moved, &shifted) <= 1);
     let a = filtered(
         "<feTurbulence baseFrequency='0.05' numOctaves='2' seed='3'/>",
@@ -657,5 +661,9 @@ fn missing_font_directory_is_an_error() {
         ..Source::default()
     };
     let err = parse_svg(text, Dialect::Svg, &source).unwrap_err();
-    assert!(err.to_string().starts_with("/nonexistent/fonts: font directory:"), "{err}");
+    assert!(
+        err.to_string()
+            .starts_with("/nonexistent/fonts: font directory:"),
+        "{err}"
+    );
 }

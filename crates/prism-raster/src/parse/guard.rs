@@ -1,15 +1,20 @@
 //! The checks made on a standard SVG's XML before usvg reads it: an `<svg>` root; nesting
 //! depth counted through references (`url(#id)`, `href="#id"`), so that no reading
 //! recurses deeper than [`MAX_DEPTH`]; and the elements `use` copies would create, at most
-//! [`MAX_USE_ELEMENTS`], each refused at the element where it passes its limit.
+//! [`MAX_USE_ELEMENTS`], each refused at the element where it passes its limit; and paths
+//! that text follows within [`MAX_TEXT_PATH`].
 
 use std::collections::HashMap;
 
-use prism_math::Loc;
+use prism_math::{DVec2, Loc};
 use roxmltree::{Document, Node, NodeId, ParsingOptions};
 
 use super::common::{SvgError, MAX_DEPTH, MAX_USE_ELEMENTS};
 use super::context::Source;
+use crate::path::Segment;
+
+/// The largest coordinate, in user units, of a path that text follows (`textPath`).
+pub const MAX_TEXT_PATH: f64 = 1e9;
 
 /// Parses the XML and checks its nesting.
 ///
@@ -37,6 +42,39 @@ pub(crate) fn check_nesting<'a>(text: &'a str, source: &Source) -> Result<Docume
             element: root.tag_name().name().to_string(),
             message: "expected the root element to be <svg>".into(),
         });
+    }
+    // Text on a path is laid out by measuring the path's length, which takes time growing
+    // with its coordinates' magnitude: paths that text follows stay within MAX_TEXT_PATH.
+    for n in xml.descendants().filter(|n| n.has_tag_name("textPath")) {
+        let own = n.attribute("path");
+        let linked = n
+            .attributes()
+            .find(|a| a.name() == "href")
+            .and_then(|a| a.value().trim().strip_prefix('#'))
+            .and_then(|id| ids.get(id))
+            .and_then(|&t| xml.get_node(t))
+            .and_then(|t| t.attribute("d"));
+        for d in own.into_iter().chain(linked) {
+            let (path, _) = super::pathdata::parse_path_data_prefix(d);
+            let far = path.segments.iter().any(|seg| {
+                let pts: &[DVec2] = match seg {
+                    Segment::MoveTo(p) | Segment::LineTo(p) => std::slice::from_ref(p),
+                    Segment::CubicTo(a, b, c) => &[*a, *b, *c],
+                    Segment::Close => &[],
+                };
+                pts.iter()
+                    .any(|p| !(p.x.abs() <= MAX_TEXT_PATH && p.y.abs() <= MAX_TEXT_PATH))
+            });
+            if far {
+                return Err(SvgError::Element {
+                    at: Loc::line(&source.name, xml.text_pos_at(n.range().start).row),
+                    element: "textPath".into(),
+                    message: format!(
+                        "the path the text follows reaches beyond {MAX_TEXT_PATH:e} user units"
+                    ),
+                });
+            }
+        }
     }
     // Each element's successors: its child elements and what it references, each marked
     // with whether usvg copies it (children, and a `use` element's target).

@@ -24,6 +24,7 @@ use std::sync::Arc;
 pub use common::{SvgError, MAX_DEPTH, MAX_ITEMS, MAX_SVG_BYTES, MAX_USE_ELEMENTS};
 use context::{element_loc, Ctx};
 pub use context::{Fonts, Source};
+pub use guard::MAX_TEXT_PATH;
 pub use pathdata::{parse_path_data, parse_path_data_prefix, PathDataError};
 pub use resources::MAX_IMAGE_BYTES;
 

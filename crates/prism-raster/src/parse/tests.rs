@@ -178,3 +178,22 @@ fn namespaced_attributes_are_not_svg_attributes() {
     let doc = parse(text, Dialect::Svg).unwrap();
     assert_eq!(doc.items.len(), 1);
 }
+
+/// Regression (found by fuzzing): text on a path reaching 4.7e24 user units made usvg's
+/// arc-length measurement run for minutes; such a path is a located error.
+#[test]
+fn text_on_a_far_path_is_refused() {
+    let far = svg(
+        "<path id='p' d='M262 215 A103 103 0 0 1 4687777777777777777777777 215'/>\n\
+                   <text><textPath href='#p'>far</textPath></text>",
+    );
+    let err = parse(&far, Dialect::Svg).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("hostile.svg:3: textPath: the path the text follows"),
+        "{err}"
+    );
+    let near =
+        svg("<path id='p' d='M0 5 H1000000'/><text><textPath href='#p'>near</textPath></text>");
+    parse(&near, Dialect::Svg).unwrap();
+}
