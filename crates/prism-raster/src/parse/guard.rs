@@ -1,8 +1,9 @@
 //! The checks made on a standard SVG's XML before usvg reads it: an `<svg>` root; nesting
 //! depth counted through references (`url(#id)`, `href="#id"`), so that no reading
 //! recurses deeper than [`MAX_DEPTH`]; and the elements `use` copies would create, at most
-//! [`MAX_USE_ELEMENTS`], each refused at the element where it passes its limit; and paths
-//! that text follows within [`MAX_TEXT_PATH`].
+//! [`MAX_USE_ELEMENTS`], each refused at the element where it passes its limit; no `href`
+//! cycle among gradients, patterns and filters; and paths that text follows within
+//! [`MAX_TEXT_PATH`].
 
 use std::collections::HashMap;
 
@@ -42,6 +43,50 @@ pub(crate) fn check_nesting<'a>(text: &'a str, source: &Source) -> Result<Docume
             element: root.tag_name().name().to_string(),
             message: "expected the root element to be <svg>".into(),
         });
+    }
+    // usvg follows the `href` chains of gradients, patterns and filters until they come
+    // back to where they started: a chain that enters a cycle elsewhere would never end,
+    // so such a cycle is refused at the first element that enters it.
+    let chained = |n: Node| {
+        matches!(
+            n.tag_name().name(),
+            "linearGradient" | "radialGradient" | "pattern" | "filter"
+        )
+    };
+    let href_of = |n: Node| -> Option<NodeId> {
+        n.attributes()
+            .find(|a| a.name() == "href")
+            .and_then(|a| a.value().trim().strip_prefix('#'))
+            .and_then(|id| ids.get(id).copied())
+    };
+    let mut state: HashMap<NodeId, u8> = HashMap::new(); // 1: on the walk, 2: done
+    for start in xml.descendants().filter(|n| chained(*n)) {
+        let mut walk = Vec::new();
+        let mut cur = Some(start.id());
+        while let Some(id) = cur {
+            match state.get(&id) {
+                Some(2) => break,
+                Some(_) => {
+                    let n = xml.get_node(id).unwrap_or(root);
+                    return Err(SvgError::Element {
+                        at: Loc::line(&source.name, xml.text_pos_at(n.range().start).row),
+                        element: n.tag_name().name().to_string(),
+                        message: "href leads back to this element".into(),
+                    });
+                }
+                None => {}
+            }
+            state.insert(id, 1);
+            walk.push(id);
+            cur = xml
+                .get_node(id)
+                .filter(|n| chained(*n))
+                .and_then(href_of)
+                .filter(|t| *t != id && xml.get_node(*t).is_some_and(chained));
+        }
+        for id in walk {
+            state.insert(id, 2);
+        }
     }
     // Text on a path is laid out by measuring the path's length, which takes time growing
     // with its coordinates' magnitude: paths that text follows stay within MAX_TEXT_PATH.

@@ -197,3 +197,27 @@ fn text_on_a_far_path_is_refused() {
         svg("<path id='p' d='M0 5 H1000000'/><text><textPath href='#p'>near</textPath></text>");
     parse(&near, Dialect::Svg).unwrap();
 }
+
+/// Regression (found by fuzzing): a gradient whose `href` chain enters a cycle it did not
+/// start (a -> b -> c -> b) made usvg loop for ever; the cycle is a located error. A
+/// gradient referring to itself is left to usvg, which stops there.
+#[test]
+fn gradient_href_cycles_are_refused() {
+    let stops = "<stop offset='0' stop-color='red'/>";
+    let cyclic = svg(&format!(
+        "<linearGradient id='a' href='#b'/>\n<linearGradient id='b' href='#c'/>\n\
+         <linearGradient id='c' href='#b'>{stops}</linearGradient>\n\
+         <rect width='5' height='5' fill='url(#a)'/>"
+    ));
+    let err = parse(&cyclic, Dialect::Svg).unwrap_err();
+    assert!(
+        err.to_string().contains("href leads back to this element"),
+        "{err}"
+    );
+    assert_eq!(err.at().line, 3);
+    let own = svg(&format!(
+        "<linearGradient id='a' href='#a'>{stops}</linearGradient>\
+         <rect width='5' height='5' fill='url(#a)'/>"
+    ));
+    parse(&own, Dialect::Svg).unwrap();
+}
