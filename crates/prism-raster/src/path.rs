@@ -275,6 +275,16 @@ impl Path {
     /// the polyline (uniform subdivision with the second-difference bound).
     #[must_use]
     pub fn flatten(&self, tolerance: f64) -> Vec<Polyline> {
+        self.flatten_within(tolerance, None)
+    }
+
+    /// [`Path::flatten`], except that a curve whose control points all lie outside `keep`
+    /// (a box `(min, max)`) becomes its chord: what lies outside the box is not drawn, and
+    /// the region between a curve and its chord lies in the curve's control hull, so no
+    /// point of the box changes sides. The work then follows what can be seen, not the
+    /// curve's size.
+    #[must_use]
+    pub fn flatten_within(&self, tolerance: f64, keep: Option<(DVec2, DVec2)>) -> Vec<Polyline> {
         let mut out = Vec::new();
         let mut cur: Vec<DVec2> = Vec::new();
         let flush = |cur: &mut Vec<DVec2>, out: &mut Vec<Polyline>, closed: bool| {
@@ -304,7 +314,16 @@ impl Path {
                         cur.push(start);
                     }
                     let p0 = *cur.last().expect("non-empty");
-                    flatten_cubic(p0, c1, c2, p, tolerance, &mut cur);
+                    let outside = keep.is_some_and(|(lo, hi)| {
+                        let a = p0.min(c1).min(c2.min(p));
+                        let b = p0.max(c1).max(c2.max(p));
+                        a.x > hi.x || a.y > hi.y || b.x < lo.x || b.y < lo.y
+                    });
+                    if outside {
+                        cur.push(p);
+                    } else {
+                        flatten_cubic(p0, c1, c2, p, tolerance, &mut cur);
+                    }
                 }
                 Segment::Close => {
                     flush(&mut cur, &mut out, true);

@@ -667,3 +667,24 @@ fn missing_font_directory_is_an_error() {
         "{err}"
     );
 }
+
+/// Regression (found by fuzzing: a circle of radius 8.9e27 took 13 GB): curves outside the
+/// image are drawn as their chords, so work follows what is seen. Closed forms: a circle
+/// around the whole image covers every pixel; a circle of radius 10^6 whose edge crosses
+/// the image at x = 20 covers exactly the pixels left of it (usvg keeps coordinates in
+/// `f32`, so larger circles lose that precision, in resvg too).
+#[test]
+fn huge_shapes_draw_what_is_visible() {
+    let around = draw(
+        "<circle cx='20' cy='20' r='8888888888888888888888888838' fill='red' stroke='blue' \
+         stroke-width='3'/>",
+        40,
+        40,
+    );
+    assert!(around.pixels().iter().all(|p| *p == [255, 0, 0, 255]));
+    let edge = draw("<circle cx='-999980' cy='20' r='1e6' fill='red'/>", 40, 40);
+    for y in [0, 20, 39] {
+        assert_eq!(px(&edge, 19, y), [255, 0, 0, 255], "row {y}");
+        assert_eq!(px(&edge, 20, y)[3], 0, "row {y}");
+    }
+}

@@ -502,6 +502,11 @@ pub(super) fn prepare(
             q
         }
     };
+    // The device box whose pixels are drawn, with a margin for sub-pixel overhang.
+    let visible = (
+        DVec2::splat(-2.0),
+        DVec2::new(opts.width as f64 + 2.0, opts.height as f64 + 2.0),
+    );
     let per_item = |item: &Item| -> Vec<Placed> {
         let mut out = Vec::new();
         match item {
@@ -528,7 +533,7 @@ pub(super) fn prepare(
                     return out;
                 };
                 let dpath: Path = path.transformed(&m.to_affine());
-                let lines = dpath.flatten(TOLERANCE);
+                let lines = dpath.flatten_within(TOLERANCE, Some(visible));
                 let mut edges = Vec::new();
                 edges_of(lines.into_iter().map(|l| l.points), true, &mut edges);
                 out.extend(place_poly(edges, *rule, paint));
@@ -565,7 +570,21 @@ pub(super) fn prepare(
                     return out;
                 };
                 let tol = TOLERANCE / scale;
-                let polys = stroke(&path.flatten(tol), style, tol);
+                // The visible box in the path's own space, grown by how far a stroke
+                // (with its joins) reaches.
+                let inv = affine.inverse();
+                let reach = style.width * style.miter_limit.max(1.0) + 1.0;
+                let corners = [
+                    visible.0,
+                    DVec2::new(visible.1.x, visible.0.y),
+                    DVec2::new(visible.0.x, visible.1.y),
+                    visible.1,
+                ]
+                .map(|c| inv.transform_point2(c));
+                let lo = corners.iter().fold(corners[0], |a, b| a.min(*b)) - reach;
+                let hi = corners.iter().fold(corners[0], |a, b| a.max(*b)) + reach;
+                let keep = (lo.is_finite() && hi.is_finite()).then_some((lo, hi));
+                let polys = stroke(&path.flatten_within(tol, keep), style, tol);
                 let mut edges = Vec::new();
                 edges_of(
                     polys
