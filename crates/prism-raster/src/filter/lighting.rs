@@ -33,13 +33,13 @@ fn place(light: LightSource, ts: &DAffine2) -> LightSource {
 }
 
 /// Lights `input`'s alpha surface; `shade(normal, light direction, light colour)` gives a
-/// pixel's premultiplied result.
+/// pixel's premultiplied result. The lighting colour is taken as given, in whichever colour
+/// space the primitive works in (as resvg does).
 fn light(
     input: &Img,
     surface_scale: f32,
     source: LightSource,
     color: usvg::Color,
-    linear: bool,
     shade: impl Fn(DVec3, DVec3, [f64; 3]) -> [f32; 4],
 ) -> Img {
     let (w, h) = (input.w as i64, input.h as i64);
@@ -47,11 +47,7 @@ fn light(
     let alpha = |x: i64, y: i64| {
         f64::from(input.px[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize][3])
     };
-    let mut base = [color.red, color.green, color.blue].map(|c| f32::from(c) / 255.0);
-    if linear {
-        base = base.map(super::to_linear);
-    }
-    let base = base.map(f64::from);
+    let base = [color.red, color.green, color.blue].map(|c| f64::from(c) / 255.0);
     let mut px = vec![[0.0f32; 4]; input.px.len()];
     for y in 0..h {
         for x in 0..w {
@@ -111,13 +107,11 @@ fn light(
 /// `feDiffuseLighting`: `kd (N . L)` times the light colour, opaque.
 pub(crate) fn diffuse(input: &Img, fe: &DiffuseLighting, ts: &DAffine2) -> Img {
     let kd = f64::from(fe.diffuse_constant());
-    let linear = false;
     light(
         input,
         fe.surface_scale(),
         place(fe.light_source(), ts),
         fe.lighting_color(),
-        linear,
         |n, l, c| {
             let k = kd * n.dot(l).max(0.0);
             [
@@ -140,7 +134,6 @@ pub(crate) fn specular(input: &Img, fe: &SpecularLighting, ts: &DAffine2) -> Img
         fe.surface_scale(),
         place(fe.light_source(), ts),
         fe.lighting_color(),
-        false,
         |n, l, c| {
             let hv = (l + DVec3::Z).normalize_or_zero();
             let k = ks * n.dot(hv).max(0.0).powf(e);
