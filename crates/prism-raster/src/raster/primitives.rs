@@ -840,6 +840,20 @@ pub(super) fn bound_layers(prims: &mut [Placed]) {
     }
 }
 
+/// Gives the primitives at `at` the box `(y0, y1, x0, x1)`, or the empty box when it has
+/// no area; returns the box given.
+fn set_box(prims: &mut [Placed], at: [usize; 2], b: (i32, i32, i32, i32)) -> (i32, i32, i32, i32) {
+    let b = if b.0 < b.1 && b.2 < b.3 {
+        b
+    } else {
+        (0, 0, 0, 0)
+    };
+    for k in at {
+        (prims[k].y0, prims[k].y1, prims[k].x0, prims[k].x1) = b;
+    }
+    b
+}
+
 fn box_layers(prims: &mut [Placed]) {
     let empty = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
     let mut stack: Vec<(usize, (i32, i32, i32, i32))> = Vec::new();
@@ -856,34 +870,14 @@ fn box_layers(prims: &mut [Placed]) {
                 let Some((b, outer)) = stack.pop() else {
                     continue;
                 };
-                let boxed = if outer.0 < outer.1 && outer.2 < outer.3 {
-                    outer
-                } else {
-                    (0, 0, 0, 0)
-                };
-                for k in [b, i] {
-                    prims[k].y0 = boxed.0;
-                    prims[k].y1 = boxed.1;
-                    prims[k].x0 = boxed.2;
-                    prims[k].x1 = boxed.3;
-                }
+                set_box(prims, [b, i], outer);
                 cur = outer;
             }
             Prim::EndLayer(..) => {
                 let Some((b, outer)) = stack.pop() else {
                     continue;
                 };
-                let inner = if cur.0 < cur.1 && cur.2 < cur.3 {
-                    cur
-                } else {
-                    (0, 0, 0, 0)
-                };
-                for k in [b, i] {
-                    prims[k].y0 = inner.0;
-                    prims[k].y1 = inner.1;
-                    prims[k].x0 = inner.2;
-                    prims[k].x1 = inner.3;
-                }
+                let inner = set_box(prims, [b, i], cur);
                 cur = if inner.0 < inner.1 {
                     (
                         outer.0.min(inner.0),
