@@ -75,14 +75,7 @@ pub(crate) fn raster_texture(
         usvg::ImageKind::PNG(d) => prism_image::decode_png(d, "embedded PNG image"),
         usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "embedded JPEG image"),
         usvg::ImageKind::GIF(d) => prism_image::decode_gif(d, "embedded GIF image"),
-        usvg::ImageKind::WEBP(_) => {
-            let w = format!(
-                "{}: a WebP image was skipped: prism does not decode WebP",
-                source.name
-            );
-            warn(doc, w);
-            return Ok(None);
-        }
+        usvg::ImageKind::WEBP(d) => prism_image::decode_webp(d, "embedded WebP image"),
         usvg::ImageKind::SVG(_) => return Ok(None),
     };
     let rgba = match decoded {
