@@ -108,7 +108,11 @@ impl Img {
     fn into_space(mut self, cs: ColorInterpolation) -> Img {
         let want = cs == ColorInterpolation::LinearRGB;
         if want != self.linear {
-            let f = if want { to_linear } else { to_srgb };
+            let f = if want {
+                prism_image::srgb_to_linear
+            } else {
+                prism_image::linear_to_srgb
+            };
             for p in Arc::make_mut(&mut self.px).iter_mut() {
                 if p[3] > 0.0 {
                     for c in 0..3 {
@@ -146,24 +150,6 @@ impl Img {
                 }
             }
         }
-    }
-}
-
-/// The sRGB transfer function's inverse.
-pub(crate) fn to_linear(v: f32) -> f32 {
-    if v <= 0.04045 {
-        v / 12.92
-    } else {
-        ((v + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// The sRGB transfer function.
-pub(crate) fn to_srgb(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        v * 12.92
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
     }
 }
 
@@ -346,7 +332,7 @@ fn run(
                 let op = fe.opacity().get();
                 let mut col = [c.r, c.g, c.b];
                 if cs == ColorInterpolation::LinearRGB {
-                    col = col.map(to_linear);
+                    col = col.map(prism_image::srgb_to_linear);
                 }
                 for p in Arc::make_mut(&mut shadow.px).iter_mut() {
                     let a = p[3] * op;

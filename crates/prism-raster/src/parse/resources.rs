@@ -72,10 +72,10 @@ pub(crate) fn raster_texture(
         }
     }
     let decoded = match kind {
-        usvg::ImageKind::PNG(d) => prism_image::decode_png(d, "embedded PNG image"),
-        usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "embedded JPEG image"),
-        usvg::ImageKind::GIF(d) => prism_image::decode_gif(d, "embedded GIF image"),
-        usvg::ImageKind::WEBP(d) => prism_image::decode_webp(d, "embedded WebP image"),
+        usvg::ImageKind::PNG(d) => prism_image::decode_png(d, "a PNG image it holds"),
+        usvg::ImageKind::JPEG(d) => prism_image::decode_jpeg(d, "a JPEG image it holds"),
+        usvg::ImageKind::GIF(d) => prism_image::decode_gif(d, "a GIF image it holds"),
+        usvg::ImageKind::WEBP(d) => prism_image::decode_webp(d, "a WebP image it holds"),
         usvg::ImageKind::SVG(_) => return Ok(None),
     };
     let rgba = match decoded {
