@@ -638,6 +638,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 share: &share,
                 skip: None,
                 profile: Some(&profile),
+                stop: None,
             };
             render_share(&prepared, &options, &job, &|done| bar.set_position(done))
         });

@@ -155,31 +155,7 @@ fn output_size(doc: &Document, a: &SvgArgs) -> (u32, u32) {
     if a.compat.is_some() || a.view.is_some() {
         return (a.width.unwrap_or(1024), a.height.unwrap_or(1024));
     }
-    let aspect = doc.width / doc.height;
-    let round = |v: f64| (v.round().max(1.0)).min(f64::from(u32::MAX)) as u32;
-    let ceil = |v: f64| (v.ceil().max(1.0)).min(f64::from(u32::MAX)) as u32;
-    match (a.width, a.height) {
-        (Some(w), Some(h)) => {
-            if f64::from(w) / f64::from(h) > aspect {
-                (round(f64::from(h) * aspect), h)
-            } else {
-                (w, round(f64::from(w) / aspect))
-            }
-        }
-        // As resvg: the document's size in whole pixels, scaled, rounded up.
-        (Some(w), None) => {
-            let (iw, ih) = (doc.width.ceil().max(1.0), doc.height.ceil().max(1.0));
-            (w, ceil(f64::from(w) * ih / iw))
-        }
-        (None, Some(h)) => {
-            let (iw, ih) = (doc.width.ceil().max(1.0), doc.height.ceil().max(1.0));
-            (ceil(f64::from(h) * iw / ih), h)
-        }
-        (None, None) => {
-            let z = a.zoom.unwrap_or(1.0);
-            (ceil(doc.width * z), ceil(doc.height * z))
-        }
-    }
+    doc.output_size(a.width, a.height, a.zoom.unwrap_or(1.0))
 }
 
 fn ms(d: std::time::Duration) -> String {

@@ -293,6 +293,23 @@ pub fn encode_png(image: &Rgb8Image) -> Result<Vec<u8>, ImageError> {
     Ok(out)
 }
 
+/// Encodes an RGBA8 (straight alpha) image as PNG bytes.
+///
+/// # Errors
+/// [`ImageError::Encode`] if the encoder fails.
+pub fn encode_png_rgba(image: &Rgba8Image) -> Result<Vec<u8>, ImageError> {
+    let mut out = Vec::new();
+    let flat = image.pixels().as_flattened();
+    encode_png_channels(
+        image.width(),
+        image.height(),
+        flat,
+        png::ColorType::Rgba,
+        &mut out,
+    )?;
+    Ok(out)
+}
+
 /// Quality of the JPEG files prism writes, from 1 to 100.
 pub const JPEG_QUALITY: u8 = 95;
 

@@ -5,8 +5,10 @@ use std::ops::{Add, AddAssign, Mul, MulAssign, Sub};
 /// An RGB triple of `f32` channels; the colour space is whatever the owner states.
 ///
 /// Images from 8-bit files hold their stored (sRGB-encoded) values divided by 255; renderers
-/// that need linear light convert with `prism_image::srgb_to_linear`.
+/// that need linear light convert with `prism_image::srgb_to_linear`. Laid out as three
+/// `f32` in order, so a slice of them is a slice of `3 * len` floats.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Rgb {
     /// Red channel.
     pub r: f32,

@@ -445,3 +445,29 @@ impl BlendMode {
         }
     }
 }
+
+impl Document {
+    /// The picture's size in pixels, as resvg's command line picks it: the document's own
+    /// size in whole pixels (rounded up) times `zoom`; with only `width` or `height` the
+    /// other follows the aspect ratio of that size, rounded up; with both, the document is
+    /// fitted into that box keeping its aspect ratio (rounded).
+    #[must_use]
+    pub fn output_size(&self, width: Option<u32>, height: Option<u32>, zoom: f64) -> (u32, u32) {
+        let aspect = self.width / self.height;
+        let round = |v: f64| (v.round().max(1.0)).min(f64::from(u32::MAX)) as u32;
+        let ceil = |v: f64| (v.ceil().max(1.0)).min(f64::from(u32::MAX)) as u32;
+        let (iw, ih) = (self.width.ceil().max(1.0), self.height.ceil().max(1.0));
+        match (width, height) {
+            (Some(w), Some(h)) => {
+                if f64::from(w) / f64::from(h) > aspect {
+                    (round(f64::from(h) * aspect), h)
+                } else {
+                    (w, round(f64::from(w) / aspect))
+                }
+            }
+            (Some(w), None) => (w, ceil(f64::from(w) * ih / iw)),
+            (None, Some(h)) => (ceil(f64::from(h) * iw / ih), h),
+            (None, None) => (ceil(self.width * zoom), ceil(self.height * zoom)),
+        }
+    }
+}

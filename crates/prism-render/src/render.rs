@@ -4,6 +4,7 @@
 //! [`render`] is the whole picture as a [`Rendered`] image with its sample counts.
 
 use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use prism_image::Image;
 use prism_math::Rgb;
@@ -67,7 +68,7 @@ pub struct Rendered {
 /// What one call of [`render_share`] computes: a share of the tiles and sample indices,
 /// without the pixels `skip` marks (row by row, one entry per pixel; a progressive renderer
 /// uses it to stop converged pixels), adding the path integrator's time per stage to
-/// `profile` if there is one.
+/// `profile` if there is one. Once `stop` is set, tiles not yet started are left empty.
 #[derive(Clone, Copy, Debug)]
 pub struct Job<'a> {
     /// The tiles and sample indices computed.
@@ -76,6 +77,8 @@ pub struct Job<'a> {
     pub skip: Option<&'a [bool]>,
     /// Where the path integrator's time per stage is added.
     pub profile: Option<&'a Profile>,
+    /// Set by another thread to end the job early (its result is then incomplete).
+    pub stop: Option<&'a AtomicBool>,
 }
 
 impl<'a> Job<'a> {
@@ -86,6 +89,7 @@ impl<'a> Job<'a> {
             share,
             skip: None,
             profile: None,
+            stop: None,
         }
     }
 }
@@ -97,12 +101,24 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
+    render_until(scene, opts, None, progress)
+}
+
+/// [`render`], ending early once `stop` is set (the picture is then incomplete: the tiles
+/// not started hold no samples).
+pub fn render_until(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    stop: Option<&AtomicBool>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Rendered {
     let profile = Profile::default();
     let share = Share::whole(opts.film.spp);
     let job = Job {
         share: &share,
         skip: None,
         profile: Some(&profile),
+        stop,
     };
     let sums = render_share(scene, opts, &job, progress);
     Rendered {
@@ -126,6 +142,7 @@ pub fn render_share(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Image<PixelSum> {
     let (share, skip, profile) = (job.share, job.skip, job.profile);
+    let stopped = || job.stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let (w, h) = (opts.film.width, opts.film.height);
     if let Some(s) = skip {
         assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
@@ -145,6 +162,9 @@ pub fn render_share(
     let results: Vec<Rendered> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
+            if stopped() {
+                return (Vec::new(), Vec::new());
+            }
             let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
                 .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
                 .filter(|&(x, y)| !skipped(x, y))
@@ -166,7 +186,7 @@ pub fn render_share(
                     .collect()
             };
             let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
-            progress(done.fetch_add(n, std::sync::atomic::Ordering::Relaxed) + n);
+            progress(done.fetch_add(n, Ordering::Relaxed) + n);
             (pixels, out)
         })
         .collect();

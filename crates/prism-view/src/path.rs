@@ -197,6 +197,7 @@ impl Mode for PathMode {
                 share: &share,
                 skip,
                 profile: None,
+                stop: None,
             };
             let pass = render_share(&self.scene, &opts, &job, &|_| {});
             let secs = t.elapsed().as_secs_f64();
