@@ -114,73 +114,20 @@ enum MeshCommand {
     },
 }
 
-/// Reads a mesh by its extension (prism-scene's table of formats), printing the reader's
-/// warnings.
-fn read(path: &Path, quiet: bool) -> Result<PolyMesh> {
-    let (mesh, warnings) = prism_scene::read_mesh(path).map_err(UserError::input)?;
-    for w in warnings.iter().filter(|_| !quiet) {
-        eprintln!("warning: {w}");
-    }
-    Ok(mesh)
-}
-
 fn build(path: &Path, mesh: &PolyMesh) -> Result<HalfedgeMesh> {
     HalfedgeMesh::from_polymesh(mesh)
         .map_err(|e| UserError::input(format!("{}: {e}", path.display())).into())
 }
 
-/// Most split vertices named one by one in warnings.
-const SPLIT_WARNINGS: usize = 10;
-
-/// Reads a mesh and, unless `strict`, repairs it as OpenMesh does on load, with a warning
-/// naming each repair: a face on an edge already used in its direction gets its own
-/// vertices, and a vertex where fans of faces touch becomes one vertex per fan (vertices
-/// numbered from 1, as in OBJ files; faces from 0).
+/// Reads a mesh and, unless `strict`, repairs it as OpenMesh does on load, printing the
+/// reader's warnings and one per repair (prism-scene's [`prism_scene::read_mesh_repaired`]).
 fn load(path: &Path, (strict, quiet): (bool, bool)) -> Result<PolyMesh> {
-    let mut p = read(path, quiet)?;
-    if strict {
-        return Ok(p);
+    let (mesh, warnings) =
+        prism_scene::read_mesh_repaired(path, strict).map_err(UserError::input)?;
+    for w in warnings.iter().filter(|_| !quiet) {
+        eprintln!("warning: {w}");
     }
-    let warn = |message: String| {
-        if !quiet {
-            eprintln!("warning: {message}");
-        }
-    };
-    let detached = p.detach_faces_on_used_edges();
-    for f in detached.iter().take(SPLIT_WARNINGS) {
-        warn(format!(
-            "{}: face {f} uses an edge an earlier face already uses in that direction \
-             (a non-manifold edge or a face turned over); it gets vertices of its own \
-             (--strict refuses such a mesh)",
-            path.display()
-        ));
-    }
-    if detached.len() > SPLIT_WARNINGS {
-        warn(format!(
-            "{}: {} more faces detached the same way",
-            path.display(),
-            detached.len() - SPLIT_WARNINGS
-        ));
-    }
-    let split = p.split_nonmanifold_vertices();
-    for s in split.iter().take(SPLIT_WARNINGS) {
-        warn(format!(
-            "{}: vertex {} joins {} fans of faces that touch only there; split into \
-             {} vertices (--strict refuses such a mesh)",
-            path.display(),
-            s.vertex + 1,
-            s.copies.len() + 1,
-            s.copies.len() + 1
-        ));
-    }
-    if split.len() > SPLIT_WARNINGS {
-        warn(format!(
-            "{}: {} more vertices split the same way",
-            path.display(),
-            split.len() - SPLIT_WARNINGS
-        ));
-    }
-    Ok(p)
+    Ok(mesh)
 }
 
 /// Writes a mesh as .obj, .ply (binary little-endian) or .dae, chosen by extension,

@@ -138,3 +138,8 @@ pub fn from_error(e: &(dyn StdError + 'static), known_file: Option<&str>) -> PyE
 pub fn argument(message: impl Into<String>) -> PyErr {
     raise(Kind::Argument, message, None)
 }
+
+/// A Python exception for an I/O error reading or writing `file`, naming it.
+pub fn from_io(e: &std::io::Error, file: &str) -> PyErr {
+    raise(kind_of(e), format!("{file}: {e}"), Some(file))
+}

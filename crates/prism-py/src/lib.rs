@@ -14,6 +14,8 @@
 mod arrays;
 mod errors;
 mod images;
+mod mesh;
+mod render;
 mod svg;
 mod work;
 
@@ -24,6 +26,11 @@ use pyo3::prelude::*;
 fn _prism(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(svg::svg, m)?)?;
+    m.add_class::<mesh::Mesh>()?;
+    m.add_function(wrap_pyfunction!(mesh::bezier_patch, m)?)?;
+    m.add_class::<render::Scene>()?;
+    m.add_function(wrap_pyfunction!(render::load_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::encode_png, m)?)?;

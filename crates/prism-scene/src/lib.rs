@@ -48,7 +48,7 @@ pub use delft::{
 pub use environment::EnvironmentMapError;
 pub use error::SceneError;
 pub use load::load;
-pub use mesh_io::{read_mesh, write_mesh, MeshFormat, MeshIoError};
+pub use mesh_io::{read_mesh, read_mesh_repaired, write_mesh, MeshFormat, MeshIoError};
 pub use mitsuba::{
     read_document, read_mitsuba, read_mitsuba_with, to_scene as mitsuba_to_scene, Filter,
     MitsubaOptions, MitsubaScene, MitsubaSettings,

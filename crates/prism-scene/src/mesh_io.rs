@@ -79,6 +79,59 @@ pub fn read_mesh(path: &Path) -> Result<(PolyMesh, Vec<prism_math::Warning>), Me
     }
 }
 
+/// Most repairs of one kind named one by one in [`read_mesh_repaired`]'s warnings.
+const REPAIR_WARNINGS: usize = 10;
+
+/// [`read_mesh`], then (unless `strict`) the mesh repaired as OpenMesh repairs it on load,
+/// with a warning naming each repair: a face on an edge already used in its direction gets
+/// its own vertices, and a vertex where fans of faces touch becomes one vertex per fan
+/// (vertices numbered from 1, as in OBJ files; faces from 0).
+///
+/// # Errors
+/// As [`read_mesh`].
+pub fn read_mesh_repaired(
+    path: &Path,
+    strict: bool,
+) -> Result<(PolyMesh, Vec<prism_math::Warning>), MeshIoError> {
+    use prism_math::Warning;
+    let (mut p, mut warnings) = read_mesh(path)?;
+    if strict {
+        return Ok((p, warnings));
+    }
+    let name = path.display();
+    let detached = p.detach_faces_on_used_edges();
+    warnings.extend(detached.iter().take(REPAIR_WARNINGS).map(|f| {
+        Warning::new(format!(
+            "{name}: face {f} uses an edge an earlier face already uses in that direction \
+             (a non-manifold edge or a face turned over); it gets vertices of its own \
+             (--strict refuses such a mesh)"
+        ))
+    }));
+    if detached.len() > REPAIR_WARNINGS {
+        warnings.push(Warning::new(format!(
+            "{name}: {} more faces detached the same way",
+            detached.len() - REPAIR_WARNINGS
+        )));
+    }
+    let split = p.split_nonmanifold_vertices();
+    warnings.extend(split.iter().take(REPAIR_WARNINGS).map(|s| {
+        Warning::new(format!(
+            "{name}: vertex {} joins {} fans of faces that touch only there; split into \
+             {} vertices (--strict refuses such a mesh)",
+            s.vertex + 1,
+            s.copies.len() + 1,
+            s.copies.len() + 1
+        ))
+    }));
+    if split.len() > REPAIR_WARNINGS {
+        warnings.push(Warning::new(format!(
+            "{name}: {} more vertices split the same way",
+            split.len() - REPAIR_WARNINGS
+        )));
+    }
+    Ok((p, warnings))
+}
+
 /// Writes `mesh` in `format` to `w`.
 ///
 /// # Errors
