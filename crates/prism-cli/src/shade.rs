@@ -269,22 +269,6 @@ pub fn read_shade_mesh(path: &Path) -> Result<ShadeMesh> {
     }
 }
 
-/// The light of a mesh given none, as its position and its intensity's scale: the course's
-/// light (0.5, 2, 2) for a mesh within a unit of the origin (the course's meshes are), else
-/// that point scaled by the mesh's half diagonal `r` and moved with the centre of its
-/// bounds `lo`..`hi`, with the intensity scaled by `r^2`, so that the mesh is lit as the
-/// course's meshes are (the same directions, the same `I / d^2`).
-#[must_use]
-pub fn default_light(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
-    let course = Uniforms::default().light_pos;
-    let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
-    if lo.abs().max_element() <= 1.0 && hi.abs().max_element() <= 1.0 {
-        (course, 1.0)
-    } else {
-        (centre + course * radius, radius * radius)
-    }
-}
-
 /// Runs `prism shade`.
 pub fn run(a: &ShadeArgs) -> Result<()> {
     crate::resources::pool(a.threads)?.install(|| run_in_pool(a))
@@ -387,19 +371,7 @@ fn run_in_pool(a: &ShadeArgs) -> Result<()> {
             Framing::NarrowerSide { margin: 1.1 },
         ),
     };
-    let (placed, scale) = default_light(lo, hi);
-    let uniforms = Uniforms {
-        light_pos: light.unwrap_or(placed),
-        light_intensity: intensity.unwrap_or_else(|| {
-            let course = Uniforms::default().light_intensity;
-            if light.is_some() {
-                course
-            } else {
-                course * scale
-            }
-        }),
-        ..Uniforms::default()
-    };
+    let uniforms = Uniforms::lit_for(lo, hi, light, intensity);
     let opts = ShadeOptions {
         samples: a.samples,
         background,

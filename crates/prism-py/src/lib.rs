@@ -12,10 +12,12 @@
 //!   `arrays`: pictures as NumPy arrays.
 
 mod arrays;
+mod cloth;
 mod errors;
 mod images;
 mod mesh;
 mod render;
+mod shade;
 mod svg;
 mod work;
 
@@ -31,6 +33,8 @@ fn _prism(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<render::Scene>()?;
     m.add_function(wrap_pyfunction!(render::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_class::<cloth::Cloth>()?;
+    m.add_function(wrap_pyfunction!(shade::shade, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::encode_png, m)?)?;

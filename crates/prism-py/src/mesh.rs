@@ -37,7 +37,7 @@ impl Mesh {
     }
 
     /// The mesh as polygons (after any edits).
-    fn current(&self) -> Cow<'_, PolyMesh> {
+    pub(crate) fn current(&self) -> Cow<'_, PolyMesh> {
         match (&self.halfedge, self.edited) {
             (Some(h), true) => Cow::Owned(h.to_polymesh()),
             _ => Cow::Borrowed(&self.poly),
@@ -75,7 +75,7 @@ impl Mesh {
 }
 
 /// Python warnings for a reader's warnings.
-fn warn_all(py: Python<'_>, warnings: &[prism_math::Warning]) -> PyResult<()> {
+pub(crate) fn warn_all(py: Python<'_>, warnings: &[prism_math::Warning]) -> PyResult<()> {
     let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
     for w in warnings {
         PyErr::warn(py, &category, &std::ffi::CString::new(w.to_string())?, 1)?;

@@ -120,6 +120,35 @@ impl Default for Uniforms {
     }
 }
 
+impl Uniforms {
+    /// The course's uniforms with the light for a mesh bounded by `lo`..`hi`: `light` and
+    /// `intensity` where given; else the course's light (0.5, 2, 2) for a mesh within a unit
+    /// of the origin (the course's meshes are), or that point scaled by the mesh's half
+    /// diagonal `r` and moved with the centre of its bounds, with the course's intensity
+    /// scaled by `r^2` (unless the light's position is given), so that any mesh is lit as
+    /// the course's are (the same directions, the same `I / d^2`).
+    #[must_use]
+    pub fn lit_for(lo: Vec3, hi: Vec3, light: Option<Vec3>, intensity: Option<Rgb>) -> Uniforms {
+        let course = Uniforms::default();
+        let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+        let (placed, scale) = if lo.abs().max_element() <= 1.0 && hi.abs().max_element() <= 1.0
+        {
+            (course.light_pos, 1.0)
+        } else {
+            (centre + course.light_pos * radius, radius * radius)
+        };
+        Uniforms {
+            light_pos: light.unwrap_or(placed),
+            light_intensity: intensity.unwrap_or(if light.is_some() {
+                course.light_intensity
+            } else {
+                course.light_intensity * scale
+            }),
+            ..course
+        }
+    }
+}
+
 /// The interpolated inputs of one fragment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Varyings {
