@@ -16,10 +16,19 @@ on Ctrl-C with ``KeyboardInterrupt``. Failures raise :class:`Error` subclasses.
 
 from ._errors import ArgumentError, Error, FileError, InputError, LimitError, TopologyError
 from ._prism import (
+    Cloth,
+    Mesh,
+    Scene,
     __version__,
+    bezier_patch,
     encode_png,
+    load_scene,
+    raytrace,
     read_image,
+    render,
+    shade,
     svg,
+    trace_pixel,
     write_image,
 )
 
@@ -46,16 +55,25 @@ def show(array) -> Picture:
 
 __all__ = [
     "ArgumentError",
+    "Cloth",
     "Error",
     "FileError",
     "InputError",
     "LimitError",
+    "Mesh",
     "Picture",
+    "Scene",
     "TopologyError",
     "__version__",
+    "bezier_patch",
     "encode_png",
+    "load_scene",
+    "raytrace",
     "read_image",
+    "render",
+    "shade",
     "show",
     "svg",
+    "trace_pixel",
     "write_image",
 ]

@@ -16,6 +16,7 @@ mod cloth;
 mod errors;
 mod images;
 mod mesh;
+mod raytrace;
 mod render;
 mod shade;
 mod svg;
@@ -33,6 +34,8 @@ fn _prism(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<render::Scene>()?;
     m.add_function(wrap_pyfunction!(render::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(raytrace::raytrace, m)?)?;
+    m.add_function(wrap_pyfunction!(raytrace::trace_pixel, m)?)?;
     m.add_class::<cloth::Cloth>()?;
     m.add_function(wrap_pyfunction!(shade::shade, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
