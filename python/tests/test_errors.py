@@ -1,0 +1,43 @@
+"""Errors: one exception class per kind, with the file and line the library names."""
+
+import numpy as np
+import pytest
+
+import prism
+
+
+def test_a_malformed_file_names_its_line(tmp_path):
+    """A bad OBJ line is an InputError with .file and .line."""
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n")
+    with pytest.raises(prism.InputError) as e:
+        prism.Mesh.read(bad)
+    assert e.value.file == str(bad) and e.value.line == 4
+
+
+def test_malformed_svg_text_names_its_line():
+    """Malformed XML in SVG text is an InputError at its line."""
+    with pytest.raises(prism.InputError) as e:
+        prism.svg("<svg xmlns='http://www.w3.org/2000/svg'>\n<rect>\n")
+    assert e.value.line is not None and e.value.file == "<string>"
+
+
+def test_a_missing_file_is_an_os_error(tmp_path):
+    """A missing file is a FileError, which is also an OSError."""
+    with pytest.raises(OSError) as e:
+        prism.svg(tmp_path / "none.svg")
+    assert isinstance(e.value, prism.FileError)
+    assert e.value.file == str(tmp_path / "none.svg")
+
+
+def test_over_the_budget_is_a_limit_error():
+    """A picture too large for the memory budget is refused before it is allocated."""
+    with pytest.raises(prism.LimitError):
+        prism.render(None if False else prism.load_scene(), resolution=(16384, 16384), spp=1)
+
+
+def test_bad_arrays_are_argument_errors(tmp_path):
+    with pytest.raises(prism.ArgumentError):
+        prism.write_image(tmp_path / "x.png", np.zeros((4, 4, 2), dtype=np.uint8))
+    with pytest.raises(ValueError):
+        prism.write_image(tmp_path / "x.exr", np.zeros((4, 4, 3), dtype=np.uint8))
