@@ -32,9 +32,10 @@ pub use hdr::{decode_hdr, is_hdr};
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{
-    decode_gif, decode_jpeg, decode_png, decode_webp, encode_bmp, encode_jpeg, encode_png, encode_png_rgba,
-    read_image, read_png, remove_temporaries_before_exit, write_atomic, write_atomic_with,
-    write_bmp, write_jpeg, write_png, write_png_rgba, JPEG_QUALITY, MAX_IMAGE_FILE_BYTES,
+    decode_gif, decode_jpeg, decode_png, decode_webp, encode_bmp, encode_jpeg, encode_png,
+    encode_png_rgba, read_image, read_png, remove_temporaries_before_exit, write_atomic,
+    write_atomic_with, write_bmp, write_jpeg, write_png, write_png_rgba, JPEG_QUALITY,
+    MAX_IMAGE_FILE_BYTES,
 };
 pub use montage::montage;
 pub use srgb::{linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear};

@@ -35,26 +35,26 @@ impl Cloth {
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
         if n > MAX_STEPS {
-            return Err(argument(format!("expected at most {MAX_STEPS} steps, found {n}")));
+            return Err(argument(format!(
+                "expected at most {MAX_STEPS} steps, found {n}"
+            )));
         }
         let cloth = &mut self.cloth;
-        let taken = crate::work::run(py, threads, progress, n, |control| {
-            let mut taken = 0;
-            while taken < n && !control.stopped() {
+        // Steps taken before an interruption still count.
+        let taken = std::sync::atomic::AtomicU64::new(0);
+        let result = crate::work::run(py, threads, progress, n, |control| {
+            let mut k = 0;
+            while k < n && !control.stopped() {
                 cloth.step();
-                taken += 1;
-                if taken % prism_cloth::STEPS_PER_FRAME as u64 == 0 || taken == n {
-                    control.set_done(taken);
+                k += 1;
+                taken.store(k, std::sync::atomic::Ordering::Relaxed);
+                if k % prism_cloth::STEPS_PER_FRAME as u64 == 0 || k == n {
+                    control.set_done(k);
                 }
             }
-            taken
         });
-        // Steps taken before an interruption still count.
-        let taken = match taken {
-            Ok(t) => t,
-            Err(e) => return Err(e),
-        };
-        self.steps += taken;
+        self.steps += taken.into_inner();
+        result?;
         if !self.cloth.is_finite() {
             return Err(raise(
                 Kind::Input,
@@ -150,13 +150,7 @@ impl Cloth {
     #[getter]
     fn triangles<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
         let m = prism_cloth::cloth_mesh(&self.cloth);
-        rows(
-            py,
-            m.triangles
-                .iter()
-                .map(|t| t.map(i64::from))
-                .collect(),
-        )
+        rows(py, m.triangles.iter().map(|t| t.map(i64::from)).collect())
     }
 
     /// Time steps taken so far.

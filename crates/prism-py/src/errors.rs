@@ -51,7 +51,11 @@ pub fn location(message: &str, known: Option<&str>) -> (Option<String>, Option<u
             let column_digits = rest
                 .strip_prefix(':')
                 .map_or(0, |r| r.bytes().take_while(u8::is_ascii_digit).count());
-            let column_end = if column_digits > 0 { 1 + column_digits } else { 0 };
+            let column_end = if column_digits > 0 {
+                1 + column_digits
+            } else {
+                0
+            };
             if rest[column_end..].starts_with(": ") || rest[column_end..].is_empty() {
                 let line = message[colon + 1..after].parse().ok();
                 return (Some(message[..colon].to_string()), line);

@@ -38,9 +38,9 @@ pub fn write_image(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>) -> P
             Ok(prism_image::write_jpeg(&path, &i.linear_to_srgb8()))
         }
         ("exr", Picture::Linear(i)) => Ok(prism_image::write_exr(&path, i)),
-        ("exr", _) => Err(
-            "an .exr file holds linear radiance: give a float32 or float64 [H, W, 3] array",
-        ),
+        ("exr", _) => {
+            Err("an .exr file holds linear radiance: give a float32 or float64 [H, W, 3] array")
+        }
         _ => Err("expected a .png, .jpg or .exr file name"),
     });
     match result {

@@ -137,7 +137,10 @@ impl Mesh {
                 ))
             })?);
         }
-        Ok(Mesh::new_from(PolyMesh::new(positions, &checked), "<mesh>".into()))
+        Ok(Mesh::new_from(
+            PolyMesh::new(positions, &checked),
+            "<mesh>".into(),
+        ))
     }
 
     /// Reads an .obj, .ply or .dae mesh. Unless `strict`, a non-manifold mesh is repaired

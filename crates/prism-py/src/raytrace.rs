@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use numpy::PyArray3;
 use prism_image::Bloom;
-use prism_render::whitted::film::{raytrace as trace_image, trace_pixel as trace_one, RaytraceOptions};
+use prism_render::whitted::film::{
+    raytrace as trace_image, trace_pixel as trace_one, RaytraceOptions,
+};
 use prism_render::whitted::scene::{Environment, SceneSetup, Split, WhittedScene};
 use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera};
@@ -90,7 +92,9 @@ impl Request {
                 self.max_depth
             )));
         }
-        if !(self.bloom.threshold.is_finite() && self.bloom.threshold >= 0.0) || self.bloom.passes > 64 {
+        if !(self.bloom.threshold.is_finite() && self.bloom.threshold >= 0.0)
+            || self.bloom.passes > 64
+        {
             return Err(argument(
                 "bloom_threshold, bloom_passes: expected a threshold of at least 0 and 0 to 64 passes",
             ));
@@ -124,7 +128,13 @@ impl Request {
             )));
         }
         prism_math::limits::check_memory(prism_render::whitted::film::raytrace_bytes(w, h))
-            .map_err(|e| raise(Kind::Limit, format!("resolution {w} x {h}: the image {e}"), None))?;
+            .map_err(|e| {
+                raise(
+                    Kind::Limit,
+                    format!("resolution {w} x {h}: the image {e}"),
+                    None,
+                )
+            })?;
         let camera = *loaded.cameras.get(self.camera).ok_or_else(|| {
             argument(format!(
                 "camera: {name} has cameras 0 to {}, found {}",

@@ -99,13 +99,13 @@ pub fn load_scene(
         },
     };
     let defines = defines_of(defines);
-    let name = path
+    let name = path.as_ref().map_or_else(
+        || "the Cornell box".to_string(),
+        |p| p.display().to_string(),
+    );
+    let is_xml = path
         .as_ref()
-        .map_or_else(|| "the Cornell box".to_string(), |p| p.display().to_string());
-    let is_xml = path.as_ref().is_some_and(|p| {
-        p.extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
-    });
+        .is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("xml")));
     if let Some(r) = lens_radius {
         if !(r.is_finite() && r >= 0.0) {
             return Err(argument(format!(
@@ -133,8 +133,8 @@ pub fn load_scene(
             None => (prism_scene::cornell_box(), None),
         };
         if let Some(radius) = lens_radius {
-            let focal_distance = focal_distance
-                .unwrap_or_else(|| (scene.camera.target - scene.camera.eye).length());
+            let focal_distance =
+                focal_distance.unwrap_or_else(|| (scene.camera.target - scene.camera.eye).length());
             scene.camera.lens = Some(prism_scene::ThinLens {
                 radius,
                 focal_distance,
@@ -216,11 +216,18 @@ impl Scene {
                 "resolution: expected 1 to {MAX_SIDE} pixels a side, found {w} x {h}"
             )));
         }
-        prism_math::limits::check_memory(prism_render::film::film_bytes(w, h))
-            .map_err(|e| raise(Kind::Limit, format!("resolution {w} x {h}: the image {e}"), None))?;
+        prism_math::limits::check_memory(prism_render::film::film_bytes(w, h)).map_err(|e| {
+            raise(
+                Kind::Limit,
+                format!("resolution {w} x {h}: the image {e}"),
+                None,
+            )
+        })?;
         let spp = spp.unwrap_or(self.spp);
         if spp == 0 || spp > MAX_SPP {
-            return Err(argument(format!("spp: expected 1 to {MAX_SPP}, found {spp}")));
+            return Err(argument(format!(
+                "spp: expected 1 to {MAX_SPP}, found {spp}"
+            )));
         }
         if light_samples == 0 || light_samples > 1 << 16 {
             return Err(argument(format!(
@@ -256,7 +263,11 @@ impl Scene {
             },
         };
         // A size given here replaces a Mitsuba film's, crop and all.
-        self.prepared.camera.crop = if resolution.is_some() { None } else { self.crop };
+        self.prepared.camera.crop = if resolution.is_some() {
+            None
+        } else {
+            self.crop
+        };
         let prepared = &self.prepared;
         let total = u64::from(w) * u64::from(h) * u64::from(spp);
         let out = crate::work::run(py, threads, progress, total, |control| {
@@ -323,8 +334,18 @@ pub fn render<'py>(
             let path: PathBuf = scene
                 .extract()
                 .map_err(|_| argument("scene: expected a path or a prism.Scene"))?;
-            let loaded =
-                load_scene(py, Some(path), "area", "course", None, false, 0, None, None, None)?;
+            let loaded = load_scene(
+                py,
+                Some(path),
+                "area",
+                "course",
+                None,
+                false,
+                0,
+                None,
+                None,
+                None,
+            )?;
             owned = Bound::new(py, loaded)?;
             &owned
         }

@@ -147,8 +147,13 @@ pub fn shade<'py>(
             "samples: expected a square number from 1 to 256, found {samples}"
         )));
     }
-    prism_math::limits::check_memory(prism_shade::frame_bytes(w, h, samples))
-        .map_err(|e| raise(Kind::Limit, format!("resolution {w} x {h}: the image {e}"), None))?;
+    prism_math::limits::check_memory(prism_shade::frame_bytes(w, h, samples)).map_err(|e| {
+        raise(
+            Kind::Limit,
+            format!("resolution {w} x {h}: the image {e}"),
+            None,
+        )
+    })?;
     let (per_row, all) = (
         u64::from(w) * u64::from(samples),
         u64::from(w) * u64::from(h) * u64::from(samples),
@@ -193,7 +198,13 @@ pub fn shade<'py>(
             data,
         )?)),
         "bump" | "displacement" => {
-            let map = course_texture(shader_image(py, height_map, "texture_2.png", "height_map", data)?);
+            let map = course_texture(shader_image(
+                py,
+                height_map,
+                "texture_2.png",
+                "height_map",
+                data,
+            )?);
             if shader == "bump" {
                 Shader::Bump(map)
             } else {
@@ -217,9 +228,13 @@ pub fn shade<'py>(
             )))
         }
     };
-    let (lo, hi) = mesh
-        .bounds()
-        .ok_or_else(|| raise(Kind::Input, format!("{name}: the mesh has no faces to draw"), None))?;
+    let (lo, hi) = mesh.bounds().ok_or_else(|| {
+        raise(
+            Kind::Input,
+            format!("{name}: the mesh has no faces to draw"),
+            None,
+        )
+    })?;
     let target = three(target, "target")?.unwrap_or((lo + hi) * 0.5);
     let view = match three(eye, "eye")? {
         Some(eye) => View {

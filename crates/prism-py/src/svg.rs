@@ -40,7 +40,11 @@ pub fn svg<'py>(
     let dialect = match compat {
         None => Dialect::Svg,
         Some("cs184") => Dialect::Cs184,
-        Some(c) => return Err(argument(format!("compat: expected None or 'cs184', found {c:?}"))),
+        Some(c) => {
+            return Err(argument(format!(
+                "compat: expected None or 'cs184', found {c:?}"
+            )))
+        }
     };
     if prism_raster::sample_rate(samples).is_none() {
         return Err(argument(format!(
@@ -50,7 +54,9 @@ pub fn svg<'py>(
     }
     let zoom = zoom.unwrap_or(1.0);
     if !(zoom.is_finite() && zoom > 0.0) {
-        return Err(argument(format!("zoom: expected a positive number, found {zoom}")));
+        return Err(argument(format!(
+            "zoom: expected a positive number, found {zoom}"
+        )));
     }
     if width == Some(0) || height == Some(0) {
         return Err(argument("width, height: expected 1 or more pixels"));

@@ -75,7 +75,9 @@ pub fn run<R: Send>(
         // Shared with the GIL-free closures below, which must be `Send`.
         let receiver = std::sync::Mutex::new(receiver);
         let wait = |timeout: Option<Duration>| {
-            let r = receiver.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            let r = receiver
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
             match timeout {
                 Some(t) => r.recv_timeout(t),
                 None => r.recv().map_err(|_| mpsc::RecvTimeoutError::Disconnected),

@@ -131,8 +131,7 @@ impl Uniforms {
     pub fn lit_for(lo: Vec3, hi: Vec3, light: Option<Vec3>, intensity: Option<Rgb>) -> Uniforms {
         let course = Uniforms::default();
         let (centre, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
-        let (placed, scale) = if lo.abs().max_element() <= 1.0 && hi.abs().max_element() <= 1.0
-        {
+        let (placed, scale) = if lo.abs().max_element() <= 1.0 && hi.abs().max_element() <= 1.0 {
             (course.light_pos, 1.0)
         } else {
             (centre + course.light_pos * radius, radius * radius)
