@@ -24,7 +24,6 @@ def svg(
     skip_system_fonts: bool = False,
     font_family: Optional[str] = None,
     threads: Optional[int] = None,
-    progress: _Progress = None,
 ) -> npt.NDArray[np.uint8]:
     """Rasterizes an SVG file or text to straight-alpha RGBA, uint8[H, W, 4]."""
 

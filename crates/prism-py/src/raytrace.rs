@@ -5,9 +5,7 @@ use std::path::PathBuf;
 
 use numpy::PyArray3;
 use prism_image::Bloom;
-use prism_render::whitted::film::{
-    raytrace as trace_image, trace_pixel as trace_one, RaytraceOptions,
-};
+use prism_render::whitted::film::{raytrace_until, trace_pixel as trace_one, RaytraceOptions};
 use prism_render::whitted::scene::{Environment, SceneSetup, Split, WhittedScene};
 use prism_render::whitted::tracer::WhittedSettings;
 use prism_scene::{Features, OrbitCamera};
@@ -236,7 +234,15 @@ pub fn raytrace<'py>(
     let p = request.prepare(py)?;
     let rows = u64::from(p.opts.height);
     let out = crate::work::run(py, threads, progress, rows, |control| {
-        trace_image(&p.scene, &p.camera, &p.opts, &|done| control.set_done(done))
+        raytrace_until(
+            &p.scene,
+            &p.camera,
+            &p.opts,
+            Some(control.flag()),
+            &|done| {
+                control.set_done(done);
+            },
+        )
     })?;
     Ok(crate::arrays::rgb_f32(py, out.image))
 }

@@ -21,7 +21,7 @@ const COURSE_SIDE: u32 = 1024;
 /// course's dialect, 1024x1024 unless a size is given.
 #[pyfunction]
 #[pyo3(signature = (path_or_text, *, width=None, height=None, samples=16, compat=None, zoom=None,
-    font_dirs=Vec::new(), skip_system_fonts=false, font_family=None, threads=None, progress=None))]
+    font_dirs=Vec::new(), skip_system_fonts=false, font_family=None, threads=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn svg<'py>(
     py: Python<'py>,
@@ -35,7 +35,6 @@ pub fn svg<'py>(
     skip_system_fonts: bool,
     font_family: Option<String>,
     threads: Option<usize>,
-    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
     let dialect = match compat {
         None => Dialect::Svg,
@@ -80,7 +79,7 @@ pub fn svg<'py>(
     let name = path
         .as_ref()
         .map_or_else(|| "<string>".to_string(), |p| p.display().to_string());
-    let image = crate::work::run(py, threads, progress, 1, |_| {
+    let image = crate::work::run(py, threads, None, 1, |_| {
         let doc = match (&text, &path) {
             (Some(t), _) => {
                 let source = Source {

@@ -2,6 +2,7 @@
 //! each pixel's lower-left corner, or jittered rays), a share of its tiles for split renders,
 //! bloom, and the ray tree of one pixel for visual debugging.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 use prism_image::{Bloom, Image, RgbImage};
@@ -193,27 +194,30 @@ pub fn raytrace(
     opts: &RaytraceOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Raytraced {
+    raytrace_until(scene, camera, opts, None, progress)
+}
+
+/// [`raytrace`], ending early once `stop` is set (the rows not started are then black).
+#[must_use]
+pub fn raytrace_until(
+    scene: &WhittedScene,
+    camera: &prism_scene::OrbitCamera,
+    opts: &RaytraceOptions,
+    stop: Option<&AtomicBool>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Raytraced {
     let whole = Share::whole(rays_per_pixel(opts));
+    let pass = Pass {
+        share: &whole,
+        stop,
+        progress,
+    };
     let (image, counts) = if rays_per_pixel(opts) == 1 {
-        rows(
-            scene,
-            camera,
-            opts,
-            &whole,
-            progress,
-            Rgb::BLACK,
-            |p: One| p.mean(),
-        )
+        rows(scene, camera, opts, &pass, Rgb::BLACK, |p: One| p.mean())
     } else {
-        rows(
-            scene,
-            camera,
-            opts,
-            &whole,
-            progress,
-            Rgb::BLACK,
-            |p: PixelSum| p.mean(),
-        )
+        rows(scene, camera, opts, &pass, Rgb::BLACK, |p: PixelSum| {
+            p.mean()
+        })
     };
     with_bloom(image, counts, opts)
 }
@@ -261,15 +265,27 @@ pub fn raytrace_share(
     share: &Share,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (Image<PixelSum>, RayCounts) {
+    let pass = Pass {
+        share,
+        stop: None,
+        progress,
+    };
     rows(
         scene,
         camera,
         opts,
-        share,
-        progress,
+        &pass,
         PixelSum::default(),
         |p: PixelSum| p,
     )
+}
+
+/// What one pass of [`rows`] covers: a share of the tiles, an optional flag that ends it
+/// early, and the callback told of each row done.
+struct Pass<'a> {
+    share: &'a Share,
+    stop: Option<&'a AtomicBool>,
+    progress: &'a (dyn Fn(u64) + Sync),
 }
 
 /// What a pixel keeps of its samples.
@@ -338,19 +354,20 @@ struct First<'a> {
     blocked: &'a [Option<bool>],
 }
 
-/// The pixel loop, row by row on rayon: each pixel of `share`'s tiles stored as `store`
-/// makes it of its sums, the others `empty`; and the rays cast. With one camera ray per
+/// The pixel loop, row by row on rayon: each pixel of the pass's tiles stored as `store`
+/// makes it of its sums, the others (and every pixel of a row begun after the pass's stop
+/// flag is set) `empty`; and the rays cast. With one camera ray per
 /// pixel and neither lens nor shutter, a row's camera rays (through the pixels' corners)
 /// are traced together.
 fn rows<T: Copy + Send + Sync, S: Samples>(
     scene: &WhittedScene,
     camera: &prism_scene::OrbitCamera,
     opts: &RaytraceOptions,
-    share: &Share,
-    progress: &(dyn Fn(u64) + Sync),
+    pass: &Pass<'_>,
     empty: T,
     store: impl Fn(S) -> T + Sync,
 ) -> (Image<T>, RayCounts) {
+    let (share, progress) = (pass.share, pass.progress);
     let frame = Frame::new(scene, camera, opts);
     let view = frame.view;
     let f = opts.settings.features;
@@ -371,7 +388,8 @@ fn rows<T: Copy + Send + Sync, S: Samples>(
             let row = row as u32;
             let mut counts = RayCounts::default();
             let whole = share.parts <= 1;
-            let mine = |x: u32| whole || share.has_tile(tile_of(x, row, opts.width));
+            let stopped = pass.stop.is_some_and(|s| s.load(Ordering::Relaxed));
+            let mine = |x: u32| !stopped && (whole || share.has_tile(tile_of(x, row, opts.width)));
             let RowScratch {
                 rays,
                 hits,
@@ -432,7 +450,7 @@ fn rows<T: Copy + Send + Sync, S: Samples>(
                 .lock()
                 .expect("no panics under the lock")
                 .add(&counts);
-            let d = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
             progress(d);
         });
     // SAFETY: the loop above wrote every one of the first `n` elements (each row's every
