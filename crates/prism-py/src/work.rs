@@ -4,7 +4,9 @@
 //! callback raises.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::collections::BTreeMap;
 use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use pyo3::prelude::*;
@@ -36,25 +38,36 @@ impl Control {
     }
 }
 
-/// A rayon pool of `threads` threads (the global pool's size when `None`), at least 1.
+/// The worker pools made so far, by thread count (0: one per core), kept for the process's
+/// life so that a call in a loop does not start threads each time.
+static POOLS: Mutex<BTreeMap<usize, Arc<rayon::ThreadPool>>> = Mutex::new(BTreeMap::new());
+
+/// A rayon pool of `threads` threads (one per core when `None`).
 ///
 /// # Errors
 /// `ArgumentError` for 0 threads; a `RuntimeError` if the threads cannot be started.
-pub fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
-    match threads {
-        None => Ok(None),
-        Some(0) => Err(crate::errors::argument(
+pub fn pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
+    if threads == Some(0) {
+        return Err(crate::errors::argument(
             "threads: expected 1 or more (None: one per core)",
-        )),
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .map(Some)
-            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string())),
+        ));
     }
+    let key = threads.unwrap_or(0);
+    let mut pools = POOLS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some(p) = pools.get(&key) {
+        return Ok(Arc::clone(p));
+    }
+    let made = rayon::ThreadPoolBuilder::new()
+        .num_threads(key)
+        .build()
+        .map(Arc::new)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    pools.insert(key, Arc::clone(&made));
+    Ok(made)
 }
 
-/// Runs `work` on another thread, on `threads` workers, with the GIL released. Every
+/// Runs `work` on another thread, inside a pool of `threads` workers (so that its parallel
+/// loops start no threads), with the GIL released. Every
 /// [`TICK`] the calling thread checks for signals and calls `progress(done, total)` when
 /// the work has moved on. A signal's exception (KeyboardInterrupt) or the callback's stops
 /// the work: the flag is set, the work is waited for, and the exception is raised.
@@ -84,13 +97,9 @@ pub fn run<R: Send>(
             }
         };
         let control = &control;
-        let pool = pool.as_ref();
+        let pool = &pool;
         scope.spawn(move || {
-            let result = match pool {
-                Some(p) => p.install(|| work(control)),
-                None => work(control),
-            };
-            let _ = sender.send(result);
+            let _ = sender.send(pool.install(|| work(control)));
         });
         let mut reported = u64::MAX;
         loop {
