@@ -205,3 +205,9 @@ def read_image(path: _Path) -> npt.NDArray[Any]:
 
 def encode_png(image: npt.NDArray[Any]) -> bytes:
     """PNG bytes of a picture."""
+
+def set_memory_budget(bytes: int) -> None:
+    """Sets the memory budget (at least 64 MiB; 2 GiB unless set), as --max-memory."""
+
+def memory_budget() -> int:
+    """The memory budget in bytes."""

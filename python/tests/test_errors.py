@@ -31,9 +31,22 @@ def test_a_missing_file_is_an_os_error(tmp_path):
 
 
 def test_over_the_budget_is_a_limit_error():
-    """A picture too large for the memory budget is refused before it is allocated."""
+    """A picture too large for the memory budget is refused before it is allocated; a
+    larger budget lets a bigger request through, as --max-memory does."""
+    scene = prism.load_scene()
     with pytest.raises(prism.LimitError):
-        prism.render(None if False else prism.load_scene(), resolution=(16384, 16384), spp=1)
+        scene.render(resolution=(16384, 16384), spp=1)
+    before = prism.memory_budget()
+    try:
+        prism.set_memory_budget(64 << 20)
+        with pytest.raises(prism.LimitError):
+            scene.render(resolution=(2048, 2048), spp=1)
+        with pytest.raises(prism.LimitError):
+            prism.Mesh(np.eye(3), [[0, 1, 2]]).subdivide(12)
+    finally:
+        prism.set_memory_budget(before)
+    with pytest.raises(prism.ArgumentError):
+        prism.set_memory_budget(1000)
 
 
 def test_bad_arrays_are_argument_errors(tmp_path):

@@ -42,7 +42,7 @@ impl Cloth {
         let cloth = &mut self.cloth;
         // Steps taken before an interruption still count.
         let taken = std::sync::atomic::AtomicU64::new(0);
-        let result = crate::work::run(py, threads, progress, n, |control| {
+        let work = |control: &crate::work::Control| {
             let mut k = 0;
             while k < n && !control.stopped() {
                 cloth.step();
@@ -52,7 +52,13 @@ impl Cloth {
                     control.set_done(k);
                 }
             }
-        });
+        };
+        // A frame or less runs on this thread: a step in a Python loop costs a step.
+        let result = if n <= prism_cloth::STEPS_PER_FRAME as u64 && progress.is_none() {
+            crate::work::run_short(py, threads, work)
+        } else {
+            crate::work::run(py, threads, progress, n, work)
+        };
         self.steps += taken.into_inner();
         result?;
         if !self.cloth.is_finite() {

@@ -106,6 +106,15 @@ pub fn kind_of(e: &(dyn StdError + 'static)) -> Kind {
         if err.is::<prism_mesh::TopologyError>() {
             return Kind::Topology;
         }
+        if let Some(r) = err.downcast_ref::<prism_raster::RasterError>() {
+            return match r {
+                prism_raster::RasterError::BadSize(..) => Kind::Limit,
+                _ => Kind::Argument,
+            };
+        }
+        if let Some(prism_cloth::ClothError::Io { .. }) = err.downcast_ref() {
+            return Kind::File;
+        }
         next = err.source();
     }
     Kind::Input

@@ -7,11 +7,12 @@
 //! - `raytrace`: the Whitted ray tracer and its ray trees.
 //! - `shade`: the course's shaders.
 //! - `cloth`: the mass-spring cloth.
-//! - `images`: pictures to and from files.
+//! - `images`: pictures to and from files; `budget`: the memory budget.
 //! - `work`: long calls off the GIL, with progress and Ctrl-C; `errors`: exceptions;
 //!   `arrays`: pictures as NumPy arrays.
 
 mod arrays;
+mod budget;
 mod cloth;
 mod errors;
 mod images;
@@ -39,6 +40,8 @@ fn _prism(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<cloth::Cloth>()?;
     m.add_function(wrap_pyfunction!(shade::shade, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
+    m.add_function(wrap_pyfunction!(budget::set_memory_budget, m)?)?;
+    m.add_function(wrap_pyfunction!(budget::memory_budget, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::encode_png, m)?)?;
     Ok(())

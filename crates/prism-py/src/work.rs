@@ -135,3 +135,21 @@ pub fn run<R: Send>(
         }
     })
 }
+
+/// Runs a short `work` (at most a few milliseconds) on this thread inside the pool of
+/// `threads` workers, with the GIL released: no second thread and no polling, so that calls
+/// made in a loop cost little more than the work. A Ctrl-C pressed during it is raised after.
+///
+/// # Errors
+/// The exception a signal handler raised.
+pub fn run_short<R: Send>(
+    py: Python<'_>,
+    threads: Option<usize>,
+    work: impl FnOnce(&Control) -> R + Send,
+) -> PyResult<R> {
+    let pool = pool(threads)?;
+    let control = Control::default();
+    let result = py.detach(|| pool.install(|| work(&control)));
+    py.check_signals()?;
+    Ok(result)
+}
