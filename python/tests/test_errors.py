@@ -54,3 +54,28 @@ def test_bad_arrays_are_argument_errors(tmp_path):
         prism.write_image(tmp_path / "x.png", np.zeros((4, 4, 2), dtype=np.uint8))
     with pytest.raises(ValueError):
         prism.write_image(tmp_path / "x.exr", np.zeros((4, 4, 3), dtype=np.uint8))
+
+
+def test_a_tiny_png_asking_for_gigabytes_is_refused(tmp_path):
+    """Hostile input: a PNG header declaring 60000 x 60000 pixels (14 GB decoded) is refused
+    as over the budget before anything is allocated."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    ihdr = struct.pack(">IIBBBBB", 60000, 60000, 8, 6, 0, 0, 0)
+    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b"")
+    path = tmp_path / "huge.png"
+    path.write_bytes(png)
+    assert len(png) < 600
+    with pytest.raises(prism.LimitError):
+        prism.read_image(path)
+
+
+def test_an_oversized_picture_is_a_limit_error():
+    with pytest.raises(prism.LimitError):
+        prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>', width=10**6)
+    with pytest.raises(prism.ArgumentError):
+        prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>', samples=3)
