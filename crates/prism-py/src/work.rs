@@ -3,8 +3,8 @@
 //! to an optional callback and stops the work on Ctrl-C (KeyboardInterrupt) or when the
 //! callback raises.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -53,7 +53,9 @@ pub fn pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
         ));
     }
     let key = threads.unwrap_or(0);
-    let mut pools = POOLS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut pools = POOLS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     if let Some(p) = pools.get(&key) {
         return Ok(Arc::clone(p));
     }
