@@ -1,7 +1,7 @@
 """Type stubs of prism's native module (re-exported by ``prism``)."""
 
 import os
-from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -11,6 +11,24 @@ _Progress = Optional[Callable[[int, int], Any]]
 _Vec3 = Tuple[float, float, float]
 
 __version__: str
+__all__ = [
+    "Cloth",
+    "Mesh",
+    "Scene",
+    "__version__",
+    "bezier_patch",
+    "encode_png",
+    "load_scene",
+    "memory_budget",
+    "raytrace",
+    "read_image",
+    "render",
+    "set_memory_budget",
+    "shade",
+    "svg",
+    "trace_pixel",
+    "write_image",
+]
 
 def svg(
     path_or_text: Union[_Path, str],
@@ -27,10 +45,11 @@ def svg(
 ) -> npt.NDArray[np.uint8]:
     """Rasterizes an SVG file or text to straight-alpha RGBA, uint8[H, W, 4]."""
 
+@final
 class Mesh:
     """A polygon mesh with halfedge edits, Loop subdivision and normals."""
 
-    def __init__(self, vertices: npt.ArrayLike, faces: Union[npt.ArrayLike, Sequence[Sequence[int]]]) -> None: ...
+    def __new__(cls, vertices: npt.ArrayLike, faces: Union[npt.ArrayLike, Sequence[Sequence[int]]]) -> "Mesh": ...
     @staticmethod
     def read(path: _Path, *, strict: bool = False) -> "Mesh":
         """Reads an .obj, .ply or .dae mesh, repairing a non-manifold one unless strict."""
@@ -63,6 +82,7 @@ class Mesh:
 def bezier_patch(path: _Path, resolution: int = 8) -> Mesh:
     """Tessellates the course's .bez Bezier patches into a welded triangle mesh."""
 
+@final
 class Scene:
     """A scene read and prepared for the path tracer, rendered as often as asked."""
 
@@ -121,7 +141,7 @@ def render(
     """Path-traces a scene to linear radiance, float32[H, W, 3]."""
 
 def raytrace(
-    config_or_preset: _Path = "cornell-box",
+    config_or_preset: _Path = ...,  # "cornell-box"
     *,
     resolution: Optional[Tuple[int, int]] = None,
     features: Optional[Union[Mapping[str, bool], Iterable[str]]] = None,
@@ -160,13 +180,13 @@ def shade(
     shader: str = "phong",
     eye: Optional[_Vec3] = None,
     target: Optional[_Vec3] = None,
-    up: _Vec3 = (0.0, 1.0, 0.0),
+    up: _Vec3 = ...,  # (0, 1, 0)
     fov_y: float = 45.0,
-    resolution: Tuple[int, int] = (800, 600),
+    resolution: Tuple[int, int] = ...,  # (800, 600)
     samples: int = 1,
     light: Optional[_Vec3] = None,
     light_intensity: Optional[_Vec3] = None,
-    background: _Vec3 = (0.0, 0.0, 0.0),
+    background: _Vec3 = ...,  # black
     wireframe: Optional[_Vec3] = None,
     texture: Optional[Union[_Path, npt.NDArray[np.uint8]]] = None,
     height_map: Optional[Union[_Path, npt.NDArray[np.uint8]]] = None,
@@ -176,10 +196,11 @@ def shade(
 ) -> npt.NDArray[np.uint8]:
     """Draws a mesh with one of the course's shaders, uint8[H, W, 3]."""
 
+@final
 class Cloth:
     """The course's mass-spring cloth, stepped exactly as its algorithm."""
 
-    def __init__(self, scene_json_path: _Path, overrides: Optional[Mapping[str, Any]] = None) -> None: ...
+    def __new__(cls, scene_json_path: _Path, overrides: Optional[Mapping[str, Any]] = None) -> "Cloth": ...
     def step(self, n: int = 1, *, threads: Optional[int] = None, progress: _Progress = None) -> None:
         """Takes n time steps (1/2700 s each)."""
     def frame(self, n: int = 1, *, threads: Optional[int] = None, progress: _Progress = None) -> None:
