@@ -261,3 +261,35 @@ fn identity_survives_the_part_file() {
     assert_eq!(PartIdentity::from_attributes(&merged.identity), Ok(id));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Property: a render told to stop before it starts takes no samples; one told to stop after
+/// its first tile keeps that tile's samples exactly and leaves the others empty; one never
+/// told equals `render`.
+#[test]
+fn a_stopped_render_ends_early_and_keeps_what_it_took() {
+    use prism_render::render::{render, render_until};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let scene = RenderScene::new(&prism_scene::cornell_box());
+    let opts = options();
+    let stop = AtomicBool::new(true);
+    let none = render_until(&scene, &opts, Some(&stop), &|_| {});
+    assert_eq!(none.total_samples, 0);
+    let whole = render(&scene, &opts, &|_| {});
+    let running = AtomicBool::new(false);
+    let early = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| {
+            render_until(&scene, &opts, Some(&running), &|_| {
+                running.store(true, Ordering::Relaxed)
+            })
+        });
+    assert!(early.total_samples > 0 && early.total_samples < whole.total_samples);
+    for (a, b) in early.samples.pixels().iter().zip(whole.samples.pixels()) {
+        assert!(*a == 0 || a == b);
+    }
+    let never = AtomicBool::new(false);
+    let same = render_until(&scene, &opts, Some(&never), &|_| {});
+    assert_eq!(same.image.pixels(), whole.image.pixels());
+}

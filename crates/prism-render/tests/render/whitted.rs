@@ -528,3 +528,20 @@ fn row_directions_equal_single_rays_bit_for_bit() {
         }
     }
 }
+
+/// Property: a Whitted render told to stop before it starts leaves every pixel black and
+/// casts no ray; one never told equals `raytrace`.
+#[test]
+fn a_stopped_whitted_render_ends_early() {
+    use prism_render::whitted::film::raytrace_until;
+    use std::sync::atomic::AtomicBool;
+    let ws = WhittedScene::new(&Preset::CornellBox.load(&[]).unwrap(), true);
+    let cam = OrbitCamera::default();
+    let o = options(16, 16, all_on());
+    let stopped = raytrace_until(&ws, &cam, &o, Some(&AtomicBool::new(true)), &|_| {});
+    assert!(stopped.image.pixels().iter().all(|p| *p == Rgb::BLACK));
+    assert_eq!(stopped.counts.total(), 0);
+    let whole = raytrace(&ws, &cam, &o, &|_| {});
+    let same = raytrace_until(&ws, &cam, &o, Some(&AtomicBool::new(false)), &|_| {});
+    assert_eq!(same.image.pixels(), whole.image.pixels());
+}
