@@ -506,7 +506,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         ))
         .into());
     }
-    crate::resources::check_frame("--resolution", w, h, prism_render::film::film_bytes(w, h))?;
+    let film = match share {
+        Some(_) => prism_render::film::share_bytes(w, h),
+        None => prism_render::film::film_bytes(w, h),
+    };
+    crate::resources::check_frame("--resolution", w, h, film)?;
     if a.light_samples == 0 || a.light_samples > MAX_LIGHT_SAMPLES {
         return Err(UserError::Refused(format!(
             "--light-samples: expected 1 to {MAX_LIGHT_SAMPLES}, found {}",

@@ -99,16 +99,23 @@ impl Share {
     }
 }
 
-/// The most bytes a `width x height` path-traced render's film holds at once: the pixel
-/// sums twice (the tiles' results and the image they are gathered into), each pixel's
-/// place in its tile, and three colour images made from the sums. A caller checks it
-/// against the memory budget before rendering. (Measured: a 2048 x 2048 render peaks at
-/// 680 MB of the 856 MB this gives.)
+/// The most bytes a `width x height` path-traced picture's film holds at once: each pixel's
+/// colour and sample count as its tile leaves them and again in the images they are gathered
+/// into (the exact sums are kept per tile only while it renders), and one encoded copy of
+/// the picture (an EXR's float channels; an 8-bit PNG's is smaller). A caller checks it
+/// against the memory budget before rendering.
 #[must_use]
 pub fn film_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = 2 * std::mem::size_of::<PixelSum>()
-        + std::mem::size_of::<(u32, u32)>()
-        + 3 * std::mem::size_of::<Rgb>();
+    let per_pixel = 2 * std::mem::size_of::<(Rgb, u32)>() + std::mem::size_of::<Rgb>();
+    u64::from(width) * u64::from(height) * per_pixel as u64
+}
+
+/// The most bytes a share of a `width x height` render (a part file's) holds at once: the
+/// pixel sums twice (the tiles' results and the image they are gathered into) and the part
+/// file's encoded channels.
+#[must_use]
+pub fn share_bytes(width: u32, height: u32) -> u64 {
+    let per_pixel = 3 * std::mem::size_of::<PixelSum>();
     u64::from(width) * u64::from(height) * per_pixel as u64
 }
 

@@ -120,11 +120,24 @@ pub fn render_until(
         profile: Some(&profile),
         stop,
     };
-    let sums = render_share(scene, opts, &job, progress);
+    // Each tile's sums become colours and counts as soon as it is done: the film holds 16
+    // bytes a pixel, not the sums' 80.
+    let (w, h) = (opts.film.width, opts.film.height);
+    let empty = PixelSum::default();
+    let mut image = Image::new(w, h, empty.mean());
+    let mut samples = Image::new(w, h, 0u32);
+    let mut total_samples = 0;
+    for (origin, values) in render_tiles(scene, opts, &job, progress, |p| (p.mean(), p.n)) {
+        for ((x, y), (c, n)) in tile_pixels(origin, w, h).zip(values) {
+            image.set(x, y, c);
+            samples.set(x, y, n);
+            total_samples += u64::from(n);
+        }
+    }
     Rendered {
-        image: sums.map(|p| p.mean()),
-        samples: sums.map(|p| p.n),
-        total_samples: sums.pixels().iter().map(|p| u64::from(p.n)).sum(),
+        image,
+        samples,
+        total_samples,
         profile,
     }
 }
@@ -141,6 +154,35 @@ pub fn render_share(
     job: &Job<'_>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Image<PixelSum> {
+    let (w, h) = (opts.film.width, opts.film.height);
+    let mut sums = Image::new(w, h, PixelSum::default());
+    for (origin, values) in render_tiles(scene, opts, job, progress, |p| *p) {
+        for ((x, y), s) in tile_pixels(origin, w, h).zip(values) {
+            sums.set(x, y, s);
+        }
+    }
+    sums
+}
+
+/// The pixels of the tile at `(x0, y0)` of a `w x h` film, row by row.
+fn tile_pixels((x0, y0): (u32, u32), w: u32, h: u32) -> impl Iterator<Item = (u32, u32)> {
+    (y0..(y0 + TILE).min(h)).flat_map(move |y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+}
+
+/// Renders the job's tiles on rayon; each pixel's sums, as soon as its tile is done, become
+/// what `keep` makes of them. Returns each tile's origin and its pixels' values row by row
+/// (a pixel the job skips is kept as having no samples); a tile begun after `stop` is set
+/// has no values.
+///
+/// # Panics
+/// If the job's `skip` does not have one entry per pixel.
+fn render_tiles<T: Send>(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    job: &Job<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+    keep: impl Fn(&PixelSum) -> T + Sync,
+) -> Vec<((u32, u32), Vec<T>)> {
     let (share, skip, profile) = (job.share, job.skip, job.profile);
     let stopped = || job.stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let (w, h) = (opts.film.width, opts.film.height);
@@ -157,19 +199,16 @@ pub fn render_share(
         .map(|(_, t)| t)
         .collect();
     let done = std::sync::atomic::AtomicU64::new(0);
-    // Each tile's pixels rendered and their sums.
-    type Rendered = (Vec<(u32, u32)>, Vec<PixelSum>);
-    let results: Vec<Rendered> = tiles
+    tiles
         .par_iter()
-        .map(|&(x0, y0)| {
+        .map(|&origin| {
             if stopped() {
-                return (Vec::new(), Vec::new());
+                return (origin, Vec::new());
             }
-            let pixels: Vec<(u32, u32)> = (y0..(y0 + TILE).min(h))
-                .flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+            let pixels: Vec<(u32, u32)> = tile_pixels(origin, w, h)
                 .filter(|&(x, y)| !skipped(x, y))
                 .collect();
-            let out = if opts.path.integrator == Integrator::Path {
+            let out: Vec<PixelSum> = if opts.path.integrator == Integrator::Path {
                 wavefront::tile(
                     scene,
                     &camera,
@@ -187,16 +226,21 @@ pub fn render_share(
             };
             let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
             progress(done.fetch_add(n, Ordering::Relaxed) + n);
-            (pixels, out)
+            let mut sums = out.iter();
+            let empty = PixelSum::default();
+            let values = tile_pixels(origin, w, h)
+                .map(|(x, y)| {
+                    let s = if skipped(x, y) {
+                        &empty
+                    } else {
+                        sums.next().expect("one sum a pixel rendered")
+                    };
+                    keep(s)
+                })
+                .collect();
+            (origin, values)
         })
-        .collect();
-    let mut sums = Image::new(w, h, PixelSum::default());
-    for (pixels, out) in &results {
-        for (&(x, y), s) in pixels.iter().zip(out) {
-            sums.set(x, y, *s);
-        }
-    }
-    sums
+        .collect()
 }
 
 fn pixel(
