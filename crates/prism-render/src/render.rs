@@ -5,6 +5,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use prism_image::Image;
 use prism_math::Rgb;
@@ -120,20 +121,24 @@ pub fn render_until(
         profile: Some(&profile),
         stop,
     };
-    // Each tile's sums become colours and counts as soon as it is done: the film holds 16
-    // bytes a pixel, not the sums' 80.
+    // Each tile's sums become colours and counts as soon as it is done, and go straight into
+    // the picture: the film holds 16 bytes a pixel, not the sums' 80.
     let (w, h) = (opts.film.width, opts.film.height);
-    let empty = PixelSum::default();
-    let mut image = Image::new(w, h, empty.mean());
-    let mut samples = Image::new(w, h, 0u32);
-    let mut total_samples = 0;
-    for (origin, values) in render_tiles(scene, opts, &job, progress, |p| (p.mean(), p.n)) {
-        for ((x, y), (c, n)) in tile_pixels(origin, w, h).zip(values) {
-            image.set(x, y, c);
-            samples.set(x, y, n);
-            total_samples += u64::from(n);
+    let film = Mutex::new((
+        Image::new(w, h, PixelSum::default().mean()),
+        Image::new(w, h, 0u32),
+        0u64,
+    ));
+    render_tiles(scene, opts, &job, progress, |origin, sums| {
+        let mut f = film.lock().unwrap_or_else(PoisonError::into_inner);
+        let (image, samples, total) = &mut *f;
+        for ((x, y), p) in tile_pixels(origin, w, h).zip(sums) {
+            image.set(x, y, p.mean());
+            samples.set(x, y, p.n);
+            *total += u64::from(p.n);
         }
-    }
+    });
+    let (image, samples, total_samples) = film.into_inner().unwrap_or_else(PoisonError::into_inner);
     Rendered {
         image,
         samples,
@@ -155,13 +160,14 @@ pub fn render_share(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Image<PixelSum> {
     let (w, h) = (opts.film.width, opts.film.height);
-    let mut sums = Image::new(w, h, PixelSum::default());
-    for (origin, values) in render_tiles(scene, opts, job, progress, |p| *p) {
-        for ((x, y), s) in tile_pixels(origin, w, h).zip(values) {
-            sums.set(x, y, s);
+    let sums = Mutex::new(Image::new(w, h, PixelSum::default()));
+    render_tiles(scene, opts, job, progress, |origin, tile| {
+        let mut image = sums.lock().unwrap_or_else(PoisonError::into_inner);
+        for ((x, y), s) in tile_pixels(origin, w, h).zip(tile) {
+            image.set(x, y, *s);
         }
-    }
-    sums
+    });
+    sums.into_inner().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// The pixels of the tile at `(x0, y0)` of a `w x h` film, row by row.
@@ -169,20 +175,20 @@ fn tile_pixels((x0, y0): (u32, u32), w: u32, h: u32) -> impl Iterator<Item = (u3
     (y0..(y0 + TILE).min(h)).flat_map(move |y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
 }
 
-/// Renders the job's tiles on rayon; each pixel's sums, as soon as its tile is done, become
-/// what `keep` makes of them. Returns each tile's origin and its pixels' values row by row
-/// (a pixel the job skips is kept as having no samples); a tile begun after `stop` is set
-/// has no values.
+/// Renders the job's tiles on rayon, handing each to `done` as soon as it is rendered: its
+/// origin and its pixels' sums row by row (a pixel the job skips has no samples). A tile
+/// begun after `stop` is set is not rendered and not handed on. The tiles arrive in any
+/// order; each pixel's sums do not depend on it.
 ///
 /// # Panics
 /// If the job's `skip` does not have one entry per pixel.
-fn render_tiles<T: Send>(
+fn render_tiles(
     scene: &RenderScene,
     opts: &RenderOptions,
     job: &Job<'_>,
     progress: &(dyn Fn(u64) + Sync),
-    keep: impl Fn(&PixelSum) -> T + Sync,
-) -> Vec<((u32, u32), Vec<T>)> {
+    done: impl Fn((u32, u32), &[PixelSum]) + Sync,
+) {
     let (share, skip, profile) = (job.share, job.skip, job.profile);
     let stopped = || job.stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let (w, h) = (opts.film.width, opts.film.height);
@@ -198,49 +204,48 @@ fn render_tiles<T: Send>(
         .filter(|&(k, _)| share.has_tile(k))
         .map(|(_, t)| t)
         .collect();
-    let done = std::sync::atomic::AtomicU64::new(0);
-    tiles
-        .par_iter()
-        .map(|&origin| {
-            if stopped() {
-                return (origin, Vec::new());
-            }
-            let pixels: Vec<(u32, u32)> = tile_pixels(origin, w, h)
-                .filter(|&(x, y)| !skipped(x, y))
-                .collect();
-            let out: Vec<PixelSum> = if opts.path.integrator == Integrator::Path {
-                wavefront::tile(
-                    scene,
-                    &camera,
-                    &opts.film,
-                    &opts.path,
-                    &pixels,
-                    &share.samples,
-                    profile,
-                )
-            } else {
-                pixels
-                    .iter()
-                    .map(|&(x, y)| pixel(scene, &camera, opts, x, y, &share.samples))
-                    .collect()
-            };
-            let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
-            progress(done.fetch_add(n, Ordering::Relaxed) + n);
-            let mut sums = out.iter();
-            let empty = PixelSum::default();
-            let values = tile_pixels(origin, w, h)
-                .map(|(x, y)| {
-                    let s = if skipped(x, y) {
-                        &empty
-                    } else {
-                        sums.next().expect("one sum a pixel rendered")
-                    };
-                    keep(s)
-                })
-                .collect();
-            (origin, values)
-        })
-        .collect()
+    let taken = std::sync::atomic::AtomicU64::new(0);
+    tiles.par_iter().for_each(|&origin| {
+        if stopped() {
+            return;
+        }
+        let pixels: Vec<(u32, u32)> = tile_pixels(origin, w, h)
+            .filter(|&(x, y)| !skipped(x, y))
+            .collect();
+        let out: Vec<PixelSum> = if opts.path.integrator == Integrator::Path {
+            wavefront::tile(
+                scene,
+                &camera,
+                &opts.film,
+                &opts.path,
+                &pixels,
+                &share.samples,
+                profile,
+            )
+        } else {
+            pixels
+                .iter()
+                .map(|&(x, y)| pixel(scene, &camera, opts, x, y, &share.samples))
+                .collect()
+        };
+        let n: u64 = out.iter().map(|p| u64::from(p.n)).sum();
+        progress(taken.fetch_add(n, Ordering::Relaxed) + n);
+        if skip.is_none() {
+            done(origin, &out);
+            return;
+        }
+        let mut sums = out.into_iter();
+        let all: Vec<PixelSum> = tile_pixels(origin, w, h)
+            .map(|(x, y)| {
+                if skipped(x, y) {
+                    PixelSum::default()
+                } else {
+                    sums.next().expect("one sum a pixel rendered")
+                }
+            })
+            .collect();
+        done(origin, &all);
+    });
 }
 
 fn pixel(
