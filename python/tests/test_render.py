@@ -39,6 +39,43 @@ def test_a_mitsuba_scene_uses_its_own_settings(tmp_path, cli):
     assert np.array_equal(prism.read_image(ref), image)
 
 
+def test_a_crop_window_is_kept_unless_a_size_is_given(tmp_path, cli):
+    """Oracle: a Mitsuba film's crop window renders as the command renders it, and a size
+    given to render replaces the film, crop and all, as `-r` does."""
+    text = MITSUBA.read_text().replace(
+        '<film type="hdrfilm">',
+        '<film type="hdrfilm"><integer name="crop_offset_x" value="50"/>'
+        '<integer name="crop_offset_y" value="10"/><integer name="crop_width" value="30"/>'
+        '<integer name="crop_height" value="20"/>',
+    )
+    cropped = tmp_path / "cropped.xml"
+    cropped.write_text(text)
+    (tmp_path / "pattern.png").symlink_to(MITSUBA.parent / "pattern.png")
+    scene = prism.load_scene(cropped)
+    assert scene.resolution == (30, 20)
+    run(cli, "render", cropped, "-o", tmp_path / "crop.exr", "-s", "2")
+    assert np.array_equal(prism.read_image(tmp_path / "crop.exr"), scene.render(spp=2))
+    run(cli, "render", cropped, "-o", tmp_path / "full.exr", "-s", "2", "-r", "64", "48")
+    assert np.array_equal(prism.read_image(tmp_path / "full.exr"), scene.render(spp=2, resolution=(64, 48)))
+
+
+def test_two_threads_render_one_scene_at_once():
+    """A scene renders from two Python threads at once, each as it renders alone."""
+    scene = prism.load_scene(course_file("CBspheres_lambertian.dae"))
+    alone = [scene.render(spp=2, resolution=(48, 32), seed=s) for s in (0, 1)]
+    out = [None, None]
+
+    def go(i):
+        out[i] = scene.render(spp=2, resolution=(48, 32), seed=i)
+
+    threads = [threading.Thread(target=go, args=(i,)) for i in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert all(np.array_equal(a, b) for a, b in zip(alone, out))
+
+
 def test_a_loaded_scene_renders_again_the_same_on_any_threads():
     """Property: a scene read once renders the same bytes again, on 1 or 2 threads, and a
     new seed gives new noise."""

@@ -643,6 +643,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 skip: None,
                 profile: Some(&profile),
                 stop: None,
+                camera: None,
             };
             render_share(&prepared, &options, &job, &|done| bar.set_position(done))
         });

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use numpy::PyArray3;
 use prism_render::film::FilmSettings;
 use prism_render::integrators::{Integrator, PathSettings};
-use prism_render::render::{render_until, RenderOptions};
+use prism_render::render::{render_until, Controls, RenderOptions};
 use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, Filter, NormalsMode, SceneOptions};
 use pyo3::prelude::*;
@@ -34,8 +34,9 @@ const DEFAULT_BATCH: u32 = 32;
 #[pyclass(module = "prism", name = "Scene")]
 pub struct Scene {
     prepared: RenderScene,
-    /// The camera's crop window, as the file gives it (a size given to `render` drops it).
-    crop: Option<prism_scene::Crop>,
+    /// The scene's camera without its crop window, for a render given its own size (which
+    /// replaces a Mitsuba film's, crop and all, as on the command line).
+    uncropped: prism_scene::Camera,
     size: (u32, u32),
     spp: u32,
     max_bounces: u32,
@@ -149,12 +150,15 @@ pub fn load_scene(
                 .map_err(|e| raise(Kind::Input, format!("{map_name}: {e}"), Some(&map_name)))?;
         }
         let warnings = scene.warnings.iter().map(ToString::to_string).collect();
-        let crop = scene.camera.crop;
+        let uncropped = prism_scene::Camera {
+            crop: None,
+            ..scene.camera
+        };
         let prepared = RenderScene::new(&scene);
         let s = settings.as_ref();
         Ok(Scene {
             prepared,
-            crop,
+            uncropped,
             size: s.map_or(DEFAULT_SIZE, |s| s.size),
             spp: s.map_or(DEFAULT_SPP, |s| s.spp),
             max_bounces: s.map_or(DEFAULT_BOUNCES, |s| {
@@ -186,7 +190,7 @@ impl Scene {
         light_samples=1, adaptive=None, batch=None, threads=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         spp: Option<u32>,
         resolution: Option<(u32, u32)>,
@@ -263,15 +267,15 @@ impl Scene {
             },
         };
         // A size given here replaces a Mitsuba film's, crop and all.
-        self.prepared.camera.crop = if resolution.is_some() {
-            None
-        } else {
-            self.crop
-        };
+        let camera = resolution.map(|_| &self.uncropped);
         let prepared = &self.prepared;
         let total = u64::from(w) * u64::from(h) * u64::from(spp);
         let out = crate::work::run(py, threads, progress, total, |control| {
-            render_until(prepared, &options, Some(control.flag()), &|done| {
+            let controls = Controls {
+                stop: Some(control.flag()),
+                camera,
+            };
+            render_until(prepared, &options, controls, &|done| {
                 control.set_done(done);
             })
         })?;
@@ -350,7 +354,7 @@ pub fn render<'py>(
             &owned
         }
     };
-    let mut scene = target.try_borrow_mut()?;
+    let scene = target.try_borrow()?;
     scene.render(
         py,
         spp,

@@ -80,6 +80,19 @@ pub struct Job<'a> {
     pub profile: Option<&'a Profile>,
     /// Set by another thread to end the job early (its result is then incomplete).
     pub stop: Option<&'a AtomicBool>,
+    /// The camera to render through instead of the scene's (the same one without its crop
+    /// window, say).
+    pub camera: Option<&'a prism_scene::Camera>,
+}
+
+/// What a whole-picture render may be given besides its options.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Controls<'a> {
+    /// Set by another thread to end the render early (the tiles not started then hold no
+    /// samples).
+    pub stop: Option<&'a AtomicBool>,
+    /// The camera to render through instead of the scene's.
+    pub camera: Option<&'a prism_scene::Camera>,
 }
 
 impl<'a> Job<'a> {
@@ -91,6 +104,7 @@ impl<'a> Job<'a> {
             skip: None,
             profile: None,
             stop: None,
+            camera: None,
         }
     }
 }
@@ -102,15 +116,14 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
-    render_until(scene, opts, None, progress)
+    render_until(scene, opts, Controls::default(), progress)
 }
 
-/// [`render`], ending early once `stop` is set (the picture is then incomplete: the tiles
-/// not started hold no samples).
+/// [`render`] under `controls`: through another camera, or ending early once told to stop.
 pub fn render_until(
     scene: &RenderScene,
     opts: &RenderOptions,
-    stop: Option<&AtomicBool>,
+    controls: Controls<'_>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
     let profile = Profile::default();
@@ -119,7 +132,8 @@ pub fn render_until(
         share: &share,
         skip: None,
         profile: Some(&profile),
-        stop,
+        stop: controls.stop,
+        camera: controls.camera,
     };
     // Each tile's sums become colours and counts as soon as it is done, and go straight into
     // the picture: the film holds 16 bytes a pixel, not the sums' 80.
@@ -196,7 +210,7 @@ fn render_tiles(
         assert_eq!(s.len(), w as usize * h as usize, "one skip flag per pixel");
     }
     let skipped = |x: u32, y: u32| skip.is_some_and(|s| s[(y * w + x) as usize]);
-    let camera = Perspective::new(&scene.camera, w, h)
+    let camera = Perspective::new(job.camera.unwrap_or(&scene.camera), w, h)
         .with_filter(crate::pixel_filter::PixelFilter::new(&opts.film.filter));
     let tiles: Vec<(u32, u32)> = tiles(w, h)
         .into_iter()

@@ -198,6 +198,7 @@ impl Mode for PathMode {
                 skip,
                 profile: None,
                 stop: None,
+                camera: None,
             };
             let pass = render_share(&self.scene, &opts, &job, &|_| {});
             let secs = t.elapsed().as_secs_f64();

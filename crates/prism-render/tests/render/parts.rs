@@ -267,12 +267,16 @@ fn identity_survives_the_part_file() {
 /// told equals `render`.
 #[test]
 fn a_stopped_render_ends_early_and_keeps_what_it_took() {
-    use prism_render::render::{render, render_until};
+    use prism_render::render::{render, render_until, Controls};
     use std::sync::atomic::{AtomicBool, Ordering};
     let scene = RenderScene::new(&prism_scene::cornell_box());
     let opts = options();
-    let stop = AtomicBool::new(true);
-    let none = render_until(&scene, &opts, Some(&stop), &|_| {});
+    let stopping = |stop| Controls {
+        stop: Some(stop),
+        camera: None,
+    };
+    let (stopped, never) = (AtomicBool::new(true), AtomicBool::new(false));
+    let none = render_until(&scene, &opts, stopping(&stopped), &|_| {});
     assert_eq!(none.total_samples, 0);
     let whole = render(&scene, &opts, &|_| {});
     let running = AtomicBool::new(false);
@@ -281,7 +285,7 @@ fn a_stopped_render_ends_early_and_keeps_what_it_took() {
         .build()
         .unwrap()
         .install(|| {
-            render_until(&scene, &opts, Some(&running), &|_| {
+            render_until(&scene, &opts, stopping(&running), &|_| {
                 running.store(true, Ordering::Relaxed)
             })
         });
@@ -289,7 +293,6 @@ fn a_stopped_render_ends_early_and_keeps_what_it_took() {
     for (a, b) in early.samples.pixels().iter().zip(whole.samples.pixels()) {
         assert!(*a == 0 || a == b);
     }
-    let never = AtomicBool::new(false);
-    let same = render_until(&scene, &opts, Some(&never), &|_| {});
+    let same = render_until(&scene, &opts, stopping(&never), &|_| {});
     assert_eq!(same.image.pixels(), whole.image.pixels());
 }
