@@ -79,3 +79,13 @@ def test_an_oversized_picture_is_a_limit_error():
         prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>', width=10**6)
     with pytest.raises(prism.ArgumentError):
         prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>', samples=3)
+
+
+def test_a_hostile_thread_count_is_clamped():
+    """threads=10**6 starts at most four threads a core (at least 16), with a warning, as
+    the command's -t does; threads=0 is refused."""
+    with pytest.warns(UserWarning, match="more than four a core"):
+        image = prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="4" height="4"/>', threads=10**6)
+    assert image.shape == (4, 4, 4)
+    with pytest.raises(prism.ArgumentError):
+        prism.svg('<svg xmlns="http://www.w3.org/2000/svg" width="4" height="4"/>', threads=0)

@@ -35,12 +35,6 @@ pub fn check_frame(flag: &str, width: u32, height: u32, bytes: u64) -> Result<()
         .map_err(|e| UserError::Refused(format!("{flag} {width} {height}: the image {e}")).into())
 }
 
-/// The most worker threads a command starts: four a core, at least 16.
-fn max_threads() -> usize {
-    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
-    (4 * cores).max(16)
-}
-
 /// A worker pool of `threads` threads (default: one per core), at least 1 and at most
 /// four a core (at least 16), with a warning when clamped.
 pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
@@ -51,7 +45,7 @@ pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 fn builder(threads: Option<usize>) -> rayon::ThreadPoolBuilder {
     let b = rayon::ThreadPoolBuilder::new();
     let Some(t) = threads else { return b };
-    let most = max_threads();
+    let most = prism_math::limits::max_threads();
     if t > most {
         eprintln!("prism: warning: --threads {t}: more than four a core; using {most} threads");
     }

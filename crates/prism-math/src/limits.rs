@@ -20,6 +20,14 @@ pub fn set_memory_budget(bytes: u64) {
     MEMORY_BUDGET.store(bytes.max(MIN_MEMORY_BUDGET), Ordering::Relaxed);
 }
 
+/// The most worker threads a call starts: four a core, at least 16 (more only crowd the
+/// machine; a hostile `-t` or `threads=` asking for millions is clamped to this).
+#[must_use]
+pub fn max_threads() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
+    (4 * cores).max(16)
+}
+
 /// The process's memory budget in bytes: what one buffer sized by an input (a film, a frame,
 /// a window's pixels) may take.
 #[must_use]

@@ -42,7 +42,8 @@ impl Control {
 /// life so that a call in a loop does not start threads each time.
 static POOLS: Mutex<BTreeMap<usize, Arc<rayon::ThreadPool>>> = Mutex::new(BTreeMap::new());
 
-/// A rayon pool of `threads` threads (one per core when `None`).
+/// A rayon pool of `threads` threads (one per core when `None`; at most
+/// [`prism_math::limits::max_threads`], with a warning when clamped).
 ///
 /// # Errors
 /// `ArgumentError` for 0 threads; a `RuntimeError` if the threads cannot be started.
@@ -52,7 +53,15 @@ pub fn pool(threads: Option<usize>) -> PyResult<Arc<rayon::ThreadPool>> {
             "threads: expected 1 or more (None: one per core)",
         ));
     }
-    let key = threads.unwrap_or(0);
+    let most = prism_math::limits::max_threads();
+    if let Some(t) = threads.filter(|&t| t > most) {
+        Python::attach(|py| {
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            let message = format!("threads={t}: more than four a core; using {most} threads");
+            PyErr::warn(py, &category, &std::ffi::CString::new(message)?, 1)
+        })?;
+    }
+    let key = threads.map_or(0, |t| t.min(most));
     let mut pools = POOLS
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
