@@ -4,7 +4,7 @@
 //!   checked, with `--set` overrides; `json` is its small reader with line numbers.
 //! - `sim`: [`Cloth`], the mass-spring simulation stepped exactly as the course's algorithm
 //!   (`FORMATS.md` §4), in f64.
-//! - `simd`: the spring force law's AVX kernel, the crate's only intrinsics.
+//! - `springs`: the springs' forces by family on the grid, and each mass's sum of them.
 //! - `random`: [`GlibcRand`], the C library's `rand()` that jitters the vertical cloth.
 //! - `draw`: the cloth and its obstacles as prism-shade meshes, and the course app's camera.
 #![warn(missing_docs)]
@@ -15,7 +15,7 @@ mod json;
 mod random;
 mod scene;
 mod sim;
-mod simd;
+mod springs;
 
 pub use draw::{cloth_mesh, course_view, obstacles};
 pub use error::ClothError;

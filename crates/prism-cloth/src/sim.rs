@@ -9,8 +9,7 @@ use std::time::{Duration, Instant};
 
 use crate::random::{GlibcRand, RAND_MAX};
 use crate::scene::{ClothScene, Orientation, PlaneParams, SphereParams};
-#[cfg(target_arch = "x86_64")]
-use crate::simd;
+use crate::springs::SpringGrid;
 
 /// Frames per simulated second.
 pub const FRAMES_PER_SECOND: f64 = 90.0;
@@ -78,13 +77,12 @@ pub struct Cloth {
     pub last: Vec<DVec3>,
     /// Pinned masses.
     pub pinned: Vec<bool>,
-    /// Springs in creation order.
-    pub springs: Vec<Spring>,
+    springs: Vec<Spring>,
     /// The mass of every point mass.
     pub mass: f64,
     /// Time spent in each of the five steps so far.
     pub times: StepTimes,
-    spring_forces: Vec<ForceLanes>,
+    grid: SpringGrid,
     incident_start: Vec<u32>,
     incident: Vec<u32>,
     sorted: Vec<DVec3>,
@@ -112,13 +110,15 @@ struct BoxGrid {
 
 impl BoxGrid {
     /// The box of a position, `floor(p / size)` per axis.
-    #[inline(always)]
+    #[cfg(test)]
     fn key(&self, p: DVec3) -> BoxKey {
-        let exact = [
-            floor_i64(p.x / self.size.x),
-            floor_i64(p.y / self.size.y),
-            floor_i64(p.z / self.size.z),
-        ];
+        self.key_of_quotients((p / self.size).to_array())
+    }
+
+    /// The box of a position from its quotients `p / size` per axis.
+    #[inline(always)]
+    fn key_of_quotients(&self, q: [f64; 3]) -> BoxKey {
+        let exact = q.map(floor_i64);
         let hash = (exact[0] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
             ^ (exact[1] as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
             ^ (exact[2] as u64).wrapping_mul(0x1656_67b1_9e37_79f9);
@@ -155,6 +155,96 @@ fn collide(
         }
     }
     x
+}
+
+/// The three equal thirds of a slice.
+fn thirds(s: &mut [f64]) -> [&mut [f64]; 3] {
+    let n = s.len() / 3;
+    let (a, bc) = s.split_at_mut(n);
+    let (b, c) = bc.split_at_mut(n);
+    [a, b, c]
+}
+
+/// Step 2's constants: Verlet with damping in percent, then the quotients that place a
+/// mass in its self-collision box.
+#[derive(Clone, Copy)]
+struct Verlet {
+    dt: f64,
+    keep: f64,
+    mass: f64,
+    size: [f64; 3],
+}
+
+impl Verlet {
+    /// One row of masses, per axis: from the positions `now`, one step ago `last`, and the
+    /// sums of forces `sums`, the next positions into `next` (`now` for a pinned mass),
+    /// then `next / size` into `sums`.
+    fn row(
+        &self,
+        now: [&[f64]; 3],
+        last: &[DVec3],
+        pinned: &[bool],
+        sums: [&mut [f64]; 3],
+        next: [&mut [f64]; 3],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if prism_math::Isa::avx() {
+            // SAFETY: the processor has AVX.
+            return unsafe { self.row_avx(now, last, pinned, sums, next) };
+        }
+        self.row_plain(now, last, pinned, sums, next);
+    }
+
+    /// [`Verlet::row`] compiled for AVX.
+    ///
+    /// # Safety
+    /// The processor must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn row_avx(
+        &self,
+        now: [&[f64]; 3],
+        last: &[DVec3],
+        pinned: &[bool],
+        sums: [&mut [f64]; 3],
+        next: [&mut [f64]; 3],
+    ) {
+        self.row_plain(now, last, pinned, sums, next);
+    }
+
+    /// [`Verlet::row`] as written: `now + keep (now - last) + f / m dt dt`, in that order.
+    #[inline(always)]
+    fn row_plain(
+        &self,
+        now: [&[f64]; 3],
+        last: &[DVec3],
+        pinned: &[bool],
+        sums: [&mut [f64]; 3],
+        next: [&mut [f64]; 3],
+    ) {
+        let n = pinned.len();
+        let Verlet {
+            dt,
+            keep,
+            mass,
+            size,
+        } = *self;
+        for (i, l) in last[..n].iter().enumerate() {
+            (next[0][i], next[1][i], next[2][i]) = (l.x, l.y, l.z);
+        }
+        let pinned = &pinned[..n];
+        for (axis, (sum, next)) in sums.into_iter().zip(next).enumerate() {
+            let (now, sum, next, size) = (&now[axis][..n], &mut sum[..n], &mut next[..n], size[axis]);
+            for i in 0..n {
+                let x = now[i];
+                let a = sum[i] / mass;
+                let moved = x + keep * (x - next[i]) + a * dt * dt;
+                let x = if pinned[i] { x } else { moved };
+                next[i] = x;
+                sum[i] = x / size;
+            }
+        }
+    }
 }
 
 /// The margin that keeps a "within the limit" decision made without a square root the
@@ -198,125 +288,6 @@ fn floor_i64(x: f64) -> i64 {
         t.saturating_sub(1)
     } else {
         t
-    }
-}
-
-/// The spring force law, `k (|pb - pa| - rest) (pb - pa) / |pb - pa|` on `a`, evaluated
-/// four springs at a time so that the square roots and divisions go through the processor's
-/// vector units (each lane is the same correctly rounded operation as the scalar one).
-#[derive(Clone, Copy)]
-struct SpringLaw {
-    k: [f64; 3],
-    enabled: [bool; 3],
-}
-
-/// Springs per [`ForceLanes`].
-const LANES: usize = 4;
-
-/// The forces of [`LANES`] consecutive springs, one array per axis.
-#[derive(Clone, Copy, Debug, Default)]
-struct ForceLanes {
-    x: [f64; LANES],
-    y: [f64; LANES],
-    z: [f64; LANES],
-}
-
-impl ForceLanes {
-    #[inline(always)]
-    fn get(lanes: &[ForceLanes], spring: usize) -> DVec3 {
-        let f = &lanes[spring / LANES];
-        let l = spring % LANES;
-        DVec3::new(f.x[l], f.y[l], f.z[l])
-    }
-}
-
-impl SpringLaw {
-    /// The force of every spring on its mass `a`; zero for a disabled family or a spring
-    /// of length zero.
-    fn forces(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
-        #[cfg(target_arch = "x86_64")]
-        if prism_math::Isa::avx() {
-            // SAFETY: the processor has AVX.
-            return unsafe { self.forces_avx(positions, springs, out) };
-        }
-        self.forces_lanes(positions, springs, out);
-    }
-
-    /// [`SpringLaw::forces`] with AVX: four springs per vector, each lane the scalar law's
-    /// operations in the scalar law's order.
-    ///
-    /// # Safety
-    /// The processor must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn forces_avx(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
-        let mut spring_chunks = springs.chunks_exact(LANES);
-        for (o, s) in out.iter_mut().zip(&mut spring_chunks) {
-            let lanes = self.load(positions, s);
-            // SAFETY: the caller guarantees AVX.
-            unsafe { simd::spring_law_avx(&lanes, &mut o.x, &mut o.y, &mut o.z) };
-        }
-        self.forces_tail(positions, spring_chunks.remainder(), out);
-    }
-
-    /// The law lane by lane, for processors without AVX.
-    fn forces_lanes(&self, positions: &[DVec3], springs: &[Spring], out: &mut [ForceLanes]) {
-        let mut spring_chunks = springs.chunks_exact(LANES);
-        for (o, s) in out.iter_mut().zip(&mut spring_chunks) {
-            for (l, s) in s.iter().enumerate() {
-                let f = self.force(positions, s);
-                (o.x[l], o.y[l], o.z[l]) = (f.x, f.y, f.z);
-            }
-        }
-        self.forces_tail(positions, spring_chunks.remainder(), out);
-    }
-
-    /// The springs after the last whole group of [`LANES`], into the last group.
-    fn forces_tail(&self, positions: &[DVec3], tail: &[Spring], out: &mut [ForceLanes]) {
-        if tail.is_empty() {
-            return;
-        }
-        if let Some(o) = out.last_mut() {
-            for (l, s) in tail.iter().enumerate() {
-                let f = self.force(positions, s);
-                (o.x[l], o.y[l], o.z[l]) = (f.x, f.y, f.z);
-            }
-        }
-    }
-
-    /// The lanes' `pb - pa` per axis, rest lengths and stiffnesses (0 for a disabled family,
-    /// which adds a signed zero: no change to a sum).
-    #[inline(always)]
-    fn load(&self, positions: &[DVec3], s: &[Spring]) -> [[f64; LANES]; 5] {
-        let mut v = [[0.0; LANES]; 5];
-        for (l, s) in s.iter().enumerate().take(LANES) {
-            let (pa, pb) = (positions[s.a as usize], positions[s.b as usize]);
-            v[0][l] = pb.x - pa.x;
-            v[1][l] = pb.y - pa.y;
-            v[2][l] = pb.z - pa.z;
-            v[3][l] = s.rest;
-            let kind = s.kind as usize;
-            v[4][l] = if self.enabled[kind] {
-                self.k[kind]
-            } else {
-                0.0
-            };
-        }
-        v
-    }
-
-    /// One spring's force, the law as written.
-    #[inline(always)]
-    fn force(&self, positions: &[DVec3], s: &Spring) -> DVec3 {
-        if !self.enabled[s.kind as usize] {
-            return DVec3::ZERO;
-        }
-        let d = positions[s.b as usize] - positions[s.a as usize];
-        let len = d.length();
-        if len == 0.0 {
-            return DVec3::ZERO;
-        }
-        self.k[s.kind as usize] * (len - s.rest) * (d / len)
     }
 }
 
@@ -394,6 +365,12 @@ impl Cloth {
             }
         }
         let count = springs.len();
+        let k = [
+            c.enable_structural.then_some(c.ks),
+            c.enable_shearing.then_some(c.ks),
+            c.enable_bending.then_some(0.2 * c.ks),
+        ];
+        let grid = SpringGrid::new(nw, nh, &springs, k);
         Cloth {
             scene: scene.clone(),
             last: positions.clone(),
@@ -402,7 +379,7 @@ impl Cloth {
             springs,
             times: StepTimes::default(),
             mass: c.width * c.height * c.density / (nw * nh) as f64,
-            spring_forces: vec![ForceLanes::default(); count.div_ceil(LANES)],
+            grid,
             incident_start,
             incident,
             sorted: vec![DVec3::ZERO; n],
@@ -414,17 +391,37 @@ impl Cloth {
         }
     }
 
+    /// The springs, in creation order.
+    #[must_use]
+    pub fn springs(&self) -> &[Spring] {
+        &self.springs
+    }
+
+    /// Makes every spring's rest length its length at the current positions: the cloth as
+    /// it is now becomes its rest shape.
+    pub fn rest_as_now(&mut self) {
+        for s in &mut self.springs {
+            s.rest = (self.positions[s.a as usize] - self.positions[s.b as usize]).length();
+        }
+        let k = self.grid.stiffness();
+        let c = &self.scene.cloth;
+        self.grid = SpringGrid::new(c.num_width_points, c.num_height_points, &self.springs, k);
+    }
+
     /// The time step, `1/90/30` s.
     #[must_use]
     pub fn dt() -> f64 {
         1.0 / FRAMES_PER_SECOND / STEPS_PER_FRAME as f64
     }
 
-    /// One frame: 30 time steps.
+    /// One frame: 30 time steps, run from one of rayon's threads so that each step's
+    /// parallel passes start without waking the pool from outside.
     pub fn frame(&mut self) {
-        for _ in 0..STEPS_PER_FRAME {
-            self.step();
-        }
+        rayon::scope(|_| {
+            for _ in 0..STEPS_PER_FRAME {
+                self.step();
+            }
+        });
     }
 
     /// One time step: forces, Verlet, self-collision, collision objects, length limit.
@@ -446,16 +443,7 @@ impl Cloth {
 
     /// Step 1, first half: each spring's force on its own.
     fn spring_forces(&mut self) {
-        let c = &self.scene.cloth;
-        let law = SpringLaw {
-            k: [c.ks, c.ks, 0.2 * c.ks],
-            enabled: [c.enable_structural, c.enable_shearing, c.enable_bending],
-        };
-        let positions = &self.positions;
-        self.spring_forces
-            .par_chunks_mut(4096 / LANES)
-            .zip(self.springs.par_chunks(4096))
-            .for_each(|(out, springs)| law.forces(positions, springs, out));
+        self.grid.forces(&self.positions);
     }
 
     /// Step 1, second half, and step 2, per mass: the forces of the mass's springs added
@@ -463,38 +451,46 @@ impl Cloth {
     /// adds them, so every sum is bit for bit the sequential one), Verlet with damping in
     /// percent for unpinned masses, then the mass's self-collision box.
     fn verlet(&mut self) {
-        let dt = Cloth::dt();
-        let keep = 1.0 - self.scene.cloth.damping / 100.0;
-        let mass = self.mass;
-        // Adding a zero force leaves a running sum unchanged: the sum starts at the weight,
-        // so it is never -0.
-        let weight = GRAVITY * mass;
-        let grid = self.box_grid();
-        let (start, incident, forces) = (&self.incident_start, &self.incident, &self.spring_forces);
+        let box_grid = self.box_grid();
+        let step = Verlet {
+            dt: Cloth::dt(),
+            keep: 1.0 - self.scene.cloth.damping / 100.0,
+            mass: self.mass,
+            size: box_grid.size.to_array(),
+        };
+        let weight = GRAVITY * self.mass;
+        let nw = self.scene.cloth.num_width_points;
+        let grid = &self.grid;
         self.positions
-            .par_iter_mut()
-            .zip(self.last.par_iter_mut())
-            .zip(self.keys.par_iter_mut().zip(self.pinned.par_iter()))
+            .par_chunks_mut(nw)
+            .zip(self.last.par_chunks_mut(nw))
+            .zip(self.keys.par_chunks_mut(nw).zip(self.pinned.par_chunks(nw)))
             .enumerate()
-            .with_min_len(1024)
-            .for_each(|(m, ((x, last), (key, &pinned)))| {
-                if !pinned {
-                    let mut f = weight;
-                    for &e in &incident[start[m] as usize..start[m + 1] as usize] {
-                        let spring = ForceLanes::get(forces, (e >> 1) as usize);
-                        if e & 1 == 0 {
-                            f += spring;
-                        } else {
-                            f -= spring;
+            .with_min_len(4)
+            .for_each_init(
+                || vec![0.0; 6 * nw],
+                |scratch, (y, ((xs, lasts), (keys, pinned)))| {
+                    let (sums, next) = scratch.split_at_mut(3 * nw);
+                    let [sx, sy, sz] = thirds(sums);
+                    grid.row_sums(y, weight, [&mut *sx, &mut *sy, &mut *sz]);
+                    let [nx, ny, nz] = thirds(next);
+                    let now = grid.row_positions(y);
+                    step.row(
+                        now,
+                        lasts,
+                        pinned,
+                        [&mut *sx, &mut *sy, &mut *sz],
+                        [&mut *nx, &mut *ny, &mut *nz],
+                    );
+                    for i in 0..xs.len() {
+                        if !pinned[i] {
+                            lasts[i] = xs[i];
+                            xs[i] = DVec3::new(nx[i], ny[i], nz[i]);
                         }
+                        keys[i] = box_grid.key_of_quotients([sx[i], sy[i], sz[i]]);
                     }
-                    let now = *x;
-                    let a = f / mass;
-                    *x = now + keep * (now - *last) + a * dt * dt;
-                    *last = now;
-                }
-                *key = grid.key(*x);
-            });
+                },
+            );
     }
 
     /// The self-collision boxes for this cloth.
