@@ -21,6 +21,70 @@ fn attr(out: &mut Vec<u8>, name: &str, ty: &str, value: &[u8]) {
     out.extend_from_slice(value);
 }
 
+/// The compression codes prism writes.
+pub(crate) const UNCOMPRESSED: u8 = 0;
+/// ZIP, sixteen lines a block in a scanline file, one tile a block in a tiled one.
+pub(crate) const ZIP: u8 = 3;
+
+/// The header of a single-part file of `width x height` pixels: magic, version (tiled with
+/// square tiles of `tile` pixels, else scanline), the channels (`(name, pixel type)`, sorted
+/// here), the standard attributes, the string attributes and the closing NUL.
+pub(crate) fn header_bytes(
+    (w, h): (usize, usize),
+    channels: &[(&str, i32)],
+    compression: u8,
+    tile: Option<u32>,
+    attributes: &[(String, String)],
+) -> Vec<u8> {
+    let mut channels = channels.to_vec();
+    channels.sort();
+    let mut out = Vec::new();
+    out.extend_from_slice(&20_000_630i32.to_le_bytes());
+    let version = if tile.is_some() { 2 | TILED } else { 2 };
+    out.extend_from_slice(&version.to_le_bytes());
+    let mut chlist = Vec::new();
+    for (name, pixel_type) in &channels {
+        chlist.extend_from_slice(name.as_bytes());
+        chlist.push(0);
+        chlist.extend_from_slice(&pixel_type.to_le_bytes());
+        chlist.extend_from_slice(&[0, 0, 0, 0]); // pLinear + reserved
+        chlist.extend_from_slice(&1i32.to_le_bytes()); // xSampling
+        chlist.extend_from_slice(&1i32.to_le_bytes()); // ySampling
+    }
+    chlist.push(0);
+    attr(&mut out, "channels", "chlist", &chlist);
+    attr(&mut out, "compression", "compression", &[compression]);
+    let mut bx = Vec::new();
+    for v in [0, 0, w as i32 - 1, h as i32 - 1] {
+        bx.extend_from_slice(&v.to_le_bytes());
+    }
+    attr(&mut out, "dataWindow", "box2i", &bx);
+    attr(&mut out, "displayWindow", "box2i", &bx);
+    attr(&mut out, "lineOrder", "lineOrder", &[0]);
+    attr(&mut out, "pixelAspectRatio", "float", &1f32.to_le_bytes());
+    let mut center = Vec::new();
+    center.extend_from_slice(&0f32.to_le_bytes());
+    center.extend_from_slice(&0f32.to_le_bytes());
+    attr(&mut out, "screenWindowCenter", "v2f", &center);
+    attr(&mut out, "screenWindowWidth", "float", &1f32.to_le_bytes());
+    if let Some(t) = tile {
+        // One level of `t x t` tiles, sizes rounded down.
+        let mut desc = Vec::new();
+        desc.extend_from_slice(&t.to_le_bytes());
+        desc.extend_from_slice(&t.to_le_bytes());
+        desc.push(0);
+        attr(&mut out, "tiles", "tiledesc", &desc);
+    }
+    for (name, value) in attributes {
+        attr(&mut out, name, "string", value.as_bytes());
+    }
+    out.push(0);
+    out
+}
+
+/// The version field's flag of a single-part tiled file.
+pub(crate) const TILED: i32 = 0x200;
+
 /// One channel's samples, row by row from the top.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExrSamples {
@@ -31,7 +95,7 @@ pub enum ExrSamples {
 }
 
 impl ExrSamples {
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         match self {
             ExrSamples::Float(v) => v.len(),
             ExrSamples::Uint(v) => v.len(),
@@ -39,7 +103,7 @@ impl ExrSamples {
     }
 
     /// The OpenEXR pixel type: 0 uint, 2 float.
-    fn pixel_type(&self) -> i32 {
+    pub(crate) fn pixel_type(&self) -> i32 {
         match self {
             ExrSamples::Float(_) => 2,
             ExrSamples::Uint(_) => 0,
@@ -83,7 +147,7 @@ impl ExrLayers {
 }
 
 /// OpenEXR's ZIP transform: interleave into even and odd bytes, the delta predictor, zlib.
-fn zip(raw: &[u8]) -> Vec<u8> {
+pub(crate) fn zip(raw: &[u8]) -> Vec<u8> {
     let mut t: Vec<u8> = raw.iter().step_by(2).copied().collect();
     t.extend(raw.iter().skip(1).step_by(2));
     for i in (1..t.len()).rev() {
@@ -106,43 +170,12 @@ fn encode(layers: &ExrLayers, compress: bool) -> Vec<u8> {
             "channel {name} holds the wrong number of samples"
         );
     }
-    let mut out = Vec::new();
-    out.extend_from_slice(&20_000_630i32.to_le_bytes());
-    out.extend_from_slice(&2i32.to_le_bytes());
-    let mut chlist = Vec::new();
-    for (name, c) in &channels {
-        chlist.extend_from_slice(name.as_bytes());
-        chlist.push(0);
-        chlist.extend_from_slice(&c.pixel_type().to_le_bytes());
-        chlist.extend_from_slice(&[0, 0, 0, 0]); // pLinear + reserved
-        chlist.extend_from_slice(&1i32.to_le_bytes()); // xSampling
-        chlist.extend_from_slice(&1i32.to_le_bytes()); // ySampling
-    }
-    chlist.push(0);
-    attr(&mut out, "channels", "chlist", &chlist);
-    attr(
-        &mut out,
-        "compression",
-        "compression",
-        &[if compress { 3 } else { 0 }],
-    );
-    let mut bx = Vec::new();
-    for v in [0, 0, w as i32 - 1, h as i32 - 1] {
-        bx.extend_from_slice(&v.to_le_bytes());
-    }
-    attr(&mut out, "dataWindow", "box2i", &bx);
-    attr(&mut out, "displayWindow", "box2i", &bx);
-    attr(&mut out, "lineOrder", "lineOrder", &[0]);
-    attr(&mut out, "pixelAspectRatio", "float", &1f32.to_le_bytes());
-    let mut center = Vec::new();
-    center.extend_from_slice(&0f32.to_le_bytes());
-    center.extend_from_slice(&0f32.to_le_bytes());
-    attr(&mut out, "screenWindowCenter", "v2f", &center);
-    attr(&mut out, "screenWindowWidth", "float", &1f32.to_le_bytes());
-    for (name, value) in &layers.attributes {
-        attr(&mut out, name, "string", value.as_bytes());
-    }
-    out.push(0);
+    let types: Vec<(&str, i32)> = channels
+        .iter()
+        .map(|(n, c)| (n.as_str(), c.pixel_type()))
+        .collect();
+    let compression = if compress { ZIP } else { UNCOMPRESSED };
+    let mut out = header_bytes((w, h), &types, compression, None, &layers.attributes);
     let lines = if compress { 16 } else { 1 };
     let blocks: Vec<Vec<u8>> = (0..h)
         .step_by(lines)
@@ -183,22 +216,95 @@ fn encode(layers: &ExrLayers, compress: bool) -> Vec<u8> {
     out
 }
 
+/// A linear RGB picture written as an uncompressed float OpenEXR file row by row, from the
+/// top: the file's bytes are those of [`encode_exr`] on the whole picture, and only a row
+/// is held at a time (every block's size is known, so the offset table comes first).
+pub struct ExrRowWriter<W: Write> {
+    out: W,
+    width: usize,
+    height: usize,
+    rows: usize,
+    line: Vec<u8>,
+}
+
+impl<W: Write> ExrRowWriter<W> {
+    /// Writes the header and offset table of a `width x height` picture to `out`.
+    ///
+    /// # Errors
+    /// [`ImageError::Encode`] if `out` fails.
+    pub fn new(mut out: W, width: u32, height: u32) -> Result<Self, ImageError> {
+        let (width, height) = (width as usize, height as usize);
+        let channels = [("B", FLOAT), ("G", FLOAT), ("R", FLOAT)];
+        let mut head = header_bytes((width, height), &channels, UNCOMPRESSED, None, &[]);
+        let block = 8 + 12 * width as u64;
+        let first = (head.len() + 8 * height) as u64;
+        for y in 0..height as u64 {
+            head.extend_from_slice(&(first + y * block).to_le_bytes());
+        }
+        out.write_all(&head).map_err(encode_io)?;
+        Ok(ExrRowWriter {
+            out,
+            width,
+            height,
+            rows: 0,
+            line: Vec::with_capacity(8 + 12 * width),
+        })
+    }
+
+    /// Writes the next row.
+    ///
+    /// # Errors
+    /// [`ImageError::Encode`] if `out` fails.
+    ///
+    /// # Panics
+    /// If the row is not `width` pixels long or every row has been written.
+    pub fn write_row(&mut self, row: &[Rgb]) -> Result<(), ImageError> {
+        assert_eq!(row.len(), self.width, "a row of the picture's width");
+        assert!(self.rows < self.height, "no more rows than the picture's height");
+        self.line.clear();
+        self.line.extend_from_slice(&(self.rows as i32).to_le_bytes());
+        self.line
+            .extend_from_slice(&((12 * self.width) as i32).to_le_bytes());
+        for c in [2, 1, 0] {
+            for p in row {
+                self.line
+                    .extend_from_slice(&p.to_array()[c].to_le_bytes());
+            }
+        }
+        self.rows += 1;
+        self.out.write_all(&self.line).map_err(encode_io)
+    }
+
+    /// Ends the file, handing back the writer.
+    ///
+    /// # Panics
+    /// If a row is missing.
+    pub fn finish(self) -> W {
+        assert_eq!(self.rows, self.height, "every row written");
+        self.out
+    }
+}
+
+/// The pixel type of 32-bit floats.
+const FLOAT: i32 = 2;
+
+/// A writer's failure while encoding.
+fn encode_io(e: std::io::Error) -> ImageError {
+    ImageError::Encode {
+        format: "OpenEXR",
+        message: e.to_string(),
+    }
+}
+
 /// Encodes a linear RGB image as an uncompressed float OpenEXR file.
 #[must_use]
 pub fn encode_exr(image: &RgbImage) -> Vec<u8> {
-    let channel =
-        |c: usize| ExrSamples::Float(image.pixels().iter().map(|p| p.to_array()[c]).collect());
-    let layers = ExrLayers {
-        width: image.width(),
-        height: image.height(),
-        channels: vec![
-            ("R".into(), channel(0)),
-            ("G".into(), channel(1)),
-            ("B".into(), channel(2)),
-        ],
-        attributes: Vec::new(),
-    };
-    encode(&layers, false)
+    let mut w = ExrRowWriter::new(Vec::new(), image.width(), image.height())
+        .expect("a Vec takes any bytes");
+    for row in image.pixels().chunks(image.width() as usize) {
+        w.write_row(row).expect("a Vec takes any bytes");
+    }
+    w.finish()
 }
 
 /// Encodes any channels and string attributes as a ZIP-compressed OpenEXR file.
@@ -233,7 +339,14 @@ fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
 /// # Errors
 /// [`ImageError::Io`] if the file cannot be written; the destination is then untouched.
 pub fn write_exr(path: &Path, image: &RgbImage) -> Result<(), ImageError> {
-    write_bytes(path, &encode_exr(image))
+    write_atomic(path, |out| {
+        let mut w = ExrRowWriter::new(out, image.width(), image.height())?;
+        for row in image.pixels().chunks(image.width() as usize) {
+            w.write_row(row)?;
+        }
+        w.finish();
+        Ok(())
+    })
 }
 
 /// A half-precision float's value.
@@ -291,7 +404,7 @@ impl<'a> Bytes<'a> {
 
 /// Undoes OpenEXR's ZIP transform: inflate, then the byte predictor, then interleave the
 /// two halves. The result must be exactly `expected` bytes.
-fn unzip(block: &[u8], expected: usize, what: &str) -> Result<Vec<u8>, ImageError> {
+pub(crate) fn unzip(block: &[u8], expected: usize, what: &str) -> Result<Vec<u8>, ImageError> {
     let t = miniz_oxide::inflate::decompress_to_vec_zlib_with_limit(block, expected)
         .map_err(|_| decode_err(what, "a ZIP block does not inflate to its scanlines"))?;
     if t.len() != expected {
@@ -367,21 +480,42 @@ pub fn decode_exr_header(data: &[u8], what: &str) -> Result<ExrLayers, ImageErro
     decode(data, what, false)
 }
 
-/// The one decoder: the header, then the pixels if `pixels`.
-fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError> {
+/// What a file's header says, for the reader.
+pub(crate) struct Header {
+    /// Channels as `(name, pixel type)`, in name order (the order of their samples).
+    pub(crate) channels: Vec<(String, i32)>,
+    /// The compression code.
+    pub(crate) compression: u8,
+    /// The data window's top row.
+    pub(crate) y0: i32,
+    /// Width and height.
+    pub(crate) size: (u64, u64),
+    /// The string attributes.
+    pub(crate) attributes: Vec<(String, String)>,
+    /// Tiled files: the tiles' width and height.
+    pub(crate) tile: Option<(u32, u32)>,
+    /// Where the header ends (the offset table begins).
+    pub(crate) end: usize,
+}
+
+/// Reads a single-part file's header, scanline or (`tiled`) tiled with one level of tiles.
+pub(crate) fn parse_header(data: &[u8], what: &str, tiled: bool) -> Result<Header, ImageError> {
     let mut b = Bytes { data, at: 0, what };
     if b.take(4)? != [0x76, 0x2f, 0x31, 0x01] {
         return Err(decode_err(what, "expected the OpenEXR signature"));
     }
     let version = b.i32()?;
-    if version & 0xff != 2 || version & 0x1e00 != 0 {
+    if tiled && (version & 0xff != 2 || version & 0x1e00 != TILED) {
+        return Err(decode_err(what, "expected a single-part tiled OpenEXR 2 file"));
+    }
+    if !tiled && (version & 0xff != 2 || version & 0x1e00 != 0) {
         return Err(decode_err(
             what,
             "expected a single-part scanline OpenEXR 2 file (tiled, deep and multi-part files are not read)",
         ));
     }
     let mut channels: Vec<(String, i32)> = Vec::new();
-    let (mut compression, mut window) = (None, None);
+    let (mut compression, mut window, mut tile) = (None, None, None);
     let mut attributes = Vec::new();
     loop {
         let name = b.name()?;
@@ -420,6 +554,22 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
                 name.to_string(),
                 String::from_utf8_lossy(value).into_owned(),
             )),
+            ("tiles", "tiledesc") => {
+                let mut c = Bytes {
+                    data: value,
+                    at: 0,
+                    what,
+                };
+                let (x, y) = (c.i32()? as u32, c.i32()? as u32);
+                let mode = c.take(1)?[0];
+                if mode != 0 || x == 0 || y == 0 || x > 1 << 16 || y > 1 << 16 {
+                    return Err(decode_err(
+                        what,
+                        "expected one level of tiles of 1 to 65536 pixels a side",
+                    ));
+                }
+                tile = Some((x, y));
+            }
             ("dataWindow", "box2i") => {
                 let mut c = Bytes {
                     data: value,
@@ -439,7 +589,44 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
     if w <= 0 || h <= 0 {
         return Err(decode_err(what, format!("dataWindow is empty ({w}x{h})")));
     }
-    let (w, h) = (w as u64, h as u64);
+    let compression = compression.ok_or_else(|| decode_err(what, "expected a compression attribute"))?;
+    if tiled && tile.is_none() {
+        return Err(decode_err(what, "expected a tiles attribute"));
+    }
+    // A file without channels holds no pixels: its data window alone would let a few bytes
+    // ask for an image of any size.
+    if channels.is_empty() {
+        return Err(decode_err(what, "expected at least one channel"));
+    }
+    channels.sort();
+    Ok(Header {
+        channels,
+        compression,
+        y0,
+        size: (w as u64, h as u64),
+        attributes,
+        tile,
+        end: b.at,
+    })
+}
+
+/// The one decoder: the header, then the pixels if `pixels`.
+fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError> {
+    let Header {
+        channels,
+        compression,
+        y0,
+        size: (w, h),
+        attributes,
+        end,
+        ..
+    } = parse_header(data, what, false)?;
+    let mut b = Bytes {
+        data,
+        at: end,
+        what,
+    };
+    let compression = Some(compression);
     let lines_per_block = match compression {
         Some(0) | Some(2) => 1,
         Some(3) => 16,
@@ -458,13 +645,7 @@ fn decode(data: &[u8], what: &str, pixels: bool) -> Result<ExrLayers, ImageError
         }
         None => return Err(decode_err(what, "expected a compression attribute")),
     };
-    // A file without channels holds no pixels: its data window alone would let a few bytes
-    // ask for an image of any size.
-    if channels.is_empty() {
-        return Err(decode_err(what, "expected at least one channel"));
-    }
     // Channels are stored in name order; each has 2 (half) or 4 (uint, float) bytes a sample.
-    channels.sort();
     let mut layout = Vec::new();
     let mut line_bytes = 0u64;
     for (name, ty) in &channels {
@@ -776,6 +957,21 @@ mod tests {
     }
 
     /// Oracle: what the writer wrote reads back exactly.
+    /// Brute force: the row writer's file is the general encoder's, uncompressed, for the
+    /// same three channels.
+    #[test]
+    fn row_writer_bytes_equal_the_general_encoder() {
+        let img = Image::from_fn(37, 5, |x, y| Rgb::new(x as f32, y as f32 * 0.25, -1.5));
+        let channel = |c: usize| ExrSamples::Float(img.pixels().iter().map(|p| p.to_array()[c]).collect());
+        let layers = ExrLayers {
+            width: 37,
+            height: 5,
+            channels: vec![("R".into(), channel(0)), ("G".into(), channel(1)), ("B".into(), channel(2))],
+            attributes: Vec::new(),
+        };
+        assert_eq!(encode_exr(&img), encode(&layers, false));
+    }
+
     #[test]
     fn uncompressed_float_round_trip() {
         let im = Image::from_fn(5, 3, |x, y| Rgb::new(x as f32 * 0.25, y as f32, -1.5));

@@ -262,18 +262,15 @@ fn encode_png_channels(
     color: png::ColorType,
     out: &mut impl Write,
 ) -> Result<(), ImageError> {
-    let err = |e: png::EncodingError| ImageError::Encode {
-        format: "PNG",
-        message: e.to_string(),
+    let color = match color {
+        png::ColorType::Rgba => crate::PngColor::Rgba,
+        _ => crate::PngColor::Rgb,
     };
-    let mut enc = png::Encoder::new(out, width, height);
-    enc.set_color(color);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_compression(png::Compression::Fast);
-    enc.set_filter(png::FilterType::Paeth);
-    let mut w = enc.write_header().map_err(err)?;
-    w.write_image_data(data).map_err(err)?;
-    w.finish().map_err(err)
+    let mut w = crate::PngRowWriter::new(out, width, height, color)?;
+    for row in data.chunks_exact(data.len() / height as usize) {
+        w.write_row(row)?;
+    }
+    w.finish().map(|_| ())
 }
 
 /// Encodes an RGB8 image as PNG bytes.

@@ -1,5 +1,6 @@
 //! Floor-1 imaging for prism: the one image type, sRGB/linear conversions, PNG/JPEG/EXR IO
-//! and Radiance HDR input, the one texture sampler (mipmaps, nearest/bilinear/trilinear),
+//! (PNG and EXR also written row by row, and tiled OpenEXR read and written a tile at a
+//! time) and Radiance HDR input, the one texture sampler (mipmaps, nearest/bilinear/trilinear),
 //! image-difference metrics, cube maps looked up as OpenGL does, heat maps, bloom, BMP
 //! output, animated PNGs and montages (pictures side by side in a grid).
 #![warn(missing_docs)]
@@ -10,12 +11,14 @@ mod cubemap;
 mod diff;
 mod error;
 mod exr;
+mod exr_tiled;
 mod hdr;
 mod heatmap;
 mod image;
 mod io;
 mod montage;
 mod piz;
+mod png_rows;
 mod srgb;
 mod texture;
 
@@ -26,8 +29,10 @@ pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{
     decode_exr, decode_exr_header, decode_exr_layers, encode_exr, encode_exr_layers, read_exr,
-    read_exr_layers, read_radiance, write_exr, write_exr_layers, ExrLayers, ExrSamples,
+    read_exr_layers, read_radiance, write_exr, write_exr_layers, ExrLayers, ExrRowWriter,
+    ExrSamples,
 };
+pub use exr_tiled::{TiledExrReader, TiledExrWriter};
 pub use hdr::{decode_hdr, is_hdr};
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
@@ -38,5 +43,6 @@ pub use io::{
     MAX_IMAGE_FILE_BYTES,
 };
 pub use montage::montage;
+pub use png_rows::{PngColor, PngRowWriter};
 pub use srgb::{linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear};
 pub use texture::{LevelSampling, PixelSampling, Texture, UvConvention, Wrap};

@@ -151,14 +151,8 @@ impl std::error::Error for InputRefused {}
 /// an [`InputRefused`].
 pub fn read_input(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     let refused = |why| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
-    if !std::fs::metadata(path)?.is_file() {
-        return Err(refused(InputRefused::NotAFile));
-    }
-    let file = std::fs::File::open(path)?;
+    let file = open_input(path)?;
     let meta = file.metadata()?;
-    if !meta.is_file() {
-        return Err(refused(InputRefused::NotAFile));
-    }
     if meta.len() > limit {
         return Err(refused(InputRefused::TooLarge {
             bytes: meta.len(),
@@ -174,6 +168,24 @@ pub fn read_input(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
         }));
     }
     Ok(bytes)
+}
+
+/// Opens an input file to read in pieces, if it is a regular file; anything else is refused
+/// as [`read_input`] refuses it.
+///
+/// # Errors
+/// The operating system's error, or an [`std::io::ErrorKind::InvalidInput`] error holding
+/// [`InputRefused::NotAFile`].
+pub fn open_input(path: &Path) -> std::io::Result<std::fs::File> {
+    let refused = || std::io::Error::new(std::io::ErrorKind::InvalidInput, InputRefused::NotAFile);
+    if !std::fs::metadata(path)?.is_file() {
+        return Err(refused());
+    }
+    let file = std::fs::File::open(path)?;
+    if !file.metadata()?.is_file() {
+        return Err(refused());
+    }
+    Ok(file)
 }
 
 /// Reads a whole input text file as [`read_input`] does; bytes that are not UTF-8 are an
