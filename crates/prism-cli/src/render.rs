@@ -2,14 +2,16 @@
 
 use prism_math::Warning;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use prism_render::film::{FilmSettings, Share};
 use prism_render::integrators::{Integrator, PathSettings};
-use prism_render::parts::{Part, PartIdentity};
-use prism_render::render::{render, render_share, Job, RenderOptions};
+use prism_render::parts::{PartIdentity, PartWriter};
+use prism_render::render::{render, render_tiles, Job, RenderOptions};
 use prism_render::render_scene::RenderScene;
 use prism_scene::{CameraMode, NormalsMode, SceneOptions};
 
@@ -637,32 +639,63 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let bar = crate::progress::samples_bar(pixels * share.samples.len() as u64, a.quiet);
         let t2 = Instant::now();
         let profile = prism_render::profile::Profile::default();
-        let sums = pool.install(|| {
-            let job = Job {
-                share: &share,
-                skip: None,
-                profile: Some(&profile),
-                stop: None,
-                camera: None,
-            };
-            render_share(&prepared, &options, &job, &|done| bar.set_position(done))
-        });
-        let render_time = t2.elapsed();
-        bar.finish_and_clear();
-        let t3 = Instant::now();
         let fingerprint = Instant::now();
         let identity = PartIdentity::path(scene.fingerprint(), &options);
         let fingerprint = fingerprint.elapsed();
-        let part = Part::new(identity.to_attributes(), share, sums);
-        crate::split::write_part(&part, &a.output, a.quiet, t0)?;
+        // Each tile goes into the part file as soon as it is rendered (in tile order): the
+        // render holds the tiles in flight, not a picture of sums.
+        let samples = std::sync::atomic::AtomicU64::new(0);
+        prism_image::write_atomic(&a.output, |out| {
+            let writer = Mutex::new(PartWriter::new(
+                out,
+                identity.to_attributes(),
+                share.clone(),
+                w,
+                h,
+            )?);
+            let failed = Mutex::new(None);
+            let stop = AtomicBool::new(false);
+            pool.install(|| {
+                let job = Job {
+                    share: &share,
+                    skip: None,
+                    profile: Some(&profile),
+                    stop: Some(&stop),
+                    camera: None,
+                };
+                let progress = |done| bar.set_position(done);
+                render_tiles(&prepared, &options, &job, &progress, |origin, sums| {
+                    let n: u64 = sums.iter().map(|p| u64::from(p.n)).sum();
+                    samples.fetch_add(n, Ordering::Relaxed);
+                    let mut w = writer.lock().unwrap_or_else(PoisonError::into_inner);
+                    if let Err(e) = w.add(origin, sums) {
+                        stop.store(true, Ordering::Relaxed);
+                        failed
+                            .lock()
+                            .unwrap_or_else(PoisonError::into_inner)
+                            .get_or_insert(e);
+                    }
+                });
+            });
+            if let Some(e) = failed.into_inner().unwrap_or_else(PoisonError::into_inner) {
+                return Err(e);
+            }
+            let writer = writer.into_inner().unwrap_or_else(PoisonError::into_inner);
+            writer.finish()?;
+            Ok(())
+        })?;
+        let render_time = t2.elapsed();
+        bar.finish_and_clear();
+        let t3 = Instant::now();
+        let samples = samples.into_inner();
+        crate::split::part_summary(&share, samples, &a.output, a.quiet, t0);
         if a.stats {
             let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-            let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
             eprintln!("read: {:.1} ms", ms(read));
             eprintln!("build: {:.1} ms", ms(build));
-            eprintln!("render: {:.1} ms", ms(render_time));
+            eprintln!("render and write: {:.1} ms", ms(render_time));
             eprintln!("fingerprint: {:.1} ms", ms(fingerprint));
-            eprintln!("write: {:.1} ms", ms(t3.elapsed()));
+            eprintln!("finish: {:.1} ms", ms(t3.elapsed()));
             eprintln!("samples: {samples}");
             eprintln!(
                 "samples/s: {:.0}",

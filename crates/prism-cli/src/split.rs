@@ -6,10 +6,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 use clap::Args;
-use prism_image::Image;
+use prism_image::{AtomicFile, ExrRowWriter, Image, ImageError, PngColor, PngRowWriter};
 use prism_math::Rgb;
-use prism_render::film::PixelSum;
-use prism_render::parts::{merge, Encoding, Part, PartFile, PartIdentity};
+use prism_render::film::{PixelSum, Share};
+use prism_render::parts::{merge, merge_rows, Encoding, Part, PartError, PartFile, PartIdentity};
 
 use crate::error::UserError;
 use crate::output::ImageFormat;
@@ -72,20 +72,25 @@ pub fn check_part_output(output: &Path, flags: &[&str]) -> Result<()> {
 /// terminal.
 pub fn write_part(part: &Part, output: &Path, quiet: bool, started: Instant) -> Result<()> {
     part.write(output)?;
+    let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
+    part_summary(&part.header.share, samples, output, quiet, started);
+    Ok(())
+}
+
+/// The summary line of a written part, when not quiet on a terminal.
+pub fn part_summary(share: &Share, samples: u64, output: &Path, quiet: bool, started: Instant) {
     if !quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        let samples: u64 = part.sums.pixels().iter().map(|p| u64::from(p.n)).sum();
         eprintln!(
             "prism: part {}/{} (samples {}..{}), {:.2} M samples in {:.1} s -> {}",
-            part.header.share.part,
-            part.header.share.parts,
-            part.header.share.samples.start,
-            part.header.share.samples.end,
+            share.part,
+            share.parts,
+            share.samples.start,
+            share.samples.end,
             samples as f64 / 1e6,
             started.elapsed().as_secs_f64(),
             output.display()
         );
     }
-    Ok(())
 }
 
 /// Arguments of `prism merge`.
@@ -132,20 +137,224 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         parts.push(PartFile::open(path).map_err(UserError::input)?);
     }
     let read_time = t0.elapsed();
-    let t1 = Instant::now();
-    let merged = merge(&parts, a.allow_missing).map_err(UserError::input)?;
-    drop(parts);
-    for hole in &merged.holes {
-        eprintln!("prism: warning: missing {hole}");
-    }
-    // Parts prism wrote always have an identity it reads (merge has checked that every part
+    // Parts prism wrote always have an identity it reads (the merge checks that every part
     // holds the same one); a part that does not is refused, not merged on guesses.
-    let identity = PartIdentity::from_attributes(&merged.identity).map_err(|e| {
+    let identity = PartIdentity::from_attributes(&parts[0].header.identity).map_err(|e| {
         UserError::Refused(format!(
             "{}: the part's identity: {e}",
             a.parts[0].display()
         ))
     })?;
+    let t1 = Instant::now();
+    let merged = if identity.bloom().is_some() {
+        merge_whole(a, &mut parts, &identity, format, heatmap_format)?
+    } else {
+        merge_streaming(a, &mut parts, &identity, format, heatmap_format)?
+    };
+    let merge_time = t1.elapsed();
+    for hole in &merged.missing {
+        eprintln!("prism: warning: missing {hole}");
+    }
+    if a.stats {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read: {:.1} ms", ms(read_time));
+        eprintln!("merge and write: {:.1} ms", ms(merge_time));
+    }
+    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        let (w, h) = merged.size;
+        let mut written = vec![a.output.display().to_string()];
+        written.extend(a.exr.iter().map(|p| p.display().to_string()));
+        if heatmap_format.is_some() {
+            written.extend(a.heatmap.iter().map(|p| p.display().to_string()));
+        }
+        eprintln!(
+            "prism: merged {} parts, {w}x{h}{} in {:.2} s -> {}",
+            a.parts.len(),
+            if merged.holes > 0 {
+                format!(", {} pixels missing (magenta)", merged.holes)
+            } else {
+                String::new()
+            },
+            t0.elapsed().as_secs_f64(),
+            written.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// What a merge made, for the summary.
+struct MergeSummary {
+    size: (u32, u32),
+    /// Pixels no part held.
+    holes: usize,
+    /// The shares no part held.
+    missing: Vec<String>,
+}
+
+/// Why a streaming merge stopped: a part, or an output.
+enum MergeFail {
+    Part(PartError),
+    Write(ImageError),
+}
+
+impl From<PartError> for MergeFail {
+    fn from(e: PartError) -> Self {
+        MergeFail::Part(e)
+    }
+}
+
+impl From<ImageError> for MergeFail {
+    fn from(e: ImageError) -> Self {
+        MergeFail::Write(e)
+    }
+}
+
+impl From<MergeFail> for anyhow::Error {
+    fn from(e: MergeFail) -> Self {
+        match e {
+            MergeFail::Part(e) => UserError::input(e).into(),
+            MergeFail::Write(e) => e.into(),
+        }
+    }
+}
+
+/// Where a streamed merge's rows go.
+enum Rows<W: std::io::Write> {
+    Png(PngRowWriter<W>),
+    Exr(ExrRowWriter<W>),
+    /// Gathered, for an encoder that takes the picture whole (JPEG).
+    Whole(Vec<[u8; 3]>),
+}
+
+/// Checks that `memory` more bytes fit the budget, naming the output that needs them.
+fn fits(memory: u64, what: &Path) -> Result<()> {
+    prism_math::limits::check_memory(memory)
+        .map_err(|e| UserError::Refused(format!("{}: {e}", what.display())).into())
+}
+
+/// The merge a row of tiles at a time, each band of rows encoded as it is made: PNG and
+/// OpenEXR outputs are written row by row (the same bytes as written whole), a JPEG or the
+/// heat map is gathered (3 or 4 bytes a pixel).
+fn merge_streaming(
+    a: &MergeArgs,
+    parts: &mut [PartFile],
+    identity: &PartIdentity,
+    format: ImageFormat,
+    heatmap_format: Option<ImageFormat>,
+) -> Result<MergeSummary> {
+    let setting = |k: &str| {
+        parts[0]
+            .header
+            .setting(k)
+            .and_then(|v| v.parse::<u32>().ok())
+            .unwrap_or(0)
+    };
+    let (w, h) = (setting("width"), setting("height"));
+    let pixels = u64::from(w) * u64::from(h);
+    if format == ImageFormat::Jpeg {
+        fits(3 * pixels, &a.output)?;
+    }
+    if let Some(path) = &a.heatmap {
+        fits(4 * pixels, path)?;
+    }
+    let truncated = identity.encoding() == Encoding::Truncated;
+    let to8 = |p: Rgb| -> [u8; 3] {
+        if truncated {
+            let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
+            [b(p.r), b(p.g), b(p.b)]
+        } else {
+            [p.r, p.g, p.b].map(prism_image::linear_to_srgb8)
+        }
+    };
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| ImageError::Io { path, source }
+    };
+    let mut main_file = AtomicFile::create(&a.output).map_err(io(&a.output))?;
+    let mut exr_file = match &a.exr {
+        Some(p) => Some(AtomicFile::create(p).map_err(io(p))?),
+        None => None,
+    };
+    let mut samples: Vec<u32> = Vec::new();
+    let mut holes = 0usize;
+    let missing;
+    {
+        let mut main = match format {
+            ImageFormat::Exr => Rows::Exr(ExrRowWriter::new(main_file.writer(), w, h)?),
+            ImageFormat::Jpeg => Rows::Whole(Vec::with_capacity(pixels as usize)),
+            _ => Rows::Png(PngRowWriter::new(main_file.writer(), w, h, PngColor::Rgb)?),
+        };
+        let mut extra = match exr_file.as_mut() {
+            Some(f) => Some(ExrRowWriter::new(f.writer(), w, h)?),
+            None => None,
+        };
+        let mut row8 = Vec::with_capacity(3 * w as usize);
+        missing = merge_rows(parts, a.allow_missing, |_, band: &[PixelSum]| {
+            for sums in band.chunks(w as usize) {
+                let row: Vec<Rgb> = sums
+                    .iter()
+                    .map(|s| if s.n == 0 { HOLE } else { s.mean() })
+                    .collect();
+                holes += sums.iter().filter(|s| s.n == 0).count();
+                if heatmap_format.is_some() {
+                    samples.extend(sums.iter().map(|s| s.n));
+                }
+                match &mut main {
+                    Rows::Exr(e) => e.write_row(&row)?,
+                    Rows::Png(p) => {
+                        row8.clear();
+                        row8.extend(row.iter().flat_map(|&p| to8(p)));
+                        p.write_row(&row8)?;
+                    }
+                    Rows::Whole(all) => all.extend(row.iter().map(|&p| to8(p))),
+                }
+                if let Some(e) = &mut extra {
+                    e.write_row(&row)?;
+                }
+            }
+            Ok::<(), MergeFail>(())
+        })?;
+        match main {
+            Rows::Exr(e) => {
+                e.finish();
+            }
+            Rows::Png(p) => {
+                p.finish()?;
+            }
+            Rows::Whole(all) => {
+                let image = Image::from_vec(w, h, all);
+                let bytes = prism_image::encode_jpeg(&image)?;
+                std::io::Write::write_all(main_file.writer(), &bytes).map_err(io(&a.output))?;
+            }
+        }
+        if let Some(e) = extra {
+            e.finish();
+        }
+    }
+    main_file.commit().map_err(io(&a.output))?;
+    if let (Some(f), Some(path)) = (exr_file, &a.exr) {
+        f.commit().map_err(io(path))?;
+    }
+    if let (Some(path), Some(f)) = (&a.heatmap, heatmap_format) {
+        let samples = Image::from_vec(w, h, samples);
+        crate::output::write_rgb8(path, f, &prism_image::heatmap(&samples))?;
+    }
+    Ok(MergeSummary {
+        size: (w, h),
+        holes,
+        missing,
+    })
+}
+
+/// The merge gathered whole, for a picture with bloom (a filter over the whole picture).
+fn merge_whole(
+    a: &MergeArgs,
+    parts: &mut [PartFile],
+    identity: &PartIdentity,
+    format: ImageFormat,
+    heatmap_format: Option<ImageFormat>,
+) -> Result<MergeSummary> {
+    let merged = merge(parts, a.allow_missing).map_err(UserError::input)?;
     let mut image: Image<Rgb> = merged.sums.map(PixelSum::mean);
     if let Some(bloom) = identity.bloom() {
         let layer = bloom.layer(&image);
@@ -159,8 +368,6 @@ pub fn run(a: &MergeArgs) -> Result<()> {
             *p = HOLE;
         }
     }
-    let merge_time = t1.elapsed();
-    let t2 = Instant::now();
     let truncated = identity.encoding() == Encoding::Truncated;
     match format {
         ImageFormat::Exr => prism_image::write_exr(&a.output, &image)?,
@@ -169,37 +376,18 @@ pub fn run(a: &MergeArgs) -> Result<()> {
         }
         _ => crate::output::write_rgb8(&a.output, format, &image.linear_to_srgb8())?,
     }
-    let mut written = vec![a.output.display().to_string()];
     if let Some(exr) = &a.exr {
         prism_image::write_exr(exr, &image)?;
-        written.push(exr.display().to_string());
     }
     if let (Some(path), Some(f)) = (&a.heatmap, heatmap_format) {
         let samples = merged.sums.map(|p| p.n);
         crate::output::write_rgb8(path, f, &prism_image::heatmap(&samples))?;
-        written.push(path.display().to_string());
     }
-    if a.stats {
-        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-        eprintln!("read: {:.1} ms", ms(read_time));
-        eprintln!("merge: {:.1} ms", ms(merge_time));
-        eprintln!("write: {:.1} ms", ms(t2.elapsed()));
-    }
-    if !a.quiet && std::io::IsTerminal::is_terminal(&std::io::stderr()) {
-        let (w, h) = (merged.sums.width(), merged.sums.height());
-        eprintln!(
-            "prism: merged {} parts, {w}x{h}{} in {:.2} s -> {}",
-            a.parts.len(),
-            if holes > 0 {
-                format!(", {holes} pixels missing (magenta)")
-            } else {
-                String::new()
-            },
-            t0.elapsed().as_secs_f64(),
-            written.join(", ")
-        );
-    }
-    Ok(())
+    Ok(MergeSummary {
+        size: (merged.sums.width(), merged.sums.height()),
+        holes,
+        missing: merged.holes,
+    })
 }
 
 #[cfg(test)]

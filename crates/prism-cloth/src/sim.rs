@@ -234,7 +234,8 @@ impl Verlet {
         }
         let pinned = &pinned[..n];
         for (axis, (sum, next)) in sums.into_iter().zip(next).enumerate() {
-            let (now, sum, next, size) = (&now[axis][..n], &mut sum[..n], &mut next[..n], size[axis]);
+            let (now, sum, next, size) =
+                (&now[axis][..n], &mut sum[..n], &mut next[..n], size[axis]);
             for i in 0..n {
                 let x = now[i];
                 let a = sum[i] / mass;

@@ -250,7 +250,11 @@ fn row_forces_plain(
         }
         let n = hi - lo;
         let b0 = (lo as isize + dx) as usize;
-        let (ax, ay, az) = (&axis(y, 0)[lo..hi], &axis(y, 1)[lo..hi], &axis(y, 2)[lo..hi]);
+        let (ax, ay, az) = (
+            &axis(y, 0)[lo..hi],
+            &axis(y, 1)[lo..hi],
+            &axis(y, 2)[lo..hi],
+        );
         let (bx, by_, bz) = (
             &axis(by, 0)[b0..b0 + n],
             &axis(by, 1)[b0..b0 + n],

@@ -260,15 +260,18 @@ impl<W: Write> ExrRowWriter<W> {
     /// If the row is not `width` pixels long or every row has been written.
     pub fn write_row(&mut self, row: &[Rgb]) -> Result<(), ImageError> {
         assert_eq!(row.len(), self.width, "a row of the picture's width");
-        assert!(self.rows < self.height, "no more rows than the picture's height");
+        assert!(
+            self.rows < self.height,
+            "no more rows than the picture's height"
+        );
         self.line.clear();
-        self.line.extend_from_slice(&(self.rows as i32).to_le_bytes());
+        self.line
+            .extend_from_slice(&(self.rows as i32).to_le_bytes());
         self.line
             .extend_from_slice(&((12 * self.width) as i32).to_le_bytes());
         for c in [2, 1, 0] {
             for p in row {
-                self.line
-                    .extend_from_slice(&p.to_array()[c].to_le_bytes());
+                self.line.extend_from_slice(&p.to_array()[c].to_le_bytes());
             }
         }
         self.rows += 1;
@@ -506,7 +509,10 @@ pub(crate) fn parse_header(data: &[u8], what: &str, tiled: bool) -> Result<Heade
     }
     let version = b.i32()?;
     if tiled && (version & 0xff != 2 || version & 0x1e00 != TILED) {
-        return Err(decode_err(what, "expected a single-part tiled OpenEXR 2 file"));
+        return Err(decode_err(
+            what,
+            "expected a single-part tiled OpenEXR 2 file",
+        ));
     }
     if !tiled && (version & 0xff != 2 || version & 0x1e00 != 0) {
         return Err(decode_err(
@@ -589,7 +595,8 @@ pub(crate) fn parse_header(data: &[u8], what: &str, tiled: bool) -> Result<Heade
     if w <= 0 || h <= 0 {
         return Err(decode_err(what, format!("dataWindow is empty ({w}x{h})")));
     }
-    let compression = compression.ok_or_else(|| decode_err(what, "expected a compression attribute"))?;
+    let compression =
+        compression.ok_or_else(|| decode_err(what, "expected a compression attribute"))?;
     if tiled && tile.is_none() {
         return Err(decode_err(what, "expected a tiles attribute"));
     }
@@ -962,11 +969,16 @@ mod tests {
     #[test]
     fn row_writer_bytes_equal_the_general_encoder() {
         let img = Image::from_fn(37, 5, |x, y| Rgb::new(x as f32, y as f32 * 0.25, -1.5));
-        let channel = |c: usize| ExrSamples::Float(img.pixels().iter().map(|p| p.to_array()[c]).collect());
+        let channel =
+            |c: usize| ExrSamples::Float(img.pixels().iter().map(|p| p.to_array()[c]).collect());
         let layers = ExrLayers {
             width: 37,
             height: 5,
-            channels: vec![("R".into(), channel(0)), ("G".into(), channel(1)), ("B".into(), channel(2))],
+            channels: vec![
+                ("R".into(), channel(0)),
+                ("G".into(), channel(1)),
+                ("B".into(), channel(2)),
+            ],
             attributes: Vec::new(),
         };
         assert_eq!(encode_exr(&img), encode(&layers, false));

@@ -81,7 +81,10 @@ impl<W: Write + Seek> TiledExrWriter<W> {
     /// file's with a sample a pixel.
     pub fn write_tile(&mut self, tx: u32, ty: u32, pixels: &ExrLayers) -> Result<(), ImageError> {
         let (across, down) = tile_grid(self.size, self.tile);
-        assert!(u64::from(tx) < across && u64::from(ty) < down, "a tile of the image");
+        assert!(
+            u64::from(tx) < across && u64::from(ty) < down,
+            "a tile of the image"
+        );
         let index = (u64::from(ty) * across + u64::from(tx)) as usize;
         assert_eq!(self.offsets[index], 0, "each tile written once");
         let t = u64::from(self.tile);
@@ -298,7 +301,10 @@ impl<R: Read + Seek> TiledExrReader<R> {
         let expected = line_bytes * h;
         let mut head = [0u8; 20];
         if offset.saturating_add(20) > self.len {
-            return Err(decode_err(what, format!("tile ({tx}, {ty}) lies past the file's end")));
+            return Err(decode_err(
+                what,
+                format!("tile ({tx}, {ty}) lies past the file's end"),
+            ));
         }
         let read_err = |e: std::io::Error| decode_err(what, e);
         self.src.seek(SeekFrom::Start(offset)).map_err(read_err)?;
@@ -409,7 +415,10 @@ mod tests {
         let len = bytes.len() as u64;
         let mut r = TiledExrReader::new(Cursor::new(bytes), len, "t.exr").unwrap();
         assert_eq!(r.tiles(), (3, 2));
-        assert_eq!(r.header().attributes, vec![("note".to_string(), "x".to_string())]);
+        assert_eq!(
+            r.header().attributes,
+            vec![("note".to_string(), "x".to_string())]
+        );
         for ty in 0..2 {
             for tx in 0..3 {
                 let got = r.read_tile(tx, ty).unwrap();

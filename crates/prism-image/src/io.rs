@@ -427,10 +427,87 @@ pub fn write_png_rgba(path: &Path, image: &Rgba8Image) -> Result<(), ImageError>
     })
 }
 
+/// A file being written through a temporary file beside its path, renamed over the path
+/// only by [`AtomicFile::commit`]: dropped uncommitted (an error, a panic), it leaves
+/// nothing behind and the path untouched. The temporary file is removed as well by
+/// [`remove_temporaries_before_exit`].
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    out: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path`.
+    ///
+    /// # Errors
+    /// The operating system's error creating the temporary file.
+    pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".to_string());
+        static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let k = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{k}.tmp", std::process::id()));
+        register_temporary(&tmp, true);
+        match File::create(&tmp) {
+            Ok(file) => Ok(AtomicFile {
+                path: path.to_path_buf(),
+                tmp,
+                out: Some(BufWriter::new(file)),
+            }),
+            Err(e) => {
+                register_temporary(&tmp, false);
+                Err(e)
+            }
+        }
+    }
+
+    /// The path being written (not the temporary file's).
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Where the bytes go.
+    pub fn writer(&mut self) -> &mut BufWriter<File> {
+        self.out
+            .as_mut()
+            .expect("an uncommitted file has its writer")
+    }
+
+    /// Flushes the file to disk and renames it over the path.
+    ///
+    /// # Errors
+    /// The operating system's error; the path is then untouched.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let out = self.out.take().expect("an uncommitted file has its writer");
+        let file = out.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        std::fs::rename(&self.tmp, &self.path)?;
+        register_temporary(&self.tmp, false);
+        Ok(())
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+            register_temporary(&self.tmp, false);
+        }
+    }
+}
+
 /// Writes a file by streaming into a temporary file beside `path`, then renaming it over
-/// `path`, so that a failure never leaves a truncated file or clobbers an existing one.
-/// The caller's error type carries file-system errors too: `io_error` builds one from
-/// `path` (the caller's, not the temporary file's) and the OS error.
+/// `path`, so that a failure never leaves a truncated file or clobbers an existing one
+/// (an [`AtomicFile`]). The caller's error type carries file-system errors too: `io_error`
+/// builds one from `path` (the caller's, not the temporary file's) and the OS error.
 ///
 /// # Errors
 /// `io_error(..)` for file-system errors, or whatever `write` returns.
@@ -439,30 +516,10 @@ pub fn write_atomic_with<E>(
     write: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
     io_error: impl Fn(&Path, std::io::Error) -> E,
 ) -> Result<(), E> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".to_string());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    register_temporary(&tmp, true);
     // Errors name the user's path, never the temporary file's.
-    let result = (|| {
-        let file = File::create(&tmp).map_err(|e| io_error(path, e))?;
-        let mut w = BufWriter::new(file);
-        write(&mut w)?;
-        let file = w.into_inner().map_err(|e| io_error(path, e.into_error()))?;
-        file.sync_all().map_err(|e| io_error(path, e))?;
-        std::fs::rename(&tmp, path).map_err(|e| io_error(path, e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    register_temporary(&tmp, false);
-    result
+    let mut file = AtomicFile::create(path).map_err(|e| io_error(path, e))?;
+    write(file.writer())?;
+    file.commit().map_err(|e| io_error(path, e))
 }
 
 /// The temporary files being written now, by every thread.

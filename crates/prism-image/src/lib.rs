@@ -39,7 +39,7 @@ pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{
     decode_gif, decode_jpeg, decode_png, decode_webp, encode_bmp, encode_jpeg, encode_png,
     encode_png_rgba, read_image, read_png, remove_temporaries_before_exit, write_atomic,
-    write_atomic_with, write_bmp, write_jpeg, write_png, write_png_rgba, JPEG_QUALITY,
+    write_atomic_with, write_bmp, write_jpeg, write_png, write_png_rgba, AtomicFile, JPEG_QUALITY,
     MAX_IMAGE_FILE_BYTES,
 };
 pub use montage::montage;

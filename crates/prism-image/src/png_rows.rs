@@ -183,13 +183,21 @@ mod tests {
     /// both layouts and over several IDAT chunks, decodes to the rows written.
     #[test]
     fn decodes_to_the_rows_written() {
-        for (color, w, h) in [(PngColor::Rgb, 300, 7), (PngColor::Rgba, 5, 3), (PngColor::Rgb, 700, 600)] {
+        for (color, w, h) in [
+            (PngColor::Rgb, 300, 7),
+            (PngColor::Rgba, 5, 3),
+            (PngColor::Rgb, 700, 600),
+        ] {
             let n = w * h * color.bytes();
             let mut state = 12345u32;
             let data: Vec<u8> = (0..n)
                 .map(|i| {
                     state = state.wrapping_mul(1_103_515_245).wrapping_add(12345);
-                    if (i / 97) % 3 == 0 { (state >> 16) as u8 } else { (i % 251) as u8 }
+                    if (i / 97) % 3 == 0 {
+                        (state >> 16) as u8
+                    } else {
+                        (i % 251) as u8
+                    }
                 })
                 .collect();
             let mut wr = PngRowWriter::new(Vec::new(), w as u32, h as u32, color).unwrap();
@@ -197,7 +205,9 @@ mod tests {
                 wr.write_row(row).unwrap();
             }
             let bytes = wr.finish().unwrap();
-            let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes)).read_info().unwrap();
+            let mut reader = png::Decoder::new(std::io::Cursor::new(&bytes))
+                .read_info()
+                .unwrap();
             let mut buf = vec![0; reader.output_buffer_size()];
             let info = reader.next_frame(&mut buf).unwrap();
             assert_eq!((info.width, info.height), (w as u32, h as u32));

@@ -111,12 +111,14 @@ pub fn film_bytes(width: u32, height: u32) -> u64 {
     u64::from(width) * u64::from(height) * per_pixel as u64
 }
 
-/// The most bytes a share of a `width x height` render (a part file's) holds at once: the
-/// pixel sums, and the part file's channels and encoded file made from them.
+/// The most bytes a share of a `width x height` render (a part file's) holds at once when
+/// written as it renders: the file's tile table, and per worker a few tiles' sums (rendered,
+/// waiting for the tiles before them, and encoded).
 #[must_use]
 pub fn share_bytes(width: u32, height: u32) -> u64 {
-    let per_pixel = 3 * std::mem::size_of::<PixelSum>();
-    u64::from(width) * u64::from(height) * per_pixel as u64
+    let tile = u64::from(TILE * TILE) * std::mem::size_of::<PixelSum>() as u64;
+    let workers = rayon::current_num_threads() as u64;
+    8 * tile_count(width, height) as u64 + 4 * workers * tile
 }
 
 /// A pixel's running sums: its radiance, exactly (so that samples split into ranges and

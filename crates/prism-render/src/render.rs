@@ -191,12 +191,13 @@ fn tile_pixels((x0, y0): (u32, u32), w: u32, h: u32) -> impl Iterator<Item = (u3
 
 /// Renders the job's tiles on rayon, handing each to `done` as soon as it is rendered: its
 /// origin and its pixels' sums row by row (a pixel the job skips has no samples). A tile
-/// begun after `stop` is set is not rendered and not handed on. The tiles arrive in any
-/// order; each pixel's sums do not depend on it.
+/// begun after `stop` is set is not rendered and not handed on. The workers take the tiles
+/// in row-major order, one at a time, so they finish nearly in that order (a writer that
+/// must store them in order holds few); each pixel's sums do not depend on the order.
 ///
 /// # Panics
 /// If the job's `skip` does not have one entry per pixel.
-fn render_tiles(
+pub fn render_tiles(
     scene: &RenderScene,
     opts: &RenderOptions,
     job: &Job<'_>,
@@ -219,10 +220,9 @@ fn render_tiles(
         .map(|(_, t)| t)
         .collect();
     let taken = std::sync::atomic::AtomicU64::new(0);
-    tiles.par_iter().for_each(|&origin| {
-        if stopped() {
-            return;
-        }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let workers = rayon::current_num_threads().min(tiles.len());
+    let each_tile = |origin: (u32, u32)| {
         let pixels: Vec<(u32, u32)> = tile_pixels(origin, w, h)
             .filter(|&(x, y)| !skipped(x, y))
             .collect();
@@ -259,7 +259,20 @@ fn render_tiles(
             })
             .collect();
         done(origin, &all);
-    });
+    };
+    (0..workers)
+        .into_par_iter()
+        .with_max_len(1)
+        .for_each(|_| loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&origin) = tiles.get(k) else {
+                break;
+            };
+            if stopped() {
+                break;
+            }
+            each_tile(origin);
+        });
 }
 
 fn pixel(

@@ -1,14 +1,19 @@
-//! Split renders: the [`Part`] file one share of a render writes (an OpenEXR file with the
-//! mean radiance, each pixel's sums and sample count, and the render's identity, a [`PartIdentity`],
-//! as string attributes), and [`merge`], which checks that a set of parts makes one whole render and
-//! adds them up.
+//! Split renders: the part file one share of a render writes (a tiled OpenEXR file holding
+//! only the share's 32x32 tiles: the mean radiance, each pixel's sums and sample count, and
+//! the render's identity, a [`PartIdentity`], as string attributes), written whole
+//! ([`Part`]) or tile by tile as they render ([`PartWriter`]), and [`merge_rows`], which
+//! checks that a set of parts makes one whole render and adds them up a row of tiles at a
+//! time.
 
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{Seek, Write};
 use std::path::{Path, PathBuf};
 
-use prism_image::{ExrLayers, ExrSamples, Image, ImageError};
+use prism_image::{ExrLayers, ExrSamples, Image, ImageError, TiledExrReader, TiledExrWriter};
 use prism_math::ExactSum;
 
-use crate::film::{tile_count, tile_of, PixelSum, Share};
+use crate::film::{tile_count, tile_of, tiles, PixelSum, Share, TILE};
 
 mod identity;
 
@@ -132,6 +137,25 @@ impl PartHeader {
             .iter()
             .find(|(k, _)| k == key)
             .map(|(_, v)| v.as_str())
+    }
+
+    /// The header as a part file's string attributes: `prism.<key>` for the identity,
+    /// `prism.part` (`I/N`) and `prism.samples` (`A..B`).
+    fn attributes(&self) -> Vec<(String, String)> {
+        let mut attributes: Vec<(String, String)> = self
+            .identity
+            .iter()
+            .map(|(k, v)| (format!("{PREFIX}{k}"), v.clone()))
+            .collect();
+        attributes.push((
+            PART.into(),
+            format!("{}/{}", self.share.part, self.share.parts),
+        ));
+        attributes.push((
+            SAMPLES.into(),
+            format!("{}..{}", self.share.samples.start, self.share.samples.end),
+        ));
+        attributes
     }
 
     /// The header held in an OpenEXR file's attributes (the channels need hold no samples);
@@ -263,62 +287,42 @@ impl Part {
     /// (`A..B`).
     #[must_use]
     pub fn to_exr(&self) -> ExrLayers {
-        let p = self.sums.pixels();
-        let float = |f: &dyn Fn(&PixelSum) -> f32| ExrSamples::Float(p.iter().map(f).collect());
-        let means: Vec<[f32; 3]> = p.iter().map(|s| s.mean().to_array()).collect();
-        let mean = |c: usize| ExrSamples::Float(means.iter().map(|m| m[c]).collect());
-        let h = &self.header;
-        let mut attributes: Vec<(String, String)> = h
-            .identity
-            .iter()
-            .map(|(k, v)| (format!("{PREFIX}{k}"), v.clone()))
-            .collect();
-        attributes.push((PART.into(), format!("{}/{}", h.share.part, h.share.parts)));
-        attributes.push((
-            SAMPLES.into(),
-            format!("{}..{}", h.share.samples.start, h.share.samples.end),
-        ));
-        let mut layers = ExrLayers {
-            width: self.sums.width(),
-            height: self.sums.height(),
-            channels: vec![
-                ("R".into(), mean(0)),
-                ("G".into(), mean(1)),
-                ("B".into(), mean(2)),
-                ("Y.sum".into(), float(&|s| s.moment1 as f32)),
-                ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
-                (
-                    "samples".into(),
-                    ExrSamples::Uint(p.iter().map(|s| s.n).collect()),
-                ),
-            ],
-            attributes,
-        };
-        for (c, names) in sum_channels().into_iter().enumerate() {
-            for (w, name) in names.into_iter().enumerate() {
-                let words = p.iter().map(|s| s.sum[c].words()[w]).collect();
-                layers.channels.push((name, ExrSamples::Uint(words)));
-            }
-        }
+        let mut layers = channels(self.sums.pixels(), self.sums.width(), self.sums.height());
+        layers.attributes = self.header.attributes();
         layers
     }
 
-    /// Writes the part (see [`Part::to_exr`]) atomically: a re-run part replaces the old
-    /// file whole or not at all.
+    /// Writes the part atomically as a tiled file of its share's tiles (see
+    /// [`PartWriter`]): a re-run part replaces the old file whole or not at all.
     ///
     /// # Errors
     /// [`PartError::Image`] if the file cannot be written.
     pub fn write(&self, path: &Path) -> Result<(), PartError> {
-        Ok(prism_image::write_exr_layers(path, &self.to_exr())?)
+        let (w, h) = (self.sums.width(), self.sums.height());
+        let identity = self.header.identity.clone();
+        let share = self.header.share.clone();
+        Ok(prism_image::write_atomic(path, |out| {
+            let mut part = PartWriter::new(out, identity, share, w, h)?;
+            for (k, &(x0, y0)) in tiles(w, h).iter().enumerate() {
+                if self.header.share.has_tile(k) {
+                    let tile: Vec<PixelSum> = tile_pixels((x0, y0), w, h)
+                        .map(|(x, y)| self.sums.get(x, y))
+                        .collect();
+                    part.add((x0, y0), &tile)?;
+                }
+            }
+            part.finish()?;
+            Ok(())
+        })?)
     }
 
-    /// Reads a part file, checking its attributes and that every pixel's data fits its share
-    /// (see [`Part::from_exr`]).
+    /// Reads a part file whole, checking its attributes and that every pixel's data fits
+    /// its share (see [`PartFile`]).
     ///
     /// # Errors
-    /// [`PartError::Image`] if it cannot be read or decoded, else as [`Part::from_exr`].
+    /// As [`PartFile::open`] and [`PartFile::load`].
     pub fn read(path: &Path) -> Result<Part, PartError> {
-        Part::from_exr(&prism_image::read_exr_layers(path)?, path)
+        PartFile::open(path)?.load()
     }
 
     /// The part held in OpenEXR channels and attributes; `file` names it in errors.
@@ -330,39 +334,96 @@ impl Part {
     pub fn from_exr(layers: &ExrLayers, file: &Path) -> Result<Part, PartError> {
         let header = PartHeader::from_exr(layers, file)?;
         let mut sums = Image::new(layers.width, layers.height, PixelSum::default());
-        each_pixel(layers, &header, file, |x, y, s| sums.set(x, y, s))?;
+        each_pixel(layers, (0, 0), &header, file, |x, y, s| sums.set(x, y, s))?;
         Ok(Part { header, sums })
     }
 }
 
-/// Checks every pixel held in `layers` against `header`'s share, then hands each pixel of the
-/// share to `f` as `(x, y, sums)`, row by row. `header` must be the one read from `layers`.
+/// The pixels of the tile at `(x0, y0)` of a `w x h` film, row by row.
+fn tile_pixels((x0, y0): (u32, u32), w: u32, h: u32) -> impl Iterator<Item = (u32, u32)> {
+    (y0..(y0 + TILE).min(h)).flat_map(move |y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)))
+}
+
+/// A part's channels for `sums`, `w x h` pixels row by row (a tile or the whole image): `R`,
+/// `G`, `B` the mean radiance (what other tools show), `sum.R.w0` to `sum.R.w3` (and for G
+/// and B) the exact radiance sums' 32-bit words, least significant first, `Y.sum` and
+/// `Y.sumsq` the luminance moments (rounded to 32-bit floats), `samples` the sample count.
+fn channels(sums: &[PixelSum], w: u32, h: u32) -> ExrLayers {
+    let float = |f: &dyn Fn(&PixelSum) -> f32| ExrSamples::Float(sums.iter().map(f).collect());
+    let means: Vec<[f32; 3]> = sums.iter().map(|s| s.mean().to_array()).collect();
+    let mean = |c: usize| ExrSamples::Float(means.iter().map(|m| m[c]).collect());
+    let mut layers = ExrLayers {
+        width: w,
+        height: h,
+        channels: vec![
+            ("R".into(), mean(0)),
+            ("G".into(), mean(1)),
+            ("B".into(), mean(2)),
+            ("Y.sum".into(), float(&|s| s.moment1 as f32)),
+            ("Y.sumsq".into(), float(&|s| s.moment2 as f32)),
+            (
+                "samples".into(),
+                ExrSamples::Uint(sums.iter().map(|s| s.n).collect()),
+            ),
+        ],
+        attributes: Vec::new(),
+    };
+    for (c, names) in sum_channels().into_iter().enumerate() {
+        for (w, name) in names.into_iter().enumerate() {
+            let words = sums.iter().map(|s| s.sum[c].words()[w]).collect();
+            layers.channels.push((name, ExrSamples::Uint(words)));
+        }
+    }
+    layers
+}
+
+/// Checks every pixel held in `layers` (at `origin` of the image: the whole image or one
+/// tile) against `header`'s share, then hands each pixel of the share to `f` as
+/// `(x, y, sums)`, row by row. `layers` must hold the channels `header`'s check found.
 fn each_pixel(
     layers: &ExrLayers,
+    origin: (u32, u32),
     header: &PartHeader,
     file: &Path,
     mut f: impl FnMut(u32, u32, PixelSum),
 ) -> Result<(), PartError> {
     let float = |name: &str| match layers.channel(name) {
-        Some(ExrSamples::Float(v)) => v,
-        _ => unreachable!("the header check found float channel {name}"),
+        Some(ExrSamples::Float(v)) => Ok(v),
+        _ => Err(PartError::NotAPart {
+            file: file.to_path_buf(),
+            what: format!("float channel {name}"),
+        }),
     };
-    let (m1, m2) = (float("Y.sum"), float("Y.sumsq"));
+    let (m1, m2) = (float("Y.sum")?, float("Y.sumsq")?);
     let uint = |name: &str| match layers.channel(name) {
-        Some(ExrSamples::Uint(v)) => v,
-        _ => unreachable!("the header check found uint channel {name}"),
+        Some(ExrSamples::Uint(v)) => Ok(v),
+        _ => Err(PartError::NotAPart {
+            file: file.to_path_buf(),
+            what: format!("uint channel {name}"),
+        }),
     };
-    let n = uint("samples");
-    let words = sum_channels().map(|names| names.map(|name| uint(&name)));
+    let n = uint("samples")?;
+    let mut words: Vec<&Vec<u32>> = Vec::with_capacity(12);
+    for name in sum_channels().iter().flatten() {
+        words.push(uint(name)?);
+    }
     let (width, height) = (layers.width, layers.height);
+    let image_width = header
+        .setting("width")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(width);
     let share = &header.share;
     let (part, parts) = (share.part, share.parts);
     let most = share.samples.len() as u32;
-    for y in 0..height {
-        for x in 0..width {
-            let i = (y * width + x) as usize;
+    for ty in 0..height {
+        for tx in 0..width {
+            let i = (ty * width + tx) as usize;
+            let (x, y) = (origin.0 + tx, origin.1 + ty);
+            let word = |c: usize, k: usize| words[4 * c + k][i];
             let s = PixelSum {
-                sum: words.map(|w| ExactSum::from_words([w[0][i], w[1][i], w[2][i], w[3][i]])),
+                sum: [0, 1, 2].map(|c| {
+                    ExactSum::from_words([word(c, 0), word(c, 1), word(c, 2), word(c, 3)])
+                }),
                 moment1: f64::from(m1[i]),
                 moment2: f64::from(m2[i]),
                 n: n[i],
@@ -374,7 +435,7 @@ fn each_pixel(
                 y,
                 why,
             };
-            let mine = share.has_tile(tile_of(x, y, width));
+            let mine = share.has_tile(tile_of(x, y, image_width));
             if mine && !(1..=most).contains(&s.n) {
                 return Err(corrupt(format!(
                     "holds {} samples; its share takes 1 to {most}",
@@ -397,50 +458,225 @@ fn each_pixel(
     Ok(())
 }
 
-/// A part file opened for merging: its header read and checked, its pixels decoded only
-/// when merged, one part at a time.
-#[derive(Clone, Debug)]
+/// A part file being written tile by tile: [`PartWriter::add`] takes the share's tiles in
+/// any order and writes them in order (so the bytes do not depend on which tile finished
+/// first), holding those that arrive early until the ones before them are in.
+pub struct PartWriter<W: Write + Seek> {
+    exr: TiledExrWriter<W>,
+    share: Share,
+    size: (u32, u32),
+    /// The share's tiles, in order: their row-major index and origin.
+    order: Vec<(usize, (u32, u32))>,
+    /// How many of `order` are written.
+    written: usize,
+    /// Tiles that arrived before the ones ahead of them, by row-major index.
+    early: BTreeMap<usize, Vec<PixelSum>>,
+}
+
+impl<W: Write + Seek> PartWriter<W> {
+    /// Starts the part file of `share` of a `width x height` render whose settings are
+    /// `identity` (it must hold `kind`, `width`, `height` and `spp`).
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if `out` fails.
+    ///
+    /// # Panics
+    /// If a required identity key is missing.
+    pub fn new(
+        out: W,
+        mut identity: Vec<(String, String)>,
+        share: Share,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, ImageError> {
+        identity.sort();
+        for k in REQUIRED {
+            assert!(
+                identity.iter().any(|(n, _)| n == k),
+                "a part's identity needs {k}"
+            );
+        }
+        let header = PartHeader {
+            identity,
+            share: share.clone(),
+        };
+        let mut layers = channels(&[], width, height);
+        layers.attributes = header.attributes();
+        let exr = TiledExrWriter::new(out, &layers, TILE)?;
+        let order = tiles(width, height)
+            .into_iter()
+            .enumerate()
+            .filter(|&(k, _)| share.has_tile(k))
+            .collect();
+        Ok(PartWriter {
+            exr,
+            share,
+            size: (width, height),
+            order,
+            written: 0,
+            early: BTreeMap::new(),
+        })
+    }
+
+    /// Takes the tile at `origin`: its pixels' sums row by row.
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if the destination fails.
+    ///
+    /// # Panics
+    /// If the tile is not the share's or has the wrong number of pixels.
+    pub fn add(&mut self, origin: (u32, u32), sums: &[PixelSum]) -> Result<(), ImageError> {
+        let k = tile_of(origin.0, origin.1, self.size.0);
+        assert!(self.share.has_tile(k), "a tile of the share");
+        self.early.insert(k, sums.to_vec());
+        while let Some(&(k, (x0, y0))) = self.order.get(self.written) {
+            let Some(sums) = self.early.remove(&k) else {
+                break;
+            };
+            let (w, h) = self.size;
+            let (tw, th) = ((w - x0).min(TILE), (h - y0).min(TILE));
+            assert_eq!(
+                sums.len(),
+                (tw * th) as usize,
+                "one sum a pixel of the tile"
+            );
+            self.exr
+                .write_tile(x0 / TILE, y0 / TILE, &channels(&sums, tw, th))?;
+            self.written += 1;
+        }
+        Ok(())
+    }
+
+    /// Ends the file, handing back the writer.
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if the destination fails.
+    ///
+    /// # Panics
+    /// If a tile of the share is missing.
+    pub fn finish(self) -> Result<W, ImageError> {
+        assert_eq!(
+            self.written,
+            self.order.len(),
+            "every tile of the share added"
+        );
+        self.exr.finish()
+    }
+}
+
+/// A part file opened for merging: its header and tile table read and checked, its tiles
+/// read and decoded only when merged.
 pub struct PartFile {
     /// The file.
     pub path: PathBuf,
     /// What it is a share of.
     pub header: PartHeader,
-    bytes: Vec<u8>,
+    reader: TiledExrReader<File>,
+}
+
+impl std::fmt::Debug for PartFile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PartFile")
+            .field("path", &self.path)
+            .field("header", &self.header)
+            .finish_non_exhaustive()
+    }
 }
 
 impl PartFile {
-    /// Reads a part file and checks its header.
+    /// Opens a part file and checks its header and that it holds exactly its share's tiles.
     ///
     /// # Errors
-    /// [`PartError::Image`] if it cannot be read or is not an OpenEXR file prism reads, else
-    /// as [`PartHeader::from_exr`].
+    /// [`PartError::Image`] if it cannot be read or is not a tiled OpenEXR file prism
+    /// reads, [`PartError::Corrupt`] if its tiles are not its share's, else as
+    /// [`PartHeader::from_exr`].
     pub fn open(path: &Path) -> Result<PartFile, PartError> {
-        let limit = prism_image::MAX_IMAGE_FILE_BYTES;
-        let bytes =
-            prism_math::limits::read_input(path, limit).map_err(|source| ImageError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        let layers = prism_image::decode_exr_header(&bytes, &path.display().to_string())?;
+        let reader = TiledExrReader::open(path)?;
+        let header = PartHeader::from_exr(&reader.header(), path)?;
+        if reader.tile_size() != (TILE, TILE) {
+            return Err(PartError::NotAPart {
+                file: path.to_path_buf(),
+                what: format!("{TILE}x{TILE} tiles"),
+            });
+        }
+        let (across, down) = reader.tiles();
+        for ty in 0..down {
+            for tx in 0..across {
+                let mine = header.share.has_tile((ty * across + tx) as usize);
+                if mine != reader.has_tile(tx, ty) {
+                    return Err(PartError::Corrupt {
+                        file: path.to_path_buf(),
+                        x: tx * TILE,
+                        y: ty * TILE,
+                        why: if mine {
+                            format!(
+                                "is in a tile of share {} that the file lacks",
+                                header.share.part
+                            )
+                        } else {
+                            format!(
+                                "is in a tile the file holds outside share {}",
+                                header.share.part
+                            )
+                        },
+                    });
+                }
+            }
+        }
         Ok(PartFile {
             path: path.to_path_buf(),
-            header: PartHeader::from_exr(&layers, path)?,
-            bytes,
+            header,
+            reader,
         })
     }
 
-    /// Decodes the part's pixels and checks them against its share.
-    ///
-    /// # Errors
-    /// As [`Part::from_exr`], or [`PartError::Image`] if the pixels do not decode.
-    pub fn load(&self) -> Result<Part, PartError> {
-        Part::from_exr(&self.layers()?, &self.path)
+    /// The sums of tile `(tx, ty)` (of the share), checked against the share, each handed
+    /// to `f` as `(x, y, sums)`.
+    fn tile(
+        &mut self,
+        tx: u32,
+        ty: u32,
+        f: impl FnMut(u32, u32, PixelSum),
+    ) -> Result<(), PartError> {
+        let layers = self
+            .reader
+            .read_tile(tx, ty)?
+            .ok_or_else(|| PartError::Corrupt {
+                file: self.path.clone(),
+                x: tx * TILE,
+                y: ty * TILE,
+                why: "is in a tile the file lacks".to_string(),
+            })?;
+        each_pixel(&layers, (tx * TILE, ty * TILE), &self.header, &self.path, f)
     }
 
-    /// The decoded channels.
-    fn layers(&self) -> Result<ExrLayers, PartError> {
-        let what = self.path.display().to_string();
-        Ok(prism_image::decode_exr_layers(&self.bytes, &what)?)
+    /// Decodes the part's pixels whole and checks them against its share.
+    ///
+    /// # Errors
+    /// [`PartError::Image`] if a tile does not decode, [`PartError::Corrupt`] for a pixel
+    /// whose sample count or sums contradict the share.
+    pub fn load(mut self) -> Result<Part, PartError> {
+        let (w, h) = (self.reader.header().width, self.reader.header().height);
+        let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
+        prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
+            file: self.path.clone(),
+            width: w,
+            height: h,
+            source,
+        })?;
+        let mut sums = Image::new(w, h, PixelSum::default());
+        let (across, down) = self.reader.tiles();
+        for ty in 0..down {
+            for tx in 0..across {
+                if self.header.share.has_tile((ty * across + tx) as usize) {
+                    self.tile(tx, ty, |x, y, s| sums.set(x, y, s))?;
+                }
+            }
+        }
+        Ok(Part {
+            header: self.header,
+            sums,
+        })
     }
 }
 
@@ -538,62 +774,111 @@ pub fn merge_order(
 }
 
 /// Checks that `files` are shares of one render, every tile and sample exactly once, and
-/// adds them up, decoding one part at a time. Each pixel adds its parts in the order of
-/// their first sample, whatever the order given, so a tile split gives exactly the sums of
-/// the whole render. With `allow_missing`, missing shares are listed in [`Merged::holes`]
-/// instead of refused.
+/// adds them up a row of tiles at a time, handing each band of rows to `band` as its first
+/// row and its pixels' sums row by row (the whole width, up to 32 rows). Each pixel adds its
+/// parts in the order of their first sample, whatever the order given, so a tile split gives
+/// exactly the sums of the whole render. Only a band's sums and one tile per part at a time
+/// are held. With `allow_missing`, missing shares are returned instead of refused (their
+/// pixels hold fewer samples, or none).
 ///
 /// # Errors
-/// As [`merge_order`], [`PartError::Missing`] for work held nowhere, and as
-/// [`PartFile::load`] for a part whose pixels are corrupt.
-pub fn merge(files: &[PartFile], allow_missing: bool) -> Result<Merged, PartError> {
+/// As [`merge_order`], [`PartError::Missing`] for work held nowhere,
+/// [`PartError::Corrupt`] for a part whose pixels are corrupt or whose sums overflow, or
+/// whatever `band` returns.
+pub fn merge_rows<E: From<PartError>>(
+    files: &mut [PartFile],
+    allow_missing: bool,
+    mut band: impl FnMut(u32, &[PixelSum]) -> Result<(), E>,
+) -> Result<Vec<String>, E> {
     let headers: Vec<(&Path, &PartHeader)> = files
         .iter()
         .map(|f| (f.path.as_path(), &f.header))
         .collect();
     let (order, holes) = merge_order(&headers)?;
     if !holes.is_empty() && !allow_missing {
-        return Err(PartError::Missing { holes });
+        return Err(PartError::Missing { holes }.into());
     }
-    let first = &files[0].header;
-    let setting = |k: &str| first.setting(k).and_then(|v| v.parse::<u32>().ok());
-    let (w, h) = (
-        setting("width").unwrap_or(0),
-        setting("height").unwrap_or(0),
-    );
-    let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
+    let (w, h) = merged_size(files);
+    let bytes = u64::from(w) * u64::from(TILE) * size_of::<PixelSum>() as u64;
     prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
         file: files[0].path.clone(),
         width: w,
         height: h,
         source,
     })?;
-    let mut sums = Image::new(w, h, PixelSum::default());
-    for i in order {
-        let file = &files[i];
-        let layers = file.layers()?;
-        // Straight from the channels into the sums: no second image per part.
-        let mut overflow = None;
-        each_pixel(&layers, &file.header, &file.path, |x, y, add| {
-            let acc = &mut sums.pixels_mut()[(y * w + x) as usize];
-            if acc.n == 0 {
-                *acc = add;
-            } else if !acc.merge(&add) && overflow.is_none() {
-                overflow = Some((x, y));
+    let across = w.div_ceil(TILE);
+    let mut sums = Vec::new();
+    for ty in 0..h.div_ceil(TILE) {
+        let (y0, rows) = (ty * TILE, (h - ty * TILE).min(TILE));
+        sums.clear();
+        sums.resize((w * rows) as usize, PixelSum::default());
+        for &i in &order {
+            let file = &mut files[i];
+            for tx in 0..across {
+                if !file.header.share.has_tile((ty * across + tx) as usize) {
+                    continue;
+                }
+                let mut overflow = None;
+                file.tile(tx, ty, |x, y, add| {
+                    let acc = &mut sums[((y - y0) * w + x) as usize];
+                    if acc.n == 0 {
+                        *acc = add;
+                    } else if !acc.merge(&add) && overflow.is_none() {
+                        overflow = Some((x, y));
+                    }
+                })?;
+                if let Some((x, y)) = overflow {
+                    return Err(PartError::Corrupt {
+                        file: file.path.clone(),
+                        x,
+                        y,
+                        why: "has sums that overflow when added to the other parts'".to_string(),
+                    }
+                    .into());
+                }
             }
-        })?;
-        if let Some((x, y)) = overflow {
-            return Err(PartError::Corrupt {
-                file: file.path.clone(),
-                x,
-                y,
-                why: "has sums that overflow when added to the other parts'".to_string(),
-            });
         }
+        band(y0, &sums)?;
     }
+    Ok(holes)
+}
+
+/// The size the parts' identity gives (the first part's; [`merge_order`] checks the rest).
+fn merged_size(files: &[PartFile]) -> (u32, u32) {
+    let setting = |k: &str| {
+        files
+            .first()
+            .and_then(|f| f.header.setting(k))
+            .and_then(|v| v.parse::<u32>().ok())
+            .unwrap_or(0)
+    };
+    (setting("width"), setting("height"))
+}
+
+/// [`merge_rows`] gathered into one picture of sums.
+///
+/// # Errors
+/// As [`merge_rows`], and [`PartError::OverBudget`] if the picture's sums do not fit the
+/// memory budget.
+pub fn merge(files: &mut [PartFile], allow_missing: bool) -> Result<Merged, PartError> {
+    let (w, h) = merged_size(files);
+    if let Some(first) = files.first() {
+        let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
+        prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
+            file: first.path.clone(),
+            width: w,
+            height: h,
+            source,
+        })?;
+    }
+    let mut all = Vec::new();
+    let holes = merge_rows(files, allow_missing, |_, rows: &[PixelSum]| {
+        all.extend_from_slice(rows);
+        Ok::<(), PartError>(())
+    })?;
     Ok(Merged {
-        identity: first.identity.clone(),
-        sums,
+        identity: files[0].header.identity.clone(),
+        sums: Image::from_vec(w, h, all),
         holes,
     })
 }

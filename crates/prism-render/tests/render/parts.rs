@@ -99,9 +99,9 @@ fn parts_round_trip_and_merge_to_the_whole_render() {
             parts.push(PartFile::open(&file).unwrap());
         }
     }
-    let forward = merge(&parts, false).unwrap();
+    let forward = merge(&mut parts, false).unwrap();
     parts.reverse();
-    let backward = merge(&parts, false).unwrap();
+    let backward = merge(&mut parts, false).unwrap();
     assert!(forward.holes.is_empty());
     for ((f, b), w) in forward
         .sums
@@ -232,7 +232,7 @@ fn sums_that_overflow_are_refused() {
             .unwrap();
         parts.push(PartFile::open(&file).unwrap());
     }
-    let e = merge(&parts, false).unwrap_err();
+    let e = merge(&mut parts, false).unwrap_err();
     assert!(
         matches!(&e, PartError::Corrupt { file, x: 0, y: 0, .. } if file.ends_with("o1.exr")),
         "{e}"
@@ -257,7 +257,7 @@ fn identity_survives_the_part_file() {
     Part::new(id.to_attributes(), share, sums)
         .write(&file)
         .unwrap();
-    let merged = merge(&[PartFile::open(&file).unwrap()], false).unwrap();
+    let merged = merge(&mut [PartFile::open(&file).unwrap()], false).unwrap();
     assert_eq!(PartIdentity::from_attributes(&merged.identity), Ok(id));
     std::fs::remove_dir_all(&dir).unwrap();
 }
