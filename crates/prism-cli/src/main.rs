@@ -51,7 +51,7 @@ enum Command {
     Shade(shade::ShadeArgs),
     /// Simulate the course's ClothSim scenes exactly; write OBJ and draw the run.
     Cloth(cloth::ClothArgs),
-    /// Check the part files of a split render and assemble its picture.
+    /// Check the part files of a split render and assemble its picture, a row of tiles at a time.
     Merge(split::MergeArgs),
     /// Open an SVG drawing, a lit COLLADA scene (path-traced) or a cloth scene in an
     /// interactive window drawn on the CPU (X11 or Xvfb).
