@@ -563,12 +563,17 @@ impl Frame<'_> {
             ];
             let inv = F16::splat(1.0) / (pw[0] + pw[1] + pw[2]);
             let wt = [pw[0] * inv, pw[1] * inv, pw[2] * inv];
-            let blend = |v: &[V16; 3]| v[0] * wt[0] + v[1] * wt[1] + v[2] * wt[2];
-            let normal = blend(&normals);
+            // A function, not a closure: a closure would be compiled apart, without the
+            // band's vector instruction set.
+            #[inline(always)]
+            fn blend(v: &[V16; 3], wt: &[F16; 3]) -> V16 {
+                v[0] * wt[0] + v[1] * wt[1] + v[2] * wt[2]
+            }
+            let normal = blend(&normals, &wt);
             let lanes = if matches!(shader, Shader::Normal | Shader::Wireframe) {
                 fragment_lanes(shader, u, V16::default(), normal)
             } else if matches!(shader, Shader::Diffuse | Shader::Phong) {
-                fragment_lanes(shader, u, blend(&positions), normal)
+                fragment_lanes(shader, u, blend(&positions, &wt), normal)
             } else {
                 None
             };
@@ -928,7 +933,14 @@ mod tests {
             let half = (k as f32 + 0.5) / 255.0;
             values.extend([half, half.next_up(), half.next_down()]);
         }
-        values.extend([f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.0, 1e30, -1e30]);
+        values.extend([
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            1e30,
+            -1e30,
+        ]);
         for v in values {
             assert_eq!(byte(v), reference(v), "{v:e}");
         }

@@ -334,11 +334,18 @@ pub(crate) fn fragment_lanes(
             let spec = (s16 * s16) * 0.5;
             let diffuse = F16::splat(0.8) * n.dot(l).max0();
             let i = u.light_intensity;
-            let channel = |i: f32| {
+            // A function, not a closure: a closure would be compiled apart, without the
+            // caller's vector instruction set.
+            #[inline(always)]
+            fn channel(i: f32, inv_r2: F16, diffuse: F16, spec: F16) -> F16 {
                 let e = F16::splat(i) * inv_r2;
                 (F16::splat(0.1) + e * diffuse) + e * spec
-            };
-            Some([channel(i.r), channel(i.g), channel(i.b)])
+            }
+            Some([
+                channel(i.r, inv_r2, diffuse, spec),
+                channel(i.g, inv_r2, diffuse, spec),
+                channel(i.b, inv_r2, diffuse, spec),
+            ])
         }
         _ => None,
     }
