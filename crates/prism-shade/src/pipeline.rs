@@ -843,7 +843,9 @@ fn row_span(
 
 /// Draws a triangle's edges into a band: samples within `half_width` pixels of an edge,
 /// inside the triangle, take `color`, the depth test passing up to a small bias so that
-/// edges show on their own faces.
+/// edges show on their own faces. Sixteen samples of a sample row at a time, each lane the
+/// scalar test's operations in its order.
+#[inline(always)]
 fn raster_wire(t: [&ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, half_width: f32) {
     let Some(set) = Setup::new(t, to) else {
         return;
@@ -856,34 +858,69 @@ fn raster_wire(t: [&ScreenVertex; 3], to: &Target, buf: &mut Band, color: Rgb, h
         ((a.x - c.x).powi(2) + (a.y - c.y).powi(2)).sqrt(),
         ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt(),
     ];
+    let (j0, j1) = ((set.x.0 * k) as usize, (set.x.1 * k) as usize);
+    let sign = F16::splat(set.sign);
+    let zero = F16::splat(0.0);
+    let strict = set.own.map(|o| M16::splat(!o));
+    let from = [(b.x, b.y), (c.x, c.y), (a.x, a.y)];
+    let along = [
+        (c.x - b.x, c.y - b.y),
+        (a.x - c.x, a.y - c.y),
+        (b.x - a.x, b.y - a.y),
+    ];
+    let width = F16::splat(half_width);
+    // `e / len <= w` implies `e <= w len` up to a few roundings: a relative margin of
+    // 1e-5 (and an absolute one for lengths near 0) covers them.
+    let reach = edge_len.map(|len| F16::splat(half_width * len * (1.0 + 1e-5) + 1e-30));
+    let colour = [color.r, color.g, color.b].map(F16::splat);
     for py in set.y.0..set.y.1 {
         for sy in 0..k {
             let y = py as f32 + sample_offset(sy, k);
             let row = ((py - to.y_start) * k + sy) as usize * row_len;
-            for j in (set.x.0 * k) as usize..(set.x.1 * k) as usize {
-                let x = buf.xs[j];
+            // edge(p) = dx (y - fy) - dy (x - fx), as `edge` evaluates it.
+            let across = [
+                along[0].0 * (y - from[0].1),
+                along[1].0 * (y - from[1].1),
+                along[2].0 * (y - from[2].1),
+            ];
+            let mut j = j0;
+            while j < j1 {
+                let xs = F16::load(&buf.xs[j..]);
                 let e = [
-                    edge(b.x, b.y, c.x, c.y, x, y) * set.sign,
-                    edge(c.x, c.y, a.x, a.y, x, y) * set.sign,
-                    edge(a.x, a.y, b.x, b.y, x, y) * set.sign,
+                    (F16::splat(across[0]) - F16::splat(along[0].1) * (xs - from[0].0)) * sign,
+                    (F16::splat(across[1]) - F16::splat(along[1].1) * (xs - from[1].0)) * sign,
+                    (F16::splat(across[2]) - F16::splat(along[2].1) * (xs - from[2].0)) * sign,
                 ];
-                if e.iter()
-                    .zip(set.own)
-                    .any(|(&v, o)| v < 0.0 || (v == 0.0 && !o))
-                {
-                    continue;
+                let mut inside = M16::first(j1 - j);
+                for i in 0..3 {
+                    inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
                 }
-                let l = e.map(|v| v * set.inv_area);
-                let rz = l[0] * a.rz + l[1] * b.rz + l[2] * c.rz;
-                // Distance in pixels to the nearest edge.
-                let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
-                let s = row + j;
-                // Behind what is drawn by more than the bias (1e-4 of window depth).
-                if !near_edge || rz < buf.depth[s] - 1e-4 {
-                    continue;
+                // Near an edge, by a test without division that takes a little more than
+                // the exact one (decided below, only where this one passes).
+                let roughly = e[0].le(reach[0]) | e[1].le(reach[1]) | e[2].le(reach[2]);
+                if (inside & roughly).any() {
+                    // Distance in pixels to the nearest edge.
+                    let near = (e[0] / F16::splat(edge_len[0])).le(width)
+                        | (e[1] / F16::splat(edge_len[1])).le(width)
+                        | (e[2] / F16::splat(edge_len[2])).le(width);
+                    let candidates = inside & near;
+                    let l = [
+                        e[0] * set.inv_area,
+                        e[1] * set.inv_area,
+                        e[2] * set.inv_area,
+                    ];
+                    let rz = l[0] * a.rz + l[1] * b.rz + l[2] * c.rz;
+                    let s = row + j;
+                    let depth = F16::load(&buf.depth[s..]);
+                    // Behind what is drawn by more than the bias (1e-4 of window depth).
+                    let pass = candidates & !rz.lt(depth - F16::splat(1e-4));
+                    F16::select(pass, rz, depth).store(&mut buf.depth[s..]);
+                    for (ch, value) in buf.color.iter_mut().zip(colour) {
+                        let old = F16::load(&ch[s..]);
+                        F16::select(pass, value, old).store(&mut ch[s..]);
+                    }
                 }
-                buf.depth[s] = rz;
-                (buf.color[0][s], buf.color[1][s], buf.color[2][s]) = (color.r, color.g, color.b);
+                j += LANES;
             }
         }
     }
@@ -914,7 +951,115 @@ pub fn to_bytes(img: &RgbImage) -> prism_image::Rgb8Image {
 
 #[cfg(test)]
 mod tests {
-    use super::byte;
+    use super::*;
+
+    /// The wireframe as first written, a sample at a time: the oracle for [`raster_wire`].
+    fn raster_wire_scalar(
+        t: [&ScreenVertex; 3],
+        to: &Target,
+        buf: &mut Band,
+        color: Rgb,
+        half_width: f32,
+    ) {
+        let Some(set) = Setup::new(t, to) else {
+            return;
+        };
+        let [a, b, c] = t;
+        let k = to.k;
+        let row_len = (to.w * k) as usize;
+        let edge_len = [
+            ((c.x - b.x).powi(2) + (c.y - b.y).powi(2)).sqrt(),
+            ((a.x - c.x).powi(2) + (a.y - c.y).powi(2)).sqrt(),
+            ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt(),
+        ];
+        for py in set.y.0..set.y.1 {
+            for sy in 0..k {
+                let y = py as f32 + sample_offset(sy, k);
+                let row = ((py - to.y_start) * k + sy) as usize * row_len;
+                for j in (set.x.0 * k) as usize..(set.x.1 * k) as usize {
+                    let x = buf.xs[j];
+                    let e = [
+                        edge(b.x, b.y, c.x, c.y, x, y) * set.sign,
+                        edge(c.x, c.y, a.x, a.y, x, y) * set.sign,
+                        edge(a.x, a.y, b.x, b.y, x, y) * set.sign,
+                    ];
+                    if e.iter()
+                        .zip(set.own)
+                        .any(|(&v, o)| v < 0.0 || (v == 0.0 && !o))
+                    {
+                        continue;
+                    }
+                    let l = e.map(|v| v * set.inv_area);
+                    let rz = l[0] * a.rz + l[1] * b.rz + l[2] * c.rz;
+                    let near_edge = (0..3).any(|i| e[i] / edge_len[i] <= half_width);
+                    let s = row + j;
+                    if !near_edge || rz < buf.depth[s] - 1e-4 {
+                        continue;
+                    }
+                    buf.depth[s] = rz;
+                    (buf.color[0][s], buf.color[1][s], buf.color[2][s]) = (color.r, color.g, color.b);
+                }
+            }
+        }
+    }
+
+    /// Brute force: the sixteen-lane wireframe writes exactly the samples, depths and
+    /// colours the sample-at-a-time one does, over random triangles of every size (slivers
+    /// and ones larger than the band included), 1 and 4 samples a pixel, on a band whose
+    /// depth is already partly drawn.
+    #[test]
+    fn lane_wireframe_equals_the_sample_at_a_time_one() {
+        let mut state = 7u32;
+        let mut rand = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32
+        };
+        let v = |x: f32, y: f32, rz: f32| ScreenVertex {
+            x,
+            y,
+            rz,
+            inv_w: 1.0,
+            v: Varyings {
+                position: Vec3::ZERO,
+                normal: Vec3::Z,
+                tangent: Vec3::X,
+                uv: prism_math::Vec2::ZERO,
+            },
+        };
+        for k in [1u32, 2] {
+            let to = Target {
+                k,
+                w: 61,
+                y_start: 16,
+                rows: 16,
+            };
+            let row_len = (to.w * k) as usize;
+            let len = (to.rows * k) as usize * row_len;
+            let mut lanes = Band::default();
+            lanes.clear(len, k, row_len);
+            for (i, d) in lanes.depth.iter_mut().enumerate() {
+                *d = if i % 3 == 0 { 0.5 } else { 0.0 };
+            }
+            let mut scalar = Band::default();
+            scalar.clear(len, k, row_len);
+            scalar.depth.clone_from(&lanes.depth);
+            for n in 0..400 {
+                let size = [3.0, 12.0, 70.0][n % 3];
+                let (cx, cy) = (rand() * 61.0, 16.0 + rand() * 16.0);
+                let mut p = || v(cx + (rand() - 0.5) * size, cy + (rand() - 0.5) * size, rand());
+                let t = [p(), p(), p()];
+                let colour = Rgb::new(rand(), rand(), rand());
+                let hw = 0.3 + rand();
+                raster_wire(t.each_ref(), &to, &mut lanes, colour, hw);
+                raster_wire_scalar(t.each_ref(), &to, &mut scalar, colour, hw);
+            }
+            assert!(lanes.depth[..len] == scalar.depth[..len], "depth, k = {k}");
+            for c in 0..3 {
+                assert!(lanes.color[c][..len] == scalar.color[c][..len], "colour, k = {k}");
+            }
+            assert!(lanes.depth[..len].iter().filter(|&&d| d != 0.0 && d != 0.5).count() > 100);
+        }
+    }
 
     /// Brute force against the library's rounding: every float from -0.01 to 1.01 in steps
     /// of a tenth of a byte (halves included), the neighbours of every half, and NaN and the
