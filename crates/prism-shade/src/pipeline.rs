@@ -744,8 +744,15 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
                 along[1].0 * (y - from[1].1),
                 along[2].0 * (y - from[2].1),
             ];
-            let Some((lo, hi)) = row_span(&across, &along, &from, set.sign, k, (j0, j1)) else {
-                continue;
+            // A triangle no wider than a group of lanes takes one group a row: narrowing
+            // the row first would cost more than the lanes it saves.
+            let (lo, hi) = if j1 - j0 <= LANES {
+                (j0, j1)
+            } else {
+                match row_span(&across, &along, &from, set.sign, k, (j0, j1)) {
+                    Some(span) => span,
+                    None => continue,
+                }
             };
             let mut j = lo;
             while j < hi {
