@@ -782,11 +782,16 @@ fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut Band) {
                         let old = F16::load(&weights[s..]);
                         F16::select(pass, *corner, old).store(&mut weights[s..]);
                     }
-                    // A select per lane, without branches.
-                    let prim = &mut buf.prim[s..s + LANES];
-                    for (p, &m) in prim.iter_mut().zip(&pass.0) {
-                        *p = if m != 0 { id } else { *p };
+                    // A select per lane by its mask's bits (all ones or none), without
+                    // branches.
+                    let prim: &mut [u32; LANES] = (&mut buf.prim[s..s + LANES])
+                        .try_into()
+                        .expect("a group of lanes");
+                    let mut seen = *prim;
+                    for (p, &m) in seen.iter_mut().zip(&pass.0) {
+                        *p = (id & m as u32) | (*p & !(m as u32));
                     }
+                    *prim = seen;
                 }
                 j += LANES;
             }
