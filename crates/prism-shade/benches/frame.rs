@@ -106,7 +106,11 @@ fn main() {
         println!(
             "{path} ({} triangles) phong 960x720{}: {:.2} ms per frame",
             mesh.triangles.len(),
-            if wireframe.is_some() { ", wireframe" } else { "" },
+            if wireframe.is_some() {
+                ", wireframe"
+            } else {
+                ""
+            },
             t.as_secs_f64() * 1e3
         );
     }

@@ -1009,7 +1009,8 @@ mod tests {
                         continue;
                     }
                     buf.depth[s] = rz;
-                    (buf.color[0][s], buf.color[1][s], buf.color[2][s]) = (color.r, color.g, color.b);
+                    (buf.color[0][s], buf.color[1][s], buf.color[2][s]) =
+                        (color.r, color.g, color.b);
                 }
             }
         }
@@ -1058,7 +1059,13 @@ mod tests {
             for n in 0..400 {
                 let size = [3.0, 12.0, 70.0][n % 3];
                 let (cx, cy) = (rand() * 61.0, 16.0 + rand() * 16.0);
-                let mut p = || v(cx + (rand() - 0.5) * size, cy + (rand() - 0.5) * size, rand());
+                let mut p = || {
+                    v(
+                        cx + (rand() - 0.5) * size,
+                        cy + (rand() - 0.5) * size,
+                        rand(),
+                    )
+                };
                 let t = [p(), p(), p()];
                 let colour = Rgb::new(rand(), rand(), rand());
                 let hw = 0.3 + rand();
@@ -1067,9 +1074,18 @@ mod tests {
             }
             assert!(lanes.depth[..len] == scalar.depth[..len], "depth, k = {k}");
             for c in 0..3 {
-                assert!(lanes.color[c][..len] == scalar.color[c][..len], "colour, k = {k}");
+                assert!(
+                    lanes.color[c][..len] == scalar.color[c][..len],
+                    "colour, k = {k}"
+                );
             }
-            assert!(lanes.depth[..len].iter().filter(|&&d| d != 0.0 && d != 0.5).count() > 100);
+            assert!(
+                lanes.depth[..len]
+                    .iter()
+                    .filter(|&&d| d != 0.0 && d != 0.5)
+                    .count()
+                    > 100
+            );
         }
     }
 
