@@ -945,7 +945,7 @@ fn byte(v: f32) -> u8 {
     // 0..=255 in the low bits of the sum (`round_ties_even` would be a library call on plain
     // x86-64, and a float-to-integer conversion costs more). NaN clamps to 0.
     const SHIFT: f32 = 8_388_608.0;
-    let v = v.max(0.0).min(1.0);
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
     ((v * 255.0 + SHIFT).to_bits() & 0xff) as u8
 }
 
