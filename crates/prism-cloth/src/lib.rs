@@ -4,7 +4,7 @@
 //!   checked, with `--set` overrides; `json` is its small reader with line numbers.
 //! - `sim`: [`Cloth`], the mass-spring simulation stepped exactly as the course's algorithm
 //!   (`FORMATS.md` §4), in f64.
-//! - `springs`: the springs' forces by family on the grid, and each mass's sum of them.
+//! - `springs`: [`Spring`]s, their forces by family on the grid, and each mass's sum of them.
 //! - `random`: [`GlibcRand`], the C library's `rand()` that jitters the vertical cloth.
 //! - `draw`: the cloth and its obstacles as prism-shade meshes, and the course app's camera.
 #![warn(missing_docs)]
@@ -25,4 +25,5 @@ pub use scene::{
     parse_scene, read_scene, ClothParams, ClothScene, Orientation, PlaneParams, SphereParams,
     MAX_DENSITY, MAX_GRID_SIDE, MAX_KS, MAX_MASSES, MAX_SCENE_BYTES, MAX_SIZE,
 };
-pub use sim::{Cloth, Spring, SpringKind, StepTimes, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};
+pub use sim::{Cloth, StepTimes, FRAMES_PER_SECOND, GRAVITY, STEPS_PER_FRAME};
+pub use springs::{Spring, SpringKind};

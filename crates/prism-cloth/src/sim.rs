@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use crate::random::{GlibcRand, RAND_MAX};
 use crate::scene::{ClothScene, Orientation, PlaneParams, SphereParams};
-use crate::springs::SpringGrid;
+use crate::springs::{Spring, SpringGrid, SpringKind};
 
 /// Frames per simulated second.
 pub const FRAMES_PER_SECOND: f64 = 90.0;
@@ -17,30 +17,6 @@ pub const FRAMES_PER_SECOND: f64 = 90.0;
 pub const STEPS_PER_FRAME: usize = 30;
 /// Gravity.
 pub const GRAVITY: DVec3 = DVec3::new(0.0, -9.8, 0.0);
-
-/// The three spring families.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SpringKind {
-    /// To the neighbours left and above.
-    Structural,
-    /// To the diagonal neighbours above.
-    Shearing,
-    /// To the masses two away, left and above.
-    Bending,
-}
-
-/// A spring between masses `a` and `b`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Spring {
-    /// First mass.
-    pub a: u32,
-    /// Second mass.
-    pub b: u32,
-    /// Length at construction.
-    pub rest: f64,
-    /// Family.
-    pub kind: SpringKind,
-}
 
 /// Wall time spent in each stage of the time step, summed over the steps taken.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

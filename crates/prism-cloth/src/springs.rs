@@ -1,10 +1,33 @@
-//! [`SpringGrid`]: the springs' forces laid out by family on the cloth's grid, so that a
-//! mass's sum of forces reads fixed neighbours in creation order and runs four masses to a
-//! vector, each lane the scalar sum's operations in the scalar sum's order.
+//! The springs: [`Spring`] and its [`SpringKind`], and [`SpringGrid`], their forces laid
+//! out by family on the cloth's grid, so that a mass's sum of forces reads fixed neighbours
+//! in creation order and runs four masses to a vector, each lane the scalar sum's
+//! operations in the scalar sum's order.
 
 use prism_math::glam::DVec3;
 
-use crate::sim::{Spring, SpringKind};
+/// The three spring families.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpringKind {
+    /// To the neighbours left and above.
+    Structural,
+    /// To the diagonal neighbours above.
+    Shearing,
+    /// To the masses two away, left and above.
+    Bending,
+}
+
+/// A spring between masses `a` and `b`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    /// First mass.
+    pub a: u32,
+    /// Second mass.
+    pub b: u32,
+    /// Length at construction.
+    pub rest: f64,
+    /// Family.
+    pub kind: SpringKind,
+}
 
 /// The six spring families in the order a mass creates its springs: structural left and
 /// up, shearing up-left and up-right, bending two right and two up.

@@ -7,7 +7,8 @@ use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
-use crate::exr::{header_bytes, parse_header, unzip, zip, Header, ZIP};
+use crate::exr::{parse_header, unzip, Header};
+use crate::exr_write::{header_bytes, zip, ZIP};
 use crate::io::decode_err;
 use crate::{ExrLayers, ExrSamples, ImageError};
 

@@ -12,6 +12,7 @@ mod diff;
 mod error;
 mod exr;
 mod exr_tiled;
+mod exr_write;
 mod hdr;
 mod heatmap;
 mod image;
@@ -28,11 +29,11 @@ pub use cubemap::{cube_face, CubeMap, CUBE_FACES};
 pub use diff::{compare_rgb8, DiffStats};
 pub use error::ImageError;
 pub use exr::{
-    decode_exr, decode_exr_header, decode_exr_layers, encode_exr, encode_exr_layers, read_exr,
-    read_exr_layers, read_radiance, write_exr, write_exr_layers, ExrLayers, ExrRowWriter,
-    ExrSamples,
+    decode_exr, decode_exr_header, decode_exr_layers, read_exr, read_exr_layers, read_radiance,
+    ExrLayers, ExrSamples,
 };
 pub use exr_tiled::{TiledExrReader, TiledExrWriter};
+pub use exr_write::{encode_exr, encode_exr_layers, write_exr, write_exr_layers, ExrRowWriter};
 pub use hdr::{decode_hdr, is_hdr};
 pub use heatmap::{heat_colour, heatmap};
 pub use image::{Image, Rgb8Image, RgbImage, Rgba8Image};

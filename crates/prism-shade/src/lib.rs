@@ -4,8 +4,10 @@
 //! - `mesh`: [`ShadeMesh`], one vertex per distinct corner with normals, uvs and tangents, as
 //!   the course app builds its buffers (from OBJ text, or any polygon mesh).
 //! - `shaders`: [`Shader`], the course's shaders with their [`Uniforms`] and formulas.
-//! - `pipeline`: [`shade`], vertex stage, clipping, depth-tested rasterization with
-//!   perspective-correct varyings, supersampling and an optional wireframe on top.
+//! - `pipeline`: [`shade`], vertex stage, clipping, bands of rows on rayon,
+//!   perspective-correct varyings into the shaders, and the supersampling resolve.
+//! - `raster`: depth-tested rasterization of a triangle into a band's samples, and the
+//!   optional wireframe on top.
 //! - `framing`: [`View::fit`], a view that frames a bounding sphere ([`Framing`]).
 #![warn(missing_docs)]
 
@@ -13,6 +15,7 @@ mod error;
 mod framing;
 mod mesh;
 mod pipeline;
+mod raster;
 mod shaders;
 
 pub use error::ShadeError;
