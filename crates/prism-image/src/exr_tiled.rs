@@ -283,7 +283,8 @@ impl<R: Read + Seek> TiledExrReader<R> {
     ///
     /// # Errors
     /// [`ImageError::Decode`] for a tile whose block is not where the table says, names
-    /// another tile, or does not decode to the tile's pixels.
+    /// another tile, or does not decode to the tile's pixels; [`ImageError::OverBudget`]
+    /// for a tile (its channels counted) over one image's memory budget.
     pub fn read_tile(&mut self, tx: u32, ty: u32) -> Result<Option<ExrLayers>, ImageError> {
         let (across, down) = self.tiles();
         if tx >= across || ty >= down {
@@ -300,6 +301,16 @@ impl<R: Read + Seek> TiledExrReader<R> {
         let h = (h - u64::from(ty) * u64::from(th)).min(u64::from(th)) as usize;
         let line_bytes = 4 * self.header.channels.len() * w;
         let expected = line_bytes * h;
+        // The raw tile and its channels, each counted against one image's budget before
+        // either is allocated (a tile may be as large as its header says).
+        prism_math::limits::check_image_memory(2 * expected as u64).map_err(|source| {
+            ImageError::OverBudget {
+                what: what.to_string(),
+                width: w as u64,
+                height: h as u64,
+                source,
+            }
+        })?;
         let mut head = [0u8; 20];
         if offset.saturating_add(20) > self.len {
             return Err(decode_err(
@@ -458,5 +469,39 @@ mod tests {
         let scan = crate::encode_exr_layers(&layers(4, 4, 0));
         let len = scan.len() as u64;
         assert!(TiledExrReader::new(Cursor::new(scan), len, "s.exr").is_err());
+    }
+
+    /// Hostile input: a header that makes its one tile 65536 x 65536 pixels is refused by
+    /// the image budget when the tile is read, before anything of that size is allocated.
+    #[test]
+    fn a_tile_over_the_budget_is_refused_before_it_is_read() {
+        let one = ExrLayers {
+            width: 32,
+            height: 32,
+            channels: vec![("a".into(), ExrSamples::Float(vec![0.5; 32 * 32]))],
+            attributes: Vec::new(),
+        };
+        let mut wr = TiledExrWriter::new(Cursor::new(Vec::new()), &one, 32).unwrap();
+        wr.write_tile(0, 0, &one).unwrap();
+        let mut bytes = wr.finish().unwrap().into_inner();
+        let patch = |bytes: &mut Vec<u8>, name: &[u8], skip: usize, values: &[u32]| {
+            let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + skip;
+            for (k, v) in values.iter().enumerate() {
+                bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+            }
+        };
+        // Name, NUL, type name, NUL, size: then the value.
+        patch(
+            &mut bytes,
+            b"dataWindow\0box2i\0",
+            21,
+            &[0, 0, 65535, 65535],
+        );
+        patch(&mut bytes, b"tiles\0tiledesc\0", 19, &[65536, 65536]);
+        let len = bytes.len() as u64;
+        let mut r = TiledExrReader::new(Cursor::new(bytes), len, "big.exr").unwrap();
+        assert_eq!(r.tiles(), (1, 1));
+        let e = r.read_tile(0, 0).unwrap_err().to_string();
+        assert!(e.contains("big.exr: a 65536x65536 image needs"), "{e}");
     }
 }
