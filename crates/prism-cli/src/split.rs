@@ -118,7 +118,8 @@ pub struct MergeArgs {
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
-    /// Print per-stage times on stderr: read (opening and checking the parts), merge, write.
+    /// Print per-stage times on stderr: read (opening and checking the parts), then merge
+    /// and write (one pass, a row of tiles at a time).
     #[arg(long)]
     stats: bool,
 }
