@@ -243,14 +243,7 @@ fn merge_streaming(
     format: ImageFormat,
     heatmap_format: Option<ImageFormat>,
 ) -> Result<MergeSummary> {
-    let setting = |k: &str| {
-        parts[0]
-            .header
-            .setting(k)
-            .and_then(|v| v.parse::<u32>().ok())
-            .unwrap_or(0)
-    };
-    let (w, h) = (setting("width"), setting("height"));
+    let (w, h) = prism_render::parts::merged_size(parts);
     let pixels = u64::from(w) * u64::from(h);
     if format == ImageFormat::Jpeg {
         fits(3 * pixels, &a.output)?;
@@ -259,13 +252,10 @@ fn merge_streaming(
         fits(4 * pixels, path)?;
     }
     let truncated = identity.encoding() == Encoding::Truncated;
-    let to8 = |p: Rgb| -> [u8; 3] {
-        if truncated {
-            let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
-            [b(p.r), b(p.g), b(p.b)]
-        } else {
-            [p.r, p.g, p.b].map(prism_image::linear_to_srgb8)
-        }
+    let to8 = if truncated {
+        prism_image::truncated8
+    } else {
+        prism_image::srgb8
     };
     let io = |path: &Path| {
         let path = path.to_path_buf();

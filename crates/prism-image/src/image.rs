@@ -182,21 +182,28 @@ impl Image<Rgb> {
     /// `byte = trunc(255 v)` (the Delft ray tracer's bitmap output).
     #[must_use]
     pub fn to_rgb8_truncated(&self) -> Rgb8Image {
-        let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
-        self.map(|p| [b(p.r), b(p.g), b(p.b)])
+        self.map(|&p| truncated8(p))
     }
 
     /// Encodes linear values as 8-bit sRGB (clamped to [0, 1], rounded; NaN becomes 0).
     #[must_use]
     pub fn linear_to_srgb8(&self) -> Rgb8Image {
-        self.map(|p| {
-            [
-                crate::linear_to_srgb8(p.r),
-                crate::linear_to_srgb8(p.g),
-                crate::linear_to_srgb8(p.b),
-            ]
-        })
+        self.map(|&p| srgb8(p))
     }
+}
+
+/// A pixel as [`Image::to_rgb8_truncated`] writes it: each channel clamped to `[0, 1]`,
+/// `byte = trunc(255 v)`.
+#[must_use]
+pub fn truncated8(p: Rgb) -> [u8; 3] {
+    let b = |v: f32| (255.0 * v.clamp(0.0, 1.0)) as u8;
+    [b(p.r), b(p.g), b(p.b)]
+}
+
+/// A pixel as [`Image::linear_to_srgb8`] writes it.
+#[must_use]
+pub fn srgb8(p: Rgb) -> [u8; 3] {
+    [p.r, p.g, p.b].map(crate::linear_to_srgb8)
 }
 
 #[cfg(test)]

@@ -528,22 +528,34 @@ impl<W: Write + Seek> PartWriter<W> {
     pub fn add(&mut self, origin: (u32, u32), sums: &[PixelSum]) -> Result<(), ImageError> {
         let k = tile_of(origin.0, origin.1, self.size.0);
         assert!(self.share.has_tile(k), "a tile of the share");
-        self.early.insert(k, sums.to_vec());
-        while let Some(&(k, (x0, y0))) = self.order.get(self.written) {
+        if self.order.get(self.written).map(|&(next, _)| next) != Some(k) {
+            // Early: kept until the tiles before it are in.
+            self.early.insert(k, sums.to_vec());
+            return Ok(());
+        }
+        self.write_next(sums)?;
+        while let Some(&(k, _)) = self.order.get(self.written) {
             let Some(sums) = self.early.remove(&k) else {
                 break;
             };
-            let (w, h) = self.size;
-            let (tw, th) = ((w - x0).min(TILE), (h - y0).min(TILE));
-            assert_eq!(
-                sums.len(),
-                (tw * th) as usize,
-                "one sum a pixel of the tile"
-            );
-            self.exr
-                .write_tile(x0 / TILE, y0 / TILE, &channels(&sums, tw, th))?;
-            self.written += 1;
+            self.write_next(&sums)?;
         }
+        Ok(())
+    }
+
+    /// Writes the next tile of the share, in order.
+    fn write_next(&mut self, sums: &[PixelSum]) -> Result<(), ImageError> {
+        let (_, (x0, y0)) = self.order[self.written];
+        let (w, h) = self.size;
+        let (tw, th) = ((w - x0).min(TILE), (h - y0).min(TILE));
+        assert_eq!(
+            sums.len(),
+            (tw * th) as usize,
+            "one sum a pixel of the tile"
+        );
+        self.exr
+            .write_tile(x0 / TILE, y0 / TILE, &channels(sums, tw, th))?;
+        self.written += 1;
         Ok(())
     }
 
@@ -656,14 +668,8 @@ impl PartFile {
     /// [`PartError::Image`] if a tile does not decode, [`PartError::Corrupt`] for a pixel
     /// whose sample count or sums contradict the share.
     pub fn load(mut self) -> Result<Part, PartError> {
-        let (w, h) = (self.reader.header().width, self.reader.header().height);
-        let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
-        prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
-            file: self.path.clone(),
-            width: w,
-            height: h,
-            source,
-        })?;
+        let (w, h) = merged_size(std::slice::from_ref(&self));
+        sums_fit(&self.path, (w, h), u64::from(w) * u64::from(h))?;
         let mut sums = Image::new(w, h, PixelSum::default());
         let (across, down) = self.reader.tiles();
         for ty in 0..down {
@@ -799,13 +805,7 @@ pub fn merge_rows<E: From<PartError>>(
         return Err(PartError::Missing { holes }.into());
     }
     let (w, h) = merged_size(files);
-    let bytes = u64::from(w) * u64::from(TILE) * size_of::<PixelSum>() as u64;
-    prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
-        file: files[0].path.clone(),
-        width: w,
-        height: h,
-        source,
-    })?;
+    sums_fit(&files[0].path, (w, h), u64::from(w) * u64::from(TILE))?;
     let across = w.div_ceil(TILE);
     let mut sums = Vec::new();
     for ty in 0..h.div_ceil(TILE) {
@@ -843,8 +843,21 @@ pub fn merge_rows<E: From<PartError>>(
     Ok(holes)
 }
 
+/// Checks that `pixels` pixels' sums fit the memory budget, for a `width x height` render
+/// whose part `file` asked for them.
+fn sums_fit(file: &Path, (width, height): (u32, u32), pixels: u64) -> Result<(), PartError> {
+    let bytes = pixels * size_of::<PixelSum>() as u64;
+    prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
+        file: file.to_path_buf(),
+        width,
+        height,
+        source,
+    })
+}
+
 /// The size the parts' identity gives (the first part's; [`merge_order`] checks the rest).
-fn merged_size(files: &[PartFile]) -> (u32, u32) {
+#[must_use]
+pub fn merged_size(files: &[PartFile]) -> (u32, u32) {
     let setting = |k: &str| {
         files
             .first()
@@ -863,13 +876,7 @@ fn merged_size(files: &[PartFile]) -> (u32, u32) {
 pub fn merge(files: &mut [PartFile], allow_missing: bool) -> Result<Merged, PartError> {
     let (w, h) = merged_size(files);
     if let Some(first) = files.first() {
-        let bytes = u64::from(w) * u64::from(h) * size_of::<PixelSum>() as u64;
-        prism_math::limits::check_memory(bytes).map_err(|source| PartError::OverBudget {
-            file: first.path.clone(),
-            width: w,
-            height: h,
-            source,
-        })?;
+        sums_fit(&first.path, (w, h), u64::from(w) * u64::from(h))?;
     }
     let mut all = Vec::new();
     let holes = merge_rows(files, allow_missing, |_, rows: &[PixelSum]| {
