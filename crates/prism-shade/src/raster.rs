@@ -139,6 +139,72 @@ impl Setup {
     }
 }
 
+/// A triangle's three edge functions (`b -> c`, `c -> a`, `a -> b`) over a band's sample
+/// rows, sixteen samples at a time: each lane is [`edge`]'s operations in its order, times
+/// the sign of the triangle's area, and [`Edges::inside`] applies the ownership rule.
+struct Edges {
+    /// Each edge's first corner.
+    from: [(f32, f32); 3],
+    /// Each edge's vector.
+    along: [(f32, f32); 3],
+    sign: F16,
+    /// Lanes exactly on an edge the triangle does not own are outside.
+    strict: [M16; 3],
+}
+
+impl Edges {
+    #[inline(always)]
+    fn new([a, b, c]: [&ScreenVertex; 3], set: &Setup) -> Edges {
+        Edges {
+            from: [(b.x, b.y), (c.x, c.y), (a.x, a.y)],
+            along: [
+                (c.x - b.x, c.y - b.y),
+                (a.x - c.x, a.y - c.y),
+                (b.x - a.x, b.y - a.y),
+            ],
+            sign: F16::splat(set.sign),
+            strict: set.own.map(|o| M16::splat(!o)),
+        }
+    }
+
+    /// The row's part of each function at sample row `y`: with `edge(p) = dx (y - fy) -
+    /// dy (x - fx)`, the first product.
+    #[inline(always)]
+    fn across(&self, y: f32) -> [f32; 3] {
+        let (along, from) = (&self.along, &self.from);
+        [
+            along[0].0 * (y - from[0].1),
+            along[1].0 * (y - from[1].1),
+            along[2].0 * (y - from[2].1),
+        ]
+    }
+
+    /// The three functions at the samples `xs` of a row, times the area's sign.
+    #[inline(always)]
+    fn at(&self, across: &[f32; 3], xs: F16) -> [F16; 3] {
+        // Written out, not a closure: a closure is compiled apart, without the caller's
+        // vector instruction set.
+        let (along, from, sign) = (&self.along, &self.from, self.sign);
+        [
+            (F16::splat(across[0]) - F16::splat(along[0].1) * (xs - from[0].0)) * sign,
+            (F16::splat(across[1]) - F16::splat(along[1].1) * (xs - from[1].0)) * sign,
+            (F16::splat(across[2]) - F16::splat(along[2].1) * (xs - from[2].0)) * sign,
+        ]
+    }
+
+    /// The first `live` lanes that are inside: no function below zero, and none zero on an
+    /// edge the triangle does not own.
+    #[inline(always)]
+    fn inside(&self, e: &[F16; 3], live: usize) -> M16 {
+        let zero = F16::splat(0.0);
+        let mut inside = M16::first(live);
+        for (&e, &strict) in e.iter().zip(&self.strict) {
+            inside = inside & !(e.lt(zero) | (e.eq(zero) & strict));
+        }
+        inside
+    }
+}
+
 /// Rasterizes triangle `id` into a band: the depth test and the visible triangle with its
 /// weights, sixteen samples of a sample row at a time. Each lane evaluates the edge
 /// functions exactly as [`edge`] does.
@@ -151,48 +217,26 @@ pub(crate) fn raster_fill(t: [&ScreenVertex; 3], id: u32, to: &Target, buf: &mut
     let k = to.k;
     let row_len = (to.w * k) as usize;
     let (j0, j1) = ((set.x.0 * k) as usize, (set.x.1 * k) as usize);
-    let sign = F16::splat(set.sign);
-    let zero = F16::splat(0.0);
-    let strict = set.own.map(|o| M16::splat(!o));
-    // Edges b -> c, c -> a, a -> b: from which corner, and along what.
-    let from = [(b.x, b.y), (c.x, c.y), (a.x, a.y)];
-    let along = [
-        (c.x - b.x, c.y - b.y),
-        (a.x - c.x, a.y - c.y),
-        (b.x - a.x, b.y - a.y),
-    ];
+    let edges = Edges::new(t, &set);
     for py in set.y.0..set.y.1 {
         for sy in 0..k {
             let y = py as f32 + sample_offset(sy, k);
             let row = ((py - to.y_start) * k + sy) as usize * row_len;
-            // edge(p) = dx (y - fy) - dy (x - fx): the first product is the row's.
-            let across = [
-                along[0].0 * (y - from[0].1),
-                along[1].0 * (y - from[1].1),
-                along[2].0 * (y - from[2].1),
-            ];
+            let across = edges.across(y);
             // A triangle no wider than a group of lanes takes one group a row: narrowing
             // the row first would cost more than the lanes it saves.
             let (lo, hi) = if j1 - j0 <= LANES {
                 (j0, j1)
             } else {
-                match row_span(&across, &along, &from, set.sign, k, (j0, j1)) {
+                match row_span(&across, &edges.along, &edges.from, set.sign, k, (j0, j1)) {
                     Some(span) => span,
                     None => continue,
                 }
             };
             let mut j = lo;
             while j < hi {
-                let xs = F16::load(&buf.xs[j..]);
-                let edge_at = |i: usize| {
-                    (F16::splat(across[i]) - F16::splat(along[i].1) * (xs - from[i].0)) * sign
-                };
-                let e = [edge_at(0), edge_at(1), edge_at(2)];
-                // Outside: below zero, or on an edge the triangle does not own.
-                let mut inside = M16::first(hi - j);
-                for i in 0..3 {
-                    inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
-                }
+                let e = edges.at(&across, F16::load(&buf.xs[j..]));
+                let inside = edges.inside(&e, hi - j);
                 if inside.any() {
                     let l = [
                         e[0] * set.inv_area,
@@ -304,15 +348,7 @@ pub(crate) fn raster_wire(
         ((b.x - a.x).powi(2) + (b.y - a.y).powi(2)).sqrt(),
     ];
     let (j0, j1) = ((set.x.0 * k) as usize, (set.x.1 * k) as usize);
-    let sign = F16::splat(set.sign);
-    let zero = F16::splat(0.0);
-    let strict = set.own.map(|o| M16::splat(!o));
-    let from = [(b.x, b.y), (c.x, c.y), (a.x, a.y)];
-    let along = [
-        (c.x - b.x, c.y - b.y),
-        (a.x - c.x, a.y - c.y),
-        (b.x - a.x, b.y - a.y),
-    ];
+    let edges = Edges::new(t, &set);
     let width = F16::splat(half_width);
     // `e / len <= w` implies `e <= w len` up to a few roundings: a relative margin of
     // 1e-5 (and an absolute one for lengths near 0) covers them.
@@ -322,24 +358,11 @@ pub(crate) fn raster_wire(
         for sy in 0..k {
             let y = py as f32 + sample_offset(sy, k);
             let row = ((py - to.y_start) * k + sy) as usize * row_len;
-            // edge(p) = dx (y - fy) - dy (x - fx), as `edge` evaluates it.
-            let across = [
-                along[0].0 * (y - from[0].1),
-                along[1].0 * (y - from[1].1),
-                along[2].0 * (y - from[2].1),
-            ];
+            let across = edges.across(y);
             let mut j = j0;
             while j < j1 {
-                let xs = F16::load(&buf.xs[j..]);
-                let e = [
-                    (F16::splat(across[0]) - F16::splat(along[0].1) * (xs - from[0].0)) * sign,
-                    (F16::splat(across[1]) - F16::splat(along[1].1) * (xs - from[1].0)) * sign,
-                    (F16::splat(across[2]) - F16::splat(along[2].1) * (xs - from[2].0)) * sign,
-                ];
-                let mut inside = M16::first(j1 - j);
-                for i in 0..3 {
-                    inside = inside & !(e[i].lt(zero) | (e[i].eq(zero) & strict[i]));
-                }
+                let e = edges.at(&across, F16::load(&buf.xs[j..]));
+                let inside = edges.inside(&e, j1 - j);
                 // Near an edge, by a test without division that takes a little more than
                 // the exact one (decided below, only where this one passes).
                 let roughly = e[0].le(reach[0]) | e[1].le(reach[1]) | e[2].le(reach[2]);
