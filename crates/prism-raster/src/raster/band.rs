@@ -1,8 +1,9 @@
-//! Bands: sample storage for a horizontal strip of the image, the sample-level drawing of
-//! every primitive kind, layers, and the box-filter resolve.
+//! Bands: a horizontal strip of the image as a stack of sample planes, the sample-level
+//! drawing of every primitive kind, layers, and the box-filter resolve.
 
 use prism_math::DVec2;
 
+use super::plane::{Cover, Plane, Summer};
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
 use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
@@ -20,11 +21,6 @@ pub(super) fn blend_8bit(dst: &mut [f32; 4], src: [f32; 4]) {
         let d8 = (dst[c] * 255.0) as u8 as f32;
         dst[c] = f32::from((a * s8 + (1.0 - a) * d8) as u8) / 255.0;
     }
-}
-
-#[inline(always)]
-pub(super) fn add4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
 }
 
 /// Where the samples of a pixel lie. Each pixel row is split into `sub_rows` sample rows;
@@ -49,22 +45,61 @@ impl Pattern {
     }
 }
 
-/// One band's sample storage: `rows_px * sub_rows` sample rows of `cols` samples.
+
+/// One band: `rows_px` pixel rows of `width` pixels, each of `sub_rows * sub_cols` samples,
+/// held as a stack of planes (the bottom one is the band's canvas).
 pub(super) struct Band {
-    /// Layer stack; the bottom is the band's canvas.
-    pub(super) layers: Vec<Vec<[f32; 4]>>,
-    pub(super) spare: Vec<Vec<[f32; 4]>>,
-    pub(super) cols: usize,
+    layers: Vec<Plane>,
+    spare: Vec<Plane>,
+    cover: Cover,
+    /// Pixels a plane holds (the most pixel rows a band has, times the width).
+    capacity: usize,
+    /// Sample columns across the band.
+    cols: usize,
     /// First pixel row of the band.
-    pub(super) y0: i32,
+    y0: i32,
     /// Pixel rows in the band.
-    pub(super) rows_px: i32,
-    pub(super) pat: Pattern,
-    pub(super) width: i32,
+    rows_px: i32,
+    pat: Pattern,
+    width: i32,
 }
 
 impl Band {
-    fn top(&mut self) -> &mut Vec<[f32; 4]> {
+    /// An empty band of at most `max_rows` pixel rows of `width` pixels.
+    pub(super) fn new(width: i32, max_rows: usize, pat: Pattern) -> Band {
+        Band {
+            layers: Vec::new(),
+            spare: Vec::new(),
+            cover: Cover::default(),
+            capacity: max_rows * width as usize,
+            cols: width as usize * pat.sub_cols,
+            y0: 0,
+            rows_px: 0,
+            pat,
+            width,
+        }
+    }
+
+    /// Makes this band pixel rows `[y0, y0 + rows_px)`, every sample `background`.
+    pub(super) fn start(&mut self, y0: i32, rows_px: i32, background: [f32; 4]) {
+        self.y0 = y0;
+        self.rows_px = rows_px;
+        while self.layers.len() > 1 {
+            let mut plane = self.layers.pop().expect("checked");
+            plane.reset();
+            self.spare.push(plane);
+        }
+        let n = self.pat.sub_rows * self.pat.sub_cols;
+        let mut canvas = self
+            .layers
+            .pop()
+            .unwrap_or_else(|| Plane::new(self.capacity, n));
+        canvas.reset();
+        canvas.fill(0..rows_px as usize * self.width as usize, background);
+        self.layers.push(canvas);
+    }
+
+    fn top(&mut self) -> &mut Plane {
         self.layers.last_mut().expect("band has a canvas")
     }
 
@@ -72,27 +107,30 @@ impl Band {
         f64::from(self.y0) + (j as f64 + 0.5) / self.pat.sub_rows as f64
     }
 
-    /// Sample-index ranges (rows, columns) of a placed box within this band.
-    fn region(&self, pl: &Placed) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
-        let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
-        let ya = (pl.y0.max(self.y0) - self.y0).max(0) as usize * sr;
-        let yb = (pl.y1.min(self.y0 + self.rows_px) - self.y0).max(0) as usize * sr;
-        let xa = pl.x0.max(0) as usize * sc;
-        let xb = (pl.x1.min(self.width).max(0) as usize * sc).max(xa);
-        (ya..yb.max(ya), xa..xb)
+    /// Pixel ranges of a placed box within this band, one per pixel row.
+    fn region(&self, pl: &Placed) -> impl Iterator<Item = std::ops::Range<usize>> {
+        let w = self.width as usize;
+        let ya = (pl.y0.max(self.y0) - self.y0).max(0) as usize;
+        let yb = (pl.y1.min(self.y0 + self.rows_px) - self.y0).max(0) as usize;
+        let xa = pl.x0.clamp(0, self.width) as usize;
+        let xb = (pl.x1.clamp(0, self.width) as usize).max(xa);
+        (ya..yb.max(ya)).map(move |y| y * w + xa..y * w + xb)
     }
 
     pub(super) fn draw(&mut self, pl: &Placed, compat: bool) {
         let p = &pl.prim;
         match p {
             Prim::BeginLayer => {
-                let (rows, cols) = self.region(pl);
-                let len = self.layers[0].len();
-                let mut buf = self.spare.pop().unwrap_or_else(|| vec![[0.0; 4]; len]);
-                for j in rows {
-                    buf[j * self.cols + cols.start..j * self.cols + cols.end].fill([0.0; 4]);
+                let n = self.pat.sub_rows * self.pat.sub_cols;
+                let capacity = self.capacity;
+                let mut plane = self
+                    .spare
+                    .pop()
+                    .unwrap_or_else(|| Plane::new(capacity, n));
+                for range in self.region(pl) {
+                    plane.fill(range, [0.0; 4]);
                 }
-                self.layers.push(buf);
+                self.layers.push(plane);
             }
             Prim::EndLayer(op, mode) => {
                 let op = *op;
@@ -118,49 +156,33 @@ impl Band {
                 *d = [d[0] * k, d[1] * k, d[2] * k, d[3] * k];
             }),
             Prim::Raster { x0, y0, w, px } => {
-                let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
-                let (by0, rows_px, cols, width) = (self.y0, self.rows_px, self.cols, self.width);
+                let (by0, rows_px, width) = (self.y0, self.rows_px, self.width);
                 let h = (px.len() / w.max(&1)) as i32;
                 let ya = (*y0).max(by0);
                 let yb = (y0 + h).min(by0 + rows_px);
                 let xa = (*x0).max(0);
                 let xb = (x0 + *w as i32).min(width);
-                let buf = self.top();
+                let plane = self.top();
                 for y in ya..yb {
                     let src_row = (y - y0) as usize * w;
-                    for j in 0..sr {
-                        let row = ((y - by0) as usize * sr + j) * cols;
-                        for x in xa..xb {
-                            let c = px[src_row + (x - x0) as usize];
-                            if c[3] <= 0.0 {
-                                continue;
-                            }
-                            let at = row + x as usize * sc;
-                            for s in &mut buf[at..at + sc] {
-                                blend(s, c);
-                            }
-                        }
+                    let row = (y - by0) as usize * width as usize;
+                    for x in xa..xb {
+                        plane.over(row + x as usize, px[src_row + (x - x0) as usize]);
                     }
                 }
             }
             Prim::Pixels { px, color } => {
-                let (y0, y1, cols) = (self.y0, self.y0 + self.rows_px, self.cols);
-                let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
-                let buf = self.top();
+                let (y0, y1, w) = (self.y0, self.y0 + self.rows_px, self.width as usize);
+                let plane = self.top();
                 for &(x, y) in px {
                     if y < y0 || y >= y1 {
                         continue;
                     }
-                    let base_row = (y - y0) as usize * sr;
-                    for j in 0..sr {
-                        let row = (base_row + j) * cols + x as usize * sc;
-                        for s in &mut buf[row..row + sc] {
-                            if compat && color[3] < 1.0 {
-                                blend_8bit(s, *color);
-                            } else {
-                                blend(s, *color);
-                            }
-                        }
+                    let p = (y - y0) as usize * w + x as usize;
+                    if compat && color[3] < 1.0 {
+                        plane.each(p, |s| blend_8bit(s, *color));
+                    } else {
+                        plane.over(p, *color);
                     }
                 }
             }
@@ -179,16 +201,13 @@ impl Band {
         if self.layers.len() < 2 {
             return;
         }
-        let (rows, cols) = self.region(pl);
-        let stride = self.cols;
-        let src = self.layers.pop().expect("checked");
+        let mut src = self.layers.pop().expect("checked");
+        let ranges: Vec<_> = self.region(pl).collect();
         let dst = self.top();
-        for j in rows {
-            let range = j * stride + cols.start..j * stride + cols.end;
-            for (d, s) in dst[range.clone()].iter_mut().zip(&src[range]) {
-                f(d, *s);
-            }
+        for range in ranges {
+            dst.combine(&src, range, &f);
         }
+        src.reset();
         self.spare.push(src);
     }
 
@@ -210,81 +229,53 @@ impl Band {
         }
         let cols = self.cols;
         let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
-        // Gradients are evaluated once per pixel, at its centre, and the colour given to
-        // every covered sample (as multisampling shades); alpha < 0 marks "not yet".
-        let gradient = !matches!(paint, DevPaint::Solid(_));
-        let mut row_cache: Vec<[f32; 4]> = Vec::new();
-        let mut cache_row = usize::MAX;
-        for j in 0..self.rows_px as usize * sr {
-            let y = self.sample_y(j);
-            let xo = self.pat.xoff[j % sr];
-            if gradient && j / sr != cache_row {
-                cache_row = j / sr;
-                row_cache.clear();
-                row_cache.resize(self.width as usize, [0.0, 0.0, 0.0, -1.0]);
-            }
-            let y_centre = f64::from(self.y0) + (j / sr) as f64 + 0.5;
-            xs.clear();
-            for e in &local {
-                let owns = if compat {
-                    y >= e.y0 && y < e.y1
-                } else {
-                    y > e.y0 && y <= e.y1
-                };
-                if owns {
-                    xs.push((e.x0 + (y - e.y0) * e.dxdy, e.dir));
+        for py in 0..self.rows_px as usize {
+            self.cover.clear();
+            for j in py * sr..(py + 1) * sr {
+                let y = self.sample_y(j);
+                let xo = self.pat.xoff[j % sr];
+                xs.clear();
+                for e in &local {
+                    let owns = if compat {
+                        y >= e.y0 && y < e.y1
+                    } else {
+                        y > e.y0 && y <= e.y1
+                    };
+                    if owns {
+                        xs.push((e.x0 + (y - e.y0) * e.dxdy, e.dir));
+                    }
                 }
+                if xs.len() >= 2 {
+                    xs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                    let mut wind = 0;
+                    for k in 0..xs.len() - 1 {
+                        wind += xs[k].1;
+                        let inside = match rule {
+                            FillRule::NonZero => wind != 0,
+                            FillRule::EvenOdd => wind % 2 != 0,
+                        };
+                        if inside {
+                            self.cover.push(
+                                first_sample(xs[k].0, xo, sc, cols, compat),
+                                first_sample(xs[k + 1].0, xo, sc, cols, compat),
+                            );
+                        }
+                    }
+                }
+                self.cover.end_row();
             }
-            if xs.len() < 2 {
+            if self.cover.is_empty() {
                 continue;
             }
-            xs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-            let row = &mut self.layers.last_mut().expect("canvas")[j * cols..(j + 1) * cols];
-            let mut wind = 0;
-            for k in 0..xs.len() - 1 {
-                wind += xs[k].1;
-                let inside = match rule {
-                    FillRule::NonZero => wind != 0,
-                    FillRule::EvenOdd => wind % 2 != 0,
-                };
-                if !inside {
-                    continue;
-                }
-                // The first sample at or right of x (compat), or right of x.
-                // (`floor` and `ceil` are libm calls on baseline x86-64: a truncating cast
-                // and a correction do the same for the clamped range.)
-                let first = |x: f64| {
-                    let k = ((x - xo) * sc).clamp(-1.0, cols as f64);
-                    let t = k as i64;
-                    let below = (t as f64) < k;
-                    let i = if compat {
-                        t + i64::from(below)
-                    } else {
-                        t + 1 - i64::from(k < t as f64)
-                    };
-                    i.clamp(0, cols as i64) as usize
-                };
-                let (a, b) = (first(xs[k].0), first(xs[k + 1].0));
-                match paint {
-                    DevPaint::Solid(c) if c[3] >= 1.0 => row[a..b].fill(*c),
-                    DevPaint::Solid(c) => {
-                        for s in &mut row[a..b] {
-                            blend(s, *c);
-                        }
-                    }
-                    g => {
-                        let sci = self.pat.sub_cols;
-                        for (i, s) in row[a..b].iter_mut().enumerate() {
-                            let px = (a + i) / sci;
-                            let c = &mut row_cache[px];
-                            if c[3] < 0.0 {
-                                *c = g.at(px as f64 + 0.5, y_centre);
-                            }
-                            blend(s, *c);
-                        }
-                    }
-                }
-            }
+            // Gradients and patterns are evaluated once per pixel, at its centre, and the
+            // colour given to every covered sample (as multisampling shades).
+            let y_centre = f64::from(self.y0) + py as f64 + 0.5;
+            let plane = self.layers.last_mut().expect("canvas");
+            let (w, sci) = (self.width as usize, self.pat.sub_cols);
+            self.cover.paint(plane, py, w, sci, |x| match paint {
+                DevPaint::Solid(c) => *c,
+                g => g.at(x as f64 + 0.5, y_centre),
+            });
         }
     }
 
@@ -340,233 +331,205 @@ impl Band {
         if !inclusive && area == 0.0 {
             return;
         }
-        let cols = self.cols;
-        let y0 = self.y0;
-        let buf = self.layers.last_mut().expect("canvas");
-        // Textures in standard mode are shaded once per pixel, at its centre, and the colour
-        // is given to every covered sample (as multisampling does); the course shades every
-        // sample.
+        let (y0, width) = (self.y0, self.width as usize);
+        // Solid triangles, and textures in standard mode (shaded once per pixel, at its
+        // centre, the colour given to every covered sample, as multisampling does), paint
+        // a cover; the course shades every sample.
         let per_pixel = !compat && matches!(shade, TriShade::Tex { .. });
-        let fast_interior = !compat && (per_pixel || matches!(shade, TriShade::Solid(_)));
-        // Colours of the current pixel row, by pixel column from i_lo / sc; alpha < 0 = unset.
-        let px_lo = i_lo / sc;
-        let mut row_cache: Vec<[f32; 4]> = if per_pixel {
-            vec![[0.0, 0.0, 0.0, -1.0]; (i_hi - 1) / sc - px_lo + 1]
-        } else {
-            Vec::new()
-        };
-        let mut cache_row = usize::MAX;
-        for j in j_lo..j_hi {
-            if per_pixel && j / sr != cache_row {
-                cache_row = j / sr;
-                row_cache.fill([0.0, 0.0, 0.0, -1.0]);
-            }
-            let xo = self.pat.xoff[j % sr];
-            let (row_lo, row_hi) = cols_of(xo);
-            let y = f64::from(y0) + (j as f64 + 0.5) / rf;
-            let yf = if compat { f64::from(y as f32) } else { y };
-            // A superset of the covered samples on this row, from the three edge lines.
-            let (mut xl, mut xr) = (f64::NEG_INFINITY, f64::INFINITY);
-            if area != 0.0 {
-                for (a, b) in edges {
-                    let (c, dy) = ((b.x - a.x) * (yf - a.y) * sign, (b.y - a.y) * sign);
-                    if dy > 0.0 {
-                        xr = xr.min(a.x + c / dy);
-                    } else if dy < 0.0 {
-                        xl = xl.max(a.x + c / dy);
-                    }
+        let by_pixel = per_pixel || matches!(shade, TriShade::Solid(_));
+        let fast_interior = !compat && by_pixel;
+        // The colour at barycentrics (b0, b1) (texture triangles).
+        let shade_at = |b0: f32, b1: f32| -> [f32; 4] {
+            let b2 = 1.0 - b0 - b1;
+            match shade {
+                TriShade::Solid(c) => *c,
+                TriShade::Color(c) => {
+                    let k = c[0] * b0 + c[1] * b1 + c[2] * b2;
+                    [k.r, k.g, k.b, 1.0]
+                }
+                TriShade::Tex {
+                    tex,
+                    alpha_tex,
+                    uvs,
+                    lod,
+                    psm,
+                    lsm,
+                    alpha,
+                } => {
+                    let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
+                    let k = tex.sample_lod(uv, *lod, *psm, *lsm);
+                    let cov = match alpha_tex {
+                        Some(at) => at.sample_lod(uv, *lod, *psm, *lsm).r,
+                        None => 1.0,
+                    };
+                    [k.r * alpha, k.g * alpha, k.b * alpha, cov * alpha]
                 }
             }
-            let span_lo = (((xl - xo) * cf).floor() - 1.0).max(row_lo as f64);
-            let span_hi = (((xr - xo) * cf).ceil() + 2.0).min(row_hi as f64);
-            if span_lo.partial_cmp(&span_hi) != Some(std::cmp::Ordering::Less) {
-                continue;
-            }
-            // Samples more than one sample spacing inside all three edge lines need no edge
-            // test (standard mode, and only when the shading does not use barycentrics).
-            let (in_lo, in_hi) = if fast_interior && xl.is_finite() && xr.is_finite() {
-                (
-                    ((xl - xo) * cf).ceil() + 1.0,
-                    ((xr - xo) * cf).floor() - 1.0,
-                )
+        };
+        let bary = |w0: f64, w1: f64| {
+            if area == 0.0 {
+                (1.0, 0.0)
             } else {
-                (f64::INFINITY, f64::NEG_INFINITY)
-            };
-            let end = span_hi as usize;
-            let mut i = span_lo as usize;
-            while i < end {
-                // Interior runs: solid colours and already-shaded pixels in one go.
-                if (i as f64) >= in_lo && (i as f64) <= in_hi {
-                    let run_end = (in_hi as usize + 1).min(end);
-                    if let TriShade::Solid(c) = shade {
-                        let run = &mut buf[j * cols + i..j * cols + run_end];
-                        if c[3] >= 1.0 {
-                            run.fill(*c);
-                        } else {
-                            run.iter_mut().for_each(|s| blend(s, *c));
+                ((w0 / area) as f32, (w1 / area) as f32)
+            }
+        };
+        let Band {
+            layers,
+            cover,
+            pat,
+            ..
+        } = self;
+        let plane = layers.last_mut().expect("canvas");
+        for py in j_lo / sr..(j_hi - 1) / sr + 1 {
+            cover.clear();
+            for j in (py * sr).max(j_lo)..((py + 1) * sr).min(j_hi) {
+                let s = j % sr;
+                while cover.rows() < s {
+                    cover.end_row();
+                }
+                let xo = pat.xoff[s];
+                let (row_lo, row_hi) = cols_of(xo);
+                let y = f64::from(y0) + (j as f64 + 0.5) / rf;
+                let yf = if compat { f64::from(y as f32) } else { y };
+                // A superset of the covered samples on this row, from the three edge lines.
+                let (mut xl, mut xr) = (f64::NEG_INFINITY, f64::INFINITY);
+                if area != 0.0 {
+                    for (a, b) in edges {
+                        let (c, dy) = ((b.x - a.x) * (yf - a.y) * sign, (b.y - a.y) * sign);
+                        if dy > 0.0 {
+                            xr = xr.min(a.x + c / dy);
+                        } else if dy < 0.0 {
+                            xl = xl.max(a.x + c / dy);
                         }
+                    }
+                }
+                let span_lo = (((xl - xo) * cf).floor() - 1.0).max(row_lo as f64);
+                let span_hi = (((xr - xo) * cf).ceil() + 2.0).min(row_hi as f64);
+                if span_lo.partial_cmp(&span_hi) != Some(std::cmp::Ordering::Less) {
+                    continue;
+                }
+                // Samples more than one sample spacing inside all three edge lines need no
+                // edge test (standard mode, and only when the shading is per pixel).
+                let (in_lo, in_hi) = if fast_interior && xl.is_finite() && xr.is_finite() {
+                    (
+                        ((xl - xo) * cf).ceil() + 1.0,
+                        ((xr - xo) * cf).floor() - 1.0,
+                    )
+                } else {
+                    (f64::INFINITY, f64::NEG_INFINITY)
+                };
+                let end = span_hi as usize;
+                let mut i = span_lo as usize;
+                while i < end {
+                    if (i as f64) >= in_lo && (i as f64) <= in_hi {
+                        let run_end = (in_hi as usize + 1).min(end);
+                        cover.push(i, run_end);
                         i = run_end;
                         continue;
                     }
-                    let px = i / sc;
-                    if per_pixel && row_cache[px - px_lo][3] >= 0.0 {
-                        let hit = row_cache[px - px_lo];
-                        let stop = ((px + 1) * sc).min(run_end);
-                        for s in &mut buf[j * cols + i..j * cols + stop] {
-                            blend(s, hit);
-                        }
-                        i = stop;
-                        continue;
-                    }
-                }
-                let x = i as f64 / cf + xo;
-                let interior = (i as f64) >= in_lo && (i as f64) <= in_hi;
-                let w = if interior {
-                    [0.0; 3]
-                } else {
-                    [
+                    let x = i as f64 / cf + xo;
+                    let w = [
                         ef(edges[0].0, edges[0].1, x, yf),
                         ef(edges[1].0, edges[1].1, x, yf),
                         ef(edges[2].0, edges[2].1, x, yf),
-                    ]
-                };
-                let inside = if interior {
-                    true
-                } else if inclusive {
-                    (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0)
-                        || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
-                } else {
-                    (0..3).all(|k| {
-                        let s = w[k] * sign;
-                        s > 0.0 || (s == 0.0 && own[k])
-                    })
-                };
-                if !inside {
-                    i += 1;
-                    continue;
-                }
-                let color = match shade {
-                    TriShade::Solid(c) => *c,
-                    TriShade::Color(c) => {
-                        let (b0, b1) = if area == 0.0 {
-                            (1.0, 0.0)
+                    ];
+                    let inside = if inclusive {
+                        (w[0] >= 0.0 && w[1] >= 0.0 && w[2] >= 0.0)
+                            || (w[0] <= 0.0 && w[1] <= 0.0 && w[2] <= 0.0)
+                    } else {
+                        (0..3).all(|k| {
+                            let s = w[k] * sign;
+                            s > 0.0 || (s == 0.0 && own[k])
+                        })
+                    };
+                    if inside {
+                        if by_pixel {
+                            cover.push(i, i + 1);
                         } else {
-                            ((w[0] / area) as f32, (w[1] / area) as f32)
-                        };
-                        let b2 = 1.0 - b0 - b1;
-                        let k = c[0] * b0 + c[1] * b1 + c[2] * b2;
-                        [k.r, k.g, k.b, 1.0]
-                    }
-                    TriShade::Tex {
-                        tex,
-                        alpha_tex,
-                        uvs,
-                        lod,
-                        psm,
-                        lsm,
-                        alpha,
-                    } => {
-                        let (b0, b1) = if area == 0.0 {
-                            (1.0, 0.0)
-                        } else if per_pixel {
-                            let px = i / sc;
-                            let hit = row_cache[px - px_lo];
-                            if hit[3] >= 0.0 {
-                                blend(&mut buf[j * cols + i], hit);
-                                i += 1;
-                                continue;
-                            }
-                            let (cx, cy) = (px as f64 + 0.5, f64::from(y0) + (j / sr) as f64 + 0.5);
-                            let w0 = ef(edges[0].0, edges[0].1, cx, cy);
-                            let w1 = ef(edges[1].0, edges[1].1, cx, cy);
-                            ((w0 / area) as f32, (w1 / area) as f32)
-                        } else {
-                            ((w[0] / area) as f32, (w[1] / area) as f32)
-                        };
-                        let b2 = 1.0 - b0 - b1;
-                        let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
-                        let k = tex.sample_lod(uv, *lod, *psm, *lsm);
-                        let cov = match alpha_tex {
-                            Some(at) => at.sample_lod(uv, *lod, *psm, *lsm).r,
-                            None => 1.0,
-                        };
-                        let c = [k.r * alpha, k.g * alpha, k.b * alpha, cov * alpha];
-                        if per_pixel {
-                            row_cache[i / sc - px_lo] = c;
+                            let (b0, b1) = bary(w[0], w[1]);
+                            let p = py * width + i / sc;
+                            let at = s * sc + i % sc;
+                            blend(&mut plane.split(p)[at], shade_at(b0, b1));
                         }
-                        c
                     }
-                };
-                blend(&mut buf[j * cols + i], color);
-                i += 1;
+                    i += 1;
+                }
             }
+            if !by_pixel {
+                continue;
+            }
+            while cover.rows() < sr {
+                cover.end_row();
+            }
+            let cy = f64::from(y0) + py as f64 + 0.5;
+            cover.paint(plane, py, width, sc, |x| match shade {
+                TriShade::Solid(c) => *c,
+                _ => {
+                    let cx = x as f64 + 0.5;
+                    let (b0, b1) = bary(
+                        ef(edges[0].0, edges[0].1, cx, cy),
+                        ef(edges[1].0, edges[1].1, cx, cy),
+                    );
+                    shade_at(b0, b1)
+                }
+            });
         }
     }
 
     /// Box-filters the canvas layer into premultiplied pixels.
     pub(super) fn resolve_premultiplied(&self, out: &mut [[f32; 4]]) {
-        let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
-        let k = 1.0 / (sr * sc) as f32;
-        let w = self.width as usize;
-        let stride = self.cols;
-        for py in 0..self.rows_px as usize {
-            let base = py * sr * stride;
-            for (x, o) in out[py * w..(py + 1) * w].iter_mut().enumerate() {
-                let mut sum = [0f32; 4];
-                for j in 0..sr {
-                    let start = base + j * stride + x * sc;
-                    for s in &self.layers[0][start..start + sc] {
-                        sum = add4(sum, *s);
-                    }
-                }
-                *o = sum.map(|v| v * k);
-            }
+        let n = self.pat.sub_rows * self.pat.sub_cols;
+        let k = 1.0 / n as f32;
+        let canvas = &self.layers[0];
+        let mut summer = Summer::new();
+        for (p, o) in out.iter_mut().enumerate() {
+            *o = summer.sum(canvas, p).map(|v| v * k);
         }
     }
 
     /// Box-filters the canvas layer into 8-bit straight-alpha pixels.
     pub(super) fn resolve(&self, out: &mut [[u8; 4]], compat: bool) {
-        let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
-        let n = (sr * sc) as f32;
-        let w = self.width as usize;
+        let n = (self.pat.sub_rows * self.pat.sub_cols) as f32;
         let canvas = &self.layers[0];
-        let mut acc = vec![[0f32; 4]; w];
-        let stride = self.cols;
-        for py in 0..self.rows_px as usize {
-            // Sum the samples of every pixel in registers.
-            let base = py * sr * stride;
-            for (x, a) in acc.iter_mut().enumerate() {
-                let mut sum = [0f32; 4];
-                for j in 0..sr {
-                    let start = base + j * stride + x * sc;
-                    for s in &canvas[start..start + sc] {
-                        sum = add4(sum, *s);
-                    }
+        let mut summer = Summer::new();
+        for (p, o) in out.iter_mut().enumerate() {
+            let a = summer.sum(canvas, p);
+            if compat {
+                // The course's conversion: truncate channel * 255.
+                for c in 0..3 {
+                    o[c] = ((a[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
                 }
-                *a = sum;
-            }
-            let out_row = &mut out[py * w..(py + 1) * w];
-            for (o, a) in out_row.iter_mut().zip(&acc) {
-                if compat {
-                    // The course's conversion: truncate channel * 255.
-                    for c in 0..3 {
-                        o[c] = ((a[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
-                    }
-                    o[3] = 255;
-                } else {
-                    let alpha = a[3] / n;
-                    if alpha <= 0.0 {
-                        *o = [0, 0, 0, 0];
-                        continue;
-                    }
-                    let k = 255.0 / (n * alpha);
-                    // Round to nearest (`round()` is a libm call on baseline x86-64).
-                    for c in 0..3 {
-                        o[c] = ((a[c] * k).clamp(0.0, 255.0) + 0.5) as u8;
-                    }
-                    o[3] = (alpha.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                o[3] = 255;
+            } else {
+                let alpha = a[3] / n;
+                if alpha <= 0.0 {
+                    *o = [0, 0, 0, 0];
+                    continue;
                 }
+                let k = 255.0 / (n * alpha);
+                // Round to nearest (`round()` is a libm call on baseline x86-64).
+                for c in 0..3 {
+                    o[c] = ((a[c] * k).clamp(0.0, 255.0) + 0.5) as u8;
+                }
+                o[3] = (alpha.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             }
         }
     }
+}
+
+/// The first sample column at or right of `x` (compat), or right of `x`, on a sample row
+/// whose first sample sits at `xo`, clamped to `[0, cols]`.
+#[inline]
+fn first_sample(x: f64, xo: f64, sc: f64, cols: usize, compat: bool) -> usize {
+    // (`floor` and `ceil` are libm calls on baseline x86-64: a truncating cast and a
+    // correction do the same for the clamped range.)
+    let k = ((x - xo) * sc).clamp(-1.0, cols as f64);
+    let t = k as i64;
+    let below = (t as f64) < k;
+    let i = if compat {
+        t + i64::from(below)
+    } else {
+        t + 1 - i64::from(k < t as f64)
+    };
+    i.clamp(0, cols as i64) as usize
 }

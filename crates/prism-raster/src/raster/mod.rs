@@ -17,6 +17,7 @@
 mod band;
 mod offscreen;
 mod options;
+mod plane;
 mod primitives;
 
 use std::time::{Duration, Instant};
@@ -117,38 +118,24 @@ fn draw_bands<T: Send>(
     // Regular r x r grid: it agreed better with analytic coverage (resvg) on the test suites
     // than n-rooks patterns did.
     let pat = Pattern::grid(r);
-    let cols = w as usize * pat.sub_cols;
-    // About 256 KiB of samples per band (and per layer of a band), to stay in L2.
-    let band_rows = ((256usize << 10) / (cols * pat.sub_rows * 16)).clamp(1, 64);
+    // About 256 KiB of pixel colours per band (and per layer of a band), to stay in L2.
+    let band_rows = ((256usize << 10) / (w as usize * 16)).clamp(1, 64);
     let background = if opts.compat {
         [1.0, 1.0, 1.0, 1.0]
     } else {
         [0.0; 4]
     };
-    let full = band_rows * pat.sub_rows * cols;
     pixels
         .par_chunks_mut(band_rows * w as usize)
         .enumerate()
         .map_init(
-            // Sample buffers are reused from band to band on each thread.
-            || Band {
-                layers: Vec::new(),
-                spare: Vec::new(),
-                cols,
-                y0: 0,
-                rows_px: 0,
-                pat: pat.clone(),
-                width: w as i32,
-            },
+            // Planes are reused from band to band on each thread.
+            || Band::new(w as i32, band_rows, pat.clone()),
             |band, (bi, out)| {
                 let ta = Instant::now();
-                band.y0 = (bi * band_rows) as i32;
-                band.rows_px = (out.len() / w as usize) as i32;
-                let mut canvas = band.layers.pop().unwrap_or_else(|| vec![[0.0; 4]; full]);
-                band.spare.append(&mut band.layers);
-                canvas.fill(background);
-                band.layers.push(canvas);
-                let (y0, rows_px) = (band.y0, band.rows_px);
+                let y0 = (bi * band_rows) as i32;
+                let rows_px = (out.len() / w as usize) as i32;
+                band.start(y0, rows_px, background);
                 for p in prims {
                     if p.y1 > y0 && p.y0 < y0 + rows_px {
                         band.draw(p, opts.compat);
