@@ -1,5 +1,8 @@
 //! `cargo bench -p prism-raster`: render every staged course SVG at 1024x1024 with 1 and 16
 //! samples per pixel on all cores, reporting the median of 5 runs per file and the total.
+//! With `PRISM_RASTER_SVG=folder` it renders that folder's standard SVGs instead, at
+//! 960x640 with 16 samples per pixel (the raster bench's setting), reporting the median
+//! of 41 runs per file and the stage times of the median run.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -21,7 +24,45 @@ fn svgs(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// Renders each standard SVG under `dir` at 960x640, 16 samples per pixel.
+fn standard(dir: &Path) {
+    let mut files = Vec::new();
+    svgs(dir, &mut files);
+    println!("threads: {}", rayon::current_num_threads());
+    for f in &files {
+        let doc = read_svg(f, Dialect::Svg).expect("svg parses");
+        let opts = RasterOptions {
+            width: 960,
+            height: 640,
+            samples: 16,
+            ..RasterOptions::default()
+        };
+        let mut runs: Vec<(Duration, prism_raster::RasterStats)> = (0..41)
+            .map(|_| {
+                let t = Instant::now();
+                let (_, stats) = render(&doc, &opts).expect("render");
+                (t.elapsed(), stats)
+            })
+            .collect();
+        runs.sort_by_key(|r| r.0);
+        let (t, s) = runs[20];
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        println!(
+            "{:<16} {:>7.2} ms  (prepare {:.2}, raster {:.2}, resolve {:.2})",
+            f.file_name().unwrap_or_default().to_string_lossy(),
+            ms(t),
+            ms(s.prepare),
+            ms(s.raster),
+            ms(s.resolve)
+        );
+    }
+}
+
 fn main() {
+    if let Some(dir) = std::env::var_os("PRISM_RASTER_SVG") {
+        standard(Path::new(&dir));
+        return;
+    }
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/assets/rasterizer/svg");
     let mut files = Vec::new();
     svgs(&root, &mut files);

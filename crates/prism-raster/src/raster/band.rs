@@ -3,7 +3,7 @@
 
 use prism_math::DVec2;
 
-use super::plane::{Cover, Plane, Summer};
+use super::plane::{sums, Cover, Plane};
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
 use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
@@ -197,6 +197,7 @@ impl Band {
 
     /// Pops the top layer and combines each of its samples in the placed box into the
     /// layer below with `f(below, top)`.
+    #[inline(never)]
     fn end_layer(&mut self, pl: &Placed, f: impl Fn(&mut [f32; 4], [f32; 4])) {
         if self.layers.len() < 2 {
             return;
@@ -215,18 +216,15 @@ impl Band {
     /// left and top edges own it (`y0 <= y < y1`); otherwise the right and bottom edges do
     /// (`y0 < y <= y1`), which is tiny-skia's rule, so that edges on the sample grid cover
     /// what resvg covers.
+    #[inline(never)]
     fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols as f64);
-        let band_lo = f64::from(self.y0);
         let band_hi = f64::from(self.y0 + self.rows_px);
-        let local: Vec<Edge> = edges
-            .iter()
-            .filter(|e| e.y1 > band_lo && e.y0 < band_hi)
-            .copied()
-            .collect();
-        if local.is_empty() {
-            return;
-        }
+        // Edges sorted by their top; those reaching into the band become active at their
+        // first sample row and leave after their last.
+        let end = edges.partition_point(|e| e.y0 < band_hi);
+        let mut next = 0;
+        let mut active: Vec<Edge> = Vec::new();
         let cols = self.cols;
         let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
         for py in 0..self.rows_px as usize {
@@ -234,17 +232,18 @@ impl Band {
             for j in py * sr..(py + 1) * sr {
                 let y = self.sample_y(j);
                 let xo = self.pat.xoff[j % sr];
-                xs.clear();
-                for e in &local {
-                    let owns = if compat {
-                        y >= e.y0 && y < e.y1
-                    } else {
-                        y > e.y0 && y <= e.y1
-                    };
-                    if owns {
-                        xs.push((e.x0 + (y - e.y0) * e.dxdy, e.dir));
+                // An edge owns the sample rows with y0 <= y < y1 (compat) or y0 < y <= y1.
+                let starts = |e: &Edge| if compat { e.y0 <= y } else { e.y0 < y };
+                let ended = |e: &Edge| if compat { e.y1 <= y } else { e.y1 < y };
+                while next < end && starts(&edges[next]) {
+                    if !ended(&edges[next]) {
+                        active.push(edges[next]);
                     }
+                    next += 1;
                 }
+                active.retain(|e| !ended(e));
+                xs.clear();
+                xs.extend(active.iter().map(|e| (e.x0 + (y - e.y0) * e.dxdy, e.dir)));
                 if xs.len() >= 2 {
                     xs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
                     let mut wind = 0;
@@ -272,13 +271,18 @@ impl Band {
             let y_centre = f64::from(self.y0) + py as f64 + 0.5;
             let plane = self.layers.last_mut().expect("canvas");
             let (w, sci) = (self.width as usize, self.pat.sub_cols);
-            self.cover.paint(plane, py, w, sci, |x| match paint {
+            let uniform = match paint {
+                DevPaint::Solid(c) => Some(*c),
+                _ => None,
+            };
+            self.cover.paint(plane, py, w, sci, uniform, |x| match paint {
                 DevPaint::Solid(c) => *c,
                 g => g.at(x as f64 + 0.5, y_centre),
             });
         }
     }
 
+    #[inline(never)]
     fn tri(&mut self, v: &[DVec2; 3], inclusive: bool, shade: &TriShade, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
         let (rf, cf) = (sr as f64, sc as f64);
@@ -462,7 +466,11 @@ impl Band {
                 cover.end_row();
             }
             let cy = f64::from(y0) + py as f64 + 0.5;
-            cover.paint(plane, py, width, sc, |x| match shade {
+            let uniform = match shade {
+                TriShade::Solid(c) => Some(*c),
+                _ => None,
+            };
+            cover.paint(plane, py, width, sc, uniform, |x| match shade {
                 TriShade::Solid(c) => *c,
                 _ => {
                     let cx = x as f64 + 0.5;
@@ -480,39 +488,45 @@ impl Band {
     pub(super) fn resolve_premultiplied(&self, out: &mut [[f32; 4]]) {
         let n = self.pat.sub_rows * self.pat.sub_cols;
         let k = 1.0 / n as f32;
-        let canvas = &self.layers[0];
-        let mut summer = Summer::new();
-        for (p, o) in out.iter_mut().enumerate() {
-            *o = summer.sum(canvas, p).map(|v| v * k);
+        sums(&self.layers[0], 0, out);
+        for o in out {
+            *o = o.map(|v| v * k);
         }
     }
 
     /// Box-filters the canvas layer into 8-bit straight-alpha pixels.
     pub(super) fn resolve(&self, out: &mut [[u8; 4]], compat: bool) {
         let n = (self.pat.sub_rows * self.pat.sub_cols) as f32;
-        let canvas = &self.layers[0];
-        let mut summer = Summer::new();
+        let w = self.width as usize;
+        let mut acc = vec![[0f32; 4]; w];
+        let mut last = ([f32::NAN.to_bits(); 4], [0u8; 4]);
         for (p, o) in out.iter_mut().enumerate() {
-            let a = summer.sum(canvas, p);
-            if compat {
+            if p % w == 0 {
+                sums(&self.layers[0], p, &mut acc);
+            }
+            let a = acc[p % w];
+            let bits = a.map(f32::to_bits);
+            if bits == last.0 {
+                *o = last.1;
+                continue;
+            }
+            *o = if compat {
                 // The course's conversion: truncate channel * 255.
-                for c in 0..3 {
-                    o[c] = ((a[c] / n) * 255.0).clamp(0.0, 255.0) as u8;
-                }
-                o[3] = 255;
+                let t = [a[0] / n * 255.0, a[1] / n * 255.0, a[2] / n * 255.0, 255.0];
+                t.map(|v| v.clamp(0.0, 255.0) as i32 as u8)
             } else {
                 let alpha = a[3] / n;
                 if alpha <= 0.0 {
-                    *o = [0, 0, 0, 0];
-                    continue;
+                    [0, 0, 0, 0]
+                } else {
+                    let k = 255.0 / (n * alpha);
+                    // Round to nearest (`round()` is a libm call on baseline x86-64). The
+                    // alpha lane is `alpha.clamp(0, 1) * 255`, as rounding is monotone.
+                    let t = [a[0] * k, a[1] * k, a[2] * k, alpha * 255.0];
+                    t.map(|v| (v.clamp(0.0, 255.0) + 0.5) as i32 as u8)
                 }
-                let k = 255.0 / (n * alpha);
-                // Round to nearest (`round()` is a libm call on baseline x86-64).
-                for c in 0..3 {
-                    o[c] = ((a[c] * k).clamp(0.0, 255.0) + 0.5) as u8;
-                }
-                o[3] = (alpha.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            }
+            };
+            last = (bits, *o);
         }
     }
 }

@@ -49,8 +49,35 @@ impl Plane {
 
     /// Sets every sample of the pixels in `range` to `c`.
     pub(super) fn fill(&mut self, range: std::ops::Range<usize>, c: [f32; 4]) {
-        for p in range {
-            self.set(p, c);
+        if self.block[range.clone()].iter().any(|&b| b != SHARED) {
+            for p in range.clone() {
+                self.set(p, c);
+            }
+        } else {
+            self.px[range].fill(c);
+        }
+    }
+
+    /// Composites `src` over every sample of the pixels in `range`.
+    pub(super) fn over_range(&mut self, range: std::ops::Range<usize>, src: [f32; 4]) {
+        if src[3] >= 1.0 {
+            self.fill(range, src);
+        } else if src[3] > 0.0 {
+            if self.block[range.clone()].iter().any(|&b| b != SHARED) {
+                for p in range {
+                    self.each(p, |s| over(s, src));
+                }
+            } else {
+                let k = 1.0 - src[3];
+                for d in &mut self.px[range] {
+                    *d = [
+                        src[0] + d[0] * k,
+                        src[1] + d[1] * k,
+                        src[2] + d[2] * k,
+                        src[3] + d[3] * k,
+                    ];
+                }
+            }
         }
     }
 
@@ -210,15 +237,18 @@ impl Cover {
         self.spans.is_empty()
     }
 
-    /// Composites `color(x)` over every covered sample of pixel row `row` of `plane`
-    /// (`width` pixels, `sub_cols` samples per pixel per sample row): a pixel covered in
-    /// full is composited once if shared, a pixel covered in part is split.
+    /// Composites `color(x)` (or `uniform`, when given, the same for every pixel) over
+    /// every covered sample of pixel row `row` of `plane` (`width` pixels, `sub_cols`
+    /// samples per pixel per sample row): a pixel covered in full is composited once if
+    /// shared, a pixel covered in part is split.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn paint(
         &mut self,
         plane: &mut Plane,
         row: usize,
         width: usize,
         sub_cols: usize,
+        uniform: Option<[f32; 4]>,
         mut color: impl FnMut(usize) -> [f32; 4],
     ) {
         if self.spans.is_empty() {
@@ -250,19 +280,38 @@ impl Cover {
         self.cursor.clear();
         self.cursor.push(0);
         self.cursor.extend_from_slice(&self.ends[..sub_rows - 1]);
-        let base = row * width;
+        // Samples covered per pixel.
         let mut run = 0i32;
-        for x in lo..hi {
-            run += self.whole[x - lo];
-            let covered = self.part[x - lo] as usize + run as usize;
+        for (part, whole) in self.part.iter_mut().zip(&self.whole) {
+            run += whole;
+            *part += run as u32;
+        }
+        let base = row * width;
+        let mut i = 0;
+        while i < len {
+            let covered = self.part[i] as usize;
+            if covered == n {
+                // A run of pixels covered in full.
+                let start = i;
+                while i < len && self.part[i] as usize == n {
+                    i += 1;
+                }
+                match uniform {
+                    Some(c) => plane.over_range(base + lo + start..base + lo + i, c),
+                    None => {
+                        for x in lo + start..lo + i {
+                            plane.over(base + x, color(x));
+                        }
+                    }
+                }
+                continue;
+            }
+            let x = lo + i;
+            i += 1;
             if covered == 0 {
                 continue;
             }
             let c = color(x);
-            if covered == n {
-                plane.over(base + x, c);
-                continue;
-            }
             if c[3] <= 0.0 {
                 continue;
             }
@@ -287,37 +336,45 @@ impl Cover {
     }
 }
 
-/// Sums the samples of pixel `p` of `plane` in sample order (a shared pixel's colour
-/// added `n` times, as its samples would be), reusing the last shared pixel's result.
-pub(super) struct Summer {
-    last: Option<([u32; 4], [f32; 4])>,
-}
+/// Pixels summed side by side, so that their additions overlap.
+const LANES: usize = 8;
 
-impl Summer {
-    /// A summer with nothing remembered.
-    pub(super) fn new() -> Summer {
-        Summer { last: None }
-    }
-
-    /// The sum of pixel `p`'s samples, and whether it is a shared pixel's.
-    #[inline]
-    pub(super) fn sum(&mut self, plane: &Plane, p: usize) -> [f32; 4] {
-        match plane.pixel(p) {
-            Pixel::Shared(v) => {
-                let bits = v.map(f32::to_bits);
-                if let Some((b, s)) = self.last {
-                    if b == bits {
-                        return s;
-                    }
-                }
-                let mut sum = [0f32; 4];
-                for _ in 0..plane.n {
-                    sum = add4(sum, v);
-                }
-                self.last = Some((bits, sum));
-                sum
+/// Writes the sum of each pixel's samples, added in sample order, for the pixels of
+/// `plane` from `first` on into `out` (a shared pixel's colour is added `n` times, as its
+/// samples would be). A run of pixels sharing one colour is summed once.
+pub(super) fn sums(plane: &Plane, first: usize, out: &mut [[f32; 4]]) {
+    let n = plane.n;
+    let mut last: Option<([u32; 4], [f32; 4])> = None;
+    for (c, chunk) in out.chunks_mut(LANES).enumerate() {
+        let p0 = first + c * LANES;
+        if let Some((bits, sum)) = last {
+            let same = (0..chunk.len()).all(|q| {
+                plane.block[p0 + q] == SHARED && plane.px[p0 + q].map(f32::to_bits) == bits
+            });
+            if same {
+                chunk.fill(sum);
+                continue;
             }
-            Pixel::Split(s) => s.iter().fold([0f32; 4], |acc, v| add4(acc, *v)),
+        }
+        // Each lane reads its pixel's samples, or its one colour again and again.
+        let mut src: [&[[f32; 4]]; LANES] = [&[[0.0; 4]]; LANES];
+        let mut step = [0usize; LANES];
+        for (q, (s, k)) in src.iter_mut().zip(&mut step).enumerate().take(chunk.len()) {
+            match plane.pixel(p0 + q) {
+                Pixel::Shared(_) => *s = std::slice::from_ref(&plane.px[p0 + q]),
+                Pixel::Split(samples) => (*s, *k) = (samples, 1),
+            }
+        }
+        let mut acc = [[0f32; 4]; LANES];
+        for i in 0..n {
+            for q in 0..LANES {
+                acc[q] = add4(acc[q], src[q][i * step[q]]);
+            }
+        }
+        chunk.copy_from_slice(&acc[..chunk.len()]);
+        let q = chunk.len() - 1;
+        if step[q] == 0 {
+            last = Some((src[q][0].map(f32::to_bits), acc[q]));
         }
     }
 }

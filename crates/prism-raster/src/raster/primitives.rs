@@ -253,6 +253,7 @@ pub(super) enum Prim {
         shade: TriShade,
     },
     Poly {
+        /// Sorted by `y0`.
         edges: Vec<Edge>,
         rule: FillRule,
         paint: DevPaint,
@@ -418,10 +419,12 @@ pub(super) fn prepare(
             },
         })
     };
-    let place_poly = |edges: Vec<Edge>, rule: FillRule, paint: DevPaint| -> Option<Placed> {
+    let place_poly = |mut edges: Vec<Edge>, rule: FillRule, paint: DevPaint| -> Option<Placed> {
         if edges.is_empty() {
             return None;
         }
+        // Top to bottom, so a band sweeps them in order.
+        edges.sort_unstable_by(|a, b| a.y0.total_cmp(&b.y0));
         let lo = edges.iter().map(|e| e.y0).fold(f64::INFINITY, f64::min);
         let hi = edges.iter().map(|e| e.y1).fold(f64::NEG_INFINITY, f64::max);
         let (y0, y1) = rows(lo, hi)?;
