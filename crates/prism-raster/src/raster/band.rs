@@ -45,13 +45,15 @@ impl Pattern {
     }
 }
 
-
 /// One band: `rows_px` pixel rows of `width` pixels, each of `sub_rows * sub_cols` samples,
 /// held as a stack of planes (the bottom one is the band's canvas).
 pub(super) struct Band {
     layers: Vec<Plane>,
     spare: Vec<Plane>,
     cover: Cover,
+    /// Scratch for polygons: the active edges and a sample row's crossings.
+    active: Vec<Edge>,
+    crossings: Vec<(f64, i32)>,
     /// Pixels a plane holds (the most pixel rows a band has, times the width).
     capacity: usize,
     /// Sample columns across the band.
@@ -71,6 +73,8 @@ impl Band {
             layers: Vec::new(),
             spare: Vec::new(),
             cover: Cover::default(),
+            active: Vec::new(),
+            crossings: Vec::new(),
             capacity: max_rows * width as usize,
             cols: width as usize * pat.sub_cols,
             y0: 0,
@@ -109,12 +113,7 @@ impl Band {
 
     /// Pixel ranges of a placed box within this band, one per pixel row.
     fn region(&self, pl: &Placed) -> impl Iterator<Item = std::ops::Range<usize>> {
-        let w = self.width as usize;
-        let ya = (pl.y0.max(self.y0) - self.y0).max(0) as usize;
-        let yb = (pl.y1.min(self.y0 + self.rows_px) - self.y0).max(0) as usize;
-        let xa = pl.x0.clamp(0, self.width) as usize;
-        let xb = (pl.x1.clamp(0, self.width) as usize).max(xa);
-        (ya..yb.max(ya)).map(move |y| y * w + xa..y * w + xb)
+        region(self.width, self.y0, self.rows_px, pl)
     }
 
     pub(super) fn draw(&mut self, pl: &Placed, compat: bool) {
@@ -123,10 +122,7 @@ impl Band {
             Prim::BeginLayer => {
                 let n = self.pat.sub_rows * self.pat.sub_cols;
                 let capacity = self.capacity;
-                let mut plane = self
-                    .spare
-                    .pop()
-                    .unwrap_or_else(|| Plane::new(capacity, n));
+                let mut plane = self.spare.pop().unwrap_or_else(|| Plane::new(capacity, n));
                 for range in self.region(pl) {
                     plane.fill(range, [0.0; 4]);
                 }
@@ -203,9 +199,9 @@ impl Band {
             return;
         }
         let mut src = self.layers.pop().expect("checked");
-        let ranges: Vec<_> = self.region(pl).collect();
-        let dst = self.top();
-        for range in ranges {
+        let (w, y0, rows_px) = (self.width, self.y0, self.rows_px);
+        let dst = self.layers.last_mut().expect("band has a canvas");
+        for range in region(w, y0, rows_px, pl) {
             dst.combine(&src, range, &f);
         }
         src.reset();
@@ -224,9 +220,10 @@ impl Band {
         // first sample row and leave after their last.
         let end = edges.partition_point(|e| e.y0 < band_hi);
         let mut next = 0;
-        let mut active: Vec<Edge> = Vec::new();
+        let mut active = std::mem::take(&mut self.active);
+        let mut xs = std::mem::take(&mut self.crossings);
+        active.clear();
         let cols = self.cols;
-        let mut xs: Vec<(f64, i32)> = Vec::with_capacity(16);
         for py in 0..self.rows_px as usize {
             self.cover.clear();
             for j in py * sr..(py + 1) * sr {
@@ -275,11 +272,14 @@ impl Band {
                 DevPaint::Solid(c) => Some(*c),
                 _ => None,
             };
-            self.cover.paint(plane, py, w, sci, uniform, |x| match paint {
-                DevPaint::Solid(c) => *c,
-                g => g.at(x as f64 + 0.5, y_centre),
-            });
+            self.cover
+                .paint(plane, py, w, sci, uniform, |x| match paint {
+                    DevPaint::Solid(c) => *c,
+                    g => g.at(x as f64 + 0.5, y_centre),
+                });
         }
+        self.active = active;
+        self.crossings = xs;
     }
 
     #[inline(never)]
@@ -378,10 +378,7 @@ impl Band {
             }
         };
         let Band {
-            layers,
-            cover,
-            pat,
-            ..
+            layers, cover, pat, ..
         } = self;
         let plane = layers.last_mut().expect("canvas");
         for py in j_lo / sr..(j_hi - 1) / sr + 1 {
@@ -500,35 +497,57 @@ impl Band {
         let w = self.width as usize;
         let mut acc = vec![[0f32; 4]; w];
         let mut last = ([f32::NAN.to_bits(); 4], [0u8; 4]);
-        for (p, o) in out.iter_mut().enumerate() {
-            if p % w == 0 {
-                sums(&self.layers[0], p, &mut acc);
+        for (row, out_row) in out.chunks_mut(w).enumerate() {
+            sums(&self.layers[0], row * w, &mut acc);
+            for (o, a) in out_row.iter_mut().zip(&acc) {
+                *o = convert(*a, n, compat, &mut last);
             }
-            let a = acc[p % w];
-            let bits = a.map(f32::to_bits);
-            if bits == last.0 {
-                *o = last.1;
-                continue;
-            }
-            *o = if compat {
-                // The course's conversion: truncate channel * 255.
-                let t = [a[0] / n * 255.0, a[1] / n * 255.0, a[2] / n * 255.0, 255.0];
-                t.map(|v| v.clamp(0.0, 255.0) as i32 as u8)
-            } else {
-                let alpha = a[3] / n;
-                if alpha <= 0.0 {
-                    [0, 0, 0, 0]
-                } else {
-                    let k = 255.0 / (n * alpha);
-                    // Round to nearest (`round()` is a libm call on baseline x86-64). The
-                    // alpha lane is `alpha.clamp(0, 1) * 255`, as rounding is monotone.
-                    let t = [a[0] * k, a[1] * k, a[2] * k, alpha * 255.0];
-                    t.map(|v| (v.clamp(0.0, 255.0) + 0.5) as i32 as u8)
-                }
-            };
-            last = (bits, *o);
         }
     }
+}
+
+/// The 8-bit straight-alpha pixel of the sum `a` of `n` premultiplied samples; `last`
+/// remembers the previous sum's bits and result.
+#[inline(always)]
+fn convert(a: [f32; 4], n: f32, compat: bool, last: &mut ([u32; 4], [u8; 4])) -> [u8; 4] {
+    let bits = a.map(f32::to_bits);
+    if bits == last.0 {
+        return last.1;
+    }
+    let o = if compat {
+        // The course's conversion: truncate channel * 255.
+        let t = [a[0] / n * 255.0, a[1] / n * 255.0, a[2] / n * 255.0, 255.0];
+        t.map(|v| v.clamp(0.0, 255.0) as i32 as u8)
+    } else {
+        let alpha = a[3] / n;
+        if alpha <= 0.0 {
+            [0, 0, 0, 0]
+        } else {
+            let k = 255.0 / (n * alpha);
+            // Round to nearest (`round()` is a libm call on baseline x86-64). The
+            // alpha lane is `alpha.clamp(0, 1) * 255`, as rounding is monotone.
+            let t = [a[0] * k, a[1] * k, a[2] * k, alpha * 255.0];
+            t.map(|v| (v.clamp(0.0, 255.0) + 0.5) as i32 as u8)
+        }
+    };
+    *last = (bits, o);
+    o
+}
+
+/// Pixel ranges of a placed box within the band of `rows_px` rows of `width` pixels from
+/// row `y0`, one per pixel row.
+fn region(
+    width: i32,
+    y0: i32,
+    rows_px: i32,
+    pl: &Placed,
+) -> impl Iterator<Item = std::ops::Range<usize>> {
+    let w = width as usize;
+    let ya = (pl.y0.max(y0) - y0).max(0) as usize;
+    let yb = (pl.y1.min(y0 + rows_px) - y0).max(0) as usize;
+    let xa = pl.x0.clamp(0, width) as usize;
+    let xb = (pl.x1.clamp(0, width) as usize).max(xa);
+    (ya..yb.max(ya)).map(move |y| y * w + xa..y * w + xb)
 }
 
 /// The first sample column at or right of `x` (compat), or right of `x`, on a sample row

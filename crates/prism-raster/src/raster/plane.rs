@@ -165,6 +165,13 @@ impl Plane {
         range: std::ops::Range<usize>,
         f: impl Fn(&mut [f32; 4], [f32; 4]),
     ) {
+        let shared = |plane: &Plane| plane.block[range.clone()].iter().all(|&b| b == SHARED);
+        if shared(src) && shared(self) {
+            for (d, s) in self.px[range.clone()].iter_mut().zip(&src.px[range]) {
+                f(d, *s);
+            }
+            return;
+        }
         for p in range {
             match src.pixel(p) {
                 Pixel::Shared(s) => self.each(p, |d| f(d, s)),
@@ -356,6 +363,13 @@ pub(super) fn sums(plane: &Plane, first: usize, out: &mut [[f32; 4]]) {
                 continue;
             }
         }
+        if chunk.len() == LANES && plane.block[p0..p0 + LANES].iter().all(|&b| b == SHARED) {
+            let v: [[f32; 4]; LANES] = std::array::from_fn(|q| plane.px[p0 + q]);
+            let acc = repeat_sum(v, n);
+            chunk.copy_from_slice(&acc);
+            last = Some((v[LANES - 1].map(f32::to_bits), acc[LANES - 1]));
+            continue;
+        }
         // Each lane reads its pixel's samples, or its one colour again and again.
         let mut src: [&[[f32; 4]]; LANES] = [&[[0.0; 4]]; LANES];
         let mut step = [0usize; LANES];
@@ -377,6 +391,18 @@ pub(super) fn sums(plane: &Plane, first: usize, out: &mut [[f32; 4]]) {
             last = Some((src[q][0].map(f32::to_bits), acc[q]));
         }
     }
+}
+
+/// `v` added to itself in sequence `n` times (from zero), lane by lane.
+#[inline(always)]
+fn repeat_sum(v: [[f32; 4]; LANES], n: usize) -> [[f32; 4]; LANES] {
+    let mut acc = [[0f32; 4]; LANES];
+    for _ in 0..n {
+        for q in 0..LANES {
+            acc[q] = add4(acc[q], v[q]);
+        }
+    }
+    acc
 }
 
 #[inline(always)]
