@@ -7,6 +7,7 @@ mod error;
 mod interrupt;
 mod mesh;
 mod output;
+mod present;
 mod progress;
 mod raytrace;
 mod render;

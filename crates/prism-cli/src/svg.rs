@@ -1,12 +1,16 @@
 //! `prism svg`: SVG to PNG, one file or a directory tree.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_image::{LevelSampling, PixelSampling};
-use prism_raster::{read_svg_with, render, Dialect, Document, Fonts, RasterOptions, View};
+use prism_image::{
+    AtomicFile, ImageError, LevelSampling, PixelSampling, PngColor, PngRowWriter,
+};
+use prism_raster::{
+    read_svg_with, render, Dialect, Document, Fonts, RasterOptions, RasterStats, View,
+};
 
 use crate::error::UserError;
 use crate::output::{image_output, write_rgb8, ImageFormat};
@@ -195,16 +199,19 @@ fn render_one(
         view: view.unwrap_or_default(),
         compat: a.compat.is_some(),
     };
-    let (image, stats) =
-        render(&doc, &opts).map_err(|e| UserError::input(format!("{}: {e}", input.display())))?;
-    let t1 = Instant::now();
-    match format {
+    let refused = |e| UserError::input(format!("{}: {e}", input.display()));
+    let (stats, encode) = if format == ImageFormat::Png {
+        write_png_rows(output, &doc, &opts).map_err(|e| match e {
+            Streamed::Raster(e) => refused(e).into(),
+            Streamed::Image(e) => anyhow::Error::from(e),
+        })?
+    } else {
+        let (image, stats) = render(&doc, &opts).map_err(refused)?;
+        let t1 = Instant::now();
         // JPEG has no alpha: the picture goes over white, as a browser shows it.
-        ImageFormat::Jpeg => write_rgb8(output, format, &image.over_background([255, 255, 255]))?,
-        _ if opts.compat => write_rgb8(output, format, &image.to_rgb8())?,
-        _ => prism_image::write_png_rgba(output, &image)?,
-    }
-    let encode = t1.elapsed();
+        write_rgb8(output, format, &image.over_background([255, 255, 255]))?;
+        (stats, t1.elapsed())
+    };
     if a.stats {
         if a.input.is_dir() {
             eprintln!("{}:", input.display());
@@ -216,6 +223,65 @@ fn render_one(
         eprintln!("encode: {}", ms(encode));
     }
     Ok(doc.warnings)
+}
+
+/// Why a streamed PNG was not written.
+enum Streamed {
+    Raster(prism_raster::RasterError),
+    Image(ImageError),
+}
+
+/// Renders `doc` straight into the PNG `output`, each band of rows encoded as it is drawn
+/// (RGB for the course's opaque pictures, RGBA otherwise); returns the render's stage
+/// times and the time spent encoding.
+fn write_png_rows(
+    output: &Path,
+    doc: &Document,
+    opts: &RasterOptions,
+) -> std::result::Result<(RasterStats, Duration), Streamed> {
+    let io = |source| {
+        Streamed::Image(ImageError::Io {
+            path: output.to_path_buf(),
+            source,
+        })
+    };
+    let mut file = AtomicFile::create(output).map_err(io)?;
+    let color = if opts.compat {
+        PngColor::Rgb
+    } else {
+        PngColor::Rgba
+    };
+    let mut png = PngRowWriter::new(file.writer(), opts.width, opts.height, color)
+        .map_err(Streamed::Image)?;
+    let mut failed = None;
+    let mut encode = Duration::ZERO;
+    let mut rgb = Vec::new();
+    let stats = prism_raster::render_rows(doc, opts, |rows| {
+        let t = Instant::now();
+        for row in rows.chunks(opts.width as usize) {
+            let bytes = if opts.compat {
+                rgb.clear();
+                rgb.extend(row.iter().flat_map(|p| [p[0], p[1], p[2]]));
+                &rgb[..]
+            } else {
+                row.as_flattened()
+            };
+            if let Err(e) = png.write_row(bytes) {
+                failed = Some(e);
+                return false;
+            }
+        }
+        encode += t.elapsed();
+        true
+    })
+    .map_err(Streamed::Raster)?;
+    if let Some(e) = failed {
+        return Err(Streamed::Image(e));
+    }
+    let t = Instant::now();
+    png.finish().map_err(Streamed::Image)?;
+    file.commit().map_err(io)?;
+    Ok((stats, encode + t.elapsed()))
 }
 
 /// The `*.svg` files under `dir`, in path order, walked with a stack of folders (not

@@ -1,8 +1,7 @@
 //! `prism view`: the window around prism-view's [`Viewer`]: winit for the window and its
-//! events, softbuffer for CPU-drawn pixels, X11 loaded at run time (so it runs over SSH with
-//! X forwarding and under Xvfb, and needs no GPU).
+//! events, Xlib's `XPutImage` for CPU-drawn pixels, X11 loaded at run time (so it runs over
+//! SSH with X forwarding and under Xvfb, and needs no GPU).
 
-use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::rc::Rc;
 
@@ -17,6 +16,7 @@ use winit::keyboard::{Key as WinitKey, ModifiersState, NamedKey};
 use winit::window::{Window, WindowId};
 
 use crate::error::UserError;
+use crate::present::Presenter;
 
 /// What the file is viewed as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -285,7 +285,7 @@ fn without_source_location(text: &str) -> String {
 struct App {
     viewer: Viewer,
     window: Option<Rc<Window>>,
-    surface: Option<softbuffer::Surface<Rc<Window>, Rc<Window>>>,
+    surface: Option<Presenter>,
     modifiers: ModifiersState,
     error: Option<String>,
 }
@@ -308,15 +308,9 @@ impl App {
         let Some(surface) = self.surface.as_mut() else {
             return Ok(());
         };
-        let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
-            return Ok(());
-        };
-        surface.resize(nw, nh).map_err(|e| e.to_string())?;
-        let mut buffer = surface.buffer_mut().map_err(|e| e.to_string())?;
-        for (out, p) in buffer.iter_mut().zip(frame.pixels()) {
-            *out = u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]);
-        }
-        buffer.present().map_err(|e| e.to_string())
+        surface
+            .show(frame.pixels().iter().map(|p| [p[0], p[1], p[2]]), w, h)
+            .map_err(|e| e.to_string())
     }
 }
 
@@ -335,11 +329,8 @@ impl ApplicationHandler for App {
             .create_window(attributes)
             .map_err(|e| e.to_string())
             .and_then(|w| {
-                let w = Rc::new(w);
-                let context = softbuffer::Context::new(w.clone()).map_err(|e| e.to_string())?;
-                let surface =
-                    softbuffer::Surface::new(&context, w.clone()).map_err(|e| e.to_string())?;
-                Ok((w, surface))
+                let surface = Presenter::new(&w).map_err(|e| e.to_string())?;
+                Ok((Rc::new(w), surface))
             });
         match made {
             Ok((w, surface)) => {

@@ -20,6 +20,8 @@ mod options;
 mod plane;
 mod primitives;
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{mpsc, Mutex};
 use std::time::{Duration, Instant};
 
 use prism_image::Rgba8Image;
@@ -52,6 +54,26 @@ pub fn render(
     doc: &Document,
     opts: &RasterOptions,
 ) -> Result<(Rgba8Image, RasterStats), RasterError> {
+    let mut pixels = Vec::with_capacity(opts.width as usize * opts.height as usize);
+    let stats = render_rows(doc, opts, |rows| {
+        pixels.extend_from_slice(rows);
+        true
+    })?;
+    Ok((Rgba8Image::from_vec(opts.width, opts.height, pixels), stats))
+}
+
+/// Renders a document to straight-alpha RGBA8 and hands the picture to `sink` on the
+/// calling thread, a band of whole rows at a time from the top, while the bands below are
+/// still being drawn (so the rows can be written as they come). `sink` returns `false` to
+/// stop: the bands not yet drawn are then skipped.
+///
+/// # Errors
+/// [`RasterError`] for an output size, sample count or view outside the documented limits.
+pub fn render_rows(
+    doc: &Document,
+    opts: &RasterOptions,
+    mut sink: impl FnMut(&[[u8; 4]]) -> bool,
+) -> Result<RasterStats, RasterError> {
     let (w, h) = (opts.width, opts.height);
     if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
         return Err(RasterError::BadSize(w, h));
@@ -67,24 +89,122 @@ pub fn render(
     let prims = prepare(doc, &doc.items, opts, &view, render_premultiplied);
     let prepare_time = t0.elapsed();
     let t1 = Instant::now();
-    let mut pixels = vec![[0u8; 4]; w as usize * h as usize];
-    let compat = opts.compat;
-    let times = draw_bands(&prims, opts, r, &mut pixels, |band, out| {
-        band.resolve(out, compat);
+    let band_rows = band_rows(w);
+    let bands = (h as usize).div_ceil(band_rows);
+    let pat = Pattern::grid(r);
+    let background = background(opts);
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let times = Mutex::new((Duration::ZERO, Duration::ZERO));
+    let (tx, rx) = mpsc::channel::<(usize, Vec<[u8; 4]>)>();
+    // Each worker takes the next band down, so bands finish nearly in order.
+    let worker = || {
+        let mut band = Band::new(w as i32, band_rows, pat.clone());
+        let (mut rt, mut st) = (Duration::ZERO, Duration::ZERO);
+        loop {
+            let bi = next.fetch_add(1, Ordering::Relaxed);
+            if bi >= bands || stop.load(Ordering::Relaxed) {
+                break;
+            }
+            let y0 = bi * band_rows;
+            let rows_px = band_rows.min(h as usize - y0);
+            let ta = Instant::now();
+            draw_band(&mut band, &prims, opts, y0 as i32, rows_px as i32, background);
+            let tb = Instant::now();
+            let mut out = vec![[0u8; 4]; rows_px * w as usize];
+            band.resolve(&mut out, opts.compat);
+            (rt, st) = (rt + (tb - ta), st + tb.elapsed());
+            if tx.send((bi, out)).is_err() {
+                break;
+            }
+        }
+        let mut t = times.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        (t.0, t.1) = (t.0 + rt, t.1 + st);
+    };
+    rayon::in_place_scope(|s| {
+        for _ in 0..rayon::current_num_threads().min(bands) {
+            s.spawn(|_| worker());
+        }
+        // Bands are handed on in order; those that finish early wait here.
+        let mut held: Vec<Option<Vec<[u8; 4]>>> = vec![None; bands];
+        let mut due = 0;
+        while due < bands {
+            let Some((bi, rows)) = receive(&rx) else {
+                break;
+            };
+            held[bi] = Some(rows);
+            while let Some(rows) = held.get_mut(due).and_then(Option::take) {
+                due += 1;
+                if !stop.load(Ordering::Relaxed) && !sink(&rows) {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+        }
+        drop(rx);
     });
     let wall = t1.elapsed();
-    let (rt, st): (Duration, Duration) = times
-        .iter()
-        .fold((Duration::ZERO, Duration::ZERO), |(a, b), (x, y)| {
-            (a + *x, b + *y)
-        });
+    let (rt, st) = *times.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let total = (rt + st).as_secs_f64().max(1e-12);
-    let stats = RasterStats {
+    Ok(RasterStats {
         prepare: prepare_time,
         raster: wall.mul_f64(rt.as_secs_f64() / total),
         resolve: wall.mul_f64(st.as_secs_f64() / total),
-    };
-    Ok((Rgba8Image::from_vec(w, h, pixels), stats))
+    })
+}
+
+/// The next message, waiting for it; on a pool thread, running the pool's other work
+/// while waiting (so a one-thread pool cannot wait on itself). `None` once every sender
+/// has gone.
+fn receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
+    loop {
+        match rx.try_recv() {
+            Ok(m) => return Some(m),
+            Err(mpsc::TryRecvError::Disconnected) => return None,
+            Err(mpsc::TryRecvError::Empty) => match rayon::yield_now() {
+                None => return rx.recv().ok(),
+                Some(rayon::Yield::Executed) => {}
+                Some(rayon::Yield::Idle) => {
+                    match rx.recv_timeout(Duration::from_micros(100)) {
+                        Ok(m) => return Some(m),
+                        Err(mpsc::RecvTimeoutError::Disconnected) => return None,
+                        Err(mpsc::RecvTimeoutError::Timeout) => {}
+                    }
+                }
+            },
+        }
+    }
+}
+
+/// Pixel rows per band: about 256 KiB of pixel colours per band (and per layer of a
+/// band), to stay in L2.
+fn band_rows(width: u32) -> usize {
+    ((256usize << 10) / (width as usize * 16)).clamp(1, 64)
+}
+
+/// The colour every sample starts with.
+fn background(opts: &RasterOptions) -> [f32; 4] {
+    if opts.compat {
+        [1.0, 1.0, 1.0, 1.0]
+    } else {
+        [0.0; 4]
+    }
+}
+
+/// Draws the primitives touching pixel rows `[y0, y0 + rows_px)` into `band`.
+fn draw_band(
+    band: &mut Band,
+    prims: &[Placed],
+    opts: &RasterOptions,
+    y0: i32,
+    rows_px: i32,
+    background: [f32; 4],
+) {
+    band.start(y0, rows_px, background);
+    for p in prims {
+        if p.y1 > y0 && p.y0 < y0 + rows_px {
+            band.draw(p, opts.compat);
+        }
+    }
 }
 
 /// Renders `items` of `doc` through `view` into premultiplied pixels of an
@@ -106,47 +226,33 @@ fn render_premultiplied(
 }
 
 /// Draws `prims` band by band in parallel and resolves each band into its rows of `pixels`
-/// with `resolve`; returns each band's (raster, resolve) thread time.
+/// with `resolve`.
 fn draw_bands<T: Send>(
     prims: &[Placed],
     opts: &RasterOptions,
     r: usize,
     pixels: &mut [T],
     resolve: impl Fn(&Band, &mut [T]) + Sync,
-) -> Vec<(Duration, Duration)> {
+) {
     let w = opts.width;
     // Regular r x r grid: it agreed better with analytic coverage (resvg) on the test suites
     // than n-rooks patterns did.
     let pat = Pattern::grid(r);
-    // About 256 KiB of pixel colours per band (and per layer of a band), to stay in L2.
-    let band_rows = ((256usize << 10) / (w as usize * 16)).clamp(1, 64);
-    let background = if opts.compat {
-        [1.0, 1.0, 1.0, 1.0]
-    } else {
-        [0.0; 4]
-    };
+    let band_rows = band_rows(w);
+    let background = background(opts);
     pixels
         .par_chunks_mut(band_rows * w as usize)
         .enumerate()
-        .map_init(
+        .for_each_init(
             // Planes are reused from band to band on each thread.
             || Band::new(w as i32, band_rows, pat.clone()),
             |band, (bi, out)| {
-                let ta = Instant::now();
                 let y0 = (bi * band_rows) as i32;
                 let rows_px = (out.len() / w as usize) as i32;
-                band.start(y0, rows_px, background);
-                for p in prims {
-                    if p.y1 > y0 && p.y0 < y0 + rows_px {
-                        band.draw(p, opts.compat);
-                    }
-                }
-                let tb = Instant::now();
+                draw_band(band, prims, opts, y0, rows_px, background);
                 resolve(band, out);
-                (tb - ta, tb.elapsed())
             },
-        )
-        .collect()
+        );
 }
 
 #[cfg(test)]
