@@ -481,14 +481,15 @@ impl AtomicFile {
             .expect("an uncommitted file has its writer")
     }
 
-    /// Flushes the file to disk and renames it over the path.
+    /// Flushes the file and renames it over the path, so readers see the old file or the
+    /// whole new one. Like `cp` and other image tools, it does not wait for the disk.
     ///
     /// # Errors
     /// The operating system's error; the path is then untouched.
     pub fn commit(mut self) -> std::io::Result<()> {
         let out = self.out.take().expect("an uncommitted file has its writer");
         let file = out.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
+        drop(file);
         std::fs::rename(&self.tmp, &self.path)?;
         register_temporary(&self.tmp, false);
         Ok(())

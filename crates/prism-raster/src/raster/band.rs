@@ -3,7 +3,8 @@
 
 use prism_math::DVec2;
 
-use super::plane::{sums, Cover, Plane};
+use super::plane::{Cover, Plane};
+use super::resolve::Resolver;
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
 use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
@@ -51,6 +52,7 @@ pub(super) struct Band {
     layers: Vec<Plane>,
     spare: Vec<Plane>,
     cover: Cover,
+    resolver: Resolver,
     /// Scratch for polygons: the active edges and a sample row's crossings.
     active: Vec<Edge>,
     crossings: Vec<(f64, i32)>,
@@ -73,6 +75,7 @@ impl Band {
             layers: Vec::new(),
             spare: Vec::new(),
             cover: Cover::default(),
+            resolver: Resolver::default(),
             active: Vec::new(),
             crossings: Vec::new(),
             capacity: max_rows * width as usize,
@@ -482,56 +485,44 @@ impl Band {
     }
 
     /// Box-filters the canvas layer into premultiplied pixels.
-    pub(super) fn resolve_premultiplied(&self, out: &mut [[f32; 4]]) {
+    pub(super) fn resolve_premultiplied(&mut self, out: &mut [[f32; 4]]) {
         let n = self.pat.sub_rows * self.pat.sub_cols;
         let k = 1.0 / n as f32;
-        sums(&self.layers[0], 0, out);
-        for o in out {
-            *o = o.map(|v| v * k);
+        let w = self.width as usize;
+        for (row, out_row) in out.chunks_mut(w).enumerate() {
+            self.resolver
+                .row(&self.layers[0], row * w, out_row, |s| s.map(|v| v * k));
         }
     }
 
     /// Box-filters the canvas layer into 8-bit straight-alpha pixels.
-    pub(super) fn resolve(&self, out: &mut [[u8; 4]], compat: bool) {
+    pub(super) fn resolve(&mut self, out: &mut [[u8; 4]], compat: bool) {
         let n = (self.pat.sub_rows * self.pat.sub_cols) as f32;
         let w = self.width as usize;
-        let mut acc = vec![[0f32; 4]; w];
-        let mut last = ([f32::NAN.to_bits(); 4], [0u8; 4]);
         for (row, out_row) in out.chunks_mut(w).enumerate() {
-            sums(&self.layers[0], row * w, &mut acc);
-            for (o, a) in out_row.iter_mut().zip(&acc) {
-                *o = convert(*a, n, compat, &mut last);
-            }
+            self.resolver
+                .row(&self.layers[0], row * w, out_row, |s| convert(s, n, compat));
         }
     }
 }
 
-/// The 8-bit straight-alpha pixel of the sum `a` of `n` premultiplied samples; `last`
-/// remembers the previous sum's bits and result.
+/// The 8-bit straight-alpha pixel of the sum `a` of `n` premultiplied samples.
 #[inline(always)]
-fn convert(a: [f32; 4], n: f32, compat: bool, last: &mut ([u32; 4], [u8; 4])) -> [u8; 4] {
-    let bits = a.map(f32::to_bits);
-    if bits == last.0 {
-        return last.1;
-    }
-    let o = if compat {
+fn convert(a: [f32; 4], n: f32, compat: bool) -> [u8; 4] {
+    if compat {
         // The course's conversion: truncate channel * 255.
         let t = [a[0] / n * 255.0, a[1] / n * 255.0, a[2] / n * 255.0, 255.0];
-        t.map(|v| v.clamp(0.0, 255.0) as i32 as u8)
-    } else {
-        let alpha = a[3] / n;
-        if alpha <= 0.0 {
-            [0, 0, 0, 0]
-        } else {
-            let k = 255.0 / (n * alpha);
-            // Round to nearest (`round()` is a libm call on baseline x86-64). The
-            // alpha lane is `alpha.clamp(0, 1) * 255`, as rounding is monotone.
-            let t = [a[0] * k, a[1] * k, a[2] * k, alpha * 255.0];
-            t.map(|v| (v.clamp(0.0, 255.0) + 0.5) as i32 as u8)
-        }
-    };
-    *last = (bits, o);
-    o
+        return t.map(|v| v.clamp(0.0, 255.0) as i32 as u8);
+    }
+    let alpha = a[3] / n;
+    if alpha <= 0.0 {
+        return [0, 0, 0, 0];
+    }
+    let k = 255.0 / (n * alpha);
+    // Round to nearest (`round()` is a libm call on baseline x86-64). The alpha lane is
+    // `alpha.clamp(0, 1) * 255`, as rounding is monotone.
+    let t = [a[0] * k, a[1] * k, a[2] * k, alpha * 255.0];
+    t.map(|v| (v.clamp(0.0, 255.0) + 0.5) as i32 as u8)
 }
 
 /// Pixel ranges of a placed box within the band of `rows_px` rows of `width` pixels from

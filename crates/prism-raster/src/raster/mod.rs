@@ -19,6 +19,7 @@ mod offscreen;
 mod options;
 mod plane;
 mod primitives;
+mod resolve;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{mpsc, Mutex};
@@ -232,7 +233,7 @@ fn draw_bands<T: Send>(
     opts: &RasterOptions,
     r: usize,
     pixels: &mut [T],
-    resolve: impl Fn(&Band, &mut [T]) + Sync,
+    resolve: impl Fn(&mut Band, &mut [T]) + Sync,
 ) {
     let w = opts.width;
     // Regular r x r grid: it agreed better with analytic coverage (resvg) on the test suites

@@ -5,7 +5,7 @@
 use crate::blend::over;
 
 /// Marks a pixel whose samples all hold its one colour.
-const SHARED: u32 = u32::MAX;
+pub(super) const SHARED: u32 = u32::MAX;
 
 /// One layer of a band: `pixels` pixels of `n` samples each.
 ///
@@ -13,13 +13,13 @@ const SHARED: u32 = u32::MAX;
 /// `block[p]`, `n` samples row by row). Every operation gives each sample exactly the value
 /// it would get in a buffer of all samples, so a plane is a compressed form of that buffer.
 pub(super) struct Plane {
-    px: Vec<[f32; 4]>,
-    block: Vec<u32>,
-    samples: Vec<[f32; 4]>,
+    pub(super) px: Vec<[f32; 4]>,
+    pub(super) block: Vec<u32>,
+    pub(super) samples: Vec<[f32; 4]>,
     /// The pixel owning each block, or `SHARED` for a free block.
     owner: Vec<u32>,
     free: Vec<u32>,
-    n: usize,
+    pub(super) n: usize,
 }
 
 impl Plane {
@@ -341,71 +341,4 @@ impl Cover {
             }
         }
     }
-}
-
-/// Pixels summed side by side, so that their additions overlap.
-const LANES: usize = 8;
-
-/// Writes the sum of each pixel's samples, added in sample order, for the pixels of
-/// `plane` from `first` on into `out` (a shared pixel's colour is added `n` times, as its
-/// samples would be). A run of pixels sharing one colour is summed once.
-pub(super) fn sums(plane: &Plane, first: usize, out: &mut [[f32; 4]]) {
-    let n = plane.n;
-    let mut last: Option<([u32; 4], [f32; 4])> = None;
-    for (c, chunk) in out.chunks_mut(LANES).enumerate() {
-        let p0 = first + c * LANES;
-        if let Some((bits, sum)) = last {
-            let same = (0..chunk.len()).all(|q| {
-                plane.block[p0 + q] == SHARED && plane.px[p0 + q].map(f32::to_bits) == bits
-            });
-            if same {
-                chunk.fill(sum);
-                continue;
-            }
-        }
-        if chunk.len() == LANES && plane.block[p0..p0 + LANES].iter().all(|&b| b == SHARED) {
-            let v: [[f32; 4]; LANES] = std::array::from_fn(|q| plane.px[p0 + q]);
-            let acc = repeat_sum(v, n);
-            chunk.copy_from_slice(&acc);
-            last = Some((v[LANES - 1].map(f32::to_bits), acc[LANES - 1]));
-            continue;
-        }
-        // Each lane reads its pixel's samples, or its one colour again and again.
-        let mut src: [&[[f32; 4]]; LANES] = [&[[0.0; 4]]; LANES];
-        let mut step = [0usize; LANES];
-        for (q, (s, k)) in src.iter_mut().zip(&mut step).enumerate().take(chunk.len()) {
-            match plane.pixel(p0 + q) {
-                Pixel::Shared(_) => *s = std::slice::from_ref(&plane.px[p0 + q]),
-                Pixel::Split(samples) => (*s, *k) = (samples, 1),
-            }
-        }
-        let mut acc = [[0f32; 4]; LANES];
-        for i in 0..n {
-            for q in 0..LANES {
-                acc[q] = add4(acc[q], src[q][i * step[q]]);
-            }
-        }
-        chunk.copy_from_slice(&acc[..chunk.len()]);
-        let q = chunk.len() - 1;
-        if step[q] == 0 {
-            last = Some((src[q][0].map(f32::to_bits), acc[q]));
-        }
-    }
-}
-
-/// `v` added to itself in sequence `n` times (from zero), lane by lane.
-#[inline(always)]
-fn repeat_sum(v: [[f32; 4]; LANES], n: usize) -> [[f32; 4]; LANES] {
-    let mut acc = [[0f32; 4]; LANES];
-    for _ in 0..n {
-        for q in 0..LANES {
-            acc[q] = add4(acc[q], v[q]);
-        }
-    }
-    acc
-}
-
-#[inline(always)]
-fn add4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
 }
