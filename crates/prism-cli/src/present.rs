@@ -5,7 +5,7 @@ use std::ffi::c_char;
 use std::ptr;
 
 use winit::raw_window_handle::{
-    HasDisplayHandle, HasWindowHandle, HandleError, RawDisplayHandle, RawWindowHandle,
+    HandleError, HasDisplayHandle, HasWindowHandle, RawDisplayHandle, RawWindowHandle,
 };
 use winit::window::Window;
 use x11_dl::xlib;

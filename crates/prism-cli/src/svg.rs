@@ -5,9 +5,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_image::{
-    AtomicFile, ImageError, LevelSampling, PixelSampling, PngColor, PngRowWriter,
-};
+use prism_image::{AtomicFile, ImageError, LevelSampling, PixelSampling, PngColor, PngRowWriter};
 use prism_raster::{
     read_svg_with, render, Dialect, Document, Fonts, RasterOptions, RasterStats, View,
 };

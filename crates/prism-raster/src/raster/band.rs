@@ -4,8 +4,8 @@
 use prism_math::DVec2;
 
 use super::plane::{Cover, Plane};
-use super::resolve::Resolver;
 use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
+use super::resolve::Resolver;
 use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
 
@@ -196,7 +196,6 @@ impl Band {
 
     /// Pops the top layer and combines each of its samples in the placed box into the
     /// layer below with `f(below, top)`.
-    #[inline(never)]
     fn end_layer(&mut self, pl: &Placed, f: impl Fn(&mut [f32; 4], [f32; 4])) {
         if self.layers.len() < 2 {
             return;
@@ -215,7 +214,6 @@ impl Band {
     /// left and top edges own it (`y0 <= y < y1`); otherwise the right and bottom edges do
     /// (`y0 < y <= y1`), which is tiny-skia's rule, so that edges on the sample grid cover
     /// what resvg covers.
-    #[inline(never)]
     fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols as f64);
         let band_hi = f64::from(self.y0 + self.rows_px);
@@ -285,7 +283,6 @@ impl Band {
         self.crossings = xs;
     }
 
-    #[inline(never)]
     fn tri(&mut self, v: &[DVec2; 3], inclusive: bool, shade: &TriShade, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols);
         let (rf, cf) = (sr as f64, sc as f64);

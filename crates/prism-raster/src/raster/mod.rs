@@ -110,7 +110,14 @@ pub fn render_rows(
             let y0 = bi * band_rows;
             let rows_px = band_rows.min(h as usize - y0);
             let ta = Instant::now();
-            draw_band(&mut band, &prims, opts, y0 as i32, rows_px as i32, background);
+            draw_band(
+                &mut band,
+                &prims,
+                opts,
+                y0 as i32,
+                rows_px as i32,
+                background,
+            );
             let tb = Instant::now();
             let mut out = vec![[0u8; 4]; rows_px * w as usize];
             band.resolve(&mut out, opts.compat);
@@ -119,7 +126,9 @@ pub fn render_rows(
                 break;
             }
         }
-        let mut t = times.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut t = times
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         (t.0, t.1) = (t.0 + rt, t.1 + st);
     };
     rayon::in_place_scope(|s| {
@@ -144,7 +153,9 @@ pub fn render_rows(
         drop(rx);
     });
     let wall = t1.elapsed();
-    let (rt, st) = *times.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let (rt, st) = *times
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let total = (rt + st).as_secs_f64().max(1e-12);
     Ok(RasterStats {
         prepare: prepare_time,
@@ -164,13 +175,11 @@ fn receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
             Err(mpsc::TryRecvError::Empty) => match rayon::yield_now() {
                 None => return rx.recv().ok(),
                 Some(rayon::Yield::Executed) => {}
-                Some(rayon::Yield::Idle) => {
-                    match rx.recv_timeout(Duration::from_micros(100)) {
-                        Ok(m) => return Some(m),
-                        Err(mpsc::RecvTimeoutError::Disconnected) => return None,
-                        Err(mpsc::RecvTimeoutError::Timeout) => {}
-                    }
-                }
+                Some(rayon::Yield::Idle) => match rx.recv_timeout(Duration::from_micros(100)) {
+                    Ok(m) => return Some(m),
+                    Err(mpsc::RecvTimeoutError::Disconnected) => return None,
+                    Err(mpsc::RecvTimeoutError::Timeout) => {}
+                },
             },
         }
     }
@@ -463,6 +472,78 @@ mod tests {
             };
             render(&doc, &opts).unwrap();
         }
+    }
+
+    /// A drawing with layers, translucency, a gradient and an image-free mix of shapes.
+    fn busy_drawing() -> Document {
+        use crate::{parse_svg, Dialect, Source};
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="120" height="90">
+            <defs><linearGradient id="g"><stop offset="0" stop-color="#f60"/>
+            <stop offset="1" stop-color="#06f" stop-opacity="0.5"/></linearGradient></defs>
+            <rect width="120" height="90" fill="#fff"/>
+            <circle cx="40" cy="40" r="33" fill="url(#g)" stroke="#222" stroke-width="3"/>
+            <g opacity="0.6"><path d="M10 80 L110 5 L100 85 Z" fill="#3a3"/>
+            <ellipse cx="80" cy="50" rx="30" ry="12" fill="#c0c" stroke="#000"/></g>
+            </svg>"##;
+        parse_svg(svg, Dialect::Svg, &Source::default()).unwrap()
+    }
+
+    /// `render_rows` hands on every row once, top to bottom, the same pixels as `render`;
+    /// a sink that stops is given no more rows.
+    #[test]
+    fn rows_come_in_order_and_stop_when_asked() {
+        let doc = busy_drawing();
+        let opts = RasterOptions {
+            width: 120,
+            height: 90,
+            samples: 16,
+            ..RasterOptions::default()
+        };
+        let (img, _) = render(&doc, &opts).unwrap();
+        let mut rows: Vec<[u8; 4]> = Vec::new();
+        let mut calls = 0;
+        render_rows(&doc, &opts, |band| {
+            assert_eq!(band.len() % 120, 0, "whole rows");
+            rows.extend_from_slice(band);
+            calls += 1;
+            true
+        })
+        .unwrap();
+        assert_eq!(rows, img.pixels());
+        assert!(calls > 1, "the picture comes in several bands");
+        let mut given = 0;
+        render_rows(&doc, &opts, |band| {
+            given += band.len();
+            false
+        })
+        .unwrap();
+        assert_eq!(
+            given,
+            band_rows(120).min(90) * 120,
+            "one band, then nothing"
+        );
+    }
+
+    /// Same bytes whatever the thread count (one, two or three workers).
+    #[test]
+    fn same_pixels_on_one_two_and_three_threads() {
+        let doc = busy_drawing();
+        let opts = RasterOptions {
+            width: 120,
+            height: 90,
+            samples: 9,
+            ..RasterOptions::default()
+        };
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| render(&doc, &opts).unwrap().0)
+        };
+        let one = on(1);
+        assert_eq!(one, on(2));
+        assert_eq!(one, on(3));
     }
 
     #[test]

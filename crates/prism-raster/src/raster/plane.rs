@@ -342,3 +342,162 @@ impl Cover {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::resolve::Resolver;
+    use super::*;
+
+    /// A deterministic pseudo-random stream (SplitMix64) in [0, 1).
+    fn rng(seed: &mut u64) -> f64 {
+        *seed = seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = *seed;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn colour(seed: &mut u64) -> [f32; 4] {
+        let a = if rng(seed) < 0.3 {
+            1.0
+        } else {
+            rng(seed) as f32
+        };
+        [
+            rng(seed) as f32 * a,
+            rng(seed) as f32 * a,
+            rng(seed) as f32 * a,
+            a,
+        ]
+    }
+
+    /// A plane beside a buffer of every sample: the same operations on both.
+    struct Both {
+        plane: Plane,
+        full: Vec<[f32; 4]>,
+    }
+
+    const W: usize = 11;
+    const ROWS: usize = 3;
+    const SR: usize = 4;
+    const SC: usize = 4;
+    const N: usize = SR * SC;
+
+    impl Both {
+        fn new() -> Both {
+            Both {
+                plane: Plane::new(W * ROWS, N),
+                full: vec![[0.0; 4]; W * ROWS * N],
+            }
+        }
+
+        /// Random fills, composites and covers.
+        fn step(&mut self, seed: &mut u64, cover: &mut Cover) {
+            let row = (rng(seed) * ROWS as f64) as usize;
+            let a = (rng(seed) * W as f64) as usize;
+            let b = a + (rng(seed) * (W - a) as f64) as usize;
+            let range = row * W + a..row * W + b;
+            let c = colour(seed);
+            match (rng(seed) * 3.0) as usize {
+                0 => {
+                    self.plane.fill(range.clone(), c);
+                    self.full[range.start * N..range.end * N].fill(c);
+                }
+                1 => {
+                    self.plane.over_range(range.clone(), c);
+                    self.full[range.start * N..range.end * N]
+                        .iter_mut()
+                        .for_each(|s| over(s, c));
+                }
+                _ => {
+                    // Random spans on each sample row; a colour per pixel or one for all.
+                    cover.clear();
+                    let mut covered = vec![false; SR * W * SC];
+                    for s in 0..SR {
+                        let mut i = 0;
+                        while i < W * SC {
+                            let a = i + (rng(seed) * 9.0) as usize;
+                            let b = (a + (rng(seed) * 30.0) as usize).min(W * SC);
+                            if a < b {
+                                cover.push(a, b);
+                                covered[s * W * SC + a..s * W * SC + b].fill(true);
+                            }
+                            i = b.max(a) + 1;
+                        }
+                        cover.end_row();
+                    }
+                    let uniform = rng(seed) < 0.5;
+                    let per_pixel: Vec<[f32; 4]> = (0..W).map(|_| colour(seed)).collect();
+                    let color = |x: usize| if uniform { c } else { per_pixel[x] };
+                    cover.paint(&mut self.plane, row, W, SC, uniform.then_some(c), color);
+                    for s in 0..SR {
+                        for i in 0..W * SC {
+                            if covered[s * W * SC + i] {
+                                let p = row * W + i / SC;
+                                over(&mut self.full[p * N + s * SC + i % SC], color(i / SC));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        fn check(&self) {
+            for p in 0..W * ROWS {
+                for k in 0..N {
+                    let v = match self.plane.pixel(p) {
+                        Pixel::Shared(c) => c,
+                        Pixel::Split(s) => s[k],
+                    };
+                    let want = self.full[p * N + k];
+                    assert_eq!(v.map(f32::to_bits), want.map(f32::to_bits), "pixel {p}");
+                }
+            }
+        }
+    }
+
+    /// Brute force: a plane and a buffer holding every sample, given the same random
+    /// fills, composites, covers and layers combined, hold the same samples bit for bit,
+    /// and the resolver's sums are those of the buffer's samples added in sample order.
+    #[test]
+    fn plane_equals_a_buffer_of_every_sample() {
+        let mut seed = 7;
+        let mut cover = Cover::default();
+        let mut resolver = Resolver::default();
+        for _ in 0..40 {
+            let mut base = Both::new();
+            for _ in 0..30 {
+                base.step(&mut seed, &mut cover);
+                base.check();
+                if rng(&mut seed) < 0.2 {
+                    // A layer of its own operations, composited at an opacity.
+                    let mut layer = Both::new();
+                    for _ in 0..5 {
+                        layer.step(&mut seed, &mut cover);
+                    }
+                    let op = rng(&mut seed) as f32;
+                    let f = |d: &mut [f32; 4], s: [f32; 4]| over(d, s.map(|v| v * op));
+                    base.plane.combine(&layer.plane, 0..W * ROWS, f);
+                    for (d, s) in base.full.iter_mut().zip(&layer.full) {
+                        f(d, *s);
+                    }
+                    base.check();
+                }
+            }
+            for row in 0..ROWS {
+                let mut sums = vec![[0f32; 4]; W];
+                resolver.row(&base.plane, row * W, &mut sums, |s| s);
+                for (x, got) in sums.iter().enumerate() {
+                    let p = row * W + x;
+                    let mut want = [0f32; 4];
+                    for s in &base.full[p * N..(p + 1) * N] {
+                        for c in 0..4 {
+                            want[c] += s[c];
+                        }
+                    }
+                    assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits));
+                }
+            }
+        }
+    }
+}
