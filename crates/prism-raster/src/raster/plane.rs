@@ -412,7 +412,7 @@ mod tests {
                 _ => {
                     // Random spans on each sample row; a colour per pixel or one for all.
                     cover.clear();
-                    let mut covered = vec![false; SR * W * SC];
+                    let mut covered = [false; SR * W * SC];
                     for s in 0..SR {
                         let mut i = 0;
                         while i < W * SC {
