@@ -99,7 +99,7 @@ pub fn render_rows(
     let times = Mutex::new((Duration::ZERO, Duration::ZERO));
     let (tx, rx) = mpsc::channel::<(usize, Vec<[u8; 4]>)>();
     // Each worker takes the next band down, so bands finish nearly in order.
-    let worker = || {
+    let worker = |tx: mpsc::Sender<(usize, Vec<[u8; 4]>)>| {
         let mut band = Band::new(w as i32, band_rows, pat.clone());
         let (mut rt, mut st) = (Duration::ZERO, Duration::ZERO);
         loop {
@@ -133,8 +133,11 @@ pub fn render_rows(
     };
     rayon::in_place_scope(|s| {
         for _ in 0..rayon::current_num_threads().min(bands) {
-            s.spawn(|_| worker());
+            let tx = tx.clone();
+            s.spawn(|_| worker(tx));
         }
+        // Only the workers hold senders now: the channel closes when the last one ends.
+        drop(tx);
         // Bands are handed on in order; those that finish early wait here.
         let mut held: Vec<Option<Vec<[u8; 4]>>> = vec![None; bands];
         let mut due = 0;
@@ -145,9 +148,13 @@ pub fn render_rows(
             held[bi] = Some(rows);
             while let Some(rows) = held.get_mut(due).and_then(Option::take) {
                 due += 1;
-                if !stop.load(Ordering::Relaxed) && !sink(&rows) {
+                if !sink(&rows) {
                     stop.store(true, Ordering::Relaxed);
+                    break;
                 }
+            }
+            if stop.load(Ordering::Relaxed) {
+                break;
             }
         }
         drop(rx);
