@@ -55,6 +55,7 @@ pub fn render(
     doc: &Document,
     opts: &RasterOptions,
 ) -> Result<(Rgba8Image, RasterStats), RasterError> {
+    check(opts)?;
     let mut pixels = Vec::with_capacity(opts.width as usize * opts.height as usize);
     let stats = render_rows(doc, opts, |rows| {
         pixels.extend_from_slice(rows);
@@ -76,15 +77,7 @@ pub fn render_rows(
     mut sink: impl FnMut(&[[u8; 4]]) -> bool,
 ) -> Result<RasterStats, RasterError> {
     let (w, h) = (opts.width, opts.height);
-    if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
-        return Err(RasterError::BadSize(w, h));
-    }
-    let r = sample_rate(opts.samples).ok_or(RasterError::BadSamples(opts.samples))? as usize;
-    if let View::Region { cx, cy, span } = opts.view {
-        if !(cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0) {
-            return Err(RasterError::BadView(cx, cy, span));
-        }
-    }
+    let r = check(opts)?;
     let t0 = Instant::now();
     let view = view_transform(doc, opts);
     let prims = prepare(doc, &doc.items, opts, &view, render_premultiplied);
@@ -169,6 +162,22 @@ pub fn render_rows(
         raster: wall.mul_f64(rt.as_secs_f64() / total),
         resolve: wall.mul_f64(st.as_secs_f64() / total),
     })
+}
+
+/// Checks the output size, sample count and view against the documented limits; returns
+/// the sample rate (samples per pixel side).
+fn check(opts: &RasterOptions) -> Result<usize, RasterError> {
+    let (w, h) = (opts.width, opts.height);
+    if w == 0 || h == 0 || w > MAX_DIMENSION || h > MAX_DIMENSION {
+        return Err(RasterError::BadSize(w, h));
+    }
+    let r = sample_rate(opts.samples).ok_or(RasterError::BadSamples(opts.samples))? as usize;
+    if let View::Region { cx, cy, span } = opts.view {
+        if !(cx.is_finite() && cy.is_finite() && span.is_finite() && span > 0.0) {
+            return Err(RasterError::BadView(cx, cy, span));
+        }
+    }
+    Ok(r)
 }
 
 /// The next message, waiting for it; on a pool thread, running the pool's other work
@@ -551,6 +560,22 @@ mod tests {
         let one = on(1);
         assert_eq!(one, on(2));
         assert_eq!(one, on(3));
+    }
+
+    /// A size over the limit is refused before anything is allocated for it.
+    #[test]
+    fn an_oversized_picture_is_refused_before_allocation() {
+        let opts = RasterOptions {
+            width: 1_000_000,
+            height: 1_000_000,
+            ..RasterOptions::default()
+        };
+        let doc = Document::default();
+        assert!(matches!(render(&doc, &opts), Err(RasterError::BadSize(..))));
+        assert!(matches!(
+            render_rows(&doc, &opts, |_| true),
+            Err(RasterError::BadSize(..))
+        ));
     }
 
     #[test]
