@@ -21,8 +21,7 @@ mod plane;
 mod primitives;
 mod resolve;
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{mpsc, Mutex};
+use std::sync::{mpsc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use prism_image::Rgba8Image;
@@ -87,70 +86,67 @@ pub fn render_rows(
     let bands = (h as usize).div_ceil(band_rows);
     let pat = Pattern::grid(r);
     let background = background(opts);
-    let next = AtomicUsize::new(0);
-    let stop = AtomicBool::new(false);
     let times = Mutex::new((Duration::ZERO, Duration::ZERO));
-    let (tx, rx) = mpsc::channel::<(usize, Vec<[u8; 4]>)>();
-    // Each worker takes the next band down, so bands finish nearly in order.
-    let worker = |tx: mpsc::Sender<(usize, Vec<[u8; 4]>)>| {
-        let mut band = Band::new(w as i32, band_rows, pat.clone());
-        let (mut rt, mut st) = (Duration::ZERO, Duration::ZERO);
-        loop {
-            let bi = next.fetch_add(1, Ordering::Relaxed);
-            if bi >= bands || stop.load(Ordering::Relaxed) {
-                break;
-            }
-            let y0 = bi * band_rows;
-            let rows_px = band_rows.min(h as usize - y0);
-            let ta = Instant::now();
-            draw_band(
-                &mut band,
-                &prims,
-                opts,
-                y0 as i32,
-                rows_px as i32,
-                background,
-            );
-            let tb = Instant::now();
-            let mut out = vec![[0u8; 4]; rows_px * w as usize];
-            band.resolve(&mut out, opts.compat);
-            (rt, st) = (rt + (tb - ta), st + tb.elapsed());
-            if tx.send((bi, out)).is_err() {
-                break;
-            }
-        }
-        let mut t = times
+    // Planes are reused from band to band.
+    let spare: Mutex<Vec<Band>> = Mutex::new(Vec::new());
+    let (tx, rx) = mpsc::channel::<(usize, Option<Vec<[u8; 4]>>)>();
+    // One job per band. A job that panics still reports (with no rows), so the wait below
+    // ends and the scope passes the panic on.
+    let draw = |bi: usize, tx: mpsc::Sender<(usize, Option<Vec<[u8; 4]>>)>| {
+        let mut report = Report { bi, tx, rows: None };
+        let taken = spare.lock().unwrap_or_else(PoisonError::into_inner).pop();
+        let mut band = taken.unwrap_or_else(|| Band::new(w as i32, band_rows, pat.clone()));
+        let y0 = bi * band_rows;
+        let rows_px = band_rows.min(h as usize - y0);
+        let ta = Instant::now();
+        draw_band(
+            &mut band,
+            &prims,
+            opts,
+            y0 as i32,
+            rows_px as i32,
+            background,
+        );
+        let tb = Instant::now();
+        let mut out = vec![[0u8; 4]; rows_px * w as usize];
+        band.resolve(&mut out, opts.compat);
+        let tc = Instant::now();
+        spare
             .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        (t.0, t.1) = (t.0 + rt, t.1 + st);
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(band);
+        let mut t = times.lock().unwrap_or_else(PoisonError::into_inner);
+        (t.0, t.1) = (t.0 + (tb - ta), t.1 + (tc - tb));
+        report.rows = Some(out);
     };
+    // Bands are started at most `window` ahead of the next one due, in order, so they
+    // finish nearly in order and few wait for the sink, however slow it is.
+    let window = 2 * rayon::current_num_threads() + 2;
     rayon::in_place_scope(|s| {
-        for _ in 0..rayon::current_num_threads().min(bands) {
-            let tx = tx.clone();
-            s.spawn(|_| worker(tx));
-        }
-        // Only the workers hold senders now: the channel closes when the last one ends.
-        drop(tx);
-        // Bands are handed on in order; those that finish early wait here.
         let mut held: Vec<Option<Vec<[u8; 4]>>> = vec![None; bands];
-        let mut due = 0;
+        let (mut started, mut due) = (0, 0);
         while due < bands {
-            let Some((bi, rows)) = receive(&rx) else {
+            while started < bands && started < due + window {
+                let tx = tx.clone();
+                s.spawn(move |_| draw(started, tx));
+                started += 1;
+            }
+            let Some((bi, Some(rows))) = receive(&rx) else {
                 break;
             };
             held[bi] = Some(rows);
+            let mut stop = false;
             while let Some(rows) = held.get_mut(due).and_then(Option::take) {
                 due += 1;
                 if !sink(&rows) {
-                    stop.store(true, Ordering::Relaxed);
+                    stop = true;
                     break;
                 }
             }
-            if stop.load(Ordering::Relaxed) {
+            if stop {
                 break;
             }
         }
-        drop(rx);
     });
     let wall = t1.elapsed();
     let (rt, st) = *times
@@ -162,6 +158,21 @@ pub fn render_rows(
         raster: wall.mul_f64(rt.as_secs_f64() / total),
         resolve: wall.mul_f64(st.as_secs_f64() / total),
     })
+}
+
+/// A band's rows on their way to the sink, sent when the job ends, even by a panic
+/// (then without rows).
+struct Report {
+    bi: usize,
+    tx: mpsc::Sender<(usize, Option<Vec<[u8; 4]>>)>,
+    rows: Option<Vec<[u8; 4]>>,
+}
+
+impl Drop for Report {
+    fn drop(&mut self) {
+        // The receiver is gone only when the sink has stopped: nothing is waiting.
+        let _ = self.tx.send((self.bi, self.rows.take()));
+    }
 }
 
 /// Checks the output size, sample count and view against the documented limits; returns
