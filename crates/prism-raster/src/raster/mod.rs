@@ -212,10 +212,11 @@ fn receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
     }
 }
 
-/// Pixel rows per band: about 256 KiB of pixel colours per band (and per layer of a
-/// band), to stay in L2.
+/// Pixel rows per band: about 64 KiB of pixel colours per band and per layer (4 rows at
+/// 960 pixels), so that a band's split pixels (up to 256 bytes each at 16 samples) stay
+/// small beside the rest of the process.
 fn band_rows(width: u32) -> usize {
-    ((256usize << 10) / (width as usize * 16)).clamp(1, 64)
+    ((64usize << 10) / (width as usize * 16)).clamp(1, 64)
 }
 
 /// The colour every sample starts with.
