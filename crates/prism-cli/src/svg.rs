@@ -5,9 +5,12 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use prism_image::{AtomicFile, ImageError, LevelSampling, PixelSampling, PngColor, PngRowWriter};
+use prism_image::{
+    over_background8, AtomicFile, ImageError, LevelSampling, PixelSampling, PngColor, PngRowWriter,
+    Rgb8Image,
+};
 use prism_raster::{
-    read_svg_with, render, Dialect, Document, Fonts, RasterOptions, RasterStats, View,
+    read_svg_with, render_rows, Dialect, Document, Fonts, RasterOptions, RasterStats, View,
 };
 
 use crate::error::UserError;
@@ -204,10 +207,16 @@ fn render_one(
             Streamed::Image(e) => anyhow::Error::from(e),
         })?
     } else {
-        let (image, stats) = render(&doc, &opts).map_err(refused)?;
+        // JPEG has no alpha: the picture goes over white, as a browser shows it. The
+        // encoder takes it whole, gathered as 3 bytes a pixel.
+        let mut rgb = Vec::with_capacity(width as usize * height as usize);
+        let stats = render_rows(&doc, &opts, |rows| {
+            rgb.extend(rows.iter().map(|&p| over_background8(p, [255, 255, 255])));
+            true
+        })
+        .map_err(refused)?;
         let t1 = Instant::now();
-        // JPEG has no alpha: the picture goes over white, as a browser shows it.
-        write_rgb8(output, format, &image.over_background([255, 255, 255]))?;
+        write_rgb8(output, format, &Rgb8Image::from_vec(width, height, rgb))?;
         (stats, t1.elapsed())
     };
     if a.stats {
@@ -254,7 +263,7 @@ fn write_png_rows(
     let mut failed = None;
     let mut encode = Duration::ZERO;
     let mut rgb = Vec::new();
-    let stats = prism_raster::render_rows(doc, opts, |rows| {
+    let stats = render_rows(doc, opts, |rows| {
         let t = Instant::now();
         for row in rows.chunks(opts.width as usize) {
             let bytes = if opts.compat {

@@ -148,12 +148,7 @@ impl Image<[u8; 4]> {
     /// Composites over an opaque background colour (straight alpha, in stored values).
     #[must_use]
     pub fn over_background(&self, bg: [u8; 3]) -> Rgb8Image {
-        self.map(|p| {
-            let a = u32::from(p[3]);
-            let mix =
-                |c: u8, b: u8| ((u32::from(c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8;
-            [mix(p[0], bg[0]), mix(p[1], bg[1]), mix(p[2], bg[2])]
-        })
+        self.map(|&p| over_background8(p, bg))
     }
 }
 
@@ -190,6 +185,15 @@ impl Image<Rgb> {
     pub fn linear_to_srgb8(&self) -> Rgb8Image {
         self.map(|&p| srgb8(p))
     }
+}
+
+/// A straight-alpha 8-bit pixel composited over an opaque background colour, rounded to
+/// nearest.
+#[must_use]
+pub fn over_background8(p: [u8; 4], bg: [u8; 3]) -> [u8; 3] {
+    let a = u32::from(p[3]);
+    let mix = |c: u8, b: u8| ((u32::from(c) * a + u32::from(b) * (255 - a) + 127) / 255) as u8;
+    [mix(p[0], bg[0]), mix(p[1], bg[1]), mix(p[2], bg[2])]
 }
 
 /// A pixel as [`Image::to_rgb8_truncated`] writes it: each channel clamped to `[0, 1]`,

@@ -36,7 +36,7 @@ pub use exr_tiled::{TiledExrReader, TiledExrWriter};
 pub use exr_write::{encode_exr, encode_exr_layers, write_exr, write_exr_layers, ExrRowWriter};
 pub use hdr::{decode_hdr, is_hdr};
 pub use heatmap::{heat_colour, heatmap};
-pub use image::{srgb8, truncated8, Image, Rgb8Image, RgbImage, Rgba8Image};
+pub use image::{over_background8, srgb8, truncated8, Image, Rgb8Image, RgbImage, Rgba8Image};
 pub use io::{
     decode_gif, decode_jpeg, decode_png, decode_webp, encode_bmp, encode_jpeg, encode_png,
     encode_png_rgba, read_image, read_png, remove_temporaries_before_exit, write_atomic,
