@@ -10,7 +10,7 @@ use prism_image::{
     Rgb8Image,
 };
 use prism_raster::{
-    read_svg_with, render_rows, Dialect, Document, Fonts, RasterOptions, RasterStats, View,
+    read_svg_with, Dialect, Document, Fonts, Prepared, RasterOptions, RasterStats, View,
 };
 
 use crate::error::UserError;
@@ -181,7 +181,7 @@ fn render_one(
         Dialect::Svg
     };
     let t0 = Instant::now();
-    let doc = read_svg_with(input, dialect, &fonts(a)).map_err(UserError::input)?;
+    let mut doc = read_svg_with(input, dialect, &fonts(a)).map_err(UserError::input)?;
     let parse = t0.elapsed();
     let (width, height) = output_size(&doc, a);
     let opts = RasterOptions {
@@ -201,20 +201,20 @@ fn render_one(
         compat: a.compat.is_some(),
     };
     let refused = |e| UserError::input(format!("{}: {e}", input.display()));
+    let prepared = Prepared::new(&doc, &opts).map_err(refused)?;
+    // Drawing needs only the primitives.
+    let warnings = std::mem::take(&mut doc.warnings);
+    drop(doc);
     let (stats, encode) = if format == ImageFormat::Png {
-        write_png_rows(output, &doc, &opts).map_err(|e| match e {
-            Streamed::Raster(e) => refused(e).into(),
-            Streamed::Image(e) => anyhow::Error::from(e),
-        })?
+        write_png_rows(output, &prepared, &opts)?
     } else {
         // JPEG has no alpha: the picture goes over white, as a browser shows it. The
         // encoder takes it whole, gathered as 3 bytes a pixel.
         let mut rgb = Vec::with_capacity(width as usize * height as usize);
-        let stats = render_rows(&doc, &opts, |rows| {
+        let stats = prepared.render_rows(|rows| {
             rgb.extend(rows.iter().map(|&p| over_background8(p, [255, 255, 255])));
             true
-        })
-        .map_err(refused)?;
+        });
         let t1 = Instant::now();
         write_rgb8(output, format, &Rgb8Image::from_vec(width, height, rgb))?;
         (stats, t1.elapsed())
@@ -229,28 +229,20 @@ fn render_one(
         eprintln!("resolve: {}", ms(stats.resolve));
         eprintln!("encode: {}", ms(encode));
     }
-    Ok(doc.warnings)
+    Ok(warnings)
 }
 
-/// Why a streamed PNG was not written.
-enum Streamed {
-    Raster(prism_raster::RasterError),
-    Image(ImageError),
-}
-
-/// Renders `doc` straight into the PNG `output`, each band of rows encoded as it is drawn
+/// Renders `prepared` straight into the PNG `output`, each band of rows encoded as it is drawn
 /// (RGB for the course's opaque pictures, RGBA otherwise); returns the render's stage
 /// times and the time spent encoding.
 fn write_png_rows(
     output: &Path,
-    doc: &Document,
+    prepared: &Prepared,
     opts: &RasterOptions,
-) -> std::result::Result<(RasterStats, Duration), Streamed> {
-    let io = |source| {
-        Streamed::Image(ImageError::Io {
-            path: output.to_path_buf(),
-            source,
-        })
+) -> std::result::Result<(RasterStats, Duration), ImageError> {
+    let io = |source| ImageError::Io {
+        path: output.to_path_buf(),
+        source,
     };
     let mut file = AtomicFile::create(output).map_err(io)?;
     let color = if opts.compat {
@@ -258,12 +250,11 @@ fn write_png_rows(
     } else {
         PngColor::Rgba
     };
-    let mut png = PngRowWriter::new(file.writer(), opts.width, opts.height, color)
-        .map_err(Streamed::Image)?;
+    let mut png = PngRowWriter::new(file.writer(), opts.width, opts.height, color)?;
     let mut failed = None;
     let mut encode = Duration::ZERO;
     let mut rgb = Vec::new();
-    let stats = render_rows(doc, opts, |rows| {
+    let stats = prepared.render_rows(|rows| {
         let t = Instant::now();
         for row in rows.chunks(opts.width as usize) {
             let bytes = if opts.compat {
@@ -280,13 +271,12 @@ fn write_png_rows(
         }
         encode += t.elapsed();
         true
-    })
-    .map_err(Streamed::Raster)?;
+    });
     if let Some(e) = failed {
-        return Err(Streamed::Image(e));
+        return Err(e);
     }
     let t = Instant::now();
-    png.finish().map_err(Streamed::Image)?;
+    png.finish()?;
     file.commit().map_err(io)?;
     Ok((stats, encode + t.elapsed()))
 }

@@ -34,7 +34,7 @@ pub use parse::{
     MAX_TEXT_PATH, MAX_USE_ELEMENTS,
 };
 pub use raster::{
-    render, render_rows, sample_rate, view_transform, RasterError, RasterOptions, RasterStats,
-    View, MAX_DIMENSION, MAX_SAMPLES,
+    render, render_rows, sample_rate, view_transform, Prepared, RasterError, RasterOptions,
+    RasterStats, View, MAX_DIMENSION, MAX_SAMPLES,
 };
 pub use triangulate::ear_clip;

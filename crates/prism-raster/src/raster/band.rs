@@ -3,8 +3,9 @@
 
 use prism_math::DVec2;
 
+use super::edges::{Edge, Edges};
 use super::plane::{Cover, Plane};
-use super::primitives::{DevPaint, Edge, Placed, Prim, TriShade};
+use super::primitives::{DevPaint, Placed, Prim, TriShade};
 use super::resolve::Resolver;
 use crate::blend::{composite, over as blend};
 use crate::document::{BlendMode, FillRule, MaskKind};
@@ -214,12 +215,12 @@ impl Band {
     /// left and top edges own it (`y0 <= y < y1`); otherwise the right and bottom edges do
     /// (`y0 < y <= y1`), which is tiny-skia's rule, so that edges on the sample grid cover
     /// what resvg covers.
-    fn poly(&mut self, edges: &[Edge], rule: FillRule, paint: &DevPaint, compat: bool) {
+    fn poly(&mut self, edges: &Edges, rule: FillRule, paint: &DevPaint, compat: bool) {
         let (sr, sc) = (self.pat.sub_rows, self.pat.sub_cols as f64);
         let band_hi = f64::from(self.y0 + self.rows_px);
         // Edges sorted by their top; those reaching into the band become active at their
         // first sample row and leave after their last.
-        let end = edges.partition_point(|e| e.y0 < band_hi);
+        let end = edges.starting_above(band_hi);
         let mut next = 0;
         let mut active = std::mem::take(&mut self.active);
         let mut xs = std::mem::take(&mut self.crossings);
@@ -233,9 +234,13 @@ impl Band {
                 // An edge owns the sample rows with y0 <= y < y1 (compat) or y0 < y <= y1.
                 let starts = |e: &Edge| if compat { e.y0 <= y } else { e.y0 < y };
                 let ended = |e: &Edge| if compat { e.y1 <= y } else { e.y1 < y };
-                while next < end && starts(&edges[next]) {
-                    if !ended(&edges[next]) {
-                        active.push(edges[next]);
+                while next < end {
+                    let e = edges.get(next);
+                    if !starts(&e) {
+                        break;
+                    }
+                    if !ended(&e) {
+                        active.push(e);
                     }
                     next += 1;
                 }

@@ -15,6 +15,7 @@
 //! than a pixel are drawn one pixel wide with their opacity scaled by their width.
 
 mod band;
+mod edges;
 mod offscreen;
 mod options;
 mod plane;
@@ -73,91 +74,119 @@ pub fn render(
 pub fn render_rows(
     doc: &Document,
     opts: &RasterOptions,
-    mut sink: impl FnMut(&[[u8; 4]]) -> bool,
+    sink: impl FnMut(&[[u8; 4]]) -> bool,
 ) -> Result<RasterStats, RasterError> {
-    let (w, h) = (opts.width, opts.height);
-    let r = check(opts)?;
-    let t0 = Instant::now();
-    let view = view_transform(doc, opts);
-    let prims = prepare(doc, &doc.items, opts, &view, render_premultiplied);
-    let prepare_time = t0.elapsed();
-    let t1 = Instant::now();
-    let band_rows = band_rows(w);
-    let bands = (h as usize).div_ceil(band_rows);
-    let pat = Pattern::grid(r);
-    let background = background(opts);
-    let times = Mutex::new((Duration::ZERO, Duration::ZERO));
-    // Planes are reused from band to band.
-    let spare: Mutex<Vec<Band>> = Mutex::new(Vec::new());
-    let (tx, rx) = mpsc::channel::<(usize, Option<Vec<[u8; 4]>>)>();
-    // One job per band. A job that panics still reports (with no rows), so the wait below
-    // ends and the scope passes the panic on.
-    let draw = |bi: usize, tx: mpsc::Sender<(usize, Option<Vec<[u8; 4]>>)>| {
-        let mut report = Report { bi, tx, rows: None };
-        let taken = spare.lock().unwrap_or_else(PoisonError::into_inner).pop();
-        let mut band = taken.unwrap_or_else(|| Band::new(w as i32, band_rows, pat.clone()));
-        let y0 = bi * band_rows;
-        let rows_px = band_rows.min(h as usize - y0);
-        let ta = Instant::now();
-        draw_band(
-            &mut band,
-            &prims,
-            opts,
-            y0 as i32,
-            rows_px as i32,
-            background,
-        );
-        let tb = Instant::now();
-        let mut out = vec![[0u8; 4]; rows_px * w as usize];
-        band.resolve(&mut out, opts.compat);
-        let tc = Instant::now();
-        spare
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .push(band);
-        let mut t = times.lock().unwrap_or_else(PoisonError::into_inner);
-        (t.0, t.1) = (t.0 + (tb - ta), t.1 + (tc - tb));
-        report.rows = Some(out);
-    };
-    // Bands are started at most `window` ahead of the next one due, in order, so they
-    // finish nearly in order and few wait for the sink, however slow it is.
-    let window = 2 * rayon::current_num_threads() + 2;
-    rayon::in_place_scope(|s| {
-        let mut held: Vec<Option<Vec<[u8; 4]>>> = vec![None; bands];
-        let (mut started, mut due) = (0, 0);
-        while due < bands {
-            while started < bands && started < due + window {
-                let tx = tx.clone();
-                s.spawn(move |_| draw(started, tx));
-                started += 1;
-            }
-            let Some((bi, Some(rows))) = receive(&rx) else {
-                break;
-            };
-            held[bi] = Some(rows);
-            let mut stop = false;
-            while let Some(rows) = held.get_mut(due).and_then(Option::take) {
-                due += 1;
-                if !sink(&rows) {
-                    stop = true;
+    Ok(Prepared::new(doc, opts)?.render_rows(sink))
+}
+
+/// A document turned into device-space primitives for one set of options: everything
+/// drawing needs, so the document can be dropped before the picture is drawn.
+pub struct Prepared {
+    prims: Vec<Placed>,
+    opts: RasterOptions,
+    rate: usize,
+    time: Duration,
+}
+
+impl Prepared {
+    /// Transforms, flattens and strokes the items of `doc` for `opts`.
+    ///
+    /// # Errors
+    /// [`RasterError`] for an output size, sample count or view outside the documented
+    /// limits.
+    pub fn new(doc: &Document, opts: &RasterOptions) -> Result<Prepared, RasterError> {
+        let rate = check(opts)?;
+        let t0 = Instant::now();
+        let view = view_transform(doc, opts);
+        let prims = prepare(doc, &doc.items, opts, &view, render_premultiplied);
+        Ok(Prepared {
+            prims,
+            opts: opts.clone(),
+            rate,
+            time: t0.elapsed(),
+        })
+    }
+
+    /// Draws the picture as [`render_rows`] does, handing rows to `sink` from the top.
+    pub fn render_rows(&self, mut sink: impl FnMut(&[[u8; 4]]) -> bool) -> RasterStats {
+        let (prims, opts) = (&self.prims, &self.opts);
+        let (w, h) = (opts.width, opts.height);
+        let t1 = Instant::now();
+        let band_rows = band_rows(w);
+        let bands = (h as usize).div_ceil(band_rows);
+        let pat = Pattern::grid(self.rate);
+        let background = background(opts);
+        let times = Mutex::new((Duration::ZERO, Duration::ZERO));
+        // Planes are reused from band to band.
+        let spare: Mutex<Vec<Band>> = Mutex::new(Vec::new());
+        let (tx, rx) = mpsc::channel::<(usize, Option<Vec<[u8; 4]>>)>();
+        // One job per band. A job that panics still reports (with no rows), so the wait
+        // below ends and the scope passes the panic on.
+        let draw = |bi: usize, tx: mpsc::Sender<(usize, Option<Vec<[u8; 4]>>)>| {
+            let mut report = Report { bi, tx, rows: None };
+            let taken = spare.lock().unwrap_or_else(PoisonError::into_inner).pop();
+            let mut band = taken.unwrap_or_else(|| Band::new(w as i32, band_rows, pat.clone()));
+            let y0 = bi * band_rows;
+            let rows_px = band_rows.min(h as usize - y0);
+            let ta = Instant::now();
+            draw_band(
+                &mut band,
+                prims,
+                opts,
+                y0 as i32,
+                rows_px as i32,
+                background,
+            );
+            let tb = Instant::now();
+            let mut out = vec![[0u8; 4]; rows_px * w as usize];
+            band.resolve(&mut out, opts.compat);
+            let tc = Instant::now();
+            spare
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .push(band);
+            let mut t = times.lock().unwrap_or_else(PoisonError::into_inner);
+            (t.0, t.1) = (t.0 + (tb - ta), t.1 + (tc - tb));
+            report.rows = Some(out);
+        };
+        // Bands are started at most `window` ahead of the next one due, in order, so they
+        // finish nearly in order and few wait for the sink, however slow it is.
+        let window = 2 * rayon::current_num_threads() + 2;
+        rayon::in_place_scope(|s| {
+            let mut held: Vec<Option<Vec<[u8; 4]>>> = vec![None; bands];
+            let (mut started, mut due) = (0, 0);
+            while due < bands {
+                while started < bands && started < due + window {
+                    let tx = tx.clone();
+                    s.spawn(move |_| draw(started, tx));
+                    started += 1;
+                }
+                let Some((bi, Some(rows))) = receive(&rx) else {
+                    break;
+                };
+                held[bi] = Some(rows);
+                let mut stop = false;
+                while let Some(rows) = held.get_mut(due).and_then(Option::take) {
+                    due += 1;
+                    if !sink(&rows) {
+                        stop = true;
+                        break;
+                    }
+                }
+                if stop {
                     break;
                 }
             }
-            if stop {
-                break;
-            }
+        });
+        let wall = t1.elapsed();
+        let (rt, st) = *times.lock().unwrap_or_else(PoisonError::into_inner);
+        let total = (rt + st).as_secs_f64().max(1e-12);
+        RasterStats {
+            prepare: self.time,
+            raster: wall.mul_f64(rt.as_secs_f64() / total),
+            resolve: wall.mul_f64(st.as_secs_f64() / total),
         }
-    });
-    let wall = t1.elapsed();
-    let (rt, st) = *times
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let total = (rt + st).as_secs_f64().max(1e-12);
-    Ok(RasterStats {
-        prepare: prepare_time,
-        raster: wall.mul_f64(rt.as_secs_f64() / total),
-        resolve: wall.mul_f64(st.as_secs_f64() / total),
-    })
+    }
 }
 
 /// A band's rows on their way to the sink, sent when the job ends, even by a panic
@@ -212,11 +241,11 @@ fn receive<T>(rx: &mpsc::Receiver<T>) -> Option<T> {
     }
 }
 
-/// Pixel rows per band: about 64 KiB of pixel colours per band and per layer (4 rows at
+/// Pixel rows per band: about 32 KiB of pixel colours per band and per layer (2 rows at
 /// 960 pixels), so that a band's split pixels (up to 256 bytes each at 16 samples) stay
 /// small beside the rest of the process.
 fn band_rows(width: u32) -> usize {
-    ((64usize << 10) / (width as usize * 16)).clamp(1, 64)
+    ((32usize << 10) / (width as usize * 16)).clamp(1, 64)
 }
 
 /// The colour every sample starts with.

@@ -7,50 +7,13 @@ use prism_image::{LevelSampling, PixelSampling, Texture};
 use prism_math::{DVec2, Rgb, Vec2};
 use rayon::prelude::*;
 
+use super::edges::{edges_of, Edge, Edges};
 use super::offscreen::{filtered, pattern_tile, SubRender, Tile};
 use super::options::{RasterOptions, TOLERANCE};
 use crate::document::{
     BlendMode, Document, FillRule, Gradient, GradientKind, Item, MaskKind, Mat3, Paint, Spread,
 };
 use crate::path::{stroke, Path, StrokeStyle};
-
-/// A non-horizontal polygon edge in device space with `y0 < y1`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Edge {
-    pub(super) x0: f64,
-    pub(super) y0: f64,
-    pub(super) y1: f64,
-    pub(super) dxdy: f64,
-    pub(super) dir: i32,
-}
-
-pub(super) fn edges_of(
-    polys: impl IntoIterator<Item = Vec<DVec2>>,
-    closed: bool,
-    out: &mut Vec<Edge>,
-) {
-    for poly in polys {
-        let n = poly.len();
-        if n < 2 {
-            continue;
-        }
-        let count = if closed { n } else { n - 1 };
-        for i in 0..count {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            if a.y == b.y || !a.is_finite() || !b.is_finite() {
-                continue;
-            }
-            let (p, q, dir) = if a.y < b.y { (a, b, 1) } else { (b, a, -1) };
-            out.push(Edge {
-                x0: p.x,
-                y0: p.y,
-                y1: q.y,
-                dxdy: (q.x - p.x) / (q.y - p.y),
-                dir,
-            });
-        }
-    }
-}
 
 /// A paint resolved to device space.
 #[derive(Clone, Debug)]
@@ -254,7 +217,7 @@ pub(super) enum Prim {
     },
     Poly {
         /// Sorted by `y0`.
-        edges: Vec<Edge>,
+        edges: Edges,
         rule: FillRule,
         paint: DevPaint,
     },
@@ -446,7 +409,11 @@ pub(super) fn prepare(
             y1,
             x0,
             x1,
-            prim: Prim::Poly { edges, rule, paint },
+            prim: Prim::Poly {
+                edges: Edges::new(&edges),
+                rule,
+                paint,
+            },
         })
     };
     let dev_paint = |paint: &Paint, m: &Mat3, opacity: f32| -> Option<DevPaint> {
@@ -537,8 +504,7 @@ pub(super) fn prepare(
                 };
                 let dpath: Path = path.transformed(&m.to_affine());
                 let lines = dpath.flatten_within(TOLERANCE, Some(visible));
-                let mut edges = Vec::new();
-                edges_of(lines.into_iter().map(|l| l.points), true, &mut edges);
+                let edges = edges_of(lines.iter().map(|l| &l.points[..]));
                 out.extend(place_poly(edges, *rule, paint));
             }
             Item::Stroke {
@@ -587,15 +553,11 @@ pub(super) fn prepare(
                 let lo = corners.iter().fold(corners[0], |a, b| a.min(*b)) - reach;
                 let hi = corners.iter().fold(corners[0], |a, b| a.max(*b)) + reach;
                 let keep = (lo.is_finite() && hi.is_finite()).then_some((lo, hi));
-                let polys = stroke(&path.flatten_within(tol, keep), style, tol);
-                let mut edges = Vec::new();
-                edges_of(
-                    polys
-                        .into_iter()
-                        .map(|p| p.into_iter().map(|q| affine.transform_point2(q)).collect()),
-                    true,
-                    &mut edges,
-                );
+                let mut polys = stroke(&path.flatten_within(tol, keep), style, tol);
+                for q in polys.iter_mut().flatten() {
+                    *q = affine.transform_point2(*q);
+                }
+                let edges = edges_of(polys.iter().map(|p| &p[..]));
                 out.extend(place_poly(edges, FillRule::NonZero, paint));
             }
             Item::Hairline {
