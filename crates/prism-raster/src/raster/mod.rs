@@ -581,6 +581,30 @@ mod tests {
         );
     }
 
+    /// A prepared picture needs nothing of its document: drawn after the document is
+    /// dropped, and drawn twice, it gives `render`'s pixels.
+    #[test]
+    fn a_prepared_picture_outlives_its_document() {
+        let opts = RasterOptions {
+            width: 120,
+            height: 90,
+            samples: 4,
+            ..RasterOptions::default()
+        };
+        let (img, _) = render(&busy_drawing(), &opts).unwrap();
+        let doc = busy_drawing();
+        let prepared = Prepared::new(&doc, &opts).unwrap();
+        drop(doc);
+        for _ in 0..2 {
+            let mut rows: Vec<[u8; 4]> = Vec::new();
+            prepared.render_rows(|band| {
+                rows.extend_from_slice(band);
+                true
+            });
+            assert_eq!(rows, img.pixels());
+        }
+    }
+
     /// Same bytes whatever the thread count (one, two or three workers).
     #[test]
     fn same_pixels_on_one_two_and_three_threads() {
