@@ -2,6 +2,7 @@
 
 mod bezier;
 mod cloth;
+mod deferred;
 mod demo;
 mod error;
 mod interrupt;
@@ -21,6 +22,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+use crate::deferred::Deferred;
 use crate::error::{error_chain, UserError};
 
 /// A computer-graphics toolkit on the CPU: SVG rasterization, mesh editing, path tracing.
@@ -39,26 +41,26 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Rasterize SVG files to PNG (standard SVG, or the CS184 course dialect).
-    Svg(svg::SvgArgs),
+    Svg(Deferred<svg::SvgArgs>),
     /// Draw a Bezier curve's de Casteljau construction, or tessellate Bezier patches.
-    Bezier(bezier::BezierArgs),
+    Bezier(Deferred<bezier::BezierArgs>),
     /// Inspect, convert, edit and Loop-subdivide meshes (OBJ, PLY, COLLADA).
-    Mesh(mesh::MeshArgs),
+    Mesh(Deferred<mesh::MeshArgs>),
     /// Path-trace a CS184 COLLADA scene, or the built-in Cornell box.
-    Render(render::RenderArgs),
+    Render(Deferred<render::RenderArgs>),
     /// Whitted-ray-trace a Delft scene (preset, OBJ or TOML config), with visual debugging.
-    Raytrace(raytrace::RaytraceArgs),
+    Raytrace(Deferred<raytrace::RaytraceArgs>),
     /// Draw a mesh with one of the course's shaders, as its OpenGL app would, on the CPU.
-    Shade(shade::ShadeArgs),
+    Shade(Deferred<shade::ShadeArgs>),
     /// Simulate the course's ClothSim scenes exactly; write OBJ and draw the run.
-    Cloth(cloth::ClothArgs),
+    Cloth(Deferred<cloth::ClothArgs>),
     /// Check the part files of a split render and assemble its picture, a row of tiles at a time.
-    Merge(split::MergeArgs),
+    Merge(Deferred<split::MergeArgs>),
     /// Open an SVG drawing, a lit COLLADA scene (path-traced) or a cloth scene in an
     /// interactive window drawn on the CPU (X11 or Xvfb).
-    View(view::ViewArgs),
+    View(Deferred<view::ViewArgs>),
     /// Write a gallery (index.html and one PNG per feature) from built-in inputs.
-    Demo(demo::DemoArgs),
+    Demo(Deferred<demo::DemoArgs>),
 }
 
 fn main() -> ExitCode {
@@ -117,5 +119,12 @@ mod tests {
             .map(|c| c.get_name().to_string())
             .collect();
         assert_eq!(names, super::error::SUBCOMMANDS);
+    }
+
+    /// clap's own consistency checks over every subcommand's options, once the deferred
+    /// options are built.
+    #[test]
+    fn the_command_line_is_consistent() {
+        super::Cli::command().debug_assert();
     }
 }
