@@ -206,7 +206,7 @@ fn render_one(
     let warnings = std::mem::take(&mut doc.warnings);
     drop(doc);
     let (stats, encode) = if format == ImageFormat::Png {
-        write_png_rows(output, &prepared, &opts)?
+        write_png_rows(output, &prepared)?
     } else {
         // JPEG has no alpha: the picture goes over white, as a browser shows it. The
         // encoder takes it whole, gathered as 3 bytes a pixel.
@@ -238,8 +238,8 @@ fn render_one(
 fn write_png_rows(
     output: &Path,
     prepared: &Prepared,
-    opts: &RasterOptions,
 ) -> std::result::Result<(RasterStats, Duration), ImageError> {
+    let opts = prepared.options();
     let io = |source| ImageError::Io {
         path: output.to_path_buf(),
         source,

@@ -14,27 +14,29 @@ pub(super) struct Edge {
     pub(super) dir: i32,
 }
 
-/// The non-horizontal edges of closed polygons, in a vector of exactly their number.
-pub(super) fn edges_of<'a>(polys: impl Iterator<Item = &'a [DVec2]> + Clone) -> Vec<Edge> {
-    let segments = |poly: &'a [DVec2]| {
+/// The non-horizontal edges of closed polygons (a prepared polygon keeps them as
+/// [`Edges`], sized exactly).
+pub(super) fn edges_of<'a>(polys: impl Iterator<Item = &'a [DVec2]>) -> Vec<Edge> {
+    let mut out = Vec::new();
+    for poly in polys {
         let n = poly.len();
-        let count = if n < 2 { 0 } else { n };
-        (0..count).filter_map(move |i| {
+        if n < 2 {
+            continue;
+        }
+        for i in 0..n {
             let (a, b) = (poly[i], poly[(i + 1) % n]);
-            (a.y != b.y && a.is_finite() && b.is_finite()).then_some((a, b))
-        })
-    };
-    let count = polys.clone().map(|p| segments(p).count()).sum();
-    let mut out = Vec::with_capacity(count);
-    for (a, b) in polys.flat_map(segments) {
-        let (p, q, dir) = if a.y < b.y { (a, b, 1) } else { (b, a, -1) };
-        out.push(Edge {
-            x0: p.x,
-            y0: p.y,
-            y1: q.y,
-            dxdy: (q.x - p.x) / (q.y - p.y),
-            dir,
-        });
+            if a.y == b.y || !a.is_finite() || !b.is_finite() {
+                continue;
+            }
+            let (p, q, dir) = if a.y < b.y { (a, b, 1) } else { (b, a, -1) };
+            out.push(Edge {
+                x0: p.x,
+                y0: p.y,
+                y1: q.y,
+                dxdy: (q.x - p.x) / (q.y - p.y),
+                dir,
+            });
+        }
     }
     out
 }

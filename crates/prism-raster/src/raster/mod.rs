@@ -107,6 +107,12 @@ impl Prepared {
         })
     }
 
+    /// The options the picture was prepared for.
+    #[must_use]
+    pub fn options(&self) -> &RasterOptions {
+        &self.opts
+    }
+
     /// Draws the picture as [`render_rows`] does, handing rows to `sink` from the top.
     pub fn render_rows(&self, mut sink: impl FnMut(&[[u8; 4]]) -> bool) -> RasterStats {
         let (prims, opts) = (&self.prims, &self.opts);
